@@ -1,0 +1,2 @@
+//! The waam command-line tool (work in progress).
+fn main() {}

@@ -1,0 +1,2 @@
+//! **Stage 0 — reading and writing files.** Part files, cell files, atomic writes.
+pub mod part_file;

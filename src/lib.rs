@@ -1,0 +1,54 @@
+//! # waam-slicer
+//!
+//! Plans wire-arc additive manufacturing (WAAM) of thin-walled metal tubes on
+//! industrial robots, after Chalvin (2020), *Additive manufacturing of tubes by
+//! multi-axis robotized wire deposition*. The technical reference is `SPEC.md`
+//! (shared with the project); section numbers below point into it.
+//!
+//! ## The pipeline
+//!
+//! ```text
+//! part file (TOML) -> Tube geometry -> deposition path (layers of points)
+//!                  -> tool axes -> process (speeds, bead)
+//!                  -> cell (robot + positioner + torch) -> joint trajectory (IK)
+//!                  -> layer-by-layer optimisation of R_Z -> validation -> robot program
+//! ```
+//!
+//! Each stage is one public module whose entry point takes a typed value and
+//! returns the next one, so that software embedding the library can call any
+//! stage alone:
+//!
+//! | stage | module | SPEC |
+//! |---|---|---|
+//! | 0. read a part file | [`io::part_file`] | §2 |
+//! | 1. tube geometry: guide curves, frames, profile law, substrates | [`geometry`] | §2 |
+//! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
+//!
+//! ## Units and frames
+//!
+//! * Lengths in **millimetres**, angles in **radians**, time in seconds, speeds
+//!   in mm/s throughout the API. Degrees and vendor units (cm/min, FANUC
+//!   `W P R`) appear only at the edges: part and cell files, robot programs and
+//!   reports, and every such field says so in its name (`angle_deg`).
+//! * Geometry of a part is expressed in the **part frame** (the frame the part
+//!   file is written in; Z is the nominal build direction for flat substrates).
+//!   Robot quantities are in the robot base frame unless the name says
+//!   otherwise; rigid transforms are named `a_from_b`.
+//! * Scalars are concrete `f64`; vector types are the aliases of [`math`], and
+//!   [`nalgebra`] is re-exported so that users get the same version.
+//!
+//! ## Examples
+//!
+//! * `examples/waam` — the command-line tool (`cargo run --release --example waam -- --help`).
+#![warn(missing_docs, missing_debug_implementations)]
+#![forbid(unsafe_code)]
+
+pub use nalgebra;
+
+pub mod error;
+pub mod geometry;
+pub mod io;
+pub mod math;
+pub mod robot;
+
+pub use error::Error;
