@@ -1,0 +1,231 @@
+//! Moving frames `(T, N, B)` along a guide curve (part frame, unitless):
+//! rotation-minimising (double reflection, Wang et al. 2008; the default) or
+//! Frenet (thesis eq. 2.24, undefined where the curvature vanishes).
+
+use super::guide::GuideCurve;
+use super::GeometryError;
+use crate::math::{any_perpendicular, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// How the profile's `v = 0` direction is carried along the guide.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum FrameMethod {
+    /// Rotation-minimising frame (no twist about the tangent), built by the
+    /// double-reflection method. Defined on any regular curve.
+    #[default]
+    #[serde(rename = "rmf")]
+    RotationMinimising,
+    /// Frenet frame: `N` toward the centre of curvature. Undefined on straight
+    /// segments; flips at inflection points.
+    #[serde(rename = "frenet")]
+    Frenet,
+}
+
+/// An orthonormal right-handed frame at one point of the guide (part frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// Unit tangent `T` (direction of increasing `t`).
+    pub tangent: Vector3,
+    /// Unit normal `N`: the profile direction `v = 0`.
+    pub normal: Vector3,
+    /// Unit binormal `B = T × N`: the profile direction `v = π/2`.
+    pub binormal: Vector3,
+}
+
+/// Number of tabulation intervals for the rotation-minimising frame.
+const RMF_INTERVALS: usize = 4096;
+
+/// A frame field along a guide curve over a parameter range, tabulated once.
+#[derive(Debug, Clone)]
+pub struct FrameField {
+    method: FrameMethod,
+    t_lo: f64,
+    h: f64,
+    /// RMF normals at `t_lo + i h` (empty for Frenet).
+    normals: Vec<Vector3>,
+}
+
+impl FrameField {
+    /// Builds the frame field on `[t_lo, t_hi]`.
+    ///
+    /// `reference` (part frame) fixes the RMF's `v = 0` direction at `t_lo`: its
+    /// component perpendicular to the tangent. Without it, the Frenet normal at
+    /// `t_lo` is used where defined, else the world axis least aligned with the
+    /// tangent (X for a vertical guide).
+    ///
+    /// # Errors
+    /// [`GeometryError::FrenetUndefined`] naming the first sampled `t` where the
+    /// curvature vanishes (Frenet only); [`GeometryError::InvalidField`] if the
+    /// reference is parallel to the tangent.
+    pub fn new(
+        curve: &dyn GuideCurve,
+        method: FrameMethod,
+        t_lo: f64,
+        t_hi: f64,
+        reference: Option<Vector3>,
+    ) -> Result<Self, GeometryError> {
+        let h = (t_hi - t_lo) / RMF_INTERVALS as f64;
+        match method {
+            FrameMethod::Frenet => {
+                for i in 0..=RMF_INTERVALS {
+                    let t = t_lo + i as f64 * h;
+                    if frenet(curve, t).is_none() {
+                        return Err(GeometryError::FrenetUndefined { t });
+                    }
+                }
+                Ok(Self {
+                    method,
+                    t_lo,
+                    h,
+                    normals: Vec::new(),
+                })
+            }
+            FrameMethod::RotationMinimising => {
+                let t0 = unit(curve.d1(t_lo));
+                let r0 = match reference {
+                    Some(r) => {
+                        let p = r - t0 * t0.dot(&r);
+                        if !(p.norm() > 1e-9 * r.norm()) {
+                            return Err(GeometryError::InvalidField {
+                                field: "frame.reference".into(),
+                                reason: "is parallel to the guide tangent at t_min".into(),
+                            });
+                        }
+                        p.normalize()
+                    }
+                    None => frenet(curve, t_lo)
+                        .map(|f| f.normal)
+                        .unwrap_or_else(|| any_perpendicular(&t0)),
+                };
+                let mut normals = Vec::with_capacity(RMF_INTERVALS + 1);
+                normals.push(r0);
+                let mut r = r0;
+                for i in 0..RMF_INTERVALS {
+                    let ta = t_lo + i as f64 * h;
+                    r = reflect_step(curve, ta, ta + h, r);
+                    normals.push(r);
+                }
+                Ok(Self {
+                    method,
+                    t_lo,
+                    h,
+                    normals,
+                })
+            }
+        }
+    }
+
+    /// The frame method.
+    pub fn method(&self) -> FrameMethod {
+        self.method
+    }
+
+    /// Frame at parameter `t`. Outside the tabulated range the RMF is carried
+    /// on from the nearest end in steps no longer than the table's.
+    pub fn frame(&self, curve: &dyn GuideCurve, t: f64) -> Frame {
+        match self.method {
+            FrameMethod::Frenet => frenet(curve, t).unwrap_or_else(|| {
+                // Only reached outside the validated range: fall back to any frame.
+                let tan = unit(curve.d1(t));
+                let n = any_perpendicular(&tan);
+                Frame {
+                    tangent: tan,
+                    normal: n,
+                    binormal: tan.cross(&n),
+                }
+            }),
+            FrameMethod::RotationMinimising => {
+                let last = self.normals.len() - 1;
+                let x = (t - self.t_lo) / self.h;
+                let i = if x.is_finite() {
+                    x.floor().clamp(0.0, last as f64) as usize
+                } else {
+                    0
+                };
+                let mut ta = self.t_lo + i as f64 * self.h;
+                let mut r = self.normals[i];
+                // Steps of at most h toward t (only more than one step outside the table).
+                let steps = ((t - ta).abs() / self.h).ceil().clamp(1.0, 1e6) as usize;
+                let dt = (t - ta) / steps as f64;
+                for _ in 0..steps {
+                    r = reflect_step(curve, ta, ta + dt, r);
+                    ta += dt;
+                }
+                let tan = unit(curve.d1(t));
+                let n = (r - tan * tan.dot(&r)).normalize();
+                Frame {
+                    tangent: tan,
+                    normal: n,
+                    binormal: tan.cross(&n),
+                }
+            }
+        }
+    }
+
+    /// Rate of rotation of the frame about its own tangent, `ω·T` (rad per
+    /// parameter unit): 0 for the RMF, `|Mg'| τ` for Frenet.
+    pub fn twist_rate(&self, curve: &dyn GuideCurve, t: f64) -> f64 {
+        match self.method {
+            FrameMethod::RotationMinimising => 0.0,
+            FrameMethod::Frenet => {
+                let (d1, d2, d3) = (curve.d1(t), curve.d2(t), curve.d3(t));
+                let c = d1.cross(&d2);
+                let c2 = c.norm_squared();
+                if c2 == 0.0 {
+                    0.0
+                } else {
+                    d1.norm() * c.dot(&d3) / c2
+                }
+            }
+        }
+    }
+}
+
+fn unit(v: Vector3) -> Vector3 {
+    let n = v.norm();
+    if n > 0.0 {
+        v / n
+    } else {
+        v
+    }
+}
+
+/// Frenet frame at `t`, `None` where the curvature is below 1e-9 /mm.
+fn frenet(curve: &dyn GuideCurve, t: f64) -> Option<Frame> {
+    let d1 = curve.d1(t);
+    let d2 = curve.d2(t);
+    let speed = d1.norm();
+    let c = d1.cross(&d2);
+    let cn = c.norm();
+    if !(speed > 0.0) || !(cn / (speed * speed * speed) > 1e-9) || !cn.is_finite() {
+        return None;
+    }
+    let tan = d1 / speed;
+    let b = c / cn;
+    Some(Frame {
+        tangent: tan,
+        normal: b.cross(&tan),
+        binormal: b,
+    })
+}
+
+/// One double-reflection step carrying the normal `r` from `ta` to `tb`.
+fn reflect_step(curve: &dyn GuideCurve, ta: f64, tb: f64, r: Vector3) -> Vector3 {
+    let xa = curve.point(ta);
+    let xb = curve.point(tb);
+    let v1 = xb - xa;
+    let c1 = v1.norm_squared();
+    if !(c1 > 0.0) {
+        return r;
+    }
+    let tan_a = unit(curve.d1(ta));
+    let tan_b = unit(curve.d1(tb));
+    let r_l = r - v1 * (2.0 / c1 * v1.dot(&r));
+    let t_l = tan_a - v1 * (2.0 / c1 * v1.dot(&tan_a));
+    let v2 = tan_b - t_l;
+    let c2 = v2.norm_squared();
+    if !(c2 > 1e-300) {
+        return r_l;
+    }
+    r_l - v2 * (2.0 / c2 * v2.dot(&r_l))
+}

@@ -1,0 +1,173 @@
+//! Expression guide curves `x(t), y(t), z(t)` and scalar expressions of `t`
+//! with analytic derivatives (parsed and differentiated by the `exmex` crate).
+
+use super::GuideCurve;
+use crate::geometry::GeometryError;
+use crate::math::{Point3, Vector3};
+use exmex::prelude::*;
+use exmex::Differentiate;
+use std::collections::BTreeMap;
+
+/// Longest expression text accepted (characters); longer input is refused
+/// before parsing.
+pub const MAX_EXPRESSION_LEN: usize = 4096;
+/// Most variables (the parameter plus named constants) one expression may use.
+const MAX_VARS: usize = 16;
+
+/// A scalar expression of one parameter (`t` by default) and named constants,
+/// with its first three derivatives computed symbolically once, at parse time.
+///
+/// Syntax: `+ - * / ^`, parentheses, `sin cos tan asin acos atan sinh cosh tanh
+/// exp ln log10 sqrt cbrt abs`, constants `PI`, `π`, `E`, `TAU`; e.g.
+/// `"5 + cos(8*PI*t/40)"`.
+#[derive(Clone)]
+pub struct Expression {
+    text: String,
+    /// `[f, f', f'', f''']`.
+    chain: Vec<FlatEx<f64>>,
+    /// Index of the parameter among the expression's variables, if it appears.
+    slot: Option<usize>,
+    /// Values of all variables, constants filled in, parameter slot zero.
+    template: Vec<f64>,
+}
+
+impl std::fmt::Debug for Expression {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_tuple("Expression").field(&self.text).finish()
+    }
+}
+
+impl Expression {
+    /// Parses `text` as a function of `param` (e.g. `"t"`), with the named
+    /// `constants` substituted by value.
+    ///
+    /// # Errors
+    /// [`GeometryError::Expression`] when the text is too long, does not parse,
+    /// uses an unknown variable or function, or cannot be differentiated.
+    pub fn parse(
+        text: &str,
+        param: &str,
+        constants: &BTreeMap<String, f64>,
+    ) -> Result<Self, GeometryError> {
+        let err = |reason: String| GeometryError::Expression {
+            text: text.to_string(),
+            reason,
+        };
+        if text.len() > MAX_EXPRESSION_LEN {
+            return Err(err(format!(
+                "expression is {} characters long; the limit is {MAX_EXPRESSION_LEN}",
+                text.len()
+            )));
+        }
+        if text.trim().is_empty() {
+            return Err(err("expression is empty".into()));
+        }
+        let f = exmex::parse::<f64>(text).map_err(|e| err(e.to_string()))?;
+        let names: Vec<String> = f.var_names().to_vec();
+        if names.len() > MAX_VARS {
+            return Err(err(format!(
+                "uses {} variables; the limit is {MAX_VARS}",
+                names.len()
+            )));
+        }
+        let mut template = vec![0.0; names.len()];
+        let mut slot = None;
+        for (i, name) in names.iter().enumerate() {
+            if name == param {
+                slot = Some(i);
+            } else if let Some(v) = constants.get(name) {
+                template[i] = *v;
+            } else {
+                let known: Vec<&str> = constants.keys().map(String::as_str).collect();
+                return Err(err(format!(
+                    "unknown variable `{name}` (the parameter is `{param}`; constants defined: [{}])",
+                    known.join(", ")
+                )));
+            }
+        }
+        let mut chain = vec![f];
+        if let Some(k) = slot {
+            for _ in 0..3 {
+                let last = chain.last().cloned().expect("chain starts non-empty");
+                let d = last
+                    .partial(k)
+                    .map_err(|e| err(format!("cannot differentiate: {e}")))?;
+                chain.push(d);
+            }
+        }
+        Ok(Self {
+            text: text.to_string(),
+            chain,
+            slot,
+            template,
+        })
+    }
+
+    /// Whether the expression uses its parameter (else it is a constant).
+    pub fn depends_on_param(&self) -> bool {
+        self.slot.is_some()
+    }
+
+    /// The source text.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// The `order`-th derivative (0..=3) at parameter value `t`. Returns NaN
+    /// if the expression is undefined there (callers validate).
+    pub fn eval_derivative(&self, order: usize, t: f64) -> f64 {
+        let Some(k) = self.slot else {
+            return if order == 0 { self.eval_const() } else { 0.0 };
+        };
+        let mut buf = [0.0; MAX_VARS];
+        let vars = &mut buf[..self.template.len()];
+        vars.copy_from_slice(&self.template);
+        vars[k] = t;
+        self.chain[order].eval(vars).unwrap_or(f64::NAN)
+    }
+
+    fn eval_const(&self) -> f64 {
+        self.chain[0].eval(&self.template).unwrap_or(f64::NAN)
+    }
+
+    /// Value at `t`.
+    pub fn eval(&self, t: f64) -> f64 {
+        self.eval_derivative(0, t)
+    }
+}
+
+/// Guide curve given by three expressions `x(t), y(t), z(t)` (part frame, mm).
+#[derive(Debug, Clone)]
+pub struct ExprCurve {
+    /// `x(t)` (mm).
+    pub x: Expression,
+    /// `y(t)` (mm).
+    pub y: Expression,
+    /// `z(t)` (mm).
+    pub z: Expression,
+}
+
+impl ExprCurve {
+    fn deriv(&self, order: usize, t: f64) -> Vector3 {
+        Vector3::new(
+            self.x.eval_derivative(order, t),
+            self.y.eval_derivative(order, t),
+            self.z.eval_derivative(order, t),
+        )
+    }
+}
+
+impl GuideCurve for ExprCurve {
+    fn point(&self, t: f64) -> Point3 {
+        Point3::from(self.deriv(0, t))
+    }
+    fn d1(&self, t: f64) -> Vector3 {
+        self.deriv(1, t)
+    }
+    fn d2(&self, t: f64) -> Vector3 {
+        self.deriv(2, t)
+    }
+    fn d3(&self, t: f64) -> Vector3 {
+        self.deriv(3, t)
+    }
+}

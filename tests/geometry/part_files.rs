@@ -1,0 +1,216 @@
+//! Part files: every sample parses; each kind of malformed file gives an
+//! error naming the file and the field, never a panic.
+
+use crate::common::{load_part, part_path, SAMPLE_PARTS};
+use std::path::Path;
+use waam_slicer::io::part_file::{
+    parse_part, read_part_file, Discretisation, PartFileError, Strategy,
+};
+
+const GOOD: &str = r#"
+name = "t"
+[guide]
+kind = "line"
+origin = [0, 0, 0]
+direction = [0, 0, 1]
+[profile]
+kind = "constant"
+radius = 10
+[range]
+t_min = 0
+t_max = 20
+[substrate]
+kind = "plane"
+point = [0, 0, 0]
+normal = [0, 0, 1]
+[slicing]
+delta_mm = 2
+"#;
+
+fn err(text: &str) -> PartFileError {
+    match parse_part(text, "bad.toml", Path::new(".")) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e,
+    }
+}
+
+fn assert_names(e: &PartFileError, needles: &[&str]) {
+    let msg = e.to_string();
+    assert!(msg.contains("bad.toml"), "no file name in: {msg}");
+    for n in needles {
+        assert!(msg.contains(n), "`{n}` missing in: {msg}");
+    }
+}
+
+#[test]
+fn every_sample_part_reads() {
+    for name in SAMPLE_PARTS {
+        let part = load_part(name);
+        assert!(
+            !part.name.is_empty() && !part.description.is_empty() && !part.source.is_empty(),
+            "{name}"
+        );
+        assert!(part.slicing.delta_mm > 0.0);
+    }
+    let torus = load_part("quarter-torus.toml");
+    assert_eq!(torus.slicing.strategy, Strategy::Constant);
+    assert_eq!(torus.slicing.discretisation, Discretisation::Points(500));
+    assert!(torus.end_plane.is_some());
+    assert!((torus.tube.range().t_max - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+}
+
+#[test]
+fn the_minimal_file_is_accepted() {
+    let part = parse_part(GOOD, "good.toml", Path::new(".")).unwrap();
+    assert_eq!(part.slicing.discretisation, Discretisation::Points(500));
+}
+
+#[test]
+fn syntax_error_names_file_and_line() {
+    let e = err(&GOOD.replace("t_max = 20", "t_max = = 20"));
+    assert!(matches!(e, PartFileError::Syntax { .. }));
+    assert_names(&e, &["line"]);
+}
+
+#[test]
+fn truncated_file_is_an_error() {
+    let e = err(&GOOD[..GOOD.len() / 2]);
+    assert_names(&e, &[]);
+}
+
+#[test]
+fn unknown_field_is_named() {
+    let e = err(&GOOD.replace("radius = 10", "radius = 10\nradiuss = 3"));
+    assert_names(&e, &["radiuss"]);
+    let e = err(&GOOD.replace("name = \"t\"", "name = \"t\"\ncolour = 1"));
+    assert_names(&e, &["colour"]);
+}
+
+#[test]
+fn missing_guide_is_named() {
+    let text = GOOD.replace(
+        "[guide]\nkind = \"line\"\norigin = [0, 0, 0]\ndirection = [0, 0, 1]\n",
+        "",
+    );
+    let e = err(&text);
+    assert_names(&e, &["guide"]);
+}
+
+#[test]
+fn negative_radius_is_named() {
+    let e = err(&GOOD.replace("radius = 10", "radius = -3"));
+    assert_names(&e, &["profile.radius", "positive"]);
+    let e = err(&GOOD.replace(
+        "kind = \"constant\"\nradius = 10",
+        "kind = \"expr\"\nradius = \"5 - t\"",
+    ));
+    assert!(matches!(e, PartFileError::Geometry { .. }), "{e:?}");
+    assert_names(&e, &["not positive", "t = 5"]);
+}
+
+#[test]
+fn unparsable_expression_is_named() {
+    let e = err(&GOOD.replace(
+        "kind = \"constant\"\nradius = 10",
+        "kind = \"expr\"\nradius = \"5 + cos(t\"",
+    ));
+    assert_names(&e, &["profile.radius", "5 + cos(t"]);
+    let e = err(&GOOD.replace(
+        "kind = \"constant\"\nradius = 10",
+        "kind = \"expr\"\nradius = \"5 + k * t\"",
+    ));
+    assert_names(&e, &["profile.radius", "unknown variable `k`"]);
+}
+
+#[test]
+fn empty_t_range_is_named() {
+    let e = err(&GOOD.replace("t_max = 20", "t_max = 0"));
+    assert_names(&e, &["range", "empty t-range"]);
+}
+
+#[test]
+fn wrong_type_and_non_finite_numbers_are_named() {
+    let e = err(&GOOD.replace("t_max = 20", "t_max = [1]"));
+    assert_names(&e, &["t_max"]);
+    let e = err(&GOOD.replace("t_max = 20", "t_max = nan"));
+    assert_names(&e, &["range.t_max", "finite"]);
+    let e = err(&GOOD.replace("delta_mm = 2", "delta_mm = inf"));
+    assert_names(&e, &["slicing.delta_mm"]);
+    let e = err(&GOOD.replace("delta_mm = 2", "delta_mm = -1"));
+    assert_names(&e, &["slicing.delta_mm"]);
+}
+
+#[test]
+fn self_folding_tube_names_t() {
+    let text = std::fs::read_to_string(part_path("quarter-torus.toml"))
+        .unwrap()
+        .replace("r = 15.0", "r = 55.0");
+    let e = err(&text);
+    match &e {
+        PartFileError::Geometry { source, .. } => assert!(matches!(
+            source,
+            waam_slicer::geometry::GeometryError::Folds { .. }
+        )),
+        other => panic!("{other:?}"),
+    }
+    assert_names(&e, &["folds at t = 0.000000", "55.0000", "50.0000"]);
+    // The elbow folds in its bend only: the error names a t inside the bend.
+    let text = std::fs::read_to_string(part_path("elbow.toml"))
+        .unwrap()
+        .replace("radius = 20", "radius = 61");
+    match err(&text) {
+        PartFileError::Geometry {
+            source: waam_slicer::geometry::GeometryError::Folds { t, .. },
+            ..
+        } => {
+            assert!(
+                (30.0..=30.0 + 60.0 * std::f64::consts::FRAC_PI_2).contains(&t),
+                "t = {t}"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn zero_derivative_guide_names_t() {
+    let text = GOOD.replace(
+        "kind = \"line\"\norigin = [0, 0, 0]\ndirection = [0, 0, 1]",
+        "kind = \"expr\"\nx = \"0\"\ny = \"0\"\nz = \"(t - 10)^3 + 10\"",
+    );
+    let e = err(&text);
+    assert_names(&e, &["zero derivative", "t = 10.000000"]);
+}
+
+#[test]
+fn unicode_garbage_and_missing_file_are_errors() {
+    let e = err("名前 = ☃\u{0}\u{fffd}");
+    assert!(matches!(e, PartFileError::Syntax { .. }));
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("garbage.toml");
+    std::fs::write(&p, [0xff, 0xfe, 0x00, 0x41]).unwrap();
+    let e = read_part_file(&p).unwrap_err();
+    assert!(
+        e.to_string().contains("garbage.toml") && e.to_string().contains("UTF-8"),
+        "{e}"
+    );
+    let e = read_part_file(&dir.path().join("none.toml")).unwrap_err();
+    assert!(matches!(e, PartFileError::Io { .. }) && e.to_string().contains("none.toml"));
+}
+
+#[test]
+fn conflicting_discretisations_are_named() {
+    let e = err(&GOOD.replace("delta_mm = 2", "delta_mm = 2\npoints = 100\nchord_mm = 0.1"));
+    assert_names(&e, &["slicing", "only one"]);
+    let e = err(&GOOD.replace("delta_mm = 2", "delta_mm = 2\npoints = 2"));
+    assert_names(&e, &["slicing.points"]);
+}
+
+#[test]
+fn missing_stl_substrate_names_the_field() {
+    let e = err(&GOOD.replace(
+        "kind = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 1]",
+        "kind = \"mesh\"\nfile = \"nope.stl\"",
+    ));
+    assert_names(&e, &["substrate.file", "nope.stl"]);
+}
