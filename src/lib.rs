@@ -22,6 +22,7 @@
 //! |---|---|---|
 //! | 0. read a part file | [`io::part_file`] | §2 |
 //! | 1. tube geometry: guide curves, frames, profile law, substrates | [`geometry`] | §2 |
+//! | 2. deposition paths: four strategies, distance map, truncation, seams | [`path`] | §3 |
 //! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
 //!
 //! ## Units and frames
@@ -51,6 +52,7 @@ pub mod error;
 pub mod geometry;
 pub mod io;
 pub mod math;
+pub mod path;
 pub mod robot;
 
 pub use error::Error;

@@ -10,6 +10,8 @@ use crate::geometry::{
     FrameMethod, GeometryError, MeshSubstrate, ProfileLaw, ProfilePiece, Substrate, Tube, TubeRange,
 };
 use crate::math::{Point3, UnitVector3, Vector3};
+pub use crate::path::{Discretisation, Strategy};
+use crate::path::{EndRule, SliceOptions};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -257,23 +259,6 @@ pub struct PlaneSpec {
     pub normal: Vec3Field,
 }
 
-/// Slicing strategy (SPEC §3.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Strategy {
-    /// Constant local interlayer distance (the core method).
-    #[default]
-    Constant,
-    /// Iso-parametric layers.
-    Iso,
-    /// Layers perpendicular to the guide.
-    Perpendicular,
-    /// Planar Z slices.
-    Planar,
-    /// One continuous spiral.
-    Spiral,
-}
-
 /// Default slicing settings of a part.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -323,17 +308,6 @@ pub struct PartSpec {
     pub slicing: SlicingSpec,
 }
 
-/// How to discretise a layer (validated).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Discretisation {
-    /// A fixed number of points per layer.
-    Points(usize),
-    /// Max chord error (sagitta, mm).
-    ChordError(f64),
-    /// Max distance between consecutive points (mm).
-    MaxSpacing(f64),
-}
-
 /// Validated slicing settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Slicing {
@@ -364,6 +338,21 @@ pub struct Part {
     pub slicing: Slicing,
     /// The part as written.
     pub spec: PartSpec,
+}
+
+impl Part {
+    /// The part's default slicing options: its strategy, `Delta` and
+    /// discretisation; truncation by its end plane when it has one, else whole
+    /// layers; seams aligned.
+    pub fn slice_options(&self) -> SliceOptions {
+        let mut o = SliceOptions::new(self.slicing.strategy, self.slicing.delta_mm);
+        o.discretisation = self.slicing.discretisation;
+        o.end = match self.end_plane {
+            Some(p) => EndRule::Truncate(p),
+            None => EndRule::WholeLayers,
+        };
+        o
+    }
 }
 
 /// Reads and validates a part file.

@@ -1,0 +1,416 @@
+//! The layer loop shared by every strategy: columns of constant `v` start on
+//! the substrate and advance layer by layer; each layer's points are computed
+//! in parallel (rayon, order preserved), then cut by the end plane, split
+//! where points are missing, decimated, and their seams aligned.
+
+use super::distance_map::fill_deltas;
+use super::index::{SegmentId, SegmentIndex};
+use super::strategy::{constant_distance, iso_parametric, normal_to_guide, planar_z, Step};
+use super::*;
+use crate::geometry::{Substrate, Tube};
+use crate::math::RootFailure;
+use rayon::prelude::*;
+use std::f64::consts::TAU;
+
+/// Builds the deposition path of `tube` on `substrate` [SPEC §3].
+///
+/// # Errors
+/// [`PathError`] naming the option, layer or point: invalid options, a
+/// `Delta` larger than the part, a substrate that misses the tube, a failed
+/// root find, too many points, an end plane beyond the evaluable range.
+pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<Path, PathError> {
+    opts.validate()?;
+    if opts.strategy == Strategy::Spiral {
+        return Err(PathError::NotImplemented("spiral"));
+    }
+    let range = tube.range();
+    let length_mm = tube.arc_length(range.t_max);
+    if opts.delta_mm >= length_mm {
+        return Err(PathError::DeltaTooLarge {
+            delta_mm: opts.delta_mm,
+            length_mm,
+        });
+    }
+    let grid = grid_size(tube, opts);
+    let first = substrate.first_layer(tube, grid)?;
+    let vs: Vec<f64> = first.iter().map(|p| p.v).collect();
+    let t_first: Vec<f64> = first.iter().map(|p| p.t).collect();
+    let t_hi = match opts.end {
+        EndRule::WholeLayers => range.t_max,
+        EndRule::Truncate(_) | EndRule::EvaluableRange => range.eval_max(),
+    };
+    let open_layers_allowed = matches!(opts.strategy, Strategy::Planar | Strategy::Perpendicular);
+
+    let mut raw: Vec<Vec<Option<f64>>> = vec![t_first.iter().map(|&t| Some(t)).collect()];
+    let mut cursor = t_first.clone();
+    let mut alive = vec![true; grid];
+    let mut report = SliceReport {
+        root_finds: 0,
+        evaluations: 0,
+        max_residual_mm: 0.0,
+        truncated_points: 0,
+        grid_points: grid,
+        stop: StopReason::NoMorePoints,
+    };
+    let z_base = first.iter().map(|p| p.position.z).fold(f64::MIN, f64::max);
+    let s_base = t_first
+        .iter()
+        .map(|&t| tube.arc_length(t))
+        .fold(f64::MAX, f64::min);
+    let mut total_points = grid;
+
+    for n in 1.. {
+        if opts.max_layers.is_some_and(|m| n >= m) {
+            report.stop = StopReason::MaxLayers;
+            break;
+        }
+        let below = raw.last().expect("first layer present");
+        let (index, hints) = below_index(tube, &vs, below);
+        let layer_t = match opts.strategy {
+            Strategy::Perpendicular => tube.t_at_arc_length(s_base + n as f64 * opts.delta_mm),
+            _ => f64::NAN,
+        };
+        let z = z_base + n as f64 * opts.delta_mm;
+        let steps: Vec<Result<Step, RootFailure>> = (0..grid)
+            .into_par_iter()
+            .map(|i| {
+                if !alive[i] {
+                    return Ok(Step::End);
+                }
+                let (v, t0) = (vs[i], cursor[i]);
+                match opts.strategy {
+                    Strategy::Constant => match hints[i] {
+                        Some(h) => {
+                            constant_distance::next_t(tube, &index, h, v, t0, opts.delta_mm, t_hi)
+                        }
+                        None => Ok(Step::End),
+                    },
+                    Strategy::Iso => iso_parametric::next_t(tube, v, t0, opts.delta_mm, t_hi),
+                    Strategy::Planar => planar_z::next_t(tube, v, t0, z, t_hi),
+                    Strategy::Perpendicular => Ok(normal_to_guide::step(layer_t, t_first[i], t_hi)),
+                    Strategy::Spiral => Ok(Step::End),
+                }
+            })
+            .collect();
+        let mut layer = vec![None; grid];
+        let mut ended = Vec::new();
+        for (i, s) in steps.into_iter().enumerate() {
+            match s {
+                Ok(Step::Point {
+                    t,
+                    evaluations,
+                    residual,
+                }) => {
+                    layer[i] = Some(t);
+                    if evaluations > 0 {
+                        report.root_finds += 1;
+                        report.evaluations += evaluations;
+                        report.max_residual_mm = report.max_residual_mm.max(residual);
+                    }
+                }
+                Ok(Step::Skip) => {}
+                Ok(Step::End) => {
+                    if alive[i] {
+                        ended.push(i);
+                    }
+                }
+                Err(e) => {
+                    return Err(PathError::NoRoot {
+                        layer: n,
+                        point: i,
+                        v: vs[i],
+                        t_lo: cursor[i],
+                        t_hi,
+                        delta_mm: opts.delta_mm,
+                        reason: match e {
+                            RootFailure::NotBracketed => "not bracketed",
+                            RootFailure::NonFinite => "non-finite distance",
+                            RootFailure::NotConverged => "not converged",
+                        },
+                    })
+                }
+            }
+        }
+        // End rules.
+        if !ended.is_empty() && !open_layers_allowed {
+            match opts.end {
+                EndRule::WholeLayers => {
+                    report.stop = StopReason::ReachedEnd;
+                    break;
+                }
+                EndRule::EvaluableRange => {
+                    report.stop = StopReason::EvaluableRange;
+                    break;
+                }
+                EndRule::Truncate(plane) => {
+                    for &i in &ended {
+                        let p = tube.point(cursor[i], vs[i]);
+                        if (p - plane.point).dot(&plane.normal) <= 0.0 {
+                            return Err(PathError::ExtensionTooShort {
+                                layer: n,
+                                point: i,
+                                t_eval_max: t_hi,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        for &i in &ended {
+            alive[i] = false;
+        }
+        if layer.iter().all(Option::is_none) {
+            report.stop = if open_layers_allowed && opts.strategy == Strategy::Perpendicular {
+                StopReason::ReachedEnd
+            } else {
+                StopReason::NoMorePoints
+            };
+            break;
+        }
+        if let EndRule::Truncate(plane) = opts.end {
+            let inside = layer.iter().zip(&vs).any(|(t, &v)| {
+                t.is_some_and(|t| (tube.point(t, v) - plane.point).dot(&plane.normal) <= 0.0)
+            });
+            if !inside {
+                report.stop = StopReason::PastEndPlane;
+                break;
+            }
+        }
+        for (i, t) in layer.iter().enumerate() {
+            if let Some(t) = t {
+                cursor[i] = *t;
+            }
+        }
+        total_points += grid;
+        if total_points > MAX_POINTS_PER_PATH {
+            return Err(PathError::TooManyPoints {
+                limit: MAX_POINTS_PER_PATH,
+                layer: n,
+            });
+        }
+        raw.push(layer);
+    }
+    if raw.len() < 2 {
+        return Err(PathError::DeltaTooLarge {
+            delta_mm: opts.delta_mm,
+            length_mm,
+        });
+    }
+    let mut layers = assemble(tube, &vs, &raw, opts, &mut report);
+    align_seams(&mut layers, opts);
+    let mut path = Path {
+        strategy: opts.strategy,
+        delta_mm: opts.delta_mm,
+        layers,
+        report,
+    };
+    fill_deltas(&mut path);
+    Ok(path)
+}
+
+/// Computation grid: the requested points, or a fine grid for chord / spacing
+/// tolerances (output is decimated to the tolerance).
+fn grid_size(tube: &Tube, opts: &SliceOptions) -> usize {
+    let r = tube.range();
+    let (mut a_min, mut a_max) = (f64::MAX, 0.0_f64);
+    for i in 0..=64 {
+        let a = tube.radius(r.t_min + (r.t_max - r.t_min) * i as f64 / 64.0);
+        a_min = a_min.min(a);
+        a_max = a_max.max(a);
+    }
+    let perimeter = TAU * a_max;
+    let n = match opts.discretisation {
+        Discretisation::Points(n) => return n,
+        Discretisation::ChordError(e) => {
+            // Fine spacing with a sagitta of a tenth of the tolerance on the tightest circle.
+            let h = (8.0 * a_min * e / 10.0).sqrt();
+            perimeter / h
+        }
+        Discretisation::MaxSpacing(d) => 4.0 * perimeter / d,
+    };
+    (n.ceil() as usize).clamp(64, 20_000)
+}
+
+/// Index over the valid points of the layer below, and for each column the
+/// segment next to its point there.
+fn below_index(
+    tube: &Tube,
+    vs: &[f64],
+    below: &[Option<f64>],
+) -> (SegmentIndex, Vec<Option<SegmentId>>) {
+    let runs = runs(below);
+    let mut hints = vec![None; below.len()];
+    let mut polylines = Vec::with_capacity(runs.len());
+    for (k, (cols, closed)) in runs.iter().enumerate() {
+        let pts = cols
+            .iter()
+            .map(|&i| tube.point(below[i].expect("run holds valid points"), vs[i]))
+            .collect();
+        for (j, &i) in cols.iter().enumerate() {
+            let seg = if !closed && j + 1 == cols.len() && j > 0 {
+                j - 1
+            } else {
+                j
+            };
+            hints[i] = Some(SegmentId {
+                polyline: k,
+                segment: seg,
+            });
+        }
+        polylines.push((pts, *closed));
+    }
+    (SegmentIndex::new(polylines), hints)
+}
+
+/// Splits a cyclic column layer into runs of present points: one closed run
+/// if all are present, else open runs, each starting after a gap.
+pub(crate) fn runs<T>(layer: &[Option<T>]) -> Vec<(Vec<usize>, bool)> {
+    let n = layer.len();
+    if layer.iter().all(Option::is_some) {
+        return vec![((0..n).collect(), true)];
+    }
+    let Some(gap) = layer.iter().position(Option::is_none) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    let mut current = Vec::new();
+    for k in 1..=n {
+        let i = (gap + k) % n;
+        if layer[i].is_some() {
+            current.push(i);
+        } else if !current.is_empty() {
+            out.push((std::mem::take(&mut current), false));
+        }
+    }
+    if !current.is_empty() {
+        out.push((current, false));
+    }
+    out
+}
+
+/// Output layers: truncation, splitting into polylines, decimation.
+fn assemble(
+    tube: &Tube,
+    vs: &[f64],
+    raw: &[Vec<Option<f64>>],
+    opts: &SliceOptions,
+    report: &mut SliceReport,
+) -> Vec<Layer> {
+    let mut layers = Vec::new();
+    for (slice, cols) in raw.iter().enumerate() {
+        let mut pts: Vec<Option<PathPoint>> = cols
+            .iter()
+            .zip(vs)
+            .map(|(t, &v)| {
+                t.map(|t| PathPoint {
+                    t,
+                    v,
+                    position: tube.point(t, v),
+                    delta: None,
+                })
+            })
+            .collect();
+        if let EndRule::Truncate(plane) = opts.end {
+            for p in pts.iter_mut() {
+                if p.is_some_and(|q| (q.position - plane.point).dot(&plane.normal) > 0.0) {
+                    *p = None;
+                    report.truncated_points += 1;
+                }
+            }
+        }
+        for (run, closed) in runs(&pts) {
+            let points: Vec<PathPoint> = run.iter().map(|&i| pts[i].expect("valid")).collect();
+            let points = decimate(points, closed, opts.discretisation);
+            layers.push(Layer {
+                slice,
+                points,
+                closed,
+            });
+        }
+    }
+    layers
+}
+
+/// Keeps a subset of points so that the chord error / spacing tolerance holds.
+fn decimate(points: Vec<PathPoint>, closed: bool, d: Discretisation) -> Vec<PathPoint> {
+    let (chord, spacing) = match d {
+        Discretisation::Points(_) => return points,
+        Discretisation::ChordError(e) => (e, f64::INFINITY),
+        Discretisation::MaxSpacing(s) => (f64::INFINITY, s),
+    };
+    let n = points.len();
+    if n < 4 {
+        return points;
+    }
+    let end = if closed { n } else { n - 1 };
+    let at = |k: usize| points[k % n].position;
+    let mut keep = vec![0usize];
+    let mut i = 0;
+    while i < end {
+        let mut j = i + 1;
+        while j < end {
+            let cand = j + 1;
+            let (a, b) = (at(i), at(cand));
+            let ok = (b - a).norm() <= spacing
+                && ((i + 1)..cand)
+                    .all(|k| super::index::point_segment_distance(&at(k), &a, &b).0 <= chord);
+            if !ok {
+                break;
+            }
+            j = cand;
+        }
+        if j < n {
+            keep.push(j);
+        }
+        i = j;
+    }
+    if !closed && *keep.last().expect("non-empty") != n - 1 {
+        keep.push(n - 1);
+    }
+    keep.dedup();
+    keep.into_iter()
+        .filter(|&k| k < n)
+        .map(|k| points[k])
+        .collect()
+}
+
+/// Rotates closed layers so each starts next to the end of the layer below,
+/// then by the stagger angle.
+fn align_seams(layers: &mut [Layer], opts: &SliceOptions) {
+    for k in 1..layers.len() {
+        if !layers[k].closed {
+            continue;
+        }
+        let n = layers[k].points.len();
+        let mut start = 0;
+        if opts.align_seams {
+            let end = layers[k - 1]
+                .points
+                .last()
+                .expect("layers are non-empty")
+                .position;
+            start = (0..n)
+                .min_by(|&a, &b| {
+                    let da = (layers[k].points[a].position - end).norm();
+                    let db = (layers[k].points[b].position - end).norm();
+                    da.total_cmp(&db)
+                })
+                .unwrap_or(0);
+        }
+        let slice = layers[k].slice as f64;
+        let shift = ((opts.stagger_rad * slice / TAU).rem_euclid(1.0) * n as f64).round() as usize;
+        layers[k].points.rotate_left((start + shift) % n);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::runs;
+
+    #[test]
+    fn runs_split_cyclically() {
+        assert_eq!(runs(&[Some(1), Some(2)]), vec![(vec![0, 1], true)]);
+        let r = runs(&[Some(1), None, Some(3), Some(4), None, Some(6)]);
+        assert_eq!(r, vec![(vec![2, 3], false), (vec![5, 0], false)]);
+    }
+}

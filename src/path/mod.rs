@@ -1,0 +1,328 @@
+//! **Stage 2 — deposition paths.** Takes a validated [`Tube`] and its
+//! [`Substrate`] (part frame, mm) and returns a [`Path`]: layers of points
+//! carrying `(t, v)`, position and the local distance to the layer below.
+//! Four strategies (SPEC §3.1): planar Z slices, slices perpendicular to the
+//! guide, iso-parametric layers, and the core method — **constant local
+//! interlayer distance**, a bracketed 1-D root find per point against the
+//! layer below [thesis §2.3, eq. 2.20–2.27]. Also the distance map (SPEC §3.2),
+//! truncation by an end plane (§3.5) and seams (§3.3).
+
+pub mod distance_map;
+pub mod index;
+mod march;
+pub mod strategy;
+
+pub use distance_map::{distance_map, DistanceMap, DistanceStats};
+pub use march::slice;
+
+use crate::io::part_file::Plane;
+use crate::math::Point3;
+use serde::{Deserialize, Serialize};
+
+/// Slicing strategy (SPEC §3.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Strategy {
+    /// Constant local interlayer distance (the core method).
+    #[default]
+    Constant,
+    /// Iso-parametric layers: `Delta` between points of the same `v`.
+    Iso,
+    /// Layers perpendicular to the guide, `Delta` apart along its arc length.
+    Perpendicular,
+    /// Planar slices `Z = z0 + k Delta` (part frame).
+    Planar,
+    /// One continuous spiral (not implemented yet).
+    Spiral,
+}
+
+impl Strategy {
+    /// The name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::Constant => "constant",
+            Strategy::Iso => "iso",
+            Strategy::Perpendicular => "perpendicular",
+            Strategy::Planar => "planar",
+            Strategy::Spiral => "spiral",
+        }
+    }
+}
+
+/// How to discretise a layer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Discretisation {
+    /// A fixed number of points per layer, uniform in `v`.
+    Points(usize),
+    /// Max chord error (sagitta, mm): computed on a fine grid, output decimated.
+    ChordError(f64),
+    /// Max distance between consecutive points (mm): fine grid, output decimated.
+    MaxSpacing(f64),
+}
+
+/// Where the path ends.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EndRule {
+    /// Whole layers only: stop before the first layer with a point past
+    /// `t_max` (the thesis's rule).
+    WholeLayers,
+    /// Generate past the end and keep points with `(M - P)·p <= 0` for the
+    /// plane (P, outward p) (SPEC §3.5); stop when a layer has no point left.
+    Truncate(Plane),
+    /// Keep going while every point stays within the tube's evaluable range
+    /// (for comparisons such as the thesis's 16-layer iso path).
+    EvaluableRange,
+}
+
+/// Options of [`slice`]. Plain data; [`SliceOptions::validate`] names the field.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SliceOptions {
+    /// Strategy.
+    pub strategy: Strategy,
+    /// Target interlayer distance `Delta` (mm, > 0).
+    pub delta_mm: f64,
+    /// Discretisation of each layer.
+    pub discretisation: Discretisation,
+    /// Where the path ends.
+    pub end: EndRule,
+    /// Upper bound on the number of layers (the first layer included).
+    pub max_layers: Option<usize>,
+    /// Rotate each closed layer so it starts at the point closest to the end
+    /// of the layer below (SPEC §3.3).
+    pub align_seams: bool,
+    /// Extra rotation of the start of layer `k` by `k × stagger` (rad of `v`).
+    pub stagger_rad: f64,
+}
+
+impl SliceOptions {
+    /// Options with the given strategy and `Delta`, 500 points per layer,
+    /// whole layers, seams aligned.
+    pub fn new(strategy: Strategy, delta_mm: f64) -> Self {
+        Self {
+            strategy,
+            delta_mm,
+            discretisation: Discretisation::Points(500),
+            end: EndRule::WholeLayers,
+            max_layers: None,
+            align_seams: true,
+            stagger_rad: 0.0,
+        }
+    }
+
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`PathError::InvalidOption`] naming the field.
+    pub fn validate(&self) -> Result<(), PathError> {
+        let bad =
+            |field: &'static str, reason: String| Err(PathError::InvalidOption { field, reason });
+        if !(self.delta_mm.is_finite() && self.delta_mm > 0.0) {
+            return bad(
+                "delta_mm",
+                format!("must be positive and finite, got {}", self.delta_mm),
+            );
+        }
+        match self.discretisation {
+            Discretisation::Points(n) if !(3..=MAX_POINTS_PER_LAYER).contains(&n) => {
+                return bad(
+                    "points",
+                    format!("must be in 3..={MAX_POINTS_PER_LAYER}, got {n}"),
+                )
+            }
+            Discretisation::ChordError(e) if !(e.is_finite() && e > 0.0) => {
+                return bad("chord_mm", format!("must be positive and finite, got {e}"))
+            }
+            Discretisation::MaxSpacing(d) if !(d.is_finite() && d > 0.0) => {
+                return bad(
+                    "max_spacing_mm",
+                    format!("must be positive and finite, got {d}"),
+                )
+            }
+            _ => {}
+        }
+        if !self.stagger_rad.is_finite() {
+            return bad("stagger", "must be finite".into());
+        }
+        if self.max_layers == Some(0) {
+            return bad("max_layers", "must be at least 1".into());
+        }
+        if let EndRule::Truncate(p) = self.end {
+            if !p.point.coords.iter().all(|c| c.is_finite()) {
+                return bad("end_plane.point", "must be finite".into());
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Most points a layer may have (computation grid included).
+pub const MAX_POINTS_PER_LAYER: usize = 200_000;
+/// Most points a whole path may have.
+pub const MAX_POINTS_PER_PATH: usize = 50_000_000;
+
+/// One point of a deposition path (part frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathPoint {
+    /// Guide parameter `t`.
+    pub t: f64,
+    /// Profile angle `v` (rad, in `[0, 2π)`).
+    pub v: f64,
+    /// Position `M(t, v)` (mm).
+    pub position: Point3,
+    /// Local distance to the layer below (mm); `None` on the first layer.
+    pub delta: Option<f64>,
+}
+
+/// One layer: a polyline of points, closed (a loop) or open (where the layer
+/// leaves the part or is cut by the end plane).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layer {
+    /// Slice number: 0 is the first layer on the substrate. An open slice
+    /// cut in several pieces gives several layers with the same number.
+    pub slice: usize,
+    /// The points, in deposition order.
+    pub points: Vec<PathPoint>,
+    /// Whether the last point joins the first.
+    pub closed: bool,
+}
+
+/// Why the generation stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    /// The next layer would pass `t_max` (whole layers only).
+    ReachedEnd,
+    /// Every point of the next layer is beyond the end plane.
+    PastEndPlane,
+    /// The next layer would leave the tube's evaluable range.
+    EvaluableRange,
+    /// No point of the next layer exists (e.g. a planar slice above the part).
+    NoMorePoints,
+    /// `max_layers` reached.
+    MaxLayers,
+}
+
+/// What the slicer did, for reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SliceReport {
+    /// Root finds run.
+    pub root_finds: usize,
+    /// Function evaluations inside root finds.
+    pub evaluations: usize,
+    /// Largest |residual| of a root find (mm).
+    pub max_residual_mm: f64,
+    /// Points removed by the end plane.
+    pub truncated_points: usize,
+    /// Points per layer of the computation grid.
+    pub grid_points: usize,
+    /// Why generation stopped.
+    pub stop: StopReason,
+}
+
+/// A deposition path: layers in order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Path {
+    /// Strategy that made it.
+    pub strategy: Strategy,
+    /// Target interlayer distance `Delta` (mm).
+    pub delta_mm: f64,
+    /// The layers, first on the substrate.
+    pub layers: Vec<Layer>,
+    /// What the slicer did.
+    pub report: SliceReport,
+}
+
+impl Path {
+    /// Number of points.
+    pub fn num_points(&self) -> usize {
+        self.layers.iter().map(|l| l.points.len()).sum()
+    }
+
+    /// Number of slices (layers counted once even when cut in pieces).
+    pub fn num_slices(&self) -> usize {
+        self.layers.last().map_or(0, |l| l.slice + 1)
+    }
+
+    /// Total path length (mm), closing segments of closed layers included.
+    pub fn length_mm(&self) -> f64 {
+        self.layers
+            .iter()
+            .map(|l| {
+                let n = l.points.len();
+                let open: f64 = l
+                    .points
+                    .windows(2)
+                    .map(|w| (w[1].position - w[0].position).norm())
+                    .sum();
+                if l.closed && n > 1 {
+                    open + (l.points[0].position - l.points[n - 1].position).norm()
+                } else {
+                    open
+                }
+            })
+            .sum()
+    }
+}
+
+/// Errors of the path stage; each names the layer, point or option.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PathError {
+    /// An option is invalid.
+    #[error("slicing option `{field}`: {reason}")]
+    InvalidOption {
+        /// The option.
+        field: &'static str,
+        /// What is wrong.
+        reason: String,
+    },
+    /// `Delta` is larger than the part: not even a second layer fits.
+    #[error("Delta = {delta_mm} mm is larger than the part: no second layer fits (guide length {length_mm:.3} mm)")]
+    DeltaTooLarge {
+        /// The requested Delta (mm).
+        delta_mm: f64,
+        /// The guide length of the part (mm).
+        length_mm: f64,
+    },
+    /// The first layer could not be built.
+    #[error("first layer: {0}")]
+    FirstLayer(#[from] crate::geometry::GeometryError),
+    /// A root find failed.
+    #[error("layer {layer}, point {point} (v = {v:.4} rad): no t in [{t_lo:.6}, {t_hi:.6}] reaches delta = {delta_mm} mm ({reason})")]
+    NoRoot {
+        /// Layer.
+        layer: usize,
+        /// Point.
+        point: usize,
+        /// Profile angle (rad).
+        v: f64,
+        /// Bracket low end.
+        t_lo: f64,
+        /// Bracket high end.
+        t_hi: f64,
+        /// Target distance (mm).
+        delta_mm: f64,
+        /// Why.
+        reason: &'static str,
+    },
+    /// The path would exceed the point limit.
+    #[error("the path would exceed {limit} points (at layer {layer}); raise Delta or lower the point count")]
+    TooManyPoints {
+        /// The limit.
+        limit: usize,
+        /// Layer reached.
+        layer: usize,
+    },
+    /// The end plane is past the evaluable range of the tube.
+    #[error("layer {layer}, point {point}: the end plane is beyond the tube's evaluable range (t > {t_eval_max:.6}); raise range.extend_after")]
+    ExtensionTooShort {
+        /// Layer.
+        layer: usize,
+        /// Point.
+        point: usize,
+        /// Highest evaluable t.
+        t_eval_max: f64,
+    },
+    /// The spiral strategy is not available yet.
+    #[error("strategy `{0}` is not implemented yet")]
+    NotImplemented(&'static str),
+}

@@ -1,0 +1,69 @@
+//! Constant local interlayer distance [SPEC §3.1.4; thesis §2.3, eq. 2.20–2.27]:
+//! keep `v`, find `t` such that the distance from `M(t, v)` to the polyline of
+//! the layer below equals `Delta`, moving forward from the column's point on
+//! that layer (where the distance is zero).
+
+use super::{forward_root, Step};
+use crate::geometry::Tube;
+use crate::math::RootFailure;
+use crate::path::index::{SegmentId, SegmentIndex};
+
+/// Next `t` of the column at profile angle `v` whose point on the layer below
+/// is at `t_below`; `hint` is a segment of the layer below next to that point
+/// (speeds up nearest-segment queries; the result is confirmed exactly).
+pub fn next_t(
+    tube: &Tube,
+    below: &SegmentIndex,
+    hint: SegmentId,
+    v: f64,
+    t_below: f64,
+    delta_mm: f64,
+    t_hi: f64,
+) -> Result<Step, RootFailure> {
+    let speed = tube.surface(t_below, v).d_dt.norm();
+    let step0 = 0.9 * delta_mm / speed;
+    let mut hint = hint;
+    let mut delta_at = |t: f64| {
+        let p = tube.point(t, v);
+        let near = below.nearest_from(&p, hint);
+        hint = near.id;
+        near.distance
+    };
+    let x_tol = 1e-13 * (1.0 + t_below.abs());
+    let found = forward_root(
+        |t| delta_at(t) - delta_mm,
+        t_below,
+        step0,
+        t_hi,
+        x_tol,
+        1e-11 * delta_mm,
+    )?;
+    let Some((t, evaluations, _)) = found else {
+        return Ok(Step::End);
+    };
+    // Confirm with the exact nearest segment (the local descent could have
+    // stopped at a local minimum); redo the root find with exact queries if not.
+    let p = tube.point(t, v);
+    let exact = below.nearest(&p).map_or(f64::INFINITY, |n| n.distance);
+    if (exact - delta_mm).abs() <= 1e-9 * delta_mm {
+        return Ok(Step::Point {
+            t,
+            evaluations,
+            residual: (exact - delta_mm).abs(),
+        });
+    }
+    let exact_delta = |t: f64| {
+        below
+            .nearest(&tube.point(t, v))
+            .map_or(f64::INFINITY, |n| n.distance)
+            - delta_mm
+    };
+    match forward_root(exact_delta, t_below, step0, t_hi, x_tol, 1e-11 * delta_mm)? {
+        Some((t, more, residual)) => Ok(Step::Point {
+            t,
+            evaluations: evaluations + more,
+            residual,
+        }),
+        None => Ok(Step::End),
+    }
+}

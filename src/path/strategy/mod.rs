@@ -1,0 +1,70 @@
+//! The per-point rules of each slicing strategy (SPEC §3.1): given a column
+//! (fixed profile angle `v`) and where it stands on the layer below, the `t`
+//! of its next point. The layer loop that drives them is in `path::march`.
+
+pub mod constant_distance;
+pub mod iso_parametric;
+pub mod normal_to_guide;
+pub mod planar_z;
+
+/// Outcome of one column step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Step {
+    /// The next point of the column is at this `t`.
+    Point {
+        /// Guide parameter.
+        t: f64,
+        /// Function evaluations spent.
+        evaluations: usize,
+        /// |residual| of the root find (mm).
+        residual: f64,
+    },
+    /// The column has no point on this layer but may have one later
+    /// (e.g. still inside the substrate); its position does not change.
+    Skip,
+    /// The column has no more points (it left the part or the search range).
+    End,
+}
+
+/// Finds the first `t` in `(t0, t_hi]` where `g(t)` (with `g(t0) < 0`) turns
+/// non-negative, stepping forward by `step0` (growing ×1.6 while `g` stays
+/// well below zero), then refines with Brent. `Ok(None)` if `g` stays
+/// negative up to `t_hi`.
+pub(crate) fn forward_root(
+    mut g: impl FnMut(f64) -> f64,
+    t0: f64,
+    step0: f64,
+    t_hi: f64,
+    x_tol: f64,
+    y_tol: f64,
+) -> Result<Option<(f64, usize, f64)>, crate::math::RootFailure> {
+    let mut evaluations = 0;
+    let mut ta = t0;
+    let mut step = step0;
+    let mut tb = (t0 + step).min(t_hi);
+    loop {
+        let gb = g(tb);
+        evaluations += 1;
+        if !gb.is_finite() {
+            return Err(crate::math::RootFailure::NonFinite);
+        }
+        if gb >= 0.0 {
+            break;
+        }
+        if tb >= t_hi {
+            return Ok(None);
+        }
+        ta = tb;
+        step *= 1.6;
+        tb = (tb + step).min(t_hi);
+        if evaluations > 400 {
+            return Err(crate::math::RootFailure::NotConverged);
+        }
+    }
+    let r = crate::math::brent(&mut g, ta, tb, x_tol, y_tol)?;
+    Ok(Some((
+        r.x,
+        evaluations + r.iterations + 2,
+        r.residual.abs(),
+    )))
+}

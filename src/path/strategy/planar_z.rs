@@ -1,0 +1,36 @@
+//! Planar slicing [SPEC §3.1.1; thesis eq. 2.3, 2.12–2.14]: layer `k` is the
+//! tube ∩ plane `Z = z_k` (part frame), found on each iso-`v` line.
+
+use super::{forward_root, Step};
+use crate::geometry::Tube;
+use crate::math::RootFailure;
+
+/// Next `t` of the column `v` on the plane `Z = z` (mm): the first crossing
+/// above `t_below`. A column already above `z` is skipped (it meets a later
+/// plane); a column that never reaches `z` before `t_hi` ends.
+pub fn next_t(tube: &Tube, v: f64, t_below: f64, z: f64, t_hi: f64) -> Result<Step, RootFailure> {
+    let z0 = tube.point(t_below, v).z;
+    if z0 >= z {
+        return Ok(Step::Skip);
+    }
+    let speed = tube.surface(t_below, v).d_dt.norm();
+    // Step about a tenth of the height still to climb (in arc length), so that a
+    // column turning down again is not jumped over.
+    let step = ((z - z0) / speed).max(1e-9) * 0.5;
+    let x_tol = 1e-13 * (1.0 + t_below.abs());
+    match forward_root(
+        |t| tube.point(t, v).z - z,
+        t_below,
+        step,
+        t_hi,
+        x_tol,
+        1e-11,
+    )? {
+        Some((t, evaluations, residual)) => Ok(Step::Point {
+            t,
+            evaluations,
+            residual,
+        }),
+        None => Ok(Step::End),
+    }
+}

@@ -1,0 +1,6 @@
+//! Integration tests of the path stage (SPEC §3) on the sample parts.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod strategies;
