@@ -23,6 +23,7 @@
 //! | 0. read a part file | [`io::part_file`] | §2 |
 //! | 1. tube geometry: guide curves, frames, profile law, substrates | [`geometry`] | §2 |
 //! | 2. deposition paths: four strategies, distance map, truncation, seams | [`path`] | §3 |
+//! | 3. tool axes (local frames, build direction) | [`toolaxis`] | §4 |
 //! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
 //!
 //! ## Units and frames
@@ -54,5 +55,6 @@ pub mod io;
 pub mod math;
 pub mod path;
 pub mod robot;
+pub mod toolaxis;
 
 pub use error::Error;

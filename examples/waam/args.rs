@@ -16,9 +16,44 @@ pub struct Args {
     pub quiet: bool,
 }
 
+/// Strategy names on the command line.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum StrategyArg {
+    /// Constant local interlayer distance.
+    Constant,
+    /// Iso-parametric.
+    Iso,
+    /// Perpendicular to the guide.
+    Perpendicular,
+    /// Planar Z slices.
+    Planar,
+    /// Continuous spiral.
+    Spiral,
+}
+
 /// Sub-commands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Slice a part: writes path.csv and summary.json in --out.
+    Slice {
+        /// The part file (TOML).
+        part: PathBuf,
+        /// Strategy (default: the part file's).
+        #[arg(long, value_enum)]
+        strategy: Option<StrategyArg>,
+        /// Interlayer distance Delta in mm (default: the part file's).
+        #[arg(long)]
+        delta: Option<f64>,
+        /// Points per layer.
+        #[arg(long, conflicts_with = "chord")]
+        points: Option<usize>,
+        /// Max chord error in mm.
+        #[arg(long)]
+        chord: Option<f64>,
+        /// Output folder (default out/<part name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// List the sample parts (and cells) with one line each.
     Parts {
         /// Folder holding the part files.

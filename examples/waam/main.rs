@@ -3,10 +3,12 @@
 //! ```text
 //! cargo run --release --example waam -- parts
 //! cargo run --release --example waam -- geometry parts/quarter-torus.toml
+//! cargo run --release --example waam -- slice parts/quarter-torus.toml
 //! ```
 //! Exit codes: 0 done, 1 bad input (the message names the file and field).
 
 mod args;
+mod slice;
 
 use args::{Args, Command};
 use clap::Parser;
@@ -14,10 +16,34 @@ use std::process::ExitCode;
 use waam_slicer::io::part_file::{read_part_file, Part};
 
 fn main() -> ExitCode {
-    let args = Args::parse();
+    // Usage errors are bad input (exit 1); exit 2 is kept for infeasible plans.
+    let args = match Args::try_parse() {
+        Ok(a) => a,
+        Err(e) => {
+            let code = if e.use_stderr() { 1 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
     let result = match &args.command {
         Command::Parts { dir } => list_parts(dir),
         Command::Geometry { part, points } => geometry(part, *points, args.quiet),
+        Command::Slice {
+            part,
+            strategy,
+            delta,
+            points,
+            chord,
+            out,
+        } => slice::run(
+            part,
+            *strategy,
+            *delta,
+            *points,
+            *chord,
+            out.as_deref(),
+            args.quiet,
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -222,8 +222,9 @@ fn grid_size(tube: &Tube, opts: &SliceOptions) -> usize {
     let n = match opts.discretisation {
         Discretisation::Points(n) => return n,
         Discretisation::ChordError(e) => {
-            // Fine spacing with a sagitta of a tenth of the tolerance on the tightest circle.
-            let h = (8.0 * a_min * e / 10.0).sqrt();
+            // Fine spacing with a sagitta of 1/50 of the tolerance on the tightest
+            // circle, so that decimation lands within a few % of the ideal count.
+            let h = (8.0 * a_min * e / 50.0).sqrt();
             perimeter / h
         }
         Discretisation::MaxSpacing(d) => 4.0 * perimeter / d,
@@ -319,6 +320,10 @@ fn assemble(
             }
         }
         for (run, closed) in runs(&pts) {
+            if run.len() < 2 {
+                // A single point is no bead (a slice touching the part's top).
+                continue;
+            }
             let points: Vec<PathPoint> = run.iter().map(|&i| pts[i].expect("valid")).collect();
             let points = decimate(points, closed, opts.discretisation);
             layers.push(Layer {

@@ -3,4 +3,6 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod cli;
+mod discretisation;
 mod strategies;

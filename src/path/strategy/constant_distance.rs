@@ -22,13 +22,9 @@ pub fn next_t(
 ) -> Result<Step, RootFailure> {
     let speed = tube.surface(t_below, v).d_dt.norm();
     let step0 = 0.9 * delta_mm / speed;
-    let mut hint = hint;
-    let mut delta_at = |t: f64| {
-        let p = tube.point(t, v);
-        let near = below.nearest_from(&p, hint);
-        hint = near.id;
-        near.distance
-    };
+    // Always descend from the column's own segment, so that the function is
+    // deterministic (a bracket found stays a bracket).
+    let delta_at = |t: f64| below.nearest_from(&tube.point(t, v), hint).distance;
     let x_tol = 1e-13 * (1.0 + t_below.abs());
     let found = forward_root(
         |t| delta_at(t) - delta_mm,

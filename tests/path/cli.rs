@@ -1,0 +1,109 @@
+//! The `waam slice` command of the CLI example writes `path.csv` with the
+//! contract's columns for every strategy; reading it back gives the same
+//! distance map (so anyone can check the figures from outside).
+
+use crate::common::part_path;
+use std::path::PathBuf;
+use std::process::Command;
+use waam_slicer::io::path_csv::{read_path_csv, HEADER};
+use waam_slicer::path::distance_map::distance_map_of;
+
+/// The example binary, built by `cargo test` next to the test executables.
+fn waam() -> Command {
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe.parent().unwrap().parent().unwrap();
+    let bin: PathBuf = dir
+        .join("examples")
+        .join(format!("waam{}", std::env::consts::EXE_SUFFIX));
+    assert!(bin.exists(), "example not built at {}", bin.display());
+    Command::new(bin)
+}
+
+#[test]
+fn slice_writes_path_csv_for_every_strategy() {
+    let dir = tempfile::tempdir().unwrap();
+    for strategy in ["constant", "iso", "perpendicular", "planar"] {
+        let out = dir.path().join(strategy);
+        let status = waam()
+            .args(["--quiet", "slice"])
+            .arg(part_path("quarter-torus.toml"))
+            .args([
+                "--strategy",
+                strategy,
+                "--delta",
+                "5",
+                "--points",
+                "120",
+                "--out",
+            ])
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert!(status.success(), "{strategy}");
+        let text = std::fs::read_to_string(out.join("path.csv")).unwrap();
+        assert_eq!(text.lines().next().unwrap(), HEADER);
+        let first = text.lines().nth(1).unwrap();
+        assert_eq!(
+            first.split(',').nth(7),
+            Some(""),
+            "delta empty on the first layer"
+        );
+        let layers = read_path_csv(&text, "path.csv").unwrap();
+        assert!(layers.len() > 5);
+        // Distances recomputed from the file match the column written.
+        let map = distance_map_of(&layers, 5.0);
+        let written: Vec<Option<f64>> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(7).unwrap().parse::<f64>().ok())
+            .collect();
+        let recomputed: Vec<Option<f64>> = map
+            .points
+            .iter()
+            .flatten()
+            .map(|d| d.map(|d| d.0))
+            .collect();
+        assert_eq!(written.len(), recomputed.len());
+        for (w, r) in written.iter().zip(&recomputed) {
+            match (w, r) {
+                (Some(w), Some(r)) => assert!((w - r).abs() < 1e-5, "{strategy}: {w} vs {r}"),
+                (None, None) => {}
+                other => panic!("{strategy}: {other:?}"),
+            }
+        }
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["strategy"], strategy);
+        assert!(summary["points"].as_u64().unwrap() > 0);
+    }
+}
+
+#[test]
+fn slice_reports_bad_input_with_exit_code_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "name = \"x\"\n[guide]\nkind = \"line\"\n").unwrap();
+    let out = waam().args(["slice"]).arg(&bad).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.toml"), "{err}");
+    let out = waam()
+        .args(["slice"])
+        .arg(part_path("hemisphere.toml"))
+        .args(["--delta=-2"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("delta_mm"));
+}
+
+#[test]
+fn path_csv_reader_names_the_bad_line() {
+    let e = read_path_csv("layer,x,y,z\n0,1,2,3\n0,1,x,3\n", "p.csv").unwrap_err();
+    assert_eq!(e.line, 3);
+    assert!(e.to_string().contains("p.csv, line 3"));
+    let e = read_path_csv("layer,x,y,z\n1,1,2,3\n0,1,2,3\n", "p.csv").unwrap_err();
+    assert!(e.to_string().contains("layer 0 after layer 1"));
+    assert!(read_path_csv("a,b\n", "p.csv").is_err());
+}
