@@ -1,0 +1,91 @@
+//! Performance indices of a pose: manipulability, dexterity, joint-limit
+//! distance, positioning uncertainty. SPEC §6.5, thesis §1.4.2 eq. 1.4–1.8 and
+//! §4.2.2 eq. 4.10–4.12.
+
+use nalgebra::{Matrix3, Matrix6};
+
+use crate::robot::model::{JointLimit, Joints};
+
+/// Manipulability `sqrt(det(J Jᵀ))` [eq. 1.7] of a 6×6 Jacobian (units of J
+/// multiplied: mm³ for a Jacobian in mm/rad and rad/rad). 0 at a singularity.
+pub fn manipulability(j: &Matrix6<f64>) -> f64 {
+    (j * j.transpose()).determinant().max(0.0).sqrt()
+}
+
+/// Singular values `(xi_min, xi_max)` of `J` with its linear rows divided by
+/// `length_scale_mm` (pass 1 for the thesis's raw Jacobian in mm/rad and rad/rad).
+pub fn singular_value_range(j: &Matrix6<f64>, length_scale_mm: f64) -> (f64, f64) {
+    let mut js = *j;
+    for r in 0..3 {
+        for c in 0..6 {
+            js[(r, c)] /= length_scale_mm;
+        }
+    }
+    let sv = js.singular_values();
+    let max = sv.max();
+    let min = sv.min();
+    (min, max)
+}
+
+/// Dexterity `xi_min / xi_max` [eq. 1.8]: inverse condition number of `J`
+/// (linear rows divided by `length_scale_mm`), in `[0, 1]`: 0 at a
+/// singularity, 1 isotropic. The thesis uses the raw Jacobian
+/// (`length_scale_mm = 1`), whose values are of order 1e-3 for an arm of 1 m reach.
+pub fn dexterity(j: &Matrix6<f64>, length_scale_mm: f64) -> f64 {
+    let (min, max) = singular_value_range(j, length_scale_mm);
+    if max > 0.0 {
+        min / max
+    } else {
+        0.0
+    }
+}
+
+/// Which joint-limit distance of thesis §1.4.2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LimitDistance {
+    /// Liégeois [eq. 1.4]: `Σ ((q_j − q_mid_j)/(q_mid_j − q_max_j))²` (0 at mid-range, 1 per joint at a stop).
+    Liegeois,
+    /// Fournier [eq. 1.5]: `Σ ((q_j − q_mid_j)/Δq_j)²` with `Δq_j` the travel (0.25 per joint at a stop).
+    Fournier,
+    /// Klein [eq. 1.6]: `max |q_j − q_mid_j| / |Δq_j|` (0.5 at a stop).
+    Klein,
+}
+
+/// Joint-limit distance `Γ(q)` [eq. 1.4–1.6], unitless. Unlimited joints
+/// contribute 0.
+pub fn joint_limit_distance(q: &Joints, limits: &[JointLimit; 6], kind: LimitDistance) -> f64 {
+    let terms = (0..6).filter(|&j| !limits[j].is_unlimited()).map(|j| {
+        let l = &limits[j];
+        let dev = q[j] - l.mid_rad();
+        match kind {
+            LimitDistance::Liegeois => (dev / (l.mid_rad() - l.upper_rad)).powi(2),
+            LimitDistance::Fournier => (dev / l.range_rad()).powi(2),
+            LimitDistance::Klein => (dev / l.range_rad()).abs(),
+        }
+    });
+    match kind {
+        LimitDistance::Klein => terms.fold(0.0, f64::max),
+        _ => terms.sum(),
+    }
+}
+
+/// Positioning uncertainty `I = sqrt(|λ1| + |λ2| + |λ3|)` (mm) [eq. 4.10–4.12]:
+/// `λ` the eigenvalues of `C = J_v D J_vᵀ`, `J_v` the linear rows of the
+/// Jacobian (mm/rad) at the controlled point and `D = diag(sigma_j²)` with
+/// `sigma_j` the angular resolution of joint j (rad).
+///
+/// Eq. 4.11 prints `D = diag(sigma_j)`; that is dimensionally inconsistent
+/// (mm²·rad⁻¹), so `D` is read as the covariance of independent joint errors.
+/// `I` is then the root of the trace of the position covariance: the radius
+/// of the uncertainty sphere of eq. 4.12.
+pub fn positioning_uncertainty(j: &Matrix6<f64>, sigma_rad: &[f64; 6]) -> f64 {
+    let jv = j.fixed_view::<3, 6>(0, 0);
+    let mut c = Matrix3::zeros();
+    for k in 0..6 {
+        let col = jv.column(k);
+        c += col * col.transpose() * (sigma_rad[k] * sigma_rad[k]);
+    }
+    let eig = c.symmetric_eigenvalues();
+    eig.iter().map(|l| l.abs()).sum::<f64>().sqrt()
+}
