@@ -27,12 +27,22 @@ impl RobotModel {
     pub fn jacobian_at(&self, q: &Joints, point_in_flange: &Vector3) -> Jacobian {
         let st = self.chain_state(q);
         let p: Point3 = st.base_from_flange * Point3::from(*point_in_flange);
+        // Columns for the canonical angles (t1, t2, f3, t4, t5, t6). The forearm
+        // attitude f3 is absolute, so t2 at constant f3 translates the forearm:
+        // its column is the elbow's velocity, with no rotation.
         let mut jt = Matrix6::zeros();
         for i in 0..6 {
             let a = st.axis_dirs[i];
-            let v = a.cross(&(p - st.axis_points[i]));
+            let (v, w) = if i == 1 {
+                (
+                    a.cross(&(st.axis_points[2] - st.axis_points[1])),
+                    Vector3::zeros(),
+                )
+            } else {
+                (a.cross(&(p - st.axis_points[i])), a)
+            };
             jt.fixed_view_mut::<3, 1>(0, i).copy_from(&v);
-            jt.fixed_view_mut::<3, 1>(3, i).copy_from(&a);
+            jt.fixed_view_mut::<3, 1>(3, i).copy_from(&w);
         }
         jt * self.canonical_jacobian()
     }

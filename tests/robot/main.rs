@@ -1,1 +1,11 @@
 //! Integration tests of the robot stage (SPEC §6).
+
+mod calibration;
+mod cells;
+mod common;
+mod hemisphere;
+mod ik;
+mod jacobian;
+mod kinematics;
+mod orientation;
+mod positioner;
