@@ -63,7 +63,10 @@ impl Rng {
 /// Position distance (mm) and rotation angle (rad) between two poses.
 pub fn pose_error(a: &Isometry3, b: &Isometry3) -> (f64, f64) {
     let dp = (a.translation.vector - b.translation.vector).norm();
-    let dr = a.rotation.angle_to(&b.rotation);
+    // 2·|imaginary part| of the relative quaternion: accurate for tiny angles
+    // (acos-based angles are not below ~1e-8)
+    let rel = a.rotation.inverse() * b.rotation;
+    let dr = 2.0 * rel.imag().norm().atan2(rel.w.abs());
     (dp, dr)
 }
 
