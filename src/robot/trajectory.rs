@@ -55,6 +55,11 @@ pub struct TrajectoryOptions {
     pub dexterity_length_scale_mm: f64,
     /// Compute `dq/dR_Z` per point. Default `true`.
     pub with_derivatives: bool,
+    /// Start every layer from the joint representation inside the travel
+    /// (unlimited joints in `(-180°, 180°]`) instead of unwrapping from the
+    /// previous layer's last point: the arc is off between layers and the
+    /// robot may rewind J4/J6 there. Default `true`.
+    pub rewind_between_layers: bool,
 }
 
 impl Default for TrajectoryOptions {
@@ -65,6 +70,7 @@ impl Default for TrajectoryOptions {
             shoulder_singularity_margin_mm: 50.0,
             dexterity_length_scale_mm: 1.0,
             with_derivatives: true,
+            rewind_between_layers: true,
         }
     }
 }
@@ -301,8 +307,9 @@ impl JointTrajectory {
 ///
 /// The cell's configuration is used for every point; each point's joints
 /// are unwrapped towards the previous point's (so J6, unlimited, turns
-/// continuously), the first point of the path taking the representation
-/// nearest the middle of each joint's travel. Joint speeds are `Δq / Δt` with
+/// continuously within a layer); the first point of a layer takes the
+/// representation inside each joint's travel (see
+/// [`TrajectoryOptions::rewind_between_layers`]). Joint speeds are `Δq / Δt` with
 /// `Δt = |M_m − M_{m−1}| / TS` (part frame, consecutive points of a layer).
 ///
 /// # Errors
@@ -364,7 +371,13 @@ pub fn joint_trajectory(
                 kind,
             })
         };
-        let solved = cell.joints(&cp, p.r_z, prev_q.as_ref(), prev_q8);
+        let new_layer = idx == 0 || points[idx - 1].layer != p.layer;
+        let near = if new_layer && opts.rewind_between_layers {
+            None
+        } else {
+            prev_q.as_ref()
+        };
+        let solved = cell.joints(&cp, p.r_z, near, prev_q8);
         let (q, pose) = match solved {
             Ok(x) => x,
             Err(e) => {

@@ -26,7 +26,10 @@ fn rotations_round_trip_through_every_convention() {
         assert!(same(&Bryant::from_rotation(&r).to_rotation(), &r));
         assert!(same(&FanucWpr::from_rotation(&r).to_rotation(), &r));
         assert!(same(&KukaAbc::from_rotation(&r).to_rotation(), &r));
-        assert!(same(&rotation_from_abb_quaternion(abb_quaternion(&r)).unwrap(), &r));
+        assert!(same(
+            &rotation_from_abb_quaternion(abb_quaternion(&r)).unwrap(),
+            &r
+        ));
     }
 }
 
@@ -34,16 +37,30 @@ fn rotations_round_trip_through_every_convention() {
 fn angles_round_trip_away_from_gimbal_lock() {
     let mut rng = Rng::new(4);
     for _ in 0..2000 {
-        let (a, b, c) = (rng.range(-3.1, 3.1), rng.range(-1.5, 1.5), rng.range(-3.1, 3.1));
-        let br = Bryant { rx: a, ry: b, rz: c };
+        let (a, b, c) = (
+            rng.range(-3.1, 3.1),
+            rng.range(-1.5, 1.5),
+            rng.range(-3.1, 3.1),
+        );
+        let br = Bryant {
+            rx: a,
+            ry: b,
+            rz: c,
+        };
         let back = Bryant::from_rotation(&br.to_rotation());
-        assert!((back.rx - a).abs() < 1e-9 && (back.ry - b).abs() < 1e-9 && (back.rz - c).abs() < 1e-9);
+        assert!(
+            (back.rx - a).abs() < 1e-9 && (back.ry - b).abs() < 1e-9 && (back.rz - c).abs() < 1e-9
+        );
         let w = FanucWpr { w: a, p: b, r: c };
         let back = FanucWpr::from_rotation(&w.to_rotation());
-        assert!((back.w - a).abs() < 1e-9 && (back.p - b).abs() < 1e-9 && (back.r - c).abs() < 1e-9);
+        assert!(
+            (back.w - a).abs() < 1e-9 && (back.p - b).abs() < 1e-9 && (back.r - c).abs() < 1e-9
+        );
         let k = KukaAbc { a, b, c };
         let back = KukaAbc::from_rotation(&k.to_rotation());
-        assert!((back.a - a).abs() < 1e-9 && (back.b - b).abs() < 1e-9 && (back.c - c).abs() < 1e-9);
+        assert!(
+            (back.a - a).abs() < 1e-9 && (back.b - b).abs() < 1e-9 && (back.c - c).abs() < 1e-9
+        );
     }
 }
 
@@ -51,16 +68,31 @@ fn angles_round_trip_away_from_gimbal_lock() {
 fn gimbal_lock_round_trips() {
     for s in [1.0, -1.0] {
         for (x, z) in [(0.3, 0.0), (0.3, 0.7), (-2.0, 1.1), (0.0, 0.0)] {
-            let br = Bryant { rx: x, ry: s * FRAC_PI_2, rz: z };
+            let br = Bryant {
+                rx: x,
+                ry: s * FRAC_PI_2,
+                rz: z,
+            };
             let r = br.to_rotation();
             let back = Bryant::from_rotation(&r);
             assert!(back.rx.is_finite() && back.rz == 0.0);
-            assert!(same(&back.to_rotation(), &r), "Bryant lock {s} {x} {z}: {back:?}");
-            let w = FanucWpr { w: x, p: s * FRAC_PI_2, r: z };
+            assert!(
+                same(&back.to_rotation(), &r),
+                "Bryant lock {s} {x} {z}: {back:?}"
+            );
+            let w = FanucWpr {
+                w: x,
+                p: s * FRAC_PI_2,
+                r: z,
+            };
             let r = w.to_rotation();
             let back = FanucWpr::from_rotation(&r);
             assert!(back.w == 0.0 && same(&back.to_rotation(), &r), "WPR lock");
-            let k = KukaAbc { a: z, b: s * FRAC_PI_2, c: x };
+            let k = KukaAbc {
+                a: z,
+                b: s * FRAC_PI_2,
+                c: x,
+            };
             let r = k.to_rotation();
             let back = KukaAbc::from_rotation(&r);
             assert!(back.c == 0.0 && same(&back.to_rotation(), &r), "ABC lock");
@@ -75,9 +107,23 @@ fn conventions_match_their_definitions() {
     let rx = Rotation3::from_axis_angle(&Vector3::x_axis(), a);
     let ry = Rotation3::from_axis_angle(&Vector3::y_axis(), b);
     let rz = Rotation3::from_axis_angle(&Vector3::z_axis(), c);
-    assert!(same(&Bryant { rx: a, ry: b, rz: c }.to_rotation(), &(rx * ry * rz)));
-    assert!(same(&FanucWpr { w: a, p: b, r: c }.to_rotation(), &(rz * ry * rx)));
-    assert!(same(&KukaAbc { a: c, b, c: a }.to_rotation(), &(rz * ry * rx)));
+    assert!(same(
+        &Bryant {
+            rx: a,
+            ry: b,
+            rz: c
+        }
+        .to_rotation(),
+        &(rx * ry * rz)
+    ));
+    assert!(same(
+        &FanucWpr { w: a, p: b, r: c }.to_rotation(),
+        &(rz * ry * rx)
+    ));
+    assert!(same(
+        &KukaAbc { a: c, b, c: a }.to_rotation(),
+        &(rz * ry * rx)
+    ));
     // nalgebra's euler angles are roll-pitch-yaw about fixed axes, like FANUC's W P R
     let e = UnitQuaternion::from_euler_angles(a, b, c).to_rotation_matrix();
     assert!(same(&FanucWpr { w: a, p: b, r: c }.to_rotation(), &e));
@@ -92,7 +138,10 @@ fn table_3_7_positioner_is_turned_about_45_degrees_about_the_vertical() {
     let z = iso.rotation * Vector3::z();
     assert!(z.z > 0.9999);
     let back = FanucPose::from_isometry(&iso).to_xyzwpr_deg();
-    for (u, v) in back.iter().zip([920.588, 820.862, -254.408, 0.412, -0.131, 45.059]) {
+    for (u, v) in back
+        .iter()
+        .zip([920.588, 820.862, -254.408, 0.412, -0.131, 45.059])
+    {
         assert!((u - v).abs() < 1e-9);
     }
 }

@@ -14,7 +14,11 @@ fn fk_matches_eq_c5_c6() {
     let t = p.positioner_from_table(&[q7, q8]);
     let expect = Vector3::new(150.0 * q7.sin(), 0.0, 150.0 * q7.cos());
     assert!((t.translation.vector - expect).norm() < 1e-12);
-    assert!((p.positioner_from_table(&[0.0, 0.0]).translation.vector - Vector3::new(0.0, 0.0, 150.0)).norm() < 1e-12);
+    assert!(
+        (p.positioner_from_table(&[0.0, 0.0]).translation.vector - Vector3::new(0.0, 0.0, 150.0))
+            .norm()
+            < 1e-12
+    );
     assert_eq!(Positioner::robowam_identified().tilt_to_table_mm, 149.631);
     // table normal tilts towards +X for q7 > 0
     let n = t.rotation * Vector3::z();
@@ -41,7 +45,9 @@ fn angles_turn_the_build_direction_vertical_level_positioner() {
 #[test]
 fn angles_turn_the_build_direction_vertical_in_the_robot_frame() {
     // positioner pose of table 3.7: slightly tilted, so "up" is not its own Z
-    let base_from_pos = FanucPose::from_xyzwpr_deg([920.588, 820.862, -254.408, 0.412, -0.131, 45.059]).to_isometry();
+    let base_from_pos =
+        FanucPose::from_xyzwpr_deg([920.588, 820.862, -254.408, 0.412, -0.131, 45.059])
+            .to_isometry();
     let up = base_from_pos.rotation.inverse() * Vector3::z_axis();
     let p = Positioner::robowam_identified();
     let mut rng = Rng::new(22);
@@ -51,7 +57,8 @@ fn angles_turn_the_build_direction_vertical_in_the_robot_frame() {
             // only when b_z is out of reach of the tilted positioner's cone
             continue;
         };
-        let world = base_from_pos.rotation * (p.positioner_from_table(&q).rotation * b.into_inner());
+        let world =
+            base_from_pos.rotation * (p.positioner_from_table(&q).rotation * b.into_inner());
         assert!((world - Vector3::z()).norm() < 1e-12);
     }
 }
@@ -59,6 +66,8 @@ fn angles_turn_the_build_direction_vertical_in_the_robot_frame() {
 #[test]
 fn vertical_build_direction_keeps_the_hint() {
     let p = Positioner::robowam_nominal();
-    let q = p.angles_for_vertical(&Vector3::z_axis(), &Vector3::z_axis(), 0.7).unwrap();
+    let q = p
+        .angles_for_vertical(&Vector3::z_axis(), &Vector3::z_axis(), 0.7)
+        .unwrap();
     assert_eq!(q, [0.0, 0.7]);
 }
