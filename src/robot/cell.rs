@@ -192,6 +192,10 @@ pub struct TorchCarriedCell {
     pub configuration: Configuration,
     /// Largest admissible hose torsion `|q4 + q6|` (rad) [eq. 4.8: 120°].
     pub max_hose_torsion_rad: f64,
+    /// Largest accepted angle between the build direction and the vertical
+    /// when the positioner cannot make it exact (rad); see
+    /// [`Positioner::angles_for_vertical`]. 1° in the thesis cell files.
+    pub max_vertical_error_rad: f64,
 }
 
 impl TorchCarriedCell {
@@ -202,6 +206,14 @@ impl TorchCarriedCell {
     pub fn validate(&self) -> Result<(), RobotError> {
         self.robot.validate()?;
         self.positioner.validate()?;
+        if !(self.max_vertical_error_rad >= 0.0) {
+            return Err(RobotError::InvalidParameter {
+                what: self.name.clone(),
+                field: "max_vertical_error_deg",
+                value: self.max_vertical_error_rad.to_degrees(),
+                reason: "must be >= 0",
+            });
+        }
         if !(self.max_hose_torsion_rad > 0.0) {
             return Err(RobotError::InvalidParameter {
                 what: self.name.clone(),
@@ -226,7 +238,8 @@ impl TorchCarriedCell {
         let b_part = p.build_direction.unwrap_or(p.tool_axis);
         let b_table = self.table_from_part.rotation * b_part;
         let up = self.base_from_positioner.rotation.inverse() * Vector3::z_axis();
-        self.positioner.angles_for_vertical(&b_table, &up, q8_hint)
+        self.positioner
+            .angles_for_vertical(&b_table, &up, q8_hint, self.max_vertical_error_rad)
     }
 
     /// `base_from_part` at positioner joints `q` (mm).

@@ -116,15 +116,20 @@ impl Positioner {
     /// returned; when `b` is along the table normal `q8` is free and
     /// `q8_hint` (rad) is returned for it.
     ///
+    /// When `up` is not in the positioner's XZ plane (a positioner mounted
+    /// slightly out of level, like table 3.7's `W = 0.412°`) some directions
+    /// cannot be turned exactly vertical; the closest tilt is then accepted if
+    /// the remaining angle is at most `max_error_rad` (rad).
+    ///
     /// # Errors
-    /// [`RobotError::PositionerUnreachable`] when no tilt can do it (only
-    /// possible if `up` is not in the positioner's XZ plane) or both
-    /// solutions are outside the travel.
+    /// [`RobotError::PositionerUnreachable`] when no tilt comes within
+    /// `max_error_rad`, or both solutions are outside the travel.
     pub fn angles_for_vertical(
         &self,
         b: &UnitVector3,
         up: &UnitVector3,
         q8_hint: f64,
+        max_error_rad: f64,
     ) -> Result<PositionerJoints, RobotError> {
         let unreachable = || RobotError::PositionerUnreachable {
             bx: b.x,
@@ -137,7 +142,7 @@ impl Positioner {
             return Err(unreachable());
         }
         let ratio = b.z / rho;
-        if !(ratio.abs() <= 1.0 + 1e-12) {
+        if ratio.is_nan() {
             return Err(unreachable());
         }
         let alpha = up.x.atan2(up.z);
@@ -153,6 +158,11 @@ impl Positioner {
                 q8_hint
             };
             let cand = [q7, q8];
+            let reached = self.positioner_from_table(&cand).rotation * b.into_inner();
+            let error = reached.cross(up).norm().atan2(reached.dot(up));
+            if !(error <= max_error_rad.max(1e-12)) {
+                continue;
+            }
             let inside = self.limits[0].contains(q7) && self.limits[1].contains(q8);
             if inside && best.map_or(true, |bst| q7.abs() < bst[0].abs()) {
                 best = Some(cand);

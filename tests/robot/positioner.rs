@@ -31,7 +31,7 @@ fn angles_turn_the_build_direction_vertical_level_positioner() {
     let mut rng = Rng::new(21);
     for _ in 0..2000 {
         let b = UnitVector3::new_normalize(rng.unit());
-        let q = p.angles_for_vertical(&b, &Vector3::z_axis(), 0.0).unwrap();
+        let q = p.angles_for_vertical(&b, &Vector3::z_axis(), 0.0, 0.0).unwrap();
         let up = p.positioner_from_table(&q).rotation * b.into_inner();
         assert!((up - Vector3::z()).norm() < 1e-12, "{b:?} -> {q:?}: {up:?}");
         // the printed eq. C.24-C.25 give the same angles for a level positioner
@@ -53,7 +53,7 @@ fn angles_turn_the_build_direction_vertical_in_the_robot_frame() {
     let mut rng = Rng::new(22);
     for _ in 0..2000 {
         let b = UnitVector3::new_normalize(rng.unit());
-        let Ok(q) = p.angles_for_vertical(&b, &up, 0.0) else {
+        let Ok(q) = p.angles_for_vertical(&b, &up, 0.0, 0.0) else {
             // only when b_z is out of reach of the tilted positioner's cone
             continue;
         };
@@ -67,7 +67,19 @@ fn angles_turn_the_build_direction_vertical_in_the_robot_frame() {
 fn vertical_build_direction_keeps_the_hint() {
     let p = Positioner::robowam_nominal();
     let q = p
-        .angles_for_vertical(&Vector3::z_axis(), &Vector3::z_axis(), 0.7)
+        .angles_for_vertical(&Vector3::z_axis(), &Vector3::z_axis(), 0.7, 0.0)
         .unwrap();
     assert_eq!(q, [0.0, 0.7]);
+}
+
+#[test]
+fn out_of_level_positioner_accepts_the_closest_tilt_within_tolerance() {
+    let base_from_pos = FanucPose::from_xyzwpr_deg([0.0, 0.0, 0.0, 0.412, -0.131, 45.059]).to_isometry();
+    let up = base_from_pos.rotation.inverse() * Vector3::z_axis();
+    let p = Positioner::robowam_identified();
+    assert!(p.angles_for_vertical(&Vector3::z_axis(), &up, 0.0, 0.0).is_err());
+    let q = p.angles_for_vertical(&Vector3::z_axis(), &up, 0.0, 1f64.to_radians()).unwrap();
+    let world = base_from_pos.rotation * (p.positioner_from_table(&q).rotation * Vector3::z());
+    let err = world.z.acos().to_degrees();
+    assert!(err < 0.42 && err > 0.40, "{err}");
 }
