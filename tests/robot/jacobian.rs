@@ -3,6 +3,7 @@
 use waam_slicer::math::Vector3;
 use waam_slicer::robot::indices::{
     dexterity, joint_limit_distance, manipulability, positioning_uncertainty, LimitDistance,
+    UncertaintyFormula,
 };
 use waam_slicer::robot::RobotModel;
 
@@ -113,17 +114,17 @@ fn positioning_uncertainty_scales_with_sigma() {
     let q = [0.3, 0.2, 0.1, 0.5, -0.8, 0.7];
     let j = r.jacobian(&q);
     let sigma = r.encoder_sigma_rad.unwrap();
-    let i1 = positioning_uncertainty(&j, &sigma);
-    let i2 = positioning_uncertainty(&j, &sigma.map(|s| 2.0 * s));
+    let i1 = positioning_uncertainty(&j, &sigma, UncertaintyFormula::RootTrace);
+    let i2 = positioning_uncertainty(&j, &sigma.map(|s| 2.0 * s), UncertaintyFormula::RootTrace);
     assert!(i1 > 0.0 && (i2 / i1 - 2.0).abs() < 1e-9);
     // single joint: I = |column| sigma
     let mut one = [0.0; 6];
     one[0] = 1e-6;
-    let i = positioning_uncertainty(&j, &one);
+    let i = positioning_uncertainty(&j, &one, UncertaintyFormula::RootTrace);
     let col = j.fixed_view::<3, 1>(0, 0).norm();
     assert!((i - col * 1e-6).abs() < 1e-15);
     // programming resolution 1e-4 deg: a few micrometres at this pose
     let prog = [1e-4f64.to_radians(); 6];
-    let i = positioning_uncertainty(&j, &prog);
+    let i = positioning_uncertainty(&j, &prog, UncertaintyFormula::RootTrace);
     assert!(i > 1e-3 && i < 1e-2, "{i}");
 }

@@ -31,7 +31,9 @@ fn angles_turn_the_build_direction_vertical_level_positioner() {
     let mut rng = Rng::new(21);
     for _ in 0..2000 {
         let b = UnitVector3::new_normalize(rng.unit());
-        let q = p.angles_for_vertical(&b, &Vector3::z_axis(), 0.0, 0.0).unwrap();
+        let q = p
+            .angles_for_vertical(&b, &Vector3::z_axis(), 0.0, 0.0)
+            .unwrap();
         let up = p.positioner_from_table(&q).rotation * b.into_inner();
         assert!((up - Vector3::z()).norm() < 1e-12, "{b:?} -> {q:?}: {up:?}");
         // the printed eq. C.24-C.25 give the same angles for a level positioner
@@ -74,11 +76,16 @@ fn vertical_build_direction_keeps_the_hint() {
 
 #[test]
 fn out_of_level_positioner_accepts_the_closest_tilt_within_tolerance() {
-    let base_from_pos = FanucPose::from_xyzwpr_deg([0.0, 0.0, 0.0, 0.412, -0.131, 45.059]).to_isometry();
+    let base_from_pos =
+        FanucPose::from_xyzwpr_deg([0.0, 0.0, 0.0, 0.412, -0.131, 45.059]).to_isometry();
     let up = base_from_pos.rotation.inverse() * Vector3::z_axis();
     let p = Positioner::robowam_identified();
-    assert!(p.angles_for_vertical(&Vector3::z_axis(), &up, 0.0, 0.0).is_err());
-    let q = p.angles_for_vertical(&Vector3::z_axis(), &up, 0.0, 1f64.to_radians()).unwrap();
+    assert!(p
+        .angles_for_vertical(&Vector3::z_axis(), &up, 0.0, 0.0)
+        .is_err());
+    let q = p
+        .angles_for_vertical(&Vector3::z_axis(), &up, 0.0, 1f64.to_radians())
+        .unwrap();
     let world = base_from_pos.rotation * (p.positioner_from_table(&q).rotation * Vector3::z());
     let err = world.z.acos().to_degrees();
     assert!(err < 0.42 && err > 0.40, "{err}");
