@@ -1,6 +1,7 @@
 //! Integration tests of the robot stage (SPEC §6).
 
 mod calibration;
+mod cell_file;
 mod cells;
 mod common;
 mod hemisphere;
