@@ -1,7 +1,15 @@
 //! Criterion benches of the pipeline, one module per stage, on named sample parts.
-use criterion::{criterion_group, criterion_main, Criterion};
+//!
+//! Stage modules live in `benches/pipeline/<stage>.rs`; this crate root is
+//! `benches/pipeline.rs`, so they are declared inside an inline `pipeline`
+//! module (folder = module, no `#[path]`).
+use criterion::{criterion_group, criterion_main};
 
-fn placeholder(_c: &mut Criterion) {}
+mod pipeline {
+    pub mod robot;
+}
 
-criterion_group!(benches, placeholder);
+use pipeline::robot;
+
+criterion_group!(benches, robot::kinematics, robot::hemisphere_trajectory);
 criterion_main!(benches);
