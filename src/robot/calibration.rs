@@ -131,7 +131,8 @@ pub fn calibrate_lengths(
         fill(&model, &mut jac, &mut res);
         let svd = jac.clone().svd(true, true);
         let smax = svd.singular_values.max();
-        if !(svd.singular_values.min() > 1e-10 * smax) {
+        let smin = svd.singular_values.min();
+        if smin.is_nan() || smin <= 1e-10 * smax {
             return Err(err(
                 "the measurements do not determine all five lengths (rank-deficient)",
             ));

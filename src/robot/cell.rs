@@ -144,7 +144,7 @@ impl PartCarriedCell {
         let (s, c) = r_z.sin_cos();
         let u = t.x * c - t.y * s;
         let den = t.z * t.z + u * u;
-        if !(den > 1e-14) {
+        if den.is_nan() || den <= 1e-14 {
             return Err(RobotError::DegenerateToolAxis {
                 tx: t.x,
                 ty: t.y,
@@ -206,7 +206,7 @@ impl TorchCarriedCell {
     pub fn validate(&self) -> Result<(), RobotError> {
         self.robot.validate()?;
         self.positioner.validate()?;
-        if !(self.max_vertical_error_rad >= 0.0) {
+        if self.max_vertical_error_rad.is_nan() || self.max_vertical_error_rad < 0.0 {
             return Err(RobotError::InvalidParameter {
                 what: self.name.clone(),
                 field: "max_vertical_error_deg",
@@ -214,7 +214,7 @@ impl TorchCarriedCell {
                 reason: "must be >= 0",
             });
         }
-        if !(self.max_hose_torsion_rad > 0.0) {
+        if self.max_hose_torsion_rad.is_nan() || self.max_hose_torsion_rad <= 0.0 {
             return Err(RobotError::InvalidParameter {
                 what: self.name.clone(),
                 field: "max_hose_torsion_deg",

@@ -254,12 +254,12 @@ impl RobotModel {
         let rho2 = w.x * w.x + w.y * w.y;
         let x1_abs2 = rho2 - b * b;
         let scale = g.upper_arm_mm + ac.k;
-        if !(x1_abs2 > (SHOULDER_SINGULAR_MM * scale).powi(2)) {
-            if x1_abs2.is_nan() {
-                return Err(RobotError::NonFinite {
-                    what: "flange pose",
-                });
-            }
+        if x1_abs2.is_nan() {
+            return Err(RobotError::NonFinite {
+                what: "flange pose",
+            });
+        }
+        if x1_abs2 <= (SHOULDER_SINGULAR_MM * scale).powi(2) {
             return Err(RobotError::ShoulderSingularity {
                 distance_mm: x1_abs2.max(0.0).sqrt(),
             });
@@ -274,7 +274,7 @@ impl RobotModel {
         let d2 = r * r + z * z;
         let c2 = g.upper_arm_mm;
         let s = (d2 - c2 * c2 - ac.k * ac.k) / (2.0 * c2 * ac.k);
-        if !(s.abs() <= 1.0 + REACH_SLACK) {
+        if s.is_nan() || s.abs() > 1.0 + REACH_SLACK {
             return Err(RobotError::Unreachable {
                 wrist_x_mm: w.x,
                 wrist_y_mm: w.y,

@@ -99,9 +99,9 @@ pub fn positioning_uncertainty(
 ) -> f64 {
     let jv = j.fixed_view::<3, 6>(0, 0);
     let mut c = Matrix3::zeros();
-    for k in 0..6 {
+    for (k, s) in sigma_rad.iter().enumerate() {
         let col = jv.column(k);
-        c += col * col.transpose() * (sigma_rad[k] * sigma_rad[k]);
+        c += col * col.transpose() * (s * s);
     }
     let eig = c.symmetric_eigenvalues();
     match formula {

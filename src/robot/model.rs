@@ -360,6 +360,7 @@ impl RobotModel {
     /// URDF `abb_experimental/abb_irb2600_support/urdf/irb2600_12_185_macro.xacro`
     /// (built from the ABB product specification): `a1 150, c1 445, c2 900,
     /// c3 795, e 115, c4 85` mm. Encoder resolution not published.
+    #[allow(clippy::approx_constant)] // travel and speeds as printed in the URDF (rad, rad/s)
     pub fn abb_irb2600_12_185() -> Self {
         Self {
             name: "ABB IRB 2600-12/1.85".into(),

@@ -138,7 +138,7 @@ impl Positioner {
         };
         // Ry(q7) Rz(q8) b = up  <=>  Rz(q8) b = Ry(-q7) up; z rows: b_z = sin q7 u_x + cos q7 u_z
         let rho = up.x.hypot(up.z);
-        if !(rho > 0.0) {
+        if rho.is_nan() || rho <= 0.0 {
             return Err(unreachable());
         }
         let ratio = b.z / rho;
@@ -160,7 +160,7 @@ impl Positioner {
             let cand = [q7, q8];
             let reached = self.positioner_from_table(&cand).rotation * b.into_inner();
             let error = reached.cross(up).norm().atan2(reached.dot(up));
-            if !(error <= max_error_rad.max(1e-12)) {
+            if error.is_nan() || error > max_error_rad.max(1e-12) {
                 continue;
             }
             let inside = self.limits[0].contains(q7) && self.limits[1].contains(q8);

@@ -448,12 +448,11 @@ pub fn joint_trajectory(
             }
         }
         if let (Cell::TorchCarried(c), Some(qp)) = (cell, pose.positioner) {
-            for k in 0..2 {
-                let l = c.positioner.limits[k];
-                if !l.contains(qp[k]) {
+            for (k, (l, v)) in c.positioner.limits.iter().zip(qp).enumerate() {
+                if !l.contains(v) {
                     violation(ViolationKind::JointLimit {
                         joint: 7 + k,
-                        value_rad: qp[k],
+                        value_rad: v,
                         lower_rad: l.lower_rad,
                         upper_rad: l.upper_rad,
                     });

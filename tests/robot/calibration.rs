@@ -37,8 +37,8 @@ fn recovers_table_3_6_lengths_from_486_noisy_measurements() {
     let data = synthetic(&truth, noise, 486);
     let res = calibrate_lengths(&nominal, &data, &CalibrationOptions::default()).unwrap();
     let want = truth.geometry.segment_lengths();
-    for k in 0..5 {
-        let err = (res.lengths_mm[k] - want[k]).abs();
+    for (k, want_k) in want.iter().enumerate() {
+        let err = (res.lengths_mm[k] - want_k).abs();
         // within 4 standard deviations, and the standard deviations are of the
         // order of the noise
         assert!(

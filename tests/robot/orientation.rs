@@ -11,7 +11,10 @@ use crate::common::Rng;
 
 fn random_rotation(rng: &mut Rng) -> Rotation3 {
     let axis = waam_slicer::math::UnitVector3::new_normalize(rng.unit());
-    Rotation3::from_axis_angle(&axis, rng.range(-3.14, 3.14))
+    Rotation3::from_axis_angle(
+        &axis,
+        rng.range(-std::f64::consts::PI, std::f64::consts::PI),
+    )
 }
 
 fn same(a: &Rotation3, b: &Rotation3) -> bool {

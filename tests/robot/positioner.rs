@@ -40,7 +40,9 @@ fn angles_turn_the_build_direction_vertical_level_positioner() {
         let q7 = (b.x.hypot(b.y)).atan2(b.z);
         let q8 = b.y.atan2(-b.x);
         let d8 = (q[1] - q8).rem_euclid(std::f64::consts::TAU);
-        assert!((q[0] - q7).abs() < 1e-12 && (d8 < 1e-12 || d8 > std::f64::consts::TAU - 1e-12));
+        assert!(
+            (q[0] - q7).abs() < 1e-12 && !(1e-12..=std::f64::consts::TAU - 1e-12).contains(&d8)
+        );
     }
 }
 
