@@ -359,6 +359,12 @@ impl Cell {
     pub fn dq_drz(&self, pose: &CellPose, q: &Joints) -> Result<Joints, RobotError> {
         let robot = self.robot();
         let j = robot.jacobian(q);
+        // a near-exact singularity can leave a finite but meaningless LU solution
+        if crate::robot::indices::dexterity(&j, 1000.0) < 1e-12 {
+            return Err(RobotError::SingularJacobian {
+                manipulability: crate::robot::indices::manipulability(&j),
+            });
+        }
         let lu = j.lu();
         let sol = lu.solve(&pose.flange_twist_per_rz);
         match sol {

@@ -4,6 +4,7 @@ mod calibration;
 mod cell_file;
 mod cells;
 mod common;
+mod errors;
 mod hemisphere;
 mod ik;
 mod jacobian;
