@@ -7,9 +7,15 @@ use criterion::{criterion_group, criterion_main};
 
 mod pipeline {
     pub mod path;
+    pub mod robot;
 }
 
-use pipeline::path;
+use pipeline::{path, robot};
 
-criterion_group!(benches, path::constant_distance);
+criterion_group!(
+    benches,
+    path::constant_distance,
+    robot::kinematics,
+    robot::hemisphere_trajectory
+);
 criterion_main!(benches);

@@ -2,7 +2,9 @@
 //! error enum (which names the file, field, layer or point at fault).
 
 use crate::geometry::GeometryError;
+use crate::io::cell_file::CellFileError;
 use crate::io::part_file::PartFileError;
+use crate::robot::RobotError;
 
 /// Any error of the library.
 #[derive(Debug, thiserror::Error)]
@@ -14,4 +16,10 @@ pub enum Error {
     /// A part file could not be read.
     #[error(transparent)]
     PartFile(#[from] PartFileError),
+    /// The robot stage failed (invalid model or cell, unreachable or singular pose).
+    #[error(transparent)]
+    Robot(#[from] RobotError),
+    /// A cell file could not be read.
+    #[error(transparent)]
+    CellFile(#[from] CellFileError),
 }

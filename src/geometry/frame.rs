@@ -43,6 +43,8 @@ pub struct FrameField {
     h: f64,
     /// RMF normals at `t_lo + i h` (empty for Frenet).
     normals: Vec<Vector3>,
+    /// Their derivatives `dN/dt = -(T'·N) T` (for Hermite interpolation).
+    slopes: Vec<Vector3>,
 }
 
 impl FrameField {
@@ -78,6 +80,7 @@ impl FrameField {
                     t_lo,
                     h,
                     normals: Vec::new(),
+                    slopes: Vec::new(),
                 })
             }
             FrameMethod::RotationMinimising => {
@@ -105,11 +108,17 @@ impl FrameField {
                     r = reflect_step(curve, ta, ta + h, r);
                     normals.push(r);
                 }
+                let slopes = normals
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| rmf_slope(curve, t_lo + i as f64 * h, n))
+                    .collect();
                 Ok(Self {
                     method,
                     t_lo,
                     h,
                     normals,
+                    slopes,
                 })
             }
         }
@@ -137,21 +146,34 @@ impl FrameField {
             FrameMethod::RotationMinimising => {
                 let last = self.normals.len() - 1;
                 let x = (t - self.t_lo) / self.h;
-                let i = if x.is_finite() {
-                    x.floor().clamp(0.0, last as f64) as usize
-                } else {
-                    0
-                };
-                let mut ta = self.t_lo + i as f64 * self.h;
-                let mut r = self.normals[i];
-                // Steps of at most h toward t (only more than one step outside the table).
-                let steps = ((t - ta).abs() / self.h).ceil().clamp(1.0, 1e6) as usize;
-                let dt = (t - ta) / steps as f64;
-                for _ in 0..steps {
-                    r = reflect_step(curve, ta, ta + dt, r);
-                    ta += dt;
-                }
                 let tan = unit(curve.d1(t));
+                let r = if x.is_finite() && x >= 0.0 && x <= last as f64 {
+                    // Inside the table: cubic Hermite on the tabulated normals and
+                    // their exact derivatives (error O(h^4)).
+                    let i = (x.floor() as usize).min(last - 1);
+                    let s = x - i as f64;
+                    let (s2, s3) = (s * s, s * s * s);
+                    let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
+                    let h10 = s3 - 2.0 * s2 + s;
+                    let h01 = -2.0 * s3 + 3.0 * s2;
+                    let h11 = s3 - s2;
+                    self.normals[i] * h00
+                        + self.slopes[i] * (h10 * self.h)
+                        + self.normals[i + 1] * h01
+                        + self.slopes[i + 1] * (h11 * self.h)
+                } else {
+                    // Outside: carry the nearest end on by double reflection.
+                    let i = if x.is_finite() && x > 0.0 { last } else { 0 };
+                    let mut ta = self.t_lo + i as f64 * self.h;
+                    let mut r = self.normals[i];
+                    let steps = ((t - ta).abs() / self.h).ceil().clamp(1.0, 1e6) as usize;
+                    let dt = (t - ta) / steps as f64;
+                    for _ in 0..steps {
+                        r = reflect_step(curve, ta, ta + dt, r);
+                        ta += dt;
+                    }
+                    r
+                };
                 let n = (r - tan * tan.dot(&r)).normalize();
                 Frame {
                     tangent: tan,
@@ -207,6 +229,16 @@ fn frenet(curve: &dyn GuideCurve, t: f64) -> Option<Frame> {
         normal: b.cross(&tan),
         binormal: b,
     })
+}
+
+/// `dN/dt = -(T'·N) T` of a rotation-minimising normal `n` at `t`.
+fn rmf_slope(curve: &dyn GuideCurve, t: f64, n: &Vector3) -> Vector3 {
+    let d1 = curve.d1(t);
+    let d2 = curve.d2(t);
+    let speed = d1.norm();
+    let tan = d1 / speed;
+    let dtan = (d2 - tan * d2.dot(&tan)) / speed;
+    -tan * dtan.dot(n)
 }
 
 /// One double-reflection step carrying the normal `r` from `ta` to `tb`.

@@ -1,4 +1,5 @@
-//! **Stage 0 — reading and writing files.** Part files, cell files, atomic writes.
+//! **Stage 0 — reading and writing files.** Part files, cell files, path CSV, atomic writes.
 pub mod atomic;
+pub mod cell_file;
 pub mod part_file;
 pub mod path_csv;

@@ -20,8 +20,14 @@ pub fn next_t(
     delta_mm: f64,
     t_hi: f64,
 ) -> Result<Step, RootFailure> {
-    let speed = tube.surface(t_below, v).d_dt.norm();
-    let step0 = 0.9 * delta_mm / speed;
+    // First step from the rate at which the distance grows: the part of
+    // dM/dt across the layer below (the layer is tilted on overhangs).
+    let d_dt = tube.surface(t_below, v).d_dt;
+    let along = below.segment_direction(hint);
+    let across = (d_dt - along * d_dt.dot(&along))
+        .norm()
+        .max(1e-3 * d_dt.norm());
+    let step0 = 0.999 * delta_mm / across;
     // Always descend from the column's own segment, so that the function is
     // deterministic (a bracket found stays a bracket).
     let delta_at = |t: f64| below.nearest_from(&tube.point(t, v), hint).distance;

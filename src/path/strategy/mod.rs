@@ -40,6 +40,7 @@ pub(crate) fn forward_root(
 ) -> Result<Option<(f64, usize, f64)>, crate::math::RootFailure> {
     let mut evaluations = 0;
     let mut ta = t0;
+    let mut ga = g(t0);
     let mut step = step0;
     let mut tb = (t0 + step).min(t_hi);
     loop {
@@ -54,8 +55,22 @@ pub(crate) fn forward_root(
         if tb >= t_hi {
             return Ok(None);
         }
+        // Secant extrapolation toward the root, overshooting slightly so the
+        // next point brackets it; at least ×1.6 growth when far off.
+        let slope = (gb - ga) / (tb - ta);
+        let secant = if slope > 0.0 {
+            -gb / slope * 1.02 + 1e-9 * step0
+        } else {
+            f64::INFINITY
+        };
+        let grow = step * 1.6;
+        step = if secant.is_finite() && secant < grow {
+            secant
+        } else {
+            grow
+        };
         ta = tb;
-        step *= 1.6;
+        ga = gb;
         tb = (tb + step).min(t_hi);
         if evaluations > 400 {
             return Err(crate::math::RootFailure::NotConverged);

@@ -1,0 +1,354 @@
+//! **Cell files (TOML).** Reads a robot (a named preset, possibly with
+//! overrides, or a full definition) and optionally one cell (part carried or
+//! torch carried) from a file in `parts/cells/`. Degrees and FANUC
+//! `[X, Y, Z, W, P, R]` (mm, deg) at this edge; radians inside. Unknown keys
+//! are errors. SPEC §6.
+//!
+//! ```toml
+//! name = "ROBOWAM part carried"
+//! source = "Chalvin (2020), §3.3 eq. 3.18"
+//!
+//! [robot]
+//! preset = "arcmate120ic_nominal"
+//! lower_deg = [-170, -100, -185, -200, -135, -inf]
+//! upper_deg = [170, 160, 273, 200, 135, inf]
+//!
+//! [part_carried]
+//! deposition_point_mm = [1045.747, -630.155, 653.167]
+//! configuration = "F U T"
+//! ```
+
+use std::path::Path;
+
+use serde::Deserialize;
+
+use crate::math::{Isometry3, Point3};
+use crate::robot::orientation::FanucPose;
+use crate::robot::{
+    ArmGeometry, Cell, Configuration, JointConvention, JointLimit, PartCarriedCell, Positioner,
+    RobotError, RobotModel, RobotPreset, TorchCarriedCell, Vendor,
+};
+
+/// Errors reading a cell file; each names the file and the key at fault.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CellFileError {
+    /// The file could not be read.
+    #[error("{path}: cannot read: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML or does not match the schema (unknown or
+    /// misspelt key, wrong type); the message gives line and column.
+    #[error("{path}: {message}")]
+    Syntax {
+        /// The file.
+        path: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// A key is missing or its value is out of its domain.
+    #[error("{path}: `{key}`: {reason}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// The key, dotted (`robot.geometry`, `part_carried.configuration`).
+        key: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The robot or cell built from the file is invalid.
+    #[error("{path}: {source}")]
+    Robot {
+        /// The file.
+        path: String,
+        /// What the robot stage rejected.
+        source: RobotError,
+    },
+}
+
+/// What a cell file holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellFile {
+    /// Name of the file's content.
+    pub name: String,
+    /// Where the numbers come from.
+    pub source: String,
+    /// The robot (also inside `cell` when there is one).
+    pub robot: RobotModel,
+    /// The cell, if the file describes one.
+    pub cell: Option<Cell>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileDoc {
+    name: String,
+    #[serde(default)]
+    source: String,
+    robot: RobotSection,
+    part_carried: Option<PartCarriedSection>,
+    torch_carried: Option<TorchCarriedSection>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConventionSection {
+    sign: [f64; 6],
+    offset_deg: [f64; 6],
+    j2_j3_coupled: bool,
+    /// Rows of `wrist_from_flange`.
+    wrist_from_flange_rows: [[f64; 3]; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RobotSection {
+    preset: Option<RobotPreset>,
+    name: Option<String>,
+    source: Option<String>,
+    vendor: Option<Vendor>,
+    geometry: Option<ArmGeometry>,
+    convention: Option<ConventionSection>,
+    lower_deg: Option<[f64; 6]>,
+    upper_deg: Option<[f64; 6]>,
+    max_speed_deg_s: Option<[f64; 6]>,
+    encoder_sigma_deg: Option<[f64; 6]>,
+    twist_deviation_deg: Option<[f64; 6]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PartCarriedSection {
+    deposition_point_mm: [f64; 3],
+    configuration: String,
+    /// `flange_from_part` as FANUC `[X, Y, Z, W, P, R]` (mm, deg); identity if absent.
+    flange_from_part_xyzwpr: Option<[f64; 6]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PositionerSection {
+    name: String,
+    tilt_to_table_mm: f64,
+    lower_deg: Option<[f64; 2]>,
+    upper_deg: Option<[f64; 2]>,
+    max_speed_deg_s: Option<[f64; 2]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TorchCarriedSection {
+    configuration: String,
+    positioner_pose_xyzwpr: [f64; 6],
+    tool_xyzwpr: [f64; 6],
+    table_from_part_xyzwpr: Option<[f64; 6]>,
+    max_hose_torsion_deg: f64,
+    #[serde(default = "default_vertical_error_deg")]
+    max_vertical_error_deg: f64,
+    positioner: PositionerSection,
+}
+
+fn default_vertical_error_deg() -> f64 {
+    1.0
+}
+
+/// Reads and validates a cell file.
+///
+/// # Errors
+/// [`CellFileError`] naming the file and the key.
+pub fn read_cell_file(path: impl AsRef<Path>) -> Result<CellFile, CellFileError> {
+    let path = path.as_ref();
+    let shown = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| CellFileError::Io {
+        path: shown.clone(),
+        source,
+    })?;
+    parse_cell_file(&text, &shown)
+}
+
+fn limits_from(lower: &[f64], upper: &[f64]) -> Vec<JointLimit> {
+    lower
+        .iter()
+        .zip(upper)
+        .map(|(l, u)| JointLimit::from_degrees(*l, *u))
+        .collect()
+}
+
+/// Parses and validates the text of a cell file; `origin` names it in errors.
+///
+/// # Errors
+/// [`CellFileError`] naming `origin` and the key.
+pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileError> {
+    let doc: FileDoc = toml::from_str(text).map_err(|e| CellFileError::Syntax {
+        path: origin.to_string(),
+        message: e.to_string(),
+    })?;
+    let invalid = |key: &str, reason: &str| CellFileError::Invalid {
+        path: origin.to_string(),
+        key: key.to_string(),
+        reason: reason.to_string(),
+    };
+    let robot_err = |source| CellFileError::Robot {
+        path: origin.to_string(),
+        source,
+    };
+    let r = doc.robot;
+    let mut robot = match r.preset {
+        Some(p) => RobotModel::preset(p),
+        None => {
+            let vendor = r
+                .vendor
+                .ok_or_else(|| invalid("robot.vendor", "required when no preset is given"))?;
+            let geometry = r
+                .geometry
+                .ok_or_else(|| invalid("robot.geometry", "required when no preset is given"))?;
+            for (key, present) in [
+                ("robot.lower_deg", r.lower_deg.is_some()),
+                ("robot.upper_deg", r.upper_deg.is_some()),
+                ("robot.max_speed_deg_s", r.max_speed_deg_s.is_some()),
+            ] {
+                if !present {
+                    return Err(invalid(key, "required when no preset is given"));
+                }
+            }
+            RobotModel {
+                name: r.name.clone().unwrap_or_else(|| doc.name.clone()),
+                source: String::new(),
+                vendor,
+                geometry,
+                convention: JointConvention::of(vendor),
+                limits: [JointLimit::UNLIMITED; 6],
+                max_speed_rad_s: [1.0; 6],
+                encoder_sigma_rad: None,
+                twist_deviation_rad: [0.0; 6],
+            }
+        }
+    };
+    if let Some(n) = r.name {
+        robot.name = n;
+    }
+    if let Some(s) = r.source {
+        robot.source = s;
+    }
+    if r.preset.is_some() && (r.vendor.is_some() || r.geometry.is_some()) {
+        return Err(invalid(
+            "robot.preset",
+            "give either a preset or `vendor` + `geometry`, not both",
+        ));
+    }
+    if let Some(c) = r.convention {
+        let m = crate::math::Matrix3::from_row_slice(&c.wrist_from_flange_rows.concat());
+        robot.convention = JointConvention {
+            sign: c.sign,
+            offset_rad: c.offset_deg.map(f64::to_radians),
+            j2_j3_coupled: c.j2_j3_coupled,
+            wrist_from_flange: m,
+        };
+    }
+    match (r.lower_deg, r.upper_deg) {
+        (Some(l), Some(u)) => {
+            let v = limits_from(&l, &u);
+            robot.limits = [v[0], v[1], v[2], v[3], v[4], v[5]];
+        }
+        (None, None) => {}
+        _ => {
+            return Err(invalid(
+                "robot.lower_deg",
+                "give both lower_deg and upper_deg",
+            ))
+        }
+    }
+    if let Some(s) = r.max_speed_deg_s {
+        robot.max_speed_rad_s = s.map(f64::to_radians);
+    }
+    if let Some(s) = r.encoder_sigma_deg {
+        robot.encoder_sigma_rad = Some(s.map(f64::to_radians));
+    }
+    if let Some(s) = r.twist_deviation_deg {
+        robot.twist_deviation_rad = s.map(f64::to_radians);
+    }
+    robot.validate().map_err(robot_err)?;
+
+    let parse_cfg = |key: &str, s: &str| {
+        Configuration::from_fanuc(s)
+            .ok_or_else(|| invalid(key, "expected FANUC letters N|F, U|D, T|B, e.g. \"N U T\""))
+    };
+    let cell = match (doc.part_carried, doc.torch_carried) {
+        (Some(_), Some(_)) => {
+            return Err(invalid(
+                "torch_carried",
+                "a file describes one cell: part_carried or torch_carried",
+            ))
+        }
+        (Some(pc), None) => {
+            let configuration = parse_cfg("part_carried.configuration", &pc.configuration)?;
+            let c = PartCarriedCell {
+                name: doc.name.clone(),
+                robot: robot.clone(),
+                deposition_point_mm: Point3::from(pc.deposition_point_mm),
+                configuration,
+                flange_from_part: pc
+                    .flange_from_part_xyzwpr
+                    .map(|v| FanucPose::from_xyzwpr_deg(v).to_isometry())
+                    .unwrap_or_else(Isometry3::identity),
+            };
+            Some(Cell::PartCarried(c))
+        }
+        (None, Some(tc)) => {
+            let configuration = parse_cfg("torch_carried.configuration", &tc.configuration)?;
+            let ps = tc.positioner;
+            let limits = match (ps.lower_deg, ps.upper_deg) {
+                (Some(l), Some(u)) => {
+                    let v = limits_from(&l, &u);
+                    [v[0], v[1]]
+                }
+                (None, None) => [JointLimit::UNLIMITED; 2],
+                _ => {
+                    return Err(invalid(
+                        "torch_carried.positioner.lower_deg",
+                        "give both lower_deg and upper_deg",
+                    ))
+                }
+            };
+            let positioner = Positioner {
+                name: ps.name,
+                tilt_to_table_mm: ps.tilt_to_table_mm,
+                limits,
+                max_speed_rad_s: ps
+                    .max_speed_deg_s
+                    .map(|s| s.map(f64::to_radians))
+                    .unwrap_or([f64::INFINITY; 2]),
+            };
+            let c = TorchCarriedCell {
+                name: doc.name.clone(),
+                robot: robot.clone(),
+                positioner,
+                base_from_positioner: FanucPose::from_xyzwpr_deg(tc.positioner_pose_xyzwpr)
+                    .to_isometry(),
+                flange_from_tcp: FanucPose::from_xyzwpr_deg(tc.tool_xyzwpr).to_isometry(),
+                table_from_part: tc
+                    .table_from_part_xyzwpr
+                    .map(|v| FanucPose::from_xyzwpr_deg(v).to_isometry())
+                    .unwrap_or_else(Isometry3::identity),
+                configuration,
+                max_hose_torsion_rad: tc.max_hose_torsion_deg.to_radians(),
+                max_vertical_error_rad: tc.max_vertical_error_deg.to_radians(),
+            };
+            Some(Cell::TorchCarried(c))
+        }
+        (None, None) => None,
+    };
+    if let Some(c) = &cell {
+        c.validate().map_err(robot_err)?;
+    }
+    Ok(CellFile {
+        name: doc.name,
+        source: doc.source,
+        robot,
+        cell,
+    })
+}
