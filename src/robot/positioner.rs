@@ -164,7 +164,7 @@ impl Positioner {
                 continue;
             }
             let inside = self.limits[0].contains(q7) && self.limits[1].contains(q8);
-            if inside && best.map_or(true, |bst| q7.abs() < bst[0].abs()) {
+            if inside && best.is_none_or(|bst| q7.abs() < bst[0].abs()) {
                 best = Some(cand);
             }
         }
