@@ -39,7 +39,7 @@ pub struct Root {
     pub x: f64,
     /// The function value there.
     pub residual: f64,
-    /// Function evaluations inside the bracket.
+    /// Function evaluations made by the solver inside the bracket.
     pub iterations: usize,
 }
 
@@ -88,6 +88,19 @@ pub fn brent(
 ) -> Result<Root, RootFailure> {
     let fa = f(a);
     let fb = f(b);
+    brent_bracketed(f, (a, fa), (b, fb), x_tol, y_tol)
+}
+
+/// [`brent`] on a bracket whose end values are already known: no function
+/// evaluation is repeated (the solver's own calls at the ends and the final
+/// residual are answered from a small cache).
+pub fn brent_bracketed(
+    mut f: impl FnMut(f64) -> f64,
+    (a, fa): (f64, f64),
+    (b, fb): (f64, f64),
+    x_tol: f64,
+    y_tol: f64,
+) -> Result<Root, RootFailure> {
     if !fa.is_finite() || !fb.is_finite() {
         return Err(RootFailure::NonFinite);
     }
@@ -115,31 +128,37 @@ pub fn brent(
         iterations: 0,
     };
     let mut non_finite = false;
-    let result = roots::find_root_brent(
-        a,
-        b,
-        |x| {
-            let y = f(x);
-            if y.is_finite() {
-                y
-            } else {
-                non_finite = true;
-                0.0
-            }
-        },
-        &mut conv,
-    );
+    let mut cache = [(a, fa), (b, fb), (f64::NAN, f64::NAN)];
+    let mut next_slot = 2;
+    let mut evaluations = 0;
+    let mut g = |x: f64| {
+        if let Some(&(_, y)) = cache.iter().find(|(cx, _)| *cx == x) {
+            return y;
+        }
+        let y = f(x);
+        evaluations += 1;
+        cache[next_slot] = (x, y);
+        next_slot = if next_slot == 2 { 0 } else { next_slot + 1 };
+        if y.is_finite() {
+            y
+        } else {
+            non_finite = true;
+            0.0
+        }
+    };
+    let result = roots::find_root_brent(a, b, &mut g, &mut conv);
+    let residual = result.as_ref().map(|&x| g(x)).ok();
     if non_finite {
         return Err(RootFailure::NonFinite);
     }
-    match result {
-        Ok(x) => Ok(Root {
+    match (result, residual) {
+        (Ok(x), Some(r)) => Ok(Root {
             x,
-            residual: f(x),
-            iterations: conv.iterations,
+            residual: r,
+            iterations: evaluations,
         }),
-        Err(roots::SearchError::NoBracketing) => Err(RootFailure::NotBracketed),
-        Err(_) => Err(RootFailure::NotConverged),
+        (Err(roots::SearchError::NoBracketing), _) => Err(RootFailure::NotBracketed),
+        _ => Err(RootFailure::NotConverged),
     }
 }
 

@@ -35,6 +35,7 @@ pub fn next_t(
     let found = forward_root(
         |t| delta_at(t) - delta_mm,
         t_below,
+        -delta_mm,
         step0,
         t_hi,
         x_tol,
@@ -60,7 +61,15 @@ pub fn next_t(
             .map_or(f64::INFINITY, |n| n.distance)
             - delta_mm
     };
-    match forward_root(exact_delta, t_below, step0, t_hi, x_tol, 1e-11 * delta_mm)? {
+    match forward_root(
+        exact_delta,
+        t_below,
+        -delta_mm,
+        step0,
+        t_hi,
+        x_tol,
+        1e-11 * delta_mm,
+    )? {
         Some((t, more, residual)) => Ok(Step::Point {
             t,
             evaluations: evaluations + more,

@@ -23,6 +23,7 @@ pub fn next_t(
     match forward_root(
         |t| (tube.point(t, v) - p0).norm() - delta_mm,
         t_below,
+        -delta_mm,
         0.9 * delta_mm / speed,
         t_hi,
         x_tol,

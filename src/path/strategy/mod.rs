@@ -26,13 +26,14 @@ pub enum Step {
     End,
 }
 
-/// Finds the first `t` in `(t0, t_hi]` where `g(t)` (with `g(t0) < 0`) turns
+/// Finds the first `t` in `(t0, t_hi]` where `g(t)` (with `g(t0) = g0 < 0`) turns
 /// non-negative, stepping forward by `step0` (growing ×1.6 while `g` stays
 /// well below zero), then refines with Brent. `Ok(None)` if `g` stays
 /// negative up to `t_hi`.
 pub(crate) fn forward_root(
     mut g: impl FnMut(f64) -> f64,
     t0: f64,
+    g0: f64,
     step0: f64,
     t_hi: f64,
     x_tol: f64,
@@ -40,11 +41,12 @@ pub(crate) fn forward_root(
 ) -> Result<Option<(f64, usize, f64)>, crate::math::RootFailure> {
     let mut evaluations = 0;
     let mut ta = t0;
-    let mut ga = g(t0);
+    let mut ga = g0;
+    let mut gb;
     let mut step = step0;
     let mut tb = (t0 + step).min(t_hi);
     loop {
-        let gb = g(tb);
+        gb = g(tb);
         evaluations += 1;
         if !gb.is_finite() {
             return Err(crate::math::RootFailure::NonFinite);
@@ -76,10 +78,10 @@ pub(crate) fn forward_root(
             return Err(crate::math::RootFailure::NotConverged);
         }
     }
-    let r = crate::math::brent(&mut g, ta, tb, x_tol, y_tol)?;
+    let r = crate::math::brent_bracketed(&mut g, (ta, ga), (tb, gb), x_tol, y_tol)?;
     Ok(Some((
         r.x,
-        evaluations + r.iterations + 2,
+        evaluations + r.iterations + 1,
         r.residual.abs(),
     )))
 }

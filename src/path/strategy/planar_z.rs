@@ -14,13 +14,14 @@ pub fn next_t(tube: &Tube, v: f64, t_below: f64, z: f64, t_hi: f64) -> Result<St
         return Ok(Step::Skip);
     }
     let speed = tube.surface(t_below, v).d_dt.norm();
-    // Step about a tenth of the height still to climb (in arc length), so that a
+    // First step: half the height still to climb (in arc length), so that a
     // column turning down again is not jumped over.
     let step = ((z - z0) / speed).max(1e-9) * 0.5;
     let x_tol = 1e-13 * (1.0 + t_below.abs());
     match forward_root(
         |t| tube.point(t, v).z - z,
         t_below,
+        z0 - z,
         step,
         t_hi,
         x_tol,
