@@ -34,5 +34,21 @@ pub fn constant_distance(c: &mut Criterion) {
             })
         });
     }
+    // The spiral next to the layered path on the quarter torus.
+    let part = part("quarter-torus.toml");
+    let mut o = part.slice_options();
+    o.strategy = Strategy::Spiral;
+    o.delta_mm = 1.0;
+    o.discretisation = Discretisation::Points(500);
+    let points = slice(&part.tube, &part.substrate, &o)
+        .expect("slices")
+        .num_points();
+    g.throughput(Throughput::Elements(points as u64));
+    g.bench_function("spiral+map/quarter-torus/delta1", |b| {
+        b.iter(|| {
+            let path = slice(&part.tube, &part.substrate, black_box(&o)).expect("slices");
+            black_box(distance_map(&path))
+        })
+    });
     g.finish();
 }

@@ -118,17 +118,69 @@ pub fn distance_map_of(layers: &[Layer], delta_mm: f64) -> DistanceMap {
     }
 }
 
-/// Computes the distance map of a path.
+/// Computes the distance map of a path (for a spiral, the distance of each
+/// point to the turn below; the ramp turns are left out of the statistics).
 pub fn distance_map(path: &Path) -> DistanceMap {
-    distance_map_of(&path.layers, path.delta_mm)
+    match (path.spiral, path.layers.as_slice()) {
+        (Some(info), [layer]) => spiral_distance_map(layer, info, path.delta_mm),
+        _ => distance_map_of(&path.layers, path.delta_mm),
+    }
+}
+
+/// Distance of every spiral point of turn >= 1 to the turn below: the stretch
+/// of the spiral from 1.5 to 0.5 turns earlier. The first turn (ramp up from
+/// the substrate) and the ramp-down turn get no statistics; their points keep
+/// `None` in the map.
+pub fn spiral_distance_map(layer: &Layer, info: super::SpiralInfo, delta_mm: f64) -> DistanceMap {
+    let n = info.per_turn;
+    let half = n / 2;
+    let pts: Vec<crate::math::Point3> = layer.points.iter().map(|p| p.position).collect();
+    let index = SegmentIndex::new(vec![(pts.clone(), false)]);
+    let end = info.ramp_down_from.unwrap_or(pts.len());
+    let points: Vec<Option<(f64, bool)>> = (0..pts.len())
+        .into_par_iter()
+        .map(|m| {
+            if m < n || m >= end {
+                return None;
+            }
+            let below = m - n;
+            let lo = below.saturating_sub(half);
+            let hi = (below + half).min(pts.len() - 1);
+            // Within half a turn of the spiral's start, the stretch below is cut
+            // short by the start itself: a boundary point, not an interlayer distance.
+            let boundary = below < half;
+            index
+                .nearest_in_range(&pts[m], 0, lo, hi)
+                .map(|nr| (nr.distance, boundary))
+        })
+        .collect();
+    let vals: Vec<f64> = points
+        .iter()
+        .flatten()
+        .filter(|(_, b)| !b)
+        .map(|(d, _)| *d)
+        .collect();
+    let boundary = points.iter().flatten().filter(|(_, b)| *b).count();
+    let stats = DistanceStats::from(&vals, delta_mm, boundary);
+    DistanceMap {
+        per_layer: vec![stats],
+        overall: stats,
+        points: vec![points],
+    }
 }
 
 /// Writes each point's distance to the layer below into `PathPoint::delta`.
+/// Spiral points keep the distance their root find reached on the ramp turns.
 pub(crate) fn fill_deltas(path: &mut Path) {
     let map = distance_map(path);
+    let spiral = path.spiral.is_some();
     for (layer, pts) in path.layers.iter_mut().zip(map.points) {
         for (p, d) in layer.points.iter_mut().zip(pts) {
-            p.delta = d.map(|(d, _)| d);
+            match d {
+                Some((d, _)) => p.delta = Some(d),
+                None if spiral => {}
+                None => p.delta = None,
+            }
         }
     }
 }

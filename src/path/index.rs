@@ -190,6 +190,43 @@ impl SegmentIndex {
         best.expect("chunks hold at least one segment")
     }
 
+    /// The nearest segment of polyline `polyline` among its segments
+    /// `lo..hi` (indices of their first vertices), `None` if the range is empty.
+    pub fn nearest_in_range(
+        &self,
+        p: &Point3,
+        polyline: usize,
+        lo: usize,
+        hi: usize,
+    ) -> Option<Nearest> {
+        let mut best: Option<Nearest> = None;
+        let mut candidates: Vec<(f64, &Chunk)> = self
+            .chunks
+            .iter()
+            .filter(|c| c.polyline == polyline && c.first < hi && c.first + c.count > lo)
+            .map(|c| ((p - c.centre).norm() - c.radius, c))
+            .collect();
+        candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (bound, c) in candidates {
+            if best.is_some_and(|b| bound >= b.distance) {
+                break;
+            }
+            for j in c.first.max(lo)..(c.first + c.count).min(hi) {
+                let cand = self.make(
+                    p,
+                    SegmentId {
+                        polyline,
+                        segment: j,
+                    },
+                );
+                if best.is_none_or(|b| cand.distance < b.distance) {
+                    best = Some(cand);
+                }
+            }
+        }
+        best
+    }
+
     /// Nearest segment by local descent from `hint` along its polyline: walks
     /// to neighbouring segments while the distance decreases. Exact only when
     /// the distance along the polyline is unimodal around the hint; callers

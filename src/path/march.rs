@@ -20,9 +20,6 @@ use std::f64::consts::TAU;
 /// root find, too many points, an end plane beyond the evaluable range.
 pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<Path, PathError> {
     opts.validate()?;
-    if opts.strategy == Strategy::Spiral {
-        return Err(PathError::NotImplemented("spiral"));
-    }
     let range = tube.range();
     let length_mm = tube.arc_length(range.t_max);
     if opts.delta_mm >= length_mm {
@@ -33,6 +30,9 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
     }
     let grid = grid_size(tube, opts);
     let first = substrate.first_layer(tube, grid)?;
+    if opts.strategy == Strategy::Spiral {
+        return spiral_path(tube, first, opts, length_mm);
+    }
     let vs: Vec<f64> = first.iter().map(|p| p.v).collect();
     let t_first: Vec<f64> = first.iter().map(|p| p.t).collect();
     let t_hi = match opts.end {
@@ -122,11 +122,7 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
                         t_lo: cursor[i],
                         t_hi,
                         delta_mm: opts.delta_mm,
-                        reason: match e {
-                            RootFailure::NotBracketed => "not bracketed",
-                            RootFailure::NonFinite => "non-finite distance",
-                            RootFailure::NotConverged => "not converged",
-                        },
+                        reason: failure_reason(e),
                     })
                 }
             }
@@ -203,6 +199,93 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
         delta_mm: opts.delta_mm,
         layers,
         report,
+        spiral: None,
+    };
+    fill_deltas(&mut path);
+    Ok(path)
+}
+
+fn failure_reason(e: RootFailure) -> &'static str {
+    match e {
+        RootFailure::NotBracketed => "not bracketed",
+        RootFailure::NonFinite => "non-finite distance",
+        RootFailure::NotConverged => "not converged",
+    }
+}
+
+/// The spiral strategy: columns in travel order from the start angle, one
+/// open layer, ramp up over the first turn and down over the last
+/// (see [`spiral`](super::strategy::spiral)). The end plane is not applied: the
+/// spiral closes with its ramp-down turn below `t_max` (cutting it by a plane
+/// would add arc starts).
+fn spiral_path(
+    tube: &Tube,
+    mut first: Vec<crate::geometry::CurvePoint>,
+    opts: &SliceOptions,
+    length_mm: f64,
+) -> Result<Path, PathError> {
+    use super::strategy::spiral::{march_spiral, SpiralEnd};
+    let n = first.len();
+    let start = ((opts.spiral_start_rad.rem_euclid(TAU) / TAU) * n as f64).round() as usize % n;
+    first.rotate_left(start);
+    if opts.spiral_reverse {
+        first[1..].reverse();
+    }
+    let range = tube.range();
+    let t_hi = match opts.end {
+        EndRule::EvaluableRange => range.eval_max(),
+        _ => range.t_max,
+    };
+    let spiral = march_spiral(tube, &first, opts.delta_mm, t_hi, opts.max_layers).map_err(|f| {
+        PathError::SpiralRoot {
+            point: f.point,
+            turn: f.point / n,
+            v: first[f.point % n].v,
+            reason: failure_reason(f.reason),
+        }
+    })?;
+    let Some(spiral) = spiral else {
+        return Err(PathError::DeltaTooLarge {
+            delta_mm: opts.delta_mm,
+            length_mm,
+        });
+    };
+    let ramp_down_from =
+        (spiral.end == SpiralEnd::RampDown).then(|| spiral.points.len().saturating_sub(n));
+    let points: Vec<PathPoint> = spiral
+        .points
+        .iter()
+        .map(|p| PathPoint {
+            t: p.t,
+            v: p.v,
+            position: p.position,
+            delta: Some(p.delta),
+        })
+        .collect();
+    let report = SliceReport {
+        root_finds: points.len(),
+        evaluations: spiral.evaluations,
+        max_residual_mm: spiral.max_residual_mm,
+        truncated_points: 0,
+        grid_points: n,
+        stop: match spiral.end {
+            SpiralEnd::RampDown => StopReason::ReachedEnd,
+            SpiralEnd::MaxTurns => StopReason::MaxLayers,
+        },
+    };
+    let mut path = Path {
+        strategy: Strategy::Spiral,
+        delta_mm: opts.delta_mm,
+        layers: vec![Layer {
+            slice: 0,
+            points,
+            closed: false,
+        }],
+        report,
+        spiral: Some(SpiralInfo {
+            per_turn: n,
+            ramp_down_from,
+        }),
     };
     fill_deltas(&mut path);
     Ok(path)

@@ -12,7 +12,7 @@ pub mod index;
 mod march;
 pub mod strategy;
 
-pub use distance_map::{distance_map, DistanceMap, DistanceStats};
+pub use distance_map::{distance_map, spiral_distance_map, DistanceMap, DistanceStats};
 pub use march::slice;
 
 use crate::io::part_file::Plane;
@@ -32,7 +32,7 @@ pub enum Strategy {
     Perpendicular,
     /// Planar slices `Z = z0 + k Delta` (part frame).
     Planar,
-    /// One continuous spiral (not implemented yet).
+    /// One continuous spiral at constant distance to the turn below.
     Spiral,
 }
 
@@ -92,6 +92,10 @@ pub struct SliceOptions {
     pub align_seams: bool,
     /// Extra rotation of the start of layer `k` by `k × stagger` (rad of `v`).
     pub stagger_rad: f64,
+    /// Spiral only: profile angle `v` where the spiral starts (rad).
+    pub spiral_start_rad: f64,
+    /// Spiral only: travel toward decreasing `v` instead of increasing.
+    pub spiral_reverse: bool,
 }
 
 impl SliceOptions {
@@ -106,6 +110,8 @@ impl SliceOptions {
             max_layers: None,
             align_seams: true,
             stagger_rad: 0.0,
+            spiral_start_rad: 0.0,
+            spiral_reverse: false,
         }
     }
 
@@ -139,6 +145,9 @@ impl SliceOptions {
                 )
             }
             _ => {}
+        }
+        if !self.spiral_start_rad.is_finite() {
+            return bad("spiral_start", "must be finite".into());
         }
         if !self.stagger_rad.is_finite() {
             return bad("stagger", "must be finite".into());
@@ -218,6 +227,16 @@ pub struct SliceReport {
     pub stop: StopReason,
 }
 
+/// What makes a path a spiral.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SpiralInfo {
+    /// Points per turn.
+    pub per_turn: usize,
+    /// Index (in the spiral layer) of the first point of the ramp-down turn,
+    /// if the spiral closes with one.
+    pub ramp_down_from: Option<usize>,
+}
+
 /// A deposition path: layers in order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Path {
@@ -229,6 +248,8 @@ pub struct Path {
     pub layers: Vec<Layer>,
     /// What the slicer did.
     pub report: SliceReport,
+    /// Set for spirals: the path is one open layer winding up the tube.
+    pub spiral: Option<SpiralInfo>,
 }
 
 impl Path {
@@ -322,7 +343,16 @@ pub enum PathError {
         /// Highest evaluable t.
         t_eval_max: f64,
     },
-    /// The spiral strategy is not available yet.
-    #[error("strategy `{0}` is not implemented yet")]
-    NotImplemented(&'static str),
+    /// A spiral point could not be placed.
+    #[error("spiral point {point} (turn {turn}, v = {v:.4} rad): root find failed ({reason})")]
+    SpiralRoot {
+        /// Point index along the spiral.
+        point: usize,
+        /// Turn number.
+        turn: usize,
+        /// Profile angle (rad).
+        v: f64,
+        /// Why.
+        reason: &'static str,
+    },
 }

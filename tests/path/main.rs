@@ -5,4 +5,5 @@ mod common;
 
 mod cli;
 mod discretisation;
+mod spiral;
 mod strategies;

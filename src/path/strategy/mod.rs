@@ -6,6 +6,7 @@ pub mod constant_distance;
 pub mod iso_parametric;
 pub mod normal_to_guide;
 pub mod planar_z;
+pub mod spiral;
 
 /// Outcome of one column step.
 #[derive(Debug, Clone, Copy, PartialEq)]
