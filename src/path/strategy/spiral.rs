@@ -150,6 +150,9 @@ fn push(out: &mut Vec<SpiralPoint>, s_pos: &mut Vec<Point3>, s_t: &mut Vec<f64>,
     out.push(p);
 }
 
+/// A placed point with the evaluations spent and the |residual| (mm).
+type Placed = (SpiralPoint, usize, f64);
+
 /// Points `b0..b1` of the spiral; `None` for a point that cannot be placed.
 #[allow(clippy::too_many_arguments)]
 fn compute_batch(
@@ -162,14 +165,14 @@ fn compute_batch(
     delta_mm: f64,
     t_hi: f64,
     target: &(dyn Fn(usize) -> f64 + Sync),
-) -> Result<Vec<Option<(SpiralPoint, usize, f64)>>, SpiralFailure> {
+) -> Result<Vec<Option<Placed>>, SpiralFailure> {
     let n = first.len();
     let half = n / 2;
     // Window of S used by this batch: from half a turn before the first point
     // below to the last point computed.
     let lo = b0.saturating_sub(half);
     let index = SegmentIndex::new(vec![(s_pos[lo..].to_vec(), false)]);
-    let results: Vec<Result<Option<(SpiralPoint, usize, f64)>, SpiralFailure>> = (b0..b1)
+    let results: Vec<Result<Option<Placed>, SpiralFailure>> = (b0..b1)
         .into_par_iter()
         .map(|m| {
             let col = m % n;
