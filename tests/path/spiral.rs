@@ -79,7 +79,7 @@ fn spiral_on_torus_general_tube_and_nozzle() {
             }
             let ramp_down = info.ramp_down_from.unwrap();
             for m in (2 * n..ramp_down).step_by(7) {
-                let lo = m - 2 * n - n / 2;
+                let lo = (m - 2 * n).saturating_sub(n / 2);
                 let hi = (m - 2 * n + n / 2).min(pts.len());
                 let closest = pts[lo.min(hi)..hi]
                     .iter()
