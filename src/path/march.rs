@@ -51,6 +51,8 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
         truncated_points: 0,
         grid_points: grid,
         stop: StopReason::NoMorePoints,
+        max_turn_before_rad: 0.0,
+        max_turn_after_rad: 0.0,
     };
     let z_base = first.iter().map(|p| p.position.z).fold(f64::MIN, f64::max);
     let s_base = t_first
@@ -172,6 +174,54 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
                 break;
             }
         }
+        if opts.strategy == Strategy::Constant && layer.iter().all(Option::is_some) {
+            let mut ts: Vec<f64> = layer.iter().map(|t| t.expect("all present")).collect();
+            let pts: Vec<_> = ts
+                .iter()
+                .zip(&vs)
+                .map(|(&t, &v)| tube.point(t, v))
+                .collect();
+            let before = super::smooth::turning_angles(&pts, true)
+                .into_iter()
+                .fold(0.0, f64::max);
+            report.max_turn_before_rad = report.max_turn_before_rad.max(before);
+            let mut after = before;
+            if let Some(sm) = opts.smoothing {
+                let hint_list: Vec<SegmentId> = hints
+                    .iter()
+                    .map(|h| {
+                        h.unwrap_or(SegmentId {
+                            polyline: 0,
+                            segment: 0,
+                        })
+                    })
+                    .collect();
+                let out = super::smooth::smooth_layer(
+                    tube,
+                    &vs,
+                    &mut ts,
+                    true,
+                    &index,
+                    &hint_list,
+                    opts.delta_mm,
+                    &sm,
+                );
+                if !out.met {
+                    return Err(PathError::SmoothingInfeasible {
+                        layer: n,
+                        bound_deg: sm.max_turn_rad.to_degrees(),
+                        tolerance_pct: 100.0 * sm.tolerance,
+                        before_deg: out.max_turn_before_rad.to_degrees(),
+                        reached_deg: out.max_turn_after_rad.to_degrees(),
+                    });
+                }
+                after = out.max_turn_after_rad;
+                for (slot, t) in layer.iter_mut().zip(&ts) {
+                    *slot = Some(*t);
+                }
+            }
+            report.max_turn_after_rad = report.max_turn_after_rad.max(after);
+        }
         for (i, t) in layer.iter().enumerate() {
             if let Some(t) = t {
                 cursor[i] = *t;
@@ -268,6 +318,8 @@ fn spiral_path(
         max_residual_mm: spiral.max_residual_mm,
         truncated_points: 0,
         grid_points: n,
+        max_turn_before_rad: 0.0,
+        max_turn_after_rad: 0.0,
         stop: match spiral.end {
             SpiralEnd::RampDown => StopReason::ReachedEnd,
             SpiralEnd::MaxTurns => StopReason::MaxLayers,

@@ -10,6 +10,7 @@
 pub mod distance_map;
 pub mod index;
 mod march;
+pub mod smooth;
 pub mod strategy;
 
 pub use distance_map::{distance_map, spiral_distance_map, DistanceMap, DistanceStats};
@@ -96,6 +97,9 @@ pub struct SliceOptions {
     pub spiral_start_rad: f64,
     /// Spiral only: travel toward decreasing `v` instead of increasing.
     pub spiral_reverse: bool,
+    /// Constant strategy only: bound the turning angle of every layer
+    /// (SPEC §3.4); `None` leaves the layers as the root finds give them.
+    pub smoothing: Option<smooth::Smoothing>,
 }
 
 impl SliceOptions {
@@ -112,6 +116,7 @@ impl SliceOptions {
             stagger_rad: 0.0,
             spiral_start_rad: 0.0,
             spiral_reverse: false,
+            smoothing: None,
         }
     }
 
@@ -145,6 +150,20 @@ impl SliceOptions {
                 )
             }
             _ => {}
+        }
+        if let Some(sm) = self.smoothing {
+            if !(sm.max_turn_rad.is_finite() && sm.max_turn_rad > 0.0) {
+                return bad(
+                    "smoothing.max_turn",
+                    format!("must be positive, got {}", sm.max_turn_rad),
+                );
+            }
+            if !(sm.tolerance.is_finite() && sm.tolerance > 0.0 && sm.tolerance < 1.0) {
+                return bad(
+                    "smoothing.tolerance",
+                    format!("must be in (0, 1), got {}", sm.tolerance),
+                );
+            }
         }
         if !self.spiral_start_rad.is_finite() {
             return bad("spiral_start", "must be finite".into());
@@ -225,6 +244,11 @@ pub struct SliceReport {
     pub grid_points: usize,
     /// Why generation stopped.
     pub stop: StopReason,
+    /// Largest turning angle between consecutive segments of a computed
+    /// layer before smoothing (rad; over whole computed layers).
+    pub max_turn_before_rad: f64,
+    /// The same after smoothing (equal to the above without smoothing).
+    pub max_turn_after_rad: f64,
 }
 
 /// What makes a path a spiral.
@@ -342,6 +366,20 @@ pub enum PathError {
         point: usize,
         /// Highest evaluable t.
         t_eval_max: f64,
+    },
+    /// Smoothing could not meet the turning-angle bound within the distance tolerance.
+    #[error("layer {layer}: smoothing cannot bring the turning angle below {bound_deg:.3} deg while keeping distances within {tolerance_pct} % of Delta (reached {reached_deg:.3} deg, from {before_deg:.3} deg)")]
+    SmoothingInfeasible {
+        /// Layer.
+        layer: usize,
+        /// Requested bound (deg).
+        bound_deg: f64,
+        /// Distance tolerance (% of Delta).
+        tolerance_pct: f64,
+        /// Angle before smoothing (deg).
+        before_deg: f64,
+        /// Best angle reached (deg).
+        reached_deg: f64,
     },
     /// A spiral point could not be placed.
     #[error("spiral point {point} (turn {turn}, v = {v:.4} rad): root find failed ({reason})")]

@@ -5,5 +5,6 @@ mod common;
 
 mod cli;
 mod discretisation;
+mod smoothing;
 mod spiral;
 mod strategies;
