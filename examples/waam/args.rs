@@ -35,25 +35,7 @@ pub enum StrategyArg {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Slice a part: writes path.csv and summary.json in --out.
-    Slice {
-        /// The part file (TOML).
-        part: PathBuf,
-        /// Strategy (default: the part file's).
-        #[arg(long, value_enum)]
-        strategy: Option<StrategyArg>,
-        /// Interlayer distance Delta in mm (default: the part file's).
-        #[arg(long)]
-        delta: Option<f64>,
-        /// Points per layer.
-        #[arg(long, conflicts_with = "chord")]
-        points: Option<usize>,
-        /// Max chord error in mm.
-        #[arg(long)]
-        chord: Option<f64>,
-        /// Output folder (default out/<part name>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-    },
+    Slice(SliceArgs),
     /// List the sample parts (and cells) with one line each.
     Parts {
         /// Folder holding the part files.
@@ -68,4 +50,52 @@ pub enum Command {
         #[arg(long, default_value_t = 360)]
         points: usize,
     },
+}
+
+/// Less common slicing settings.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SliceExtras {
+    /// Bound the turning angle of constant-distance layers to DEG degrees (smoothing QP).
+    #[arg(long, value_name = "DEG")]
+    pub smooth: Option<f64>,
+    /// Distance tolerance of the smoothing, as a fraction of Delta.
+    #[arg(long, default_value_t = 0.05)]
+    pub smooth_tol: f64,
+    /// Rotate the start of layer k by k × DEG degrees (seam staggering).
+    #[arg(long, value_name = "DEG")]
+    pub stagger: Option<f64>,
+    /// Spiral: profile angle where the spiral starts (degrees).
+    #[arg(long, value_name = "DEG")]
+    pub spiral_start: Option<f64>,
+    /// Spiral: travel toward decreasing profile angle.
+    #[arg(long)]
+    pub reverse: bool,
+    /// Stop after N layers (or spiral turns).
+    #[arg(long, value_name = "N")]
+    pub max_layers: Option<usize>,
+}
+
+/// Arguments of `waam slice`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SliceArgs {
+    /// The part file (TOML).
+    pub part: PathBuf,
+    /// Strategy (default: the part file's).
+    #[arg(long, value_enum)]
+    pub strategy: Option<StrategyArg>,
+    /// Interlayer distance Delta in mm (default: the part file's).
+    #[arg(long)]
+    pub delta: Option<f64>,
+    /// Points per layer.
+    #[arg(long, conflicts_with = "chord")]
+    pub points: Option<usize>,
+    /// Max chord error in mm.
+    #[arg(long)]
+    pub chord: Option<f64>,
+    /// Output folder (default out/<part name>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Extra slicing settings.
+    #[command(flatten)]
+    pub more: SliceExtras,
 }

@@ -28,22 +28,7 @@ fn main() -> ExitCode {
     let result = match &args.command {
         Command::Parts { dir } => list_parts(dir),
         Command::Geometry { part, points } => geometry(part, *points, args.quiet),
-        Command::Slice {
-            part,
-            strategy,
-            delta,
-            points,
-            chord,
-            out,
-        } => slice::run(
-            part,
-            *strategy,
-            *delta,
-            *points,
-            *chord,
-            out.as_deref(),
-            args.quiet,
-        ),
+        Command::Slice(cmd) => slice::run(cmd, args.quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

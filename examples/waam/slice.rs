@@ -1,24 +1,20 @@
 //! `waam slice`: part file → path.csv + summary.json.
 
-use crate::args::StrategyArg;
+use crate::args::{SliceArgs, StrategyArg};
 use serde_json::json;
 use std::path::{Path as FsPath, PathBuf};
 use std::time::Instant;
 use waam_slicer::io::atomic::write_atomic;
 use waam_slicer::io::part_file::read_part_file;
 use waam_slicer::io::path_csv::write_path_csv;
+use waam_slicer::path::smooth::Smoothing;
 use waam_slicer::path::{distance_map, slice, Discretisation, Strategy};
 use waam_slicer::toolaxis::local_frames;
 
-pub fn run(
-    part_file: &FsPath,
-    strategy: Option<StrategyArg>,
-    delta: Option<f64>,
-    points: Option<usize>,
-    chord: Option<f64>,
-    out: Option<&FsPath>,
-    quiet: bool,
-) -> Result<(), String> {
+pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
+    let part_file = args.part.as_path();
+    let (strategy, delta, points, chord) = (args.strategy, args.delta, args.points, args.chord);
+    let (out, more) = (args.out.as_deref(), &args.more);
     let t0 = Instant::now();
     let part = read_part_file(part_file).map_err(|e| e.to_string())?;
     let t_read = t0.elapsed().as_secs_f64();
@@ -41,6 +37,21 @@ pub fn run(
     if let Some(e) = chord {
         opts.discretisation = Discretisation::ChordError(e);
     }
+    if let Some(deg) = more.smooth {
+        opts.smoothing = Some(Smoothing {
+            max_turn_rad: deg.to_radians(),
+            tolerance: more.smooth_tol,
+        });
+    }
+    if let Some(deg) = more.stagger {
+        opts.stagger_rad = deg.to_radians();
+        opts.align_seams = false;
+    }
+    if let Some(deg) = more.spiral_start {
+        opts.spiral_start_rad = deg.to_radians();
+    }
+    opts.spiral_reverse = more.reverse;
+    opts.max_layers = more.max_layers.or(opts.max_layers);
     let t1 = Instant::now();
     let path = slice(&part.tube, &part.substrate, &opts)
         .map_err(|e| format!("{}: {e}", part_file.display()))?;
@@ -80,6 +91,8 @@ pub fn run(
             "max_residual_mm": path.report.max_residual_mm,
             "truncated_points": path.report.truncated_points,
             "stop": format!("{:?}", path.report.stop),
+            "max_turn_before_deg": path.report.max_turn_before_rad.to_degrees(),
+            "max_turn_after_deg": path.report.max_turn_after_rad.to_degrees(),
         },
         "run_time_s": { "read": t_read, "slice": t_slice, "distance_map": t_map, "tool_axes": t_axes },
     });

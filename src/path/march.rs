@@ -206,7 +206,21 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
                     opts.delta_mm,
                     &sm,
                 );
-                if !out.met {
+                // Past the end plane the extension may fold (the torus curls
+                // back): only the kinks of the points that will be kept count.
+                let kept_ok = || match opts.end {
+                    EndRule::Truncate(plane) => {
+                        let angles = super::smooth::turning_angles(&pts, true);
+                        pts.iter()
+                            .zip(angles)
+                            .filter(|(p, _)| (*p - plane.point).dot(&plane.normal) <= 0.0)
+                            .all(|(_, a)| a <= sm.max_turn_rad)
+                    }
+                    _ => false,
+                };
+                if !out.met && kept_ok() {
+                    // Nothing to fix where the layer is kept.
+                } else if !out.met {
                     return Err(PathError::SmoothingInfeasible {
                         layer: n,
                         bound_deg: sm.max_turn_rad.to_degrees(),

@@ -327,3 +327,40 @@ fn bad_delta_and_missing_substrate_are_clear_errors() {
     );
     let _ = FRAC_PI_2;
 }
+
+/// The constant-distance method on a meshed substrate: the torus on a
+/// cylinder given as an STL (2000 facets around) matches the analytic cylinder
+/// substrate layer for layer, within the facets' sagitta.
+#[test]
+fn constant_distance_on_an_stl_substrate() {
+    let part = load_part("torus-on-cylinder.toml");
+    let mut tris = Vec::new();
+    let n = 2000;
+    for k in 0..n {
+        let a0 = TAU * k as f64 / n as f64;
+        let a1 = TAU * (k + 1) as f64 / n as f64;
+        let p = |a: f64, y: f64| waam_slicer::math::Point3::new(32.0 * a.cos(), y, 32.0 * a.sin());
+        tris.push([p(a0, -40.0), p(a1, -40.0), p(a1, 40.0)]);
+        tris.push([p(a0, -40.0), p(a1, 40.0), p(a0, 40.0)]);
+    }
+    let mesh =
+        waam_slicer::geometry::MeshSubstrate::from_triangles(&tris, "cylinder mesh").unwrap();
+    let substrate = waam_slicer::geometry::Substrate::Mesh(Box::new(mesh));
+    let mut o = part.slice_options();
+    o.discretisation = waam_slicer::path::Discretisation::Points(120);
+    let on_mesh = slice(&part.tube, &substrate, &o).unwrap();
+    let analytic = slice(&part.tube, &part.substrate, &o).unwrap();
+    let s = distance_map(&on_mesh).overall.unwrap();
+    assert!(s.variation < 1e-3, "{s:?}");
+    assert_eq!(on_mesh.num_slices(), analytic.num_slices());
+    for (a, b) in on_mesh
+        .layers
+        .iter()
+        .zip(&analytic.layers)
+        .filter(|(a, b)| a.closed && b.closed)
+    {
+        for (p, q) in a.points.iter().zip(&b.points) {
+            assert!((p.position - q.position).norm() < 1e-3, "slice {}", a.slice);
+        }
+    }
+}
