@@ -27,11 +27,9 @@ pub fn constant_distance(c: &mut Criterion) {
             .expect("slices")
             .num_points();
         g.throughput(Throughput::Elements(points as u64));
+        // `slice` computes the distance map itself (every point's delta).
         g.bench_function(format!("constant+map/{}/delta{delta}", part.name), |b| {
-            b.iter(|| {
-                let path = slice(&part.tube, &part.substrate, black_box(&o)).expect("slices");
-                black_box(distance_map(&path))
-            })
+            b.iter(|| black_box(slice(&part.tube, &part.substrate, black_box(&o)).expect("slices")))
         });
     }
     // The spiral next to the layered path on the quarter torus.
@@ -45,10 +43,13 @@ pub fn constant_distance(c: &mut Criterion) {
         .num_points();
     g.throughput(Throughput::Elements(points as u64));
     g.bench_function("spiral+map/quarter-torus/delta1", |b| {
-        b.iter(|| {
-            let path = slice(&part.tube, &part.substrate, black_box(&o)).expect("slices");
-            black_box(distance_map(&path))
-        })
+        b.iter(|| black_box(slice(&part.tube, &part.substrate, black_box(&o)).expect("slices")))
+    });
+    // The distance map alone, as for a path read from a file.
+    let path = slice(&part.tube, &part.substrate, &part.slice_options()).expect("slices");
+    g.throughput(Throughput::Elements(path.num_points() as u64));
+    g.bench_function("distance-map/quarter-torus/delta5", |b| {
+        b.iter(|| black_box(distance_map(black_box(&path))))
     });
     g.finish();
 }

@@ -85,11 +85,14 @@ pub fn distance_map_of(layers: &[Layer], delta_mm: f64) -> DistanceMap {
                 return vec![None; l.points.len()];
             }
             let idx = &indexes[l.slice - 1];
+            // Consecutive points have nearby feet: each query starts where the last ended.
+            let mut hint = None;
             l.points
                 .iter()
                 .map(|p| {
-                    idx.nearest(&p.position)
-                        .map(|n| (n.distance, n.at_open_end))
+                    let n = idx.nearest_hinted(&p.position, hint)?;
+                    hint = Some(n.id);
+                    Some((n.distance, n.at_open_end))
                 })
                 .collect()
         })

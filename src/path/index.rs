@@ -12,7 +12,7 @@
 use crate::math::Point3;
 
 /// Consecutive segments per bounding sphere.
-pub const CHUNK: usize = 16;
+pub const CHUNK: usize = 8;
 
 /// Distance from `p` to the segment `[a, b]` with the projection clamped to the
 /// segment; returns `(distance, parameter in [0, 1])`.
@@ -64,6 +64,8 @@ struct Chunk {
 #[derive(Debug, Clone)]
 pub struct SegmentIndex {
     chunks: Vec<Chunk>,
+    /// Index of the first chunk of each polyline.
+    chunk_offset: Vec<usize>,
     polylines: Vec<(Vec<Point3>, bool)>,
 }
 
@@ -83,7 +85,9 @@ impl SegmentIndex {
     /// of one vertex is a point.
     pub fn new(polylines: Vec<(Vec<Point3>, bool)>) -> Self {
         let mut chunks = Vec::new();
+        let mut chunk_offset = Vec::with_capacity(polylines.len());
         for (k, (pts, closed)) in polylines.iter().enumerate() {
+            chunk_offset.push(chunks.len());
             let n = pts.len();
             let count = segment_count(n, *closed);
             let mut first = 0;
@@ -108,7 +112,11 @@ impl SegmentIndex {
                 first += len;
             }
         }
-        Self { chunks, polylines }
+        Self {
+            chunks,
+            chunk_offset,
+            polylines,
+        }
     }
 
     /// Whether the index holds no segment.
@@ -155,18 +163,35 @@ impl SegmentIndex {
 
     /// The nearest segment to `p`, `None` if the index is empty.
     pub fn nearest(&self, p: &Point3) -> Option<Nearest> {
-        // Start from the chunk whose sphere is closest, then visit every chunk
-        // that could hold a closer segment.
-        let start = self
-            .chunks
-            .iter()
-            .enumerate()
-            .map(|(i, c)| (i, (p - c.centre).norm() - c.radius))
-            .min_by(|a, b| a.1.total_cmp(&b.1))?
-            .0;
+        self.nearest_hinted(p, None)
+    }
+
+    /// The nearest segment to `p`, exact; `hint` (a segment likely near the
+    /// answer, e.g. the previous query's) only decides where the search starts.
+    pub fn nearest_hinted(&self, p: &Point3, hint: Option<SegmentId>) -> Option<Nearest> {
+        let start = match hint {
+            Some(h) if h.polyline < self.chunk_offset.len() => {
+                let i = self.chunk_offset[h.polyline] + h.segment / CHUNK;
+                (i < self.chunks.len() && self.chunks[i].polyline == h.polyline).then_some(i)
+            }
+            _ => None,
+        };
+        let start = match start {
+            Some(i) => i,
+            None => {
+                self.chunks
+                    .iter()
+                    .enumerate()
+                    .map(|(i, c)| (i, (p - c.centre).norm() - c.radius))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))?
+                    .0
+            }
+        };
         let mut best = self.scan_chunk(p, &self.chunks[start], None);
         for (i, c) in self.chunks.iter().enumerate() {
-            if i != start && (p - c.centre).norm() - c.radius < best.distance {
+            // |p - c| - r < best  <=>  |p - c|^2 < (r + best)^2 (no square root).
+            let reach = c.radius + best.distance;
+            if i != start && (p - c.centre).norm_squared() < reach * reach {
                 best = self.scan_chunk(p, c, Some(best));
             }
         }

@@ -47,7 +47,10 @@ pub fn next_t(
     // Confirm with the exact nearest segment (the local descent could have
     // stopped at a local minimum); redo the root find with exact queries if not.
     let p = tube.point(t, v);
-    let exact = below.nearest(&p).map_or(f64::INFINITY, |n| n.distance);
+    let local = below.nearest_from(&p, hint);
+    let exact = below
+        .nearest_hinted(&p, Some(local.id))
+        .map_or(f64::INFINITY, |n| n.distance);
     if (exact - delta_mm).abs() <= 1e-9 * delta_mm {
         return Ok(Step::Point {
             t,
