@@ -8,6 +8,7 @@
 //! Exit codes: 0 done, 1 bad input (the message names the file and field).
 
 mod args;
+mod plots;
 mod slice;
 
 use args::{Args, Command};

@@ -70,6 +70,42 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     let csv = dir.join("path.csv");
     write_atomic(&csv, |w| write_path_csv(w, &path.layers, &frames))
         .map_err(|e| format!("{}: {e}", csv.display()))?;
+    // Pictures: written to temporary names, then renamed (no half-written file).
+    let t4 = Instant::now();
+    for (name, draw) in [
+        (
+            "path.svg",
+            Box::new(|f: &FsPath| {
+                crate::plots::path_view(
+                    &path,
+                    &format!(
+                        "{}: {} path, Delta = {} mm",
+                        part.name,
+                        path.strategy.name(),
+                        path.delta_mm
+                    ),
+                    f,
+                )
+            }) as Box<dyn Fn(&FsPath) -> Result<(), String>>,
+        ),
+        (
+            "distance.svg",
+            Box::new(|f: &FsPath| {
+                crate::plots::distance_plot(
+                    &path,
+                    &map,
+                    &format!("{}: local interlayer distance per layer", part.name),
+                    f,
+                )
+            }),
+        ),
+    ] {
+        let tmp = dir.join(format!(".{name}.tmp"));
+        draw(&tmp)?;
+        std::fs::rename(&tmp, dir.join(name))
+            .map_err(|e| format!("{}: {e}", dir.join(name).display()))?;
+    }
+    let t_plots = t4.elapsed().as_secs_f64();
     let summary = json!({
         "part": part.name,
         "part_file": part_file.display().to_string(),
@@ -94,7 +130,7 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             "max_turn_before_deg": path.report.max_turn_before_rad.to_degrees(),
             "max_turn_after_deg": path.report.max_turn_after_rad.to_degrees(),
         },
-        "run_time_s": { "read": t_read, "slice": t_slice, "distance_map": t_map, "tool_axes": t_axes },
+        "run_time_s": { "read": t_read, "slice": t_slice, "distance_map": t_map, "tool_axes": t_axes, "pictures": t_plots },
     });
     let summary_file = dir.join("summary.json");
     write_atomic(&summary_file, |w| {
@@ -123,7 +159,10 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
                 100.0 * o.variation
             );
         }
-        println!("  wrote {} and {}", csv.display(), summary_file.display());
+        println!(
+            "  wrote path.csv, summary.json, path.svg, distance.svg in {}",
+            dir.display()
+        );
     }
     Ok(())
 }
