@@ -70,6 +70,9 @@ pub struct SliceExtras {
     /// Spiral: travel toward decreasing profile angle.
     #[arg(long)]
     pub reverse: bool,
+    /// Bead width for wall.stl (mm; default Delta).
+    #[arg(long, value_name = "MM")]
+    pub bead_width: Option<f64>,
     /// Stop after N layers (or spiral turns).
     #[arg(long, value_name = "N")]
     pub max_layers: Option<usize>,

@@ -70,6 +70,13 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     let csv = dir.join("path.csv");
     write_atomic(&csv, |w| write_path_csv(w, &path.layers, &frames))
         .map_err(|e| format!("{}: {e}", csv.display()))?;
+    let stl = dir.join("wall.stl");
+    let width = more.bead_width.unwrap_or(path.delta_mm);
+    let triangles = waam_slicer::io::wall_stl::wall_triangles(&path, &frames, width);
+    write_atomic(&stl, |w| {
+        waam_slicer::io::wall_stl::write_stl(w, &triangles)
+    })
+    .map_err(|e| format!("{}: {e}", stl.display()))?;
     // Pictures: written to temporary names, then renamed (no half-written file).
     let t4 = Instant::now();
     for (name, draw) in [
@@ -160,7 +167,7 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             );
         }
         println!(
-            "  wrote path.csv, summary.json, path.svg, distance.svg in {}",
+            "  wrote path.csv, summary.json, path.svg, distance.svg, wall.stl in {}",
             dir.display()
         );
     }

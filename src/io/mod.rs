@@ -3,3 +3,4 @@ pub mod atomic;
 pub mod cell_file;
 pub mod part_file;
 pub mod path_csv;
+pub mod wall_stl;

@@ -71,6 +71,20 @@ fn slice_writes_path_csv_for_every_strategy() {
                 other => panic!("{strategy}: {other:?}"),
             }
         }
+        // The other outputs: pictures and the wall mesh, which reads back as an STL.
+        for f in ["path.svg", "distance.svg"] {
+            let svg = std::fs::read_to_string(out.join(f)).unwrap();
+            assert!(
+                svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+                "{f}"
+            );
+        }
+        let stl = std::fs::read(out.join("wall.stl")).unwrap();
+        let mesh = waam_slicer::geometry::MeshSubstrate::from_stl_bytes(&stl, "wall.stl").unwrap();
+        assert!(
+            mesh.num_triangles()
+                >= 8 * (layers.iter().map(|l| l.points.len()).sum::<usize>() - layers.len())
+        );
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
                 .unwrap();
