@@ -224,18 +224,13 @@ impl SegmentIndex {
         lo: usize,
         hi: usize,
     ) -> Option<Nearest> {
-        let mut best: Option<Nearest> = None;
-        let mut candidates: Vec<(f64, &Chunk)> = self
-            .chunks
-            .iter()
-            .filter(|c| c.polyline == polyline && c.first < hi && c.first + c.count > lo)
-            .map(|c| ((p - c.centre).norm() - c.radius, c))
-            .collect();
-        candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for (bound, c) in candidates {
-            if best.is_some_and(|b| bound >= b.distance) {
-                break;
-            }
+        if lo >= hi || polyline >= self.chunk_offset.len() {
+            return None;
+        }
+        // The chunks of this polyline are contiguous and hold CHUNK segments each.
+        let first = self.chunk_offset[polyline] + lo / CHUNK;
+        let last = self.chunk_offset[polyline] + (hi - 1) / CHUNK;
+        let scan = |c: &Chunk, best: &mut Option<Nearest>| {
             for j in c.first.max(lo)..(c.first + c.count).min(hi) {
                 let cand = self.make(
                     p,
@@ -245,8 +240,23 @@ impl SegmentIndex {
                     },
                 );
                 if best.is_none_or(|b| cand.distance < b.distance) {
-                    best = Some(cand);
+                    *best = Some(cand);
                 }
+            }
+        };
+        // Start in the middle of the range (where callers centre it), then
+        // visit the chunks whose sphere can beat the best so far.
+        let mid = (first + last) / 2;
+        let mut best = None;
+        scan(&self.chunks[mid], &mut best);
+        for i in first..=last {
+            if i == mid {
+                continue;
+            }
+            let c = &self.chunks[i];
+            let reach = c.radius + best.map_or(f64::INFINITY, |b| b.distance);
+            if (p - c.centre).norm_squared() < reach * reach {
+                scan(c, &mut best);
             }
         }
         best
