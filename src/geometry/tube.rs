@@ -203,9 +203,9 @@ impl Tube {
 
     /// Surface point `M(t, v)` (part frame, mm) [eq. 2.1].
     pub fn point(&self, t: f64, v: f64) -> Point3 {
-        let f = self.frame(t);
+        let (n, b) = self.frames.profile_basis(self.guide.as_ref(), t);
         let (s, c) = v.sin_cos();
-        self.guide.point(t) + (f.normal * c + f.binormal * s) * self.profile.radius(t)
+        self.guide.point(t) + (n * c + b * s) * self.profile.radius(t)
     }
 
     /// Surface point with `∂M/∂t`, `∂M/∂v` and the outward unit normal
