@@ -20,7 +20,7 @@
 //!   `<= 0` is a collision. Distances of overlapping shapes are 0 in parry, so a
 //!   penetration shows as `-bead_radius_mm` (beads) or `0` (substrate).
 
-use super::rules::{angle, smooth_layer};
+use super::rules::{angle, smooth_angles};
 use super::{LocalFrame, ToolAxisError};
 use crate::geometry::Substrate;
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, UnitVector3, Vector3};
@@ -543,9 +543,9 @@ pub struct AvoidanceOptions {
     pub azimuths: usize,
     /// Clearance to reach (mm, >= 0).
     pub margin_mm: f64,
-    /// Bound on the rate of the corrections along a layer (rad per mm of
-    /// path, > 0): the correction fades in and out over neighbouring points,
-    /// and the final axes are smoothed to this rate.
+    /// Bound on the rate of change of the corrections along a layer (rad per
+    /// mm of path, > 0): a correction fades in and out over neighbouring
+    /// points at this rate.
     pub max_rate_rad_per_mm: f64,
     /// Search rounds (>= 1): a round re-searches the points a blended
     /// correction did not clear.
@@ -653,9 +653,12 @@ fn corrected(f: &LocalFrame, tool: &Vector3, c: &[f64; 2]) -> Vector3 {
 /// that reaches the margin kept; the corrections (angle and direction in the
 /// local `(t, T × t)` basis) are then spread along the layer as an upper
 /// envelope falling off at `max_rate_rad_per_mm`, re-searched where that
-/// did not clear, and the axes finally smoothed to that rate. Returns the
+/// did not clear, and the correction field finally smoothed to that rate. Returns the
 /// new frames (only `tool` changes) and a report; points left unresolved are
-/// reported, not errors. Layers in parallel.
+/// reported, not errors. The smoothing acts on the corrections, expressed
+/// in each point's local basis, so the rate bound applies to the change of
+/// the correction, on top of the nominal axes' own variation. Layers in
+/// parallel.
 ///
 /// # Errors
 /// [`ToolAxisError`] for bad options, a shape mismatch, or an unsupported
@@ -784,12 +787,22 @@ pub fn avoid_collisions(
                 }
                 current = layer_clearances(&obstacles, torch, path, li, &axes)?;
             }
-            smooth_layer(
+            // Smooth the correction field (local coordinates) to the rate.
+            let mut pairs: Vec<(f64, f64)> = blended.iter().map(|c| (c[0], c[1])).collect();
+            if smooth_angles(
                 &positions,
-                &mut axes,
+                &mut pairs,
                 layer.closed,
                 aopts.max_rate_rad_per_mm,
-            );
+            ) > 0
+            {
+                for (b, p) in blended.iter_mut().zip(&pairs) {
+                    *b = [p.0, p.1];
+                }
+                for i in 0..n {
+                    axes[i] = corrected(&fr[i], &nominal[i], &blended[i]);
+                }
+            }
             let c1 = layer_clearances(&obstacles, torch, path, li, &axes)?;
             let after = summarise(li, &c1);
             let mut out_frames = fr.clone();

@@ -21,6 +21,9 @@ use crate::math::{Matrix3, Vector3};
 /// Tool axis `T` of a frame for lead `theta_n` and tilt `theta_t` (rad,
 /// |.| < π/2): `normalise(b + tan(theta_n) t + tan(theta_t) n)` (eq. 2.32).
 pub fn tool_axis(frame: &LocalFrame, lead_rad: f64, tilt_rad: f64) -> Vector3 {
+    if lead_rad == 0.0 && tilt_rad == 0.0 {
+        return frame.build;
+    }
     (frame.build + frame.tangent * lead_rad.tan() + frame.normal * tilt_rad.tan()).normalize()
 }
 

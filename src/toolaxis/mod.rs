@@ -13,8 +13,9 @@
 //! 3. [`lead_tilt`] — tool axis `T` from a lead angle `theta_n` (feed plane)
 //!    and a tilt angle `theta_t` (normal plane), Rodrigues (eq. 2.30–2.32),
 //!    constant, per point, or by a rule such as the 50° rule (eq. 3.20–3.21);
-//! 4. [`rules`] — smoothing of `T` along each layer with a bound on its
-//!    angular rate (rad/mm).
+//! 4. [`rules`] — smoothing of the lead/tilt angles along each layer with a
+//!    bound on their rate (rad/mm), so that `T` moves smoothly relative to the
+//!    local frame.
 //!
 //! Collision of the torch with the part built so far and the substrate, and
 //! its avoidance, are in [`collision`] (they need a torch: a separate call).
@@ -43,8 +44,8 @@ pub use collision::{
     CollisionReport, LayerClearance, Torch, TorchSpec,
 };
 pub use lead_tilt::{lead_tilt_of, tool_axis, tool_axis_rodrigues};
-pub use normals::{mean_normal_difference, NormalMethod};
-pub use rules::{smooth_layer, AxisRule};
+pub use normals::{mean_normal_difference, mean_normal_difference_per_layer, NormalMethod};
+pub use rules::{max_angle_rate, max_rate, smooth_angles, smooth_layer, AxisRule};
 
 use crate::geometry::{Substrate, Tube};
 use crate::math::Vector3;
@@ -101,8 +102,11 @@ pub struct ToolAxisOptions {
     /// outward normal (made perpendicular to `t`) instead of `t × n` (thesis
     /// §2.4.2, for features added on a non-planar substrate).
     pub first_layer_along_substrate: bool,
-    /// Bound on the angular rate of `T` along a layer (rad per mm of path);
-    /// `None` leaves `T` as computed.
+    /// Bound on the rate of change of the lead/tilt angles along a layer (rad
+    /// per mm of path), enforced by [`smooth_angles`] after the rule; `None`
+    /// leaves them as computed. The axis `T` then turns at most at this rate
+    /// relative to the local frame (the frame's own turn comes on top; a rule's
+    /// cone is not re-imposed — check the report).
     pub max_rate_rad_per_mm: Option<f64>,
 }
 
@@ -193,9 +197,12 @@ pub struct ToolAxisReport {
     pub rule_unreachable_count: usize,
     /// Largest angle between `T` and the part's +Z (rad).
     pub max_angle_from_z_rad: f64,
-    /// Largest angular rate of `T` between consecutive points (rad/mm), after
-    /// smoothing.
+    /// Largest angular rate of `T` between consecutive points (rad/mm, part
+    /// frame): the turn of the local frame plus the change of the angles.
     pub max_rate_rad_per_mm: f64,
+    /// Largest rate of change of the lead/tilt pair between consecutive
+    /// points (rad/mm), after smoothing.
+    pub max_angle_rate_rad_per_mm: f64,
     /// Points whose `T` the smoothing moved.
     pub smoothed_points: usize,
 }
@@ -348,6 +355,7 @@ pub fn tool_axes(
         rule_unreachable_count: 0,
         max_angle_from_z_rad: 0.0,
         max_rate_rad_per_mm: 0.0,
+        max_angle_rate_rad_per_mm: 0.0,
         smoothed_points: 0,
     };
     let mut angles = Vec::with_capacity(frames.len());
@@ -369,16 +377,16 @@ pub fn tool_axes(
         }
         angles.push(la);
     }
-    // 4. Smoothing.
+    // 4. Smoothing of the lead/tilt angles along each layer.
     if let Some(rate) = opts.max_rate_rad_per_mm {
         for (li, layer) in path.layers.iter().enumerate() {
             let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
-            let mut axes: Vec<Vector3> = frames[li].iter().map(|f| f.tool).collect();
-            let moved = smooth_layer(&positions, &mut axes, layer.closed, rate);
+            let moved = smooth_angles(&positions, &mut angles[li], layer.closed, rate);
             report.smoothed_points += moved;
-            for ((f, a), ang) in frames[li].iter_mut().zip(axes).zip(angles[li].iter_mut()) {
-                f.tool = a;
-                *ang = lead_tilt_of(f, &a);
+            if moved > 0 {
+                for (f, &(lead, tilt)) in frames[li].iter_mut().zip(&angles[li]) {
+                    f.tool = tool_axis(f, lead, tilt);
+                }
             }
         }
     }

@@ -82,7 +82,7 @@ fn analytic_layer(layer: &Layer, tube: &Tube, li: usize) -> Result<Vec<LocalFram
                     point: i,
                 });
             };
-            let mut build = tangent.cross(&normal);
+            let mut build = tangent.cross(&normal).normalize();
             // Toward increasing guide parameter: the direction layers advance.
             if build.dot(&sp.d_dt) < 0.0 {
                 build = -build;
@@ -202,7 +202,7 @@ fn numeric_layer(
             });
         }
         let normal = sum / s_len;
-        let build = tangent.cross(&normal);
+        let build = tangent.cross(&normal).normalize();
         frames.push(LocalFrame {
             tangent,
             normal,
@@ -273,6 +273,15 @@ pub(crate) fn orient_away_from_substrate(
             }
         }
     }
+}
+
+/// Mean difference of eq. 2.36 layer by layer: `mu_n = (1/p_n) Σ_i |n_a − n_b|`
+/// over the `p_n` points of layer `n` (unitless).
+pub fn mean_normal_difference_per_layer(a: &[Vec<LocalFrame>], b: &[Vec<LocalFrame>]) -> Vec<f64> {
+    a.iter()
+        .zip(b)
+        .map(|(la, lb)| mean_normal_difference(std::slice::from_ref(la), std::slice::from_ref(lb)))
+        .collect()
 }
 
 /// Mean difference of eq. 2.36, `mu = (1/p) Σ |n_a − n_b|`, over every point

@@ -295,13 +295,99 @@ pub fn max_rate(positions: &[Point3], axes: &[Vector3], closed: bool) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Smooths unit tool axes along a layer so that the angle between consecutive
+/// Smooths the lead/tilt angles `(theta_n, theta_t)` (rad) of a layer so that
+/// they change by at most `max_rate_rad_per_mm` per mm of path between any
+/// two points (Euclidean norm of the angle pair; distances along the layer,
+/// wrapping on a closed layer). Each angle is replaced by the mean of its
+/// lower and upper Lipschitz envelopes, `(min_j (x_j + L d_ij) + max_j (x_j −
+/// L d_ij)) / 2` with `L = rate / √2`: both are `L`-Lipschitz, so is their
+/// mean, it is exact in one pass and leaves an already smooth field alone.
+/// Returns the number of points whose angles moved.
+pub fn smooth_angles(
+    positions: &[Point3],
+    angles: &mut [(f64, f64)],
+    closed: bool,
+    max_rate_rad_per_mm: f64,
+) -> usize {
+    let n = angles.len();
+    if n < 2 {
+        return 0;
+    }
+    let mut s = vec![0.0; n];
+    for i in 1..n {
+        s[i] = s[i - 1] + (positions[i] - positions[i - 1]).norm();
+    }
+    let total = s[n - 1]
+        + if closed {
+            (positions[0] - positions[n - 1]).norm()
+        } else {
+            0.0
+        };
+    let dist = |i: usize, j: usize| {
+        let d = (s[i] - s[j]).abs();
+        if closed {
+            d.min(total - d)
+        } else {
+            d
+        }
+    };
+    let l = max_rate_rad_per_mm / std::f64::consts::SQRT_2;
+    let envelope = |x: &[f64]| -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for j in 0..n {
+                    let d = l * dist(i, j);
+                    lo = lo.min(x[j] + d);
+                    hi = hi.max(x[j] - d);
+                }
+                0.5 * (lo + hi)
+            })
+            .collect()
+    };
+    let lead: Vec<f64> = angles.iter().map(|a| a.0).collect();
+    let tilt: Vec<f64> = angles.iter().map(|a| a.1).collect();
+    let (lead, tilt) = (envelope(&lead), envelope(&tilt));
+    let mut moved = 0;
+    for (a, (ln, tn)) in angles.iter_mut().zip(lead.into_iter().zip(tilt)) {
+        if (a.0 - ln).abs() > 1e-15 || (a.1 - tn).abs() > 1e-15 {
+            moved += 1;
+        }
+        *a = (ln, tn);
+    }
+    moved
+}
+
+/// Largest rate of change of the lead/tilt pair between consecutive points
+/// (rad/mm, Euclidean norm of the pair).
+pub fn max_angle_rate(positions: &[Point3], angles: &[(f64, f64)], closed: bool) -> f64 {
+    let n = positions.len();
+    let pairs = if closed && n > 2 {
+        n
+    } else {
+        n.saturating_sub(1)
+    };
+    (0..pairs)
+        .filter_map(|i| {
+            let j = (i + 1) % n;
+            let d = (positions[j] - positions[i]).norm();
+            (d > 1e-12).then(|| (angles[j].0 - angles[i].0).hypot(angles[j].1 - angles[i].1) / d)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Smooths unit tool axes along a layer in absolute terms (best effort) so that the angle between consecutive
 /// axes is at most `max_rate_rad_per_mm` times their distance (mm): forward
 /// and backward slew-rate limiting (rotating an axis toward its neighbour),
-/// repeated until the bound holds (at most 50 sweeps), wrapping on a closed
-/// layer. Rotating toward a neighbour stays inside any cone of half-angle
+/// then symmetric relaxation of the pairs still violating the bound (at most
+/// 2000 sweeps), wrapping on a closed layer. Rotating toward a neighbour stays inside any cone of half-angle
 /// < 90° holding both (so the 50° rule survives). Returns the number of
 /// axes moved.
+///
+/// The bound must be feasible: the axes of a closed layer that lean `a` from
+/// the part's axis turn by about `sin(a) / rho` rad/mm around a part of radius
+/// `rho`; below that the sweeps stop after their budget with the bound
+/// unmet — check [`max_rate`] (reported by [`super::tool_axes`]).
 pub fn smooth_layer(
     positions: &[Point3],
     axes: &mut [Vector3],
@@ -321,21 +407,32 @@ pub fn smooth_layer(
             axes[to] = slerp(&axes[from], &axes[to], max / a);
         }
     };
-    for _ in 0..50 {
-        for i in 1..n {
-            limit(axes, i - 1, i);
-        }
-        if closed {
-            limit(axes, n - 1, 0);
-        }
-        for i in (0..n - 1).rev() {
-            limit(axes, i + 1, i);
-        }
-        if closed {
-            limit(axes, 0, n - 1);
-        }
+    // Forward and backward sweeps propagate the bound quickly; on a closed
+    // layer the wrap pair can leave them cycling, so symmetric relaxation
+    // (both ends of a violating pair move halfway, aiming slightly inside the
+    // bound) finishes the job.
+    for i in 1..n {
+        limit(axes, i - 1, i);
+    }
+    for i in (0..n - 1).rev() {
+        limit(axes, i + 1, i);
+    }
+    let pairs = if closed && n > 2 { n } else { n - 1 };
+    for _ in 0..2000 {
         if max_rate(positions, axes, closed) <= max_rate_rad_per_mm * (1.0 + 1e-9) {
             break;
+        }
+        for i in 0..pairs {
+            let j = (i + 1) % n;
+            let d = (positions[j] - positions[i]).norm();
+            let target = max_rate_rad_per_mm * d * (1.0 - 1e-6);
+            let a = angle(&axes[i], &axes[j]);
+            if a > target && a > 0.0 {
+                let (ai, aj) = (axes[i], axes[j]);
+                let f = 0.5 * (a - target) / a;
+                axes[i] = slerp(&ai, &aj, f);
+                axes[j] = slerp(&aj, &ai, f);
+            }
         }
     }
     axes.iter()
