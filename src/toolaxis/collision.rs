@@ -158,7 +158,24 @@ impl Default for TorchSpec {
 #[derive(Clone)]
 pub struct Torch {
     spec: TorchSpec,
-    parts: Vec<ConvexPolyhedron>,
+    /// Convex parts and their poses in the torch frame (`torch_from_part`).
+    parts: Vec<(Isometry3, TorchPart)>,
+}
+
+/// One convex part of a torch.
+#[derive(Clone)]
+enum TorchPart {
+    Hull(ConvexPolyhedron),
+    Cylinder(Cylinder),
+}
+
+impl TorchPart {
+    fn shape(&self) -> &dyn Shape {
+        match self {
+            TorchPart::Hull(h) => h,
+            TorchPart::Cylinder(c) => c,
+        }
+    }
 }
 
 impl std::fmt::Debug for Torch {
@@ -207,20 +224,34 @@ impl Torch {
                 body_length_mm,
             } => {
                 let z1 = tip_offset_mm + nozzle_length_mm;
+                // parry's cylinder is along its local Y: turn Y onto Z.
+                let body_pose = Isometry3::from_parts(
+                    Translation3::new(0.0, 0.0, z1 + 0.5 * body_length_mm),
+                    UnitQuaternion::from_axis_angle(
+                        &UnitVector3::new_normalize(Vector3::x()),
+                        std::f64::consts::FRAC_PI_2,
+                    ),
+                );
                 vec![
-                    hull(
-                        &frustum_points(*tip_radius_mm, *tip_offset_mm, *nozzle_radius_mm, z1),
-                        "nozzle",
-                    )?,
-                    hull(
-                        &frustum_points(*body_radius_mm, z1, *body_radius_mm, z1 + body_length_mm),
-                        "body",
-                    )?,
+                    (
+                        Isometry3::identity(),
+                        TorchPart::Hull(hull(
+                            &frustum_points(*tip_radius_mm, *tip_offset_mm, *nozzle_radius_mm, z1),
+                            "nozzle",
+                        )?),
+                    ),
+                    (
+                        body_pose,
+                        TorchPart::Cylinder(Cylinder::new(0.5 * body_length_mm, *body_radius_mm)),
+                    ),
                 ]
             }
             TorchSpec::Hull { points } => {
                 let pts: Vec<Point3> = points.iter().map(|p| Point3::from(*p)).collect();
-                vec![hull(&pts, "points")?]
+                vec![(
+                    Isometry3::identity(),
+                    TorchPart::Hull(hull(&pts, "points")?),
+                )]
             }
         };
         Ok(Self {
@@ -385,6 +416,49 @@ impl<'a> Obstacles<'a> {
         }
     }
 
+    /// Whether the clearance of the torch at `point` with axis `tool` exceeds
+    /// `margin` (mm): bounded queries that only visit obstacles within the
+    /// margin, much cheaper than [`Obstacles::clearance`].
+    fn is_clear(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin: f64,
+    ) -> Result<bool, ToolAxisError> {
+        let torch_pose = part_from_torch(point, tool);
+        for (local, part) in &torch.parts {
+            let pose = torch_pose * local;
+            let part = part.shape();
+            if let Some(built) = &self.built {
+                let q = query::closest_points(
+                    &pose,
+                    part,
+                    &Isometry3::identity(),
+                    built,
+                    margin + self.bead_radius,
+                )
+                .map_err(|_| ToolAxisError::UnsupportedQuery {
+                    what: "the built part",
+                })?;
+                if !matches!(q, query::ClosestPoints::Disjoint) {
+                    return Ok(false);
+                }
+            }
+            if let Some((iso, shape)) = self.substrate {
+                let q = query::closest_points(&pose, part, iso, shape.as_ref(), margin).map_err(
+                    |_| ToolAxisError::UnsupportedQuery {
+                        what: "the substrate",
+                    },
+                )?;
+                if !matches!(q, query::ClosestPoints::Disjoint) {
+                    return Ok(false);
+                }
+            }
+        }
+        Ok(true)
+    }
+
     /// Clearance of the torch placed at `point` with axis `tool` (mm).
     fn clearance(
         &self,
@@ -392,9 +466,11 @@ impl<'a> Obstacles<'a> {
         point: &Point3,
         tool: &Vector3,
     ) -> Result<f64, ToolAxisError> {
-        let pose = part_from_torch(point, tool);
+        let torch_pose = part_from_torch(point, tool);
         let mut best = f64::INFINITY;
-        for part in &torch.parts {
+        for (local, part) in &torch.parts {
+            let pose = torch_pose * local;
+            let part = part.shape();
             if let Some(built) = &self.built {
                 let d =
                     query::distance(&pose, part, &Isometry3::identity(), built).map_err(|_| {
@@ -648,9 +724,13 @@ fn corrected(f: &LocalFrame, tool: &Vector3, c: &[f64; 2]) -> Vector3 {
 
 /// Tilts the tool axes, within a cone around each nominal axis, to clear the
 /// torch from the part built so far and the substrate, smoothly along each
-/// layer. For each point that misses the margin, rings of directions of
-/// growing angle are searched and the clearest direction of the first ring
-/// that reaches the margin kept; the corrections (angle and direction in the
+/// layer. For each point that misses the margin, rings of directions
+/// (`azimuths` per ring, `step_rad` apart) are searched for the smallest ring
+/// with a direction reaching the margin (bounded, cheap queries), taking the
+/// bisector of its widest free arc — starting from the previous
+/// point's ring, going down while rings clear and up otherwise (clearance is
+/// assumed to grow with the tilt; the result is re-checked) — and that
+/// direction kept; the corrections (angle and direction in the
 /// local `(t, T × t)` basis) are then spread along the layer as an upper
 /// envelope falling off at `max_rate_rad_per_mm`, re-searched where that
 /// did not clear, and the correction field finally smoothed to that rate. Returns the
@@ -728,40 +808,102 @@ pub fn avoid_collisions(
                 if todo.is_empty() {
                     break;
                 }
+                let mut hint = 1;
                 for &i in &todo {
                     let start = blended[i][0].hypot(blended[i][1]);
                     let rings = (aopts.cone_half_angle_rad / aopts.step_rad).floor() as usize;
-                    let mut found: Option<([f64; 2], f64)> = None;
-                    let mut best_any: Option<([f64; 2], f64)> = None;
-                    for r in 1..=rings {
+                    let first = ((start / aopts.step_rad).floor() as usize + 1).max(1);
+                    if first > rings {
+                        unresolved[i] = true;
+                        continue;
+                    }
+                    // Ring `r`: the direction in the middle of its longest run
+                    // of clear azimuths (the bisector of the free arc), if any.
+                    let m = aopts.azimuths;
+                    let dir_of = |r: usize, k: usize| {
                         let theta = r as f64 * aopts.step_rad;
-                        if theta <= start {
-                            continue;
+                        let phi = std::f64::consts::TAU * k as f64 / m as f64;
+                        [theta * phi.cos(), theta * phi.sin()]
+                    };
+                    let ring = |r: usize| -> Result<Option<[f64; 2]>, ToolAxisError> {
+                        let mut clear = Vec::with_capacity(m);
+                        for k in 0..m {
+                            let dir = corrected(&fr[i], &nominal[i], &dir_of(r, k));
+                            clear.push(obstacles.is_clear(
+                                torch,
+                                &positions[i],
+                                &dir,
+                                aopts.margin_mm,
+                            )?);
                         }
-                        let mut ring_best: Option<([f64; 2], f64)> = None;
-                        for k in 0..aopts.azimuths {
-                            let phi = std::f64::consts::TAU * k as f64 / aopts.azimuths as f64;
-                            let c = [theta * phi.cos(), theta * phi.sin()];
-                            let dir = corrected(&fr[i], &nominal[i], &c);
-                            let cl = obstacles.clearance(torch, &positions[i], &dir)?;
-                            if ring_best.is_none_or(|b| cl > b.1) {
-                                ring_best = Some((c, cl));
+                        if clear.iter().all(|&c| c) {
+                            // No obstacle in reach: keep the tilt along t.
+                            return Ok(Some(dir_of(r, 0)));
+                        }
+                        // Longest circular run of clear azimuths.
+                        let start = clear.iter().position(|&c| !c).expect("one blocked");
+                        let (mut best, mut run) = (None::<(usize, usize)>, None::<(usize, usize)>);
+                        for step in 1..=m {
+                            let k = (start + step) % m;
+                            if clear[k] {
+                                run = Some(run.map_or((k, 1), |(s0, len)| (s0, len + 1)));
+                                let cur = run.expect("just set");
+                                if best.is_none_or(|b| cur.1 > b.1) {
+                                    best = Some(cur);
+                                }
+                            } else {
+                                run = None;
                             }
                         }
-                        let rb = ring_best.expect("at least 4 azimuths");
-                        if best_any.is_none_or(|b| rb.1 > b.1) {
-                            best_any = Some(rb);
+                        Ok(best.map(|(s0, len)| {
+                            // Middle of the run (half-step for even lengths).
+                            let mid = s0 as f64 + 0.5 * (len as f64 - 1.0);
+                            let theta = r as f64 * aopts.step_rad;
+                            let phi = std::f64::consts::TAU * mid / m as f64;
+                            [theta * phi.cos(), theta * phi.sin()]
+                        }))
+                    };
+                    // Smallest clearing ring, searched from the previous
+                    // point's answer (neighbours need similar tilts): down
+                    // while rings clear, else up until one does.
+                    let mut found: Option<[f64; 2]> = None;
+                    let mut r = hint.clamp(first, rings);
+                    if let Some(c) = ring(r)? {
+                        found = Some(c);
+                        while r > first {
+                            match ring(r - 1)? {
+                                Some(c) => {
+                                    r -= 1;
+                                    found = Some(c);
+                                }
+                                None => break,
+                            }
                         }
-                        if rb.1 >= aopts.margin_mm {
-                            found = Some(rb);
-                            break;
+                    } else {
+                        while r < rings {
+                            r += 1;
+                            if let Some(c) = ring(r)? {
+                                found = Some(c);
+                                break;
+                            }
                         }
                     }
+                    hint = r;
                     match found {
-                        Some((c, _)) => need[i] = c,
+                        Some(c) => need[i] = c,
                         None => {
+                            // Best effort: the clearest direction of the widest ring.
                             unresolved[i] = true;
-                            if let Some((c, _)) = best_any {
+                            let mut best: Option<([f64; 2], f64)> = None;
+                            for k in 0..m {
+                                let c = dir_of(rings, k);
+                                let dir = corrected(&fr[i], &nominal[i], &c);
+                                let cl = obstacles.clearance(torch, &positions[i], &dir)?;
+                                if best.is_none_or(|b| cl > b.1) {
+                                    best = Some((c, cl));
+                                }
+                            }
+                            if let Some((c, _)) = best {
                                 need[i] = c;
                             }
                         }
@@ -771,7 +913,7 @@ pub fn avoid_collisions(
                 let sources: Vec<usize> = (0..n)
                     .filter(|&j| need[j][0] != 0.0 || need[j][1] != 0.0)
                     .collect();
-                for i in 0..n {
+                for (i, bl) in blended.iter_mut().enumerate() {
                     let mut best = (0.0, [0.0, 0.0]);
                     for &j in &sources {
                         let m = need[j][0].hypot(need[j][1]);
@@ -780,7 +922,7 @@ pub fn avoid_collisions(
                             best = (v, [need[j][0] / m * v, need[j][1] / m * v]);
                         }
                     }
-                    blended[i] = best.1;
+                    *bl = best.1;
                 }
                 for i in 0..n {
                     axes[i] = corrected(&fr[i], &nominal[i], &blended[i]);

@@ -336,10 +336,10 @@ pub fn smooth_angles(
         (0..n)
             .map(|i| {
                 let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-                for j in 0..n {
+                for (j, xj) in x.iter().enumerate() {
                     let d = l * dist(i, j);
-                    lo = lo.min(x[j] + d);
-                    hi = hi.max(x[j] - d);
+                    lo = lo.min(xj + d);
+                    hi = hi.max(xj - d);
                 }
                 0.5 * (lo + hi)
             })
