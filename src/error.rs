@@ -4,7 +4,9 @@
 use crate::geometry::GeometryError;
 use crate::io::cell_file::CellFileError;
 use crate::io::part_file::PartFileError;
+use crate::process::ProcessError;
 use crate::robot::RobotError;
+use crate::toolaxis::ToolAxisError;
 
 /// Any error of the library.
 #[derive(Debug, thiserror::Error)]
@@ -22,4 +24,10 @@ pub enum Error {
     /// A cell file could not be read.
     #[error(transparent)]
     CellFile(#[from] CellFileError),
+    /// The tool-axis stage failed (invalid option or torch, degenerate point).
+    #[error(transparent)]
+    ToolAxis(#[from] ToolAxisError),
+    /// The process stage failed (invalid parameter or option).
+    #[error(transparent)]
+    Process(#[from] ProcessError),
 }

@@ -24,6 +24,7 @@
 //! | 1. tube geometry: guide curves, frames, profile law, substrates | [`geometry`] | §2 |
 //! | 2. deposition paths: four strategies, distance map, truncation, seams | [`path`] | §3 |
 //! | 3. tool axes (local frames, build direction) | [`toolaxis`] | §4 |
+//! | 3b. process: bead, travel speeds, estimates | [`process`] | §5 |
 //! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
 //!
 //! ## Units and frames
@@ -54,6 +55,7 @@ pub mod geometry;
 pub mod io;
 pub mod math;
 pub mod path;
+pub mod process;
 pub mod robot;
 pub mod toolaxis;
 

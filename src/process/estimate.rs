@@ -1,0 +1,63 @@
+//! Estimates of a deposition: time, wire length, deposited volume and mass,
+//! arc starts [SPEC §5]. mm, s, g.
+
+use crate::path::Path;
+
+/// What a deposition costs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimates {
+    /// Number of layers (beads) deposited.
+    pub layers: usize,
+    /// Arc starts (one per bead: layers, open pieces counted separately).
+    pub arc_starts: usize,
+    /// Length of the path under the arc (mm), closing segments included.
+    pub path_length_mm: f64,
+    /// Time under the arc (s): path length over the travel speed.
+    pub deposition_time_s: f64,
+    /// Wire fed (mm): WFS × time.
+    pub wire_length_mm: f64,
+    /// Wire volume (mm³): wire length × π d_f² / 4.
+    pub wire_volume_mm3: f64,
+    /// Deposited mass (g): wire volume × density (all the wire is deposited).
+    pub deposited_mass_g: f64,
+}
+
+/// Estimates for `path` given the travel speed at every point
+/// (`speeds[layer][point]`, mm/s): each segment is travelled at the mean of
+/// the inverse speeds of its ends; closing segments of closed layers count.
+pub(crate) fn estimate(
+    path: &Path,
+    speeds: &[Vec<f64>],
+    wire_diameter_mm: f64,
+    wire_feed_speed_mm_s: f64,
+    density_kg_m3: f64,
+) -> Estimates {
+    let mut length = 0.0;
+    let mut time = 0.0;
+    for (l, v) in path.layers.iter().zip(speeds) {
+        let n = l.points.len();
+        let segs = if l.closed && n > 2 {
+            n
+        } else {
+            n.saturating_sub(1)
+        };
+        for i in 0..segs {
+            let j = (i + 1) % n;
+            let d = (l.points[j].position - l.points[i].position).norm();
+            length += d;
+            time += d * 0.5 * (1.0 / v[i] + 1.0 / v[j]);
+        }
+    }
+    let wire_length_mm = wire_feed_speed_mm_s * time;
+    let wire_volume_mm3 = wire_length_mm * std::f64::consts::PI * wire_diameter_mm.powi(2) / 4.0;
+    Estimates {
+        layers: path.layers.len(),
+        arc_starts: path.layers.iter().filter(|l| !l.points.is_empty()).count(),
+        path_length_mm: length,
+        deposition_time_s: time,
+        wire_length_mm,
+        wire_volume_mm3,
+        // 1 mm³ = 1e-9 m³; kg -> g: × 1e3.
+        deposited_mass_g: wire_volume_mm3 * density_kg_m3 * 1e-6,
+    }
+}

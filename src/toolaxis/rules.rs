@@ -1,0 +1,442 @@
+//! Rules that set the tool axis point by point, the projection of build
+//! directions into a plane, and the smoothing of tool axes along a layer
+//! [SPEC §4; thesis eq. 3.20–3.21, §3.3.1]. Angles in rad, lengths in mm,
+//! part frame.
+
+use super::lead_tilt::tool_axis;
+use super::{LocalFrame, ToolAxisError};
+use crate::math::{self, Point3, Vector3};
+use crate::path::Path;
+use serde::{Deserialize, Serialize};
+
+/// How the lead/tilt angles of each point are chosen.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum AxisRule {
+    /// The constant angles of the options everywhere.
+    #[default]
+    None,
+    /// The tool axis never leans more than `max_angle_rad` from `axis` (part
+    /// frame): where it would, the tilt `theta_t` is changed so that it leans
+    /// exactly `max_angle_rad` (the lead is kept). The thesis's rule for the
+    /// hemisphere top is `axis = Z`, 50° (eq. 3.20–3.21, whose printed
+    /// inequality is garbled: as printed it would tilt the axes that are
+    /// already within 50°).
+    MaxAngleFromAxis {
+        /// The cone axis (part frame, need not be unit).
+        axis: [f64; 3],
+        /// The cone half-angle (rad, in (0, π/2)).
+        max_angle_rad: f64,
+    },
+    /// Given `(theta_n, theta_t)` (rad) per point, `angles[layer][point]`,
+    /// replacing the constants.
+    PerPoint {
+        /// Lead and tilt per point.
+        angles: Vec<Vec<[f64; 2]>>,
+    },
+}
+
+/// What a rule decided at one point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RuleOutcome {
+    /// Lead `theta_n` (rad).
+    pub lead_rad: f64,
+    /// Tilt `theta_t` (rad).
+    pub tilt_rad: f64,
+    /// Whether the rule changed the angles.
+    pub active: bool,
+    /// Whether the rule's target was met (false: best effort).
+    pub reached: bool,
+}
+
+impl AxisRule {
+    /// The thesis's 50° rule: `T` within 50° of the part's +Z (eq. 3.20–3.21).
+    pub fn thesis_50_deg() -> Self {
+        AxisRule::MaxAngleFromAxis {
+            axis: [0.0, 0.0, 1.0],
+            max_angle_rad: 50f64.to_radians(),
+        }
+    }
+
+    /// Checks the rule's own numbers.
+    ///
+    /// # Errors
+    /// [`ToolAxisError::InvalidOption`] naming the field.
+    pub fn validate(&self) -> Result<(), ToolAxisError> {
+        let bad = |field: &'static str, reason: String| {
+            Err(ToolAxisError::InvalidOption { field, reason })
+        };
+        match self {
+            AxisRule::None => Ok(()),
+            AxisRule::MaxAngleFromAxis {
+                axis,
+                max_angle_rad,
+            } => {
+                let a = Vector3::from(*axis);
+                if !(a.iter().all(|c| c.is_finite()) && a.norm() > 0.0) {
+                    return bad(
+                        "rule.axis",
+                        format!("must be finite and non-zero, got {axis:?}"),
+                    );
+                }
+                if !(*max_angle_rad > 0.0 && *max_angle_rad < std::f64::consts::FRAC_PI_2) {
+                    return bad(
+                        "rule.max_angle_rad",
+                        format!("must be in (0, π/2), got {max_angle_rad}"),
+                    );
+                }
+                Ok(())
+            }
+            AxisRule::PerPoint { angles } => {
+                for (li, l) in angles.iter().enumerate() {
+                    for (pi, a) in l.iter().enumerate() {
+                        if !a
+                            .iter()
+                            .all(|x| x.is_finite() && x.abs() < std::f64::consts::FRAC_PI_2)
+                        {
+                            return bad(
+                                "rule.angles",
+                                format!(
+                                    "layer {li}, point {pi}: angles must be finite and within (-π/2, π/2), got {a:?}"
+                                ),
+                            );
+                        }
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// The angles at point `(layer, point)` of a frame, given the constant
+    /// angles of the options.
+    pub fn apply(
+        &self,
+        frame: &LocalFrame,
+        lead_rad: f64,
+        tilt_rad: f64,
+        layer: usize,
+        point: usize,
+    ) -> RuleOutcome {
+        let unchanged = RuleOutcome {
+            lead_rad,
+            tilt_rad,
+            active: false,
+            reached: true,
+        };
+        match self {
+            AxisRule::None => unchanged,
+            AxisRule::PerPoint { angles } => {
+                let [lead_rad, tilt_rad] = angles[layer][point];
+                RuleOutcome {
+                    lead_rad,
+                    tilt_rad,
+                    active: true,
+                    reached: true,
+                }
+            }
+            AxisRule::MaxAngleFromAxis {
+                axis,
+                max_angle_rad,
+            } => {
+                let a = Vector3::from(*axis).normalize();
+                let t0 = tool_axis(frame, lead_rad, tilt_rad);
+                let cos_max = max_angle_rad.cos();
+                if t0.dot(&a) >= cos_max - 1e-15 {
+                    return unchanged;
+                }
+                match tilt_into_cone(frame, lead_rad, tilt_rad, &a, cos_max) {
+                    Ok(tilt) => RuleOutcome {
+                        lead_rad,
+                        tilt_rad: tilt,
+                        active: true,
+                        reached: true,
+                    },
+                    Err(best) => RuleOutcome {
+                        lead_rad,
+                        tilt_rad: best,
+                        active: true,
+                        reached: false,
+                    },
+                }
+            }
+        }
+    }
+}
+
+/// The tilt `theta_t` (rad) closest to `tilt_rad` that puts the tool axis at
+/// exactly `acos(cos_max)` from the unit `axis`, keeping the lead. In the
+/// normal plane `T(psi) = cos psi û + sin psi n` with `û ∝ b + tan(theta_n) t`
+/// and `tan theta_t = |b + tan(theta_n) t| tan psi`; `axis · T(psi) =
+/// rho cos(psi − phi)`. `Err(best tilt)` when the cone cannot be reached by
+/// tilting alone.
+fn tilt_into_cone(
+    frame: &LocalFrame,
+    lead_rad: f64,
+    tilt_rad: f64,
+    axis: &Vector3,
+    cos_max: f64,
+) -> Result<f64, f64> {
+    let u = frame.build + frame.tangent * lead_rad.tan();
+    let l = u.norm();
+    let uh = u / l;
+    let (au, an) = (axis.dot(&uh), axis.dot(&frame.normal));
+    let rho = au.hypot(an);
+    let phi = an.atan2(au);
+    let lim = std::f64::consts::FRAC_PI_2 - 1e-6;
+    let to_tilt = |psi: f64| (l * psi.clamp(-lim, lim).tan()).atan();
+    if rho < cos_max {
+        return Err(to_tilt(phi));
+    }
+    let psi0 = (tilt_rad.tan() / l).atan();
+    let d = (cos_max / rho).clamp(-1.0, 1.0).acos();
+    let psi = [phi - d, phi + d]
+        .into_iter()
+        .filter(|p| p.abs() < lim)
+        .min_by(|x, y| (x - psi0).abs().total_cmp(&(y - psi0).abs()));
+    match psi {
+        Some(p) => Ok(to_tilt(p)),
+        None => Err(to_tilt(phi)),
+    }
+}
+
+/// Checks that per-point data has the shape of `path.layers`.
+pub(crate) fn check_shape(
+    path: &Path,
+    lens: impl Iterator<Item = usize>,
+) -> Result<(), ToolAxisError> {
+    let lens: Vec<usize> = lens.collect();
+    for (li, l) in path.layers.iter().enumerate() {
+        let got = lens.get(li).copied().unwrap_or(0);
+        if got != l.points.len() {
+            return Err(ToolAxisError::ShapeMismatch {
+                layer: li,
+                frames: got,
+                points: l.points.len(),
+            });
+        }
+    }
+    if lens.len() > path.layers.len() {
+        return Err(ToolAxisError::ShapeMismatch {
+            layer: path.layers.len(),
+            frames: lens[path.layers.len()],
+            points: 0,
+        });
+    }
+    Ok(())
+}
+
+/// Projects every build direction into the plane of unit normal `p`
+/// (thesis §3.3.1) and re-orthonormalises `t` and `n` against it; the tool
+/// axis is reset to the projected `b`. A `b` along `p` is left as is.
+pub(crate) fn project_build(frames: &mut [Vec<LocalFrame>], p: &Vector3) {
+    for f in frames.iter_mut().flatten() {
+        let b = f.build - p * f.build.dot(p);
+        if b.norm() < 1e-9 {
+            continue;
+        }
+        let b = b.normalize();
+        let t = f.tangent - b * f.tangent.dot(&b);
+        let t = if t.norm() > 1e-9 {
+            t.normalize()
+        } else {
+            math::any_perpendicular(&b)
+        };
+        let n = f.normal - b * f.normal.dot(&b) - t * f.normal.dot(&t);
+        let n = if n.norm() > 1e-9 {
+            n.normalize()
+        } else {
+            b.cross(&t)
+        };
+        *f = LocalFrame {
+            tangent: t,
+            normal: n,
+            build: b,
+            tool: b,
+        };
+    }
+}
+
+/// Angle (rad) between two unit vectors, robust near 0 and π.
+pub(crate) fn angle(a: &Vector3, b: &Vector3) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// Rotates unit `a` toward unit `b` by `fraction` of the angle between them.
+pub(crate) fn slerp(a: &Vector3, b: &Vector3, fraction: f64) -> Vector3 {
+    let theta = angle(a, b);
+    if theta < 1e-15 {
+        return *b;
+    }
+    let mut k = a.cross(b);
+    if k.norm() < 1e-12 {
+        k = math::any_perpendicular(a);
+    }
+    let k = k.normalize();
+    let r = super::lead_tilt::rodrigues(&k, theta * fraction);
+    (r * a).normalize()
+}
+
+/// Largest angular rate of consecutive axes (rad/mm); pairs of coincident
+/// points are skipped.
+pub fn max_rate(positions: &[Point3], axes: &[Vector3], closed: bool) -> f64 {
+    let n = positions.len();
+    let pairs = if closed && n > 2 {
+        n
+    } else {
+        n.saturating_sub(1)
+    };
+    (0..pairs)
+        .filter_map(|i| {
+            let j = (i + 1) % n;
+            let d = (positions[j] - positions[i]).norm();
+            (d > 1e-12).then(|| angle(&axes[i], &axes[j]) / d)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Smooths the lead/tilt angles `(theta_n, theta_t)` (rad) of a layer so that
+/// they change by at most `max_rate_rad_per_mm` per mm of path between any
+/// two points (Euclidean norm of the angle pair; distances along the layer,
+/// wrapping on a closed layer). Each angle is replaced by the mean of its
+/// lower and upper Lipschitz envelopes, `(min_j (x_j + L d_ij) + max_j (x_j −
+/// L d_ij)) / 2` with `L = rate / √2`: both are `L`-Lipschitz, so is their
+/// mean, it is exact in one pass and leaves an already smooth field alone.
+/// Returns the number of points whose angles moved.
+pub fn smooth_angles(
+    positions: &[Point3],
+    angles: &mut [(f64, f64)],
+    closed: bool,
+    max_rate_rad_per_mm: f64,
+) -> usize {
+    let n = angles.len();
+    if n < 2 {
+        return 0;
+    }
+    let mut s = vec![0.0; n];
+    for i in 1..n {
+        s[i] = s[i - 1] + (positions[i] - positions[i - 1]).norm();
+    }
+    let total = s[n - 1]
+        + if closed {
+            (positions[0] - positions[n - 1]).norm()
+        } else {
+            0.0
+        };
+    let dist = |i: usize, j: usize| {
+        let d = (s[i] - s[j]).abs();
+        if closed {
+            d.min(total - d)
+        } else {
+            d
+        }
+    };
+    let l = max_rate_rad_per_mm / std::f64::consts::SQRT_2;
+    let envelope = |x: &[f64]| -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for (j, xj) in x.iter().enumerate() {
+                    let d = l * dist(i, j);
+                    lo = lo.min(xj + d);
+                    hi = hi.max(xj - d);
+                }
+                0.5 * (lo + hi)
+            })
+            .collect()
+    };
+    let lead: Vec<f64> = angles.iter().map(|a| a.0).collect();
+    let tilt: Vec<f64> = angles.iter().map(|a| a.1).collect();
+    let (lead, tilt) = (envelope(&lead), envelope(&tilt));
+    let mut moved = 0;
+    for (a, (ln, tn)) in angles.iter_mut().zip(lead.into_iter().zip(tilt)) {
+        if (a.0 - ln).abs() > 1e-15 || (a.1 - tn).abs() > 1e-15 {
+            moved += 1;
+        }
+        *a = (ln, tn);
+    }
+    moved
+}
+
+/// Largest rate of change of the lead/tilt pair between consecutive points
+/// (rad/mm, Euclidean norm of the pair).
+pub fn max_angle_rate(positions: &[Point3], angles: &[(f64, f64)], closed: bool) -> f64 {
+    let n = positions.len();
+    let pairs = if closed && n > 2 {
+        n
+    } else {
+        n.saturating_sub(1)
+    };
+    (0..pairs)
+        .filter_map(|i| {
+            let j = (i + 1) % n;
+            let d = (positions[j] - positions[i]).norm();
+            (d > 1e-12).then(|| (angles[j].0 - angles[i].0).hypot(angles[j].1 - angles[i].1) / d)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Smooths unit tool axes along a layer in absolute terms (best effort) so that the angle between consecutive
+/// axes is at most `max_rate_rad_per_mm` times their distance (mm): forward
+/// and backward slew-rate limiting (rotating an axis toward its neighbour),
+/// then symmetric relaxation of the pairs still violating the bound (at most
+/// 2000 sweeps), wrapping on a closed layer. Rotating toward a neighbour stays inside any cone of half-angle
+/// < 90° holding both (so the 50° rule survives). Returns the number of
+/// axes moved.
+///
+/// The bound must be feasible: the axes of a closed layer that lean `a` from
+/// the part's axis turn by about `sin(a) / rho` rad/mm around a part of radius
+/// `rho`; below that the sweeps stop after their budget with the bound
+/// unmet — check [`max_rate`] (reported by [`super::tool_axes`]).
+pub fn smooth_layer(
+    positions: &[Point3],
+    axes: &mut [Vector3],
+    closed: bool,
+    max_rate_rad_per_mm: f64,
+) -> usize {
+    let n = axes.len();
+    if n < 2 {
+        return 0;
+    }
+    let original: Vec<Vector3> = axes.to_vec();
+    let limit = |axes: &mut [Vector3], from: usize, to: usize| {
+        let d = (positions[to] - positions[from]).norm();
+        let max = max_rate_rad_per_mm * d;
+        let a = angle(&axes[from], &axes[to]);
+        if a > max * (1.0 + 1e-12) + 1e-15 {
+            axes[to] = slerp(&axes[from], &axes[to], max / a);
+        }
+    };
+    // Forward and backward sweeps propagate the bound quickly; on a closed
+    // layer the wrap pair can leave them cycling, so symmetric relaxation
+    // (both ends of a violating pair move halfway, aiming slightly inside the
+    // bound) finishes the job.
+    for i in 1..n {
+        limit(axes, i - 1, i);
+    }
+    for i in (0..n - 1).rev() {
+        limit(axes, i + 1, i);
+    }
+    let pairs = if closed && n > 2 { n } else { n - 1 };
+    for _ in 0..2000 {
+        if max_rate(positions, axes, closed) <= max_rate_rad_per_mm * (1.0 + 1e-9) {
+            break;
+        }
+        for i in 0..pairs {
+            let j = (i + 1) % n;
+            let d = (positions[j] - positions[i]).norm();
+            let target = max_rate_rad_per_mm * d * (1.0 - 1e-6);
+            let a = angle(&axes[i], &axes[j]);
+            if a > target && a > 0.0 {
+                let (ai, aj) = (axes[i], axes[j]);
+                let f = 0.5 * (a - target) / a;
+                axes[i] = slerp(&ai, &aj, f);
+                axes[j] = slerp(&aj, &ai, f);
+            }
+        }
+    }
+    axes.iter()
+        .zip(&original)
+        .filter(|(a, o)| angle(a, o) > 1e-12)
+        .count()
+}

@@ -1,0 +1,137 @@
+//! Rules on the sample parts: the 50° rule (thesis eq. 3.20–3.21), the
+//! projection of build directions into a plane (§3.3.1), smoothing.
+
+use crate::common::load_part;
+use waam_slicer::path::{slice, Discretisation};
+use waam_slicer::toolaxis::{max_angle_rate, tool_axes, tool_axis, AxisRule, ToolAxisOptions};
+
+/// Hemisphere, Delta = 5, 500 points: with the 50° rule every tool axis is
+/// within 50° of the part's Z; where `b` leans more the axis is at exactly
+/// 50°, elsewhere it is `b`.
+#[test]
+fn fifty_degree_rule_on_the_hemisphere() {
+    let part = load_part("hemisphere.toml");
+    let path = slice(&part.tube, &part.substrate, &part.slice_options()).unwrap();
+    let axes = tool_axes(
+        &path,
+        Some(&part.tube),
+        Some(&part.substrate),
+        &ToolAxisOptions::thesis_50_deg_rule(),
+    )
+    .unwrap();
+    let limit = 50f64.to_radians();
+    assert!(axes.report.max_angle_from_z_rad <= limit + 1e-9);
+    assert_eq!(axes.report.rule_unreachable_count, 0);
+    let mut active = 0;
+    for f in axes.frames.iter().flatten() {
+        let b_angle = f.build.z.clamp(-1.0, 1.0).acos();
+        let t_angle = f.tool.z.clamp(-1.0, 1.0).acos();
+        if b_angle > limit {
+            active += 1;
+            assert!((t_angle - limit).abs() < 1e-9);
+        } else {
+            assert_eq!(f.tool, f.build);
+        }
+    }
+    assert_eq!(active, axes.report.rule_active_points);
+    // b reaches ~86° at the top: the rule is active on the upper layers.
+    assert!(active >= 500 * 4, "{active}");
+    // With smoothing on top, the cone still holds (on a part of revolution
+    // the rule's tilt is constant along a layer: nothing to smooth). The
+    // axes turn with the frame: sin(50°)/rho = 0.14 rad/mm on the top layer.
+    eprintln!(
+        "rule only: max rate {:.4} rad/mm",
+        axes.report.max_rate_rad_per_mm
+    );
+    let smoothed = tool_axes(
+        &path,
+        Some(&part.tube),
+        Some(&part.substrate),
+        &ToolAxisOptions {
+            max_rate_rad_per_mm: Some(0.01),
+            ..ToolAxisOptions::thesis_50_deg_rule()
+        },
+    )
+    .unwrap();
+    assert!(smoothed.report.max_angle_from_z_rad <= limit + 1e-9);
+    assert!(smoothed.report.max_angle_rate_rad_per_mm <= 0.01 * (1.0 + 1e-9));
+    assert_eq!(smoothed.frames, axes.frames);
+}
+
+/// Torus on a cylinder: build directions projected into the YZ plane
+/// (thesis §3.3.1) have no X component, and the tool axes follow them.
+#[test]
+fn projection_into_the_yz_plane_on_the_torus_on_cylinder() {
+    let part = load_part("torus-on-cylinder.toml");
+    let mut o = part.slice_options();
+    o.discretisation = Discretisation::Points(100);
+    let path = slice(&part.tube, &part.substrate, &o).unwrap();
+    let axes = tool_axes(
+        &path,
+        Some(&part.tube),
+        Some(&part.substrate),
+        &ToolAxisOptions {
+            project_build: Some([1.0, 0.0, 0.0]),
+            ..ToolAxisOptions::default()
+        },
+    )
+    .unwrap();
+    for f in axes.frames.iter().flatten() {
+        assert!(f.build.x.abs() < 1e-12);
+        assert!((f.build.norm() - 1.0).abs() < 1e-12);
+        assert_eq!(f.tool, f.build);
+        assert!(f.tangent.dot(&f.build).abs() < 1e-12);
+    }
+}
+
+/// Smoothing bounds the rate of the lead/tilt angles along every layer of
+/// the general tube given jagged per-point angles.
+#[test]
+fn smoothing_bounds_the_rate_along_layers() {
+    let part = load_part("general-tube.toml");
+    let mut o = part.slice_options();
+    o.discretisation = Discretisation::Points(100);
+    o.max_layers = Some(6);
+    let path = slice(&part.tube, &part.substrate, &o).unwrap();
+    // Alternating tilts: a jagged axis field.
+    let angles = path
+        .layers
+        .iter()
+        .map(|l| {
+            (0..l.points.len())
+                .map(|i| [0.0, if i % 2 == 0 { 0.3 } else { -0.3 }])
+                .collect()
+        })
+        .collect();
+    let rate = 0.1;
+    let opts = ToolAxisOptions {
+        rule: AxisRule::PerPoint { angles },
+        max_rate_rad_per_mm: Some(rate),
+        ..ToolAxisOptions::default()
+    };
+    let axes = tool_axes(&path, Some(&part.tube), Some(&part.substrate), &opts).unwrap();
+    assert!(axes.report.smoothed_points > 0);
+    for (l, (fl, al)) in path.layers.iter().zip(axes.frames.iter().zip(&axes.angles)) {
+        let p: Vec<_> = l.points.iter().map(|p| p.position).collect();
+        assert!(max_angle_rate(&p, al, l.closed) <= rate * (1.0 + 1e-9));
+        // T relative to the frame is what the angles say.
+        for (f, &(lead, tilt)) in fl.iter().zip(al) {
+            assert!((f.tool - tool_axis(f, lead, tilt)).norm() < 1e-12);
+        }
+    }
+    let raw = tool_axes(
+        &path,
+        Some(&part.tube),
+        Some(&part.substrate),
+        &ToolAxisOptions {
+            max_rate_rad_per_mm: None,
+            ..opts
+        },
+    )
+    .unwrap();
+    eprintln!(
+        "jagged: {:.3} rad/mm, smoothed: {:.3} rad/mm",
+        raw.report.max_rate_rad_per_mm, axes.report.max_rate_rad_per_mm
+    );
+    assert!(raw.report.max_rate_rad_per_mm > 3.0 * axes.report.max_rate_rad_per_mm);
+}
