@@ -25,6 +25,7 @@
 //! | 2. deposition paths: four strategies, distance map, truncation, seams | [`path`] | §3 |
 //! | 3. tool axes (local frames, build direction) | [`toolaxis`] | §4 |
 //! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
+//! | 5. layer-by-layer optimisation of `R_Z` (branch, SQP, quality) | [`optimise`] | §7 |
 //!
 //! ## Units and frames
 //!
@@ -53,6 +54,7 @@ pub mod error;
 pub mod geometry;
 pub mod io;
 pub mod math;
+pub mod optimise;
 pub mod path;
 pub mod robot;
 pub mod toolaxis;
