@@ -25,7 +25,8 @@
 //!    points of the layer for a coarse set of seeds (constant `R_Z`, and
 //!    `c − theta` on layers turning about the part Z axis); the branch whose
 //!    best seed is feasible and most centred in the joint ranges is kept for
-//!    the whole layer (the cell's own branch wins near-ties) — see
+//!    the whole layer (the cell's own branch wins unless another is 1.5 times
+//!    more centred) — see
 //!    [`ConfigurationChoiceReport`]. If its optimisation ends infeasible the
 //!    next branches are tried.
 //! 2. **Polynomial degree** raised from the seed's with warm starts (the new
@@ -466,7 +467,7 @@ fn optimise_layer(cell: &Cell, lp: &LayerPoints, opts: &OptimiseOptions) -> Laye
     let own = cell.configuration();
     ranked.sort_by(|a, b| {
         let key = |x: &(Configuration, Seed)| {
-            let bonus = if x.0 == own { 0.95 } else { 1.0 };
+            let bonus = if x.0 == own { 1.0 / 1.5 } else { 1.0 };
             (x.1.violation, x.1.centring * bonus)
         };
         let (va, ca) = key(a);

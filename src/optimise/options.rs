@@ -113,8 +113,9 @@ impl Default for DexterityFloor {
 #[serde(rename_all = "snake_case")]
 pub enum ConfigurationChoice {
     /// Evaluate the eight branches on every layer and keep the one whose
-    /// seed is feasible and most centred in the joint ranges (the cell's own
-    /// branch wins ties within 5 %).
+    /// seed is feasible and most centred in the joint ranges; the cell's own
+    /// branch is kept while its centring score is within 1.5 times the best
+    /// (changing branch between layers means reconfiguring the arm).
     #[default]
     BestPerLayer,
     /// The cell's configuration on every layer.
@@ -146,8 +147,8 @@ impl Default for SqpOptions {
             max_iterations: 60,
             initial_trust_rad: 0.5,
             min_trust_rad: 1e-9,
-            step_tolerance_rad: 1e-8,
-            relative_tolerance: 1e-12,
+            step_tolerance_rad: 1e-7,
+            relative_tolerance: 1e-9,
             penalty: 1e3,
         }
     }
@@ -200,8 +201,8 @@ impl Default for OptimiseOptions {
             configuration: ConfigurationChoice::default(),
             joint_limit_margin_rad: 0.5f64.to_radians(),
             centring_weight: 1e-3,
-            seeds: 24,
-            seed_points: 24,
+            seeds: 12,
+            seed_points: 12,
             sqp: SqpOptions::default(),
             trajectory: TrajectoryOptions::default(),
             parallel: true,

@@ -298,7 +298,7 @@ impl<'a> LayerProblem<'a> {
     /// Every constraint value `c ≤ 0` at `e` (rad, or relative for the
     /// dexterity), calling `sink(point, constraint, value, gradient along R_Z
     /// at point m and at m−1)`. Gradients of the dexterity are computed only
-    /// when `with_dex_slope` and the point is within a factor 2 of its floor.
+    /// when `with_dex_slope` and the point is within a factor 1.5 of its floor.
     pub fn constraints(
         &self,
         e: &Evaluation,
@@ -331,7 +331,7 @@ impl<'a> LayerProblem<'a> {
             }
             let psi = self.psi[m];
             if psi > 0.0 {
-                let d = if with_dex_slope && e.dex[m] < 2.0 * psi {
+                let d = if with_dex_slope && e.dex[m] < 1.5 * psi {
                     self.slope(e, m, Self::dex_of)
                 } else {
                     0.0

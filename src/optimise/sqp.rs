@@ -177,7 +177,9 @@ pub(crate) fn solve(
             .zip(&e.r)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
-        if !(predicted > 1e-15 * (1.0 + merit.abs())) || step < opts.step_tolerance_rad {
+        if !(predicted > 0.1 * opts.relative_tolerance * (1.0 + merit.abs()))
+            || step < opts.step_tolerance_rad
+        {
             converged = true;
             break;
         }

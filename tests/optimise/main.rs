@@ -3,4 +3,8 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod circle;
+mod cli;
 mod explore;
+mod parts;
+mod support;
