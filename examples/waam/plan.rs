@@ -91,8 +91,8 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
     }
     let t_read = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let path =
-        slice(&part.tube, &part.substrate, &so).map_err(|e| format!("{}: {e}", a.part.display()))?;
+    let path = slice(&part.tube, &part.substrate, &so)
+        .map_err(|e| format!("{}: {e}", a.part.display()))?;
     let t_slice = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
     let frames = local_frames(&path, &part.tube);

@@ -162,8 +162,7 @@ pub fn optimise(
         for (i, p) in l.points.iter().enumerate() {
             let finite = p.position_mm.iter().all(|v| v.is_finite())
                 && p.tool_axis.iter().all(|v| v.is_finite())
-                && p
-                    .build_direction
+                && p.build_direction
                     .is_none_or(|b| b.iter().all(|v| v.is_finite()));
             if !finite {
                 return Err(OptimiseError::BadPoint {
@@ -181,7 +180,10 @@ pub fn optimise(
             .map(|l| optimise_layer(cell, l, opts))
             .collect()
     } else {
-        layers.iter().map(|l| optimise_layer(cell, l, opts)).collect()
+        layers
+            .iter()
+            .map(|l| optimise_layer(cell, l, opts))
+            .collect()
     };
     let transitions = transitions(cell, &plans);
     Ok(Plan {
@@ -386,10 +388,7 @@ impl<'a> LayerSetup<'a> {
                             if let Some(qp) = pose.positioner {
                                 q8 = qp[1];
                             }
-                            crate::robot::indices::dexterity(
-                                &robot.jacobian(&q),
-                                prob.dex_scale,
-                            )
+                            crate::robot::indices::dexterity(&robot.jacobian(&q), prob.dex_scale)
                         }
                         Err(_) => f64::NAN,
                     })
@@ -400,9 +399,14 @@ impl<'a> LayerSetup<'a> {
                     .filter(|x| x.is_finite())
                     .fold(f64::INFINITY, f64::min);
                 let fallback = if fallback.is_finite() { fallback } else { 0.0 };
-                d.iter()
-                    .map(|x| fraction * if x.is_finite() { *x } else { fallback })
-                    .collect()
+                // one floor per layer: the mean over the layer (see the
+                // option's doc for why not the thesis's per-point value)
+                let mean = d
+                    .iter()
+                    .map(|x| if x.is_finite() { *x } else { fallback })
+                    .sum::<f64>()
+                    / p as f64;
+                vec![fraction * mean; p]
             }
         }
     }
@@ -451,12 +455,12 @@ fn optimise_layer(cell: &Cell, lp: &LayerPoints, opts: &OptimiseOptions) -> Laye
 
     // 1. branches
     let fixed = matches!(opts.parameterisation, Parameterisation::Fixed { .. });
-    let candidates: Vec<Configuration> =
-        if fixed || opts.configuration == ConfigurationChoice::Cell {
-            vec![cell.configuration()]
-        } else {
-            Configuration::ALL.to_vec()
-        };
+    let candidates: Vec<Configuration> = if fixed || opts.configuration == ConfigurationChoice::Cell
+    {
+        vec![cell.configuration()]
+    } else {
+        Configuration::ALL.to_vec()
+    };
     let mut ranked: Vec<(Configuration, Seed)> = candidates
         .iter()
         .map(|&cfg| {
@@ -650,7 +654,14 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
             outcome.law = RzLaw::SmoothingSpline;
             let basis = Basis::PerPoint { points: p };
             let scale = scale_of(&problem, &seed.r, smoothness);
-            match sqp::solve(&problem, &basis, seed.r.clone(), smoothness, scale, &opts.sqp) {
+            match sqp::solve(
+                &problem,
+                &basis,
+                seed.r.clone(),
+                smoothness,
+                scale,
+                &opts.sqp,
+            ) {
                 Ok(res) => {
                     outcome.iterations = res.iterations;
                     outcome.qp_solves = res.qp_solves;
@@ -689,8 +700,7 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
                             None => true,
                             Some((_, _, _, b)) => {
                                 res.violation < b.violation
-                                    || (res.violation <= b.violation
-                                        && res.objective < b.objective)
+                                    || (res.violation <= b.violation && res.objective < b.objective)
                             }
                         };
                         let gain = match &best {
@@ -772,7 +782,10 @@ fn point_by_point(problem: &LayerProblem, r0: f64) -> Result<Evaluation, PointFa
                 let (lo, hi) = if j == 4 && q[4] >= 0.0 {
                     (problem.lower[4].max(problem.wrist_margin), problem.upper[4])
                 } else if j == 4 {
-                    (problem.lower[4], problem.upper[4].min(-problem.wrist_margin))
+                    (
+                        problem.lower[4],
+                        problem.upper[4].min(-problem.wrist_margin),
+                    )
                 } else {
                     (problem.lower[j], problem.upper[j])
                 };

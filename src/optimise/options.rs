@@ -87,8 +87,12 @@ pub enum Objective {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DexterityFloor {
-    /// `fraction ×` the dexterity of the unoptimised path (`R_Z = 0`) at the
-    /// same point (the thesis: a quarter, §4.1.3).
+    /// `fraction ×` the dexterity of the unoptimised path (`R_Z = 0`), one
+    /// floor per layer: the fraction of the layer's mean unoptimised
+    /// dexterity (the thesis: a quarter, §4.1.3). The thesis takes the
+    /// floor point by point; but the unoptimised dexterity varies along a
+    /// layer only because `R_Z = 0` turns the wrist, and a floor that varies
+    /// with it, once active, bends trajectories that could stay still.
     FractionOfUnoptimised {
         /// The fraction (0..1).
         fraction: f64,
@@ -266,7 +270,9 @@ impl OptimiseOptions {
             );
         }
         match self.dexterity_floor {
-            DexterityFloor::FractionOfUnoptimised { fraction } if !(0.0..1.0).contains(&fraction) => {
+            DexterityFloor::FractionOfUnoptimised { fraction }
+                if !(0.0..1.0).contains(&fraction) =>
+            {
                 return bad("dexterity_floor.fraction", fraction, "must be in [0, 1)")
             }
             DexterityFloor::Absolute { dexterity } if !(0.0..1.0).contains(&dexterity) => {

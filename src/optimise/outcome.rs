@@ -147,7 +147,10 @@ pub enum LayerStatus {
 impl LayerStatus {
     /// `true` when the layer can be built as planned.
     pub fn is_feasible(&self) -> bool {
-        matches!(self, LayerStatus::Optimal | LayerStatus::NotConverged { .. })
+        matches!(
+            self,
+            LayerStatus::Optimal | LayerStatus::NotConverged { .. }
+        )
     }
 }
 

@@ -129,7 +129,10 @@ impl<'a> LayerProblem<'a> {
             }
             let jac: Matrix6<f64> = robot.jacobian(&qm);
             let tw: Vector6<f64> = pose.flange_twist_per_rz;
-            let sol = jac.lu().solve(&tw).filter(|x| x.iter().all(|v| v.is_finite()));
+            let sol = jac
+                .lu()
+                .solve(&tw)
+                .filter(|x| x.iter().all(|v| v.is_finite()));
             let Some(sol) = sol else {
                 return Err(fail(RobotError::SingularJacobian {
                     manipulability: crate::robot::indices::manipulability(&jac),
@@ -336,7 +339,13 @@ impl<'a> LayerProblem<'a> {
                 } else {
                     0.0
                 };
-                sink(m, Constraint::Dexterity, (psi - e.dex[m]) / psi, -d / psi, 0.0);
+                sink(
+                    m,
+                    Constraint::Dexterity,
+                    (psi - e.dex[m]) / psi,
+                    -d / psi,
+                    0.0,
+                );
             }
             if m > 0 && self.dt[m] > 0.0 {
                 let qp = &e.q[m - 1];

@@ -223,6 +223,52 @@ pub(crate) fn solve(
             }
         }
     }
+    // Polish: with no constraint in reach, a few exact Gauss–Newton steps
+    // (Cholesky) settle the flat directions more precisely than the
+    // interior-point QPs (the centring tie-break of a part of revolution).
+    if v <= 0.0 && k <= 16 {
+        for _ in 0..4 {
+            if !problem.constraint_rows(&e, basis, 1e-3).is_empty() {
+                break;
+            }
+            let mut pm = nalgebra::DMatrix::<f64>::zeros(k, k);
+            let mut gv = nalgebra::DVector::<f64>::zeros(k);
+            problem.residuals(&e, smoothness, Some(basis), &mut |r, a| {
+                for &(i, ai) in a {
+                    gv[i] += r * ai;
+                    for &(j, aj) in a {
+                        pm[(i, j)] += ai * aj;
+                    }
+                }
+            });
+            let Some(ch) = pm.cholesky() else { break };
+            let dc = ch.solve(&(-gv));
+            let c_new: Vec<f64> = c.iter().zip(dc.iter()).map(|(a, b)| a + b).collect();
+            let r_new = basis.eval(&c_new);
+            let step = r_new
+                .iter()
+                .zip(&e.r)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            if step > 1e-3 {
+                break;
+            }
+            let Ok(e_new) = problem.evaluate(&r_new) else {
+                break;
+            };
+            let f_new = problem.objective(&e_new, smoothness);
+            let v_new = problem.max_violation(&e_new);
+            if v_new > 0.0 || f_new > f {
+                break;
+            }
+            c = c_new;
+            e = e_new;
+            f = f_new;
+            if step < 1e-12 {
+                break;
+            }
+        }
+    }
     Ok(SqpResult {
         c,
         eval: e,

@@ -3,7 +3,7 @@
 use crate::support::cell;
 use std::f64::consts::TAU;
 use waam_slicer::math::{Point3, UnitVector3, Vector3};
-use waam_slicer::optimise::{optimise, LayerPoints, OptimiseOptions};
+use waam_slicer::optimise::{optimise, Abscissa, LayerPoints, OptimiseOptions, Parameterisation};
 use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
 use waam_slicer::robot::CellPoint;
 
@@ -27,8 +27,19 @@ fn circle_is_feasible_within_the_hose_limit_and_beats_the_thesis_cubic() {
     let cell = cell("robowam_torch_carried.toml");
     let plan = optimise(
         &cell,
-        &[LayerPoints { layer: 0, points: circle() }],
-        &OptimiseOptions::default(),
+        &[LayerPoints {
+            layer: 0,
+            points: circle(),
+        }],
+        &OptimiseOptions {
+            // as in the thesis: point index, degree 4, each degree warm-started
+            parameterisation: Parameterisation::Polynomial {
+                max_degree: 4,
+                abscissa: Abscissa::PointIndex,
+                stop_relative_gain: -1.0,
+            },
+            ..OptimiseOptions::default()
+        },
     )
     .unwrap();
     let l = &plan.layers[0];

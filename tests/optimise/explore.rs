@@ -9,14 +9,25 @@ use waam_slicer::toolaxis::local_frames;
 fn explore() {
     let part = load_part(&std::env::var("PART").unwrap_or("hemisphere.toml".into()));
     let mut so = part.slice_options();
-    so.delta_mm = std::env::var("DELTA").map(|s| s.parse().unwrap()).unwrap_or(5.0);
+    so.delta_mm = std::env::var("DELTA")
+        .map(|s| s.parse().unwrap())
+        .unwrap_or(5.0);
     let path = slice(&part.tube, &part.substrate, &so).unwrap();
     let frames = local_frames(&path, &part.tube);
     let layers = layer_points(&path, &frames);
-    let cell = read_cell_file(part_path("cells/robowam_part_carried.toml")).unwrap().cell.unwrap();
+    let cell = read_cell_file(part_path("cells/robowam_part_carried.toml"))
+        .unwrap()
+        .cell
+        .unwrap();
     let mut opts = OptimiseOptions::default();
-    if let Ok(f) = std::env::var("FIXED") { opts.parameterisation = Parameterisation::Fixed { r_z_rad: f.parse::<f64>().unwrap().to_radians() }; }
-    if std::env::var("PBP").is_ok() { opts.parameterisation = Parameterisation::PointByPoint; }
+    if let Ok(f) = std::env::var("FIXED") {
+        opts.parameterisation = Parameterisation::Fixed {
+            r_z_rad: f.parse::<f64>().unwrap().to_radians(),
+        };
+    }
+    if std::env::var("PBP").is_ok() {
+        opts.parameterisation = Parameterisation::PointByPoint;
+    }
     let plan = optimise(&cell, &layers, &opts).unwrap();
     for l in &plan.layers {
         let q0 = l.points[0].joints.unwrap();
