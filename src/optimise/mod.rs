@@ -568,7 +568,7 @@ fn optimise_layer(cell: &Cell, lp: &LayerPoints, opts: &OptimiseOptions) -> Laye
         out.iterations,
         fixed,
         configuration,
-        |t| solver(t),
+        solver,
         t0,
     )
 }
@@ -956,10 +956,10 @@ fn finish(
     }
     let mut centring = 0.0;
     for q in &e.q {
-        for j in 0..6 {
+        for (j, qj) in q.iter().enumerate() {
             if problem.gamma[j] > 0.0 {
                 let l = &robot.limits[j];
-                centring += ((q[j] - l.mid_rad()) / l.range_rad()).powi(2);
+                centring += ((qj - l.mid_rad()) / l.range_rad()).powi(2);
             }
         }
     }
@@ -992,6 +992,7 @@ fn finish(
 }
 
 /// Quality figures of a layer at the travel speed.
+#[allow(clippy::needless_range_loop)]
 fn quality(problem: &LayerProblem, e: &Evaluation) -> LayerQuality {
     let p = e.q.len();
     let robot = problem.cell.robot();

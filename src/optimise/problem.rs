@@ -71,6 +71,9 @@ pub(crate) struct PointFailure {
     pub error: RobotError,
 }
 
+/// Receives one residual and its row over the coefficients.
+pub(crate) type ResidualSink<'s> = dyn FnMut(f64, &[(usize, f64)]) + 's;
+
 /// One linearised inequality `a · δc ≤ b`.
 #[derive(Debug, Clone)]
 pub(crate) struct Row {
@@ -111,6 +114,7 @@ impl<'a> LayerProblem<'a> {
     /// Evaluates the layer at `r` (one `R_Z` per point, rad). Joints are
     /// unwrapped along the layer; the first point takes the representation
     /// inside the travel.
+    #[allow(clippy::needless_range_loop)]
     pub fn evaluate(&self, r: &[f64]) -> Result<Evaluation, PointFailure> {
         let p = self.points.len();
         let robot = self.cell.robot();
@@ -201,7 +205,7 @@ impl<'a> LayerProblem<'a> {
         e: &Evaluation,
         smoothness: f64,
         basis: Option<&Basis>,
-        sink: &mut dyn FnMut(f64, &[(usize, f64)]),
+        sink: &mut ResidualSink,
     ) {
         let p = e.q.len();
         let mut row_m = Vec::new();

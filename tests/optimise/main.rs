@@ -5,6 +5,5 @@ mod common;
 
 mod circle;
 mod cli;
-mod explore;
 mod parts;
 mod support;
