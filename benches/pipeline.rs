@@ -6,16 +6,18 @@
 use criterion::{criterion_group, criterion_main};
 
 mod pipeline {
+    pub mod optimise;
     pub mod path;
     pub mod robot;
 }
 
-use pipeline::{path, robot};
+use pipeline::{optimise, path, robot};
 
 criterion_group!(
     benches,
     path::constant_distance,
     robot::kinematics,
-    robot::hemisphere_trajectory
+    robot::hemisphere_trajectory,
+    optimise::whole_parts
 );
 criterion_main!(benches);

@@ -4,6 +4,7 @@
 use crate::geometry::GeometryError;
 use crate::io::cell_file::CellFileError;
 use crate::io::part_file::PartFileError;
+use crate::optimise::OptimiseError;
 use crate::process::ProcessError;
 use crate::robot::RobotError;
 use crate::toolaxis::ToolAxisError;
@@ -30,4 +31,7 @@ pub enum Error {
     /// The process stage failed (invalid parameter or option).
     #[error(transparent)]
     Process(#[from] ProcessError),
+    /// The optimisation stage was given bad input.
+    #[error(transparent)]
+    Optimise(#[from] OptimiseError),
 }

@@ -26,6 +26,7 @@
 //! | 3. tool axes (local frames, build direction) | [`toolaxis`] | §4 |
 //! | 3b. process: bead, travel speeds, estimates | [`process`] | §5 |
 //! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
+//! | 5. layer-by-layer optimisation of `R_Z` (branch, SQP, quality) | [`optimise`] | §7 |
 //!
 //! ## Units and frames
 //!
@@ -54,6 +55,7 @@ pub mod error;
 pub mod geometry;
 pub mod io;
 pub mod math;
+pub mod optimise;
 pub mod path;
 pub mod process;
 pub mod robot;

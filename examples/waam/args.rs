@@ -36,6 +36,9 @@ pub enum StrategyArg {
 pub enum Command {
     /// Slice a part: writes path.csv and summary.json in --out.
     Slice(SliceArgs),
+    /// Plan a part in a cell: slice, tool axes, R_Z optimisation, joints;
+    /// writes joints.csv and summary.json in --out (exit 2 if infeasible).
+    Plan(PlanArgs),
     /// List the sample parts (and cells) with one line each.
     Parts {
         /// Folder holding the part files.
@@ -101,4 +104,29 @@ pub struct SliceArgs {
     /// Extra slicing settings.
     #[command(flatten)]
     pub more: SliceExtras,
+}
+
+/// Arguments of `plan`.
+#[derive(Debug, clap::Args)]
+pub struct PlanArgs {
+    /// The part file (TOML).
+    pub part: PathBuf,
+    /// The cell file (TOML, parts/cells/).
+    #[arg(long)]
+    pub cell: PathBuf,
+    /// Interlayer distance Delta in mm (default: the part file's).
+    #[arg(long)]
+    pub delta: Option<f64>,
+    /// Points per layer.
+    #[arg(long, conflicts_with = "chord")]
+    pub points: Option<usize>,
+    /// Max chord error in mm.
+    #[arg(long)]
+    pub chord: Option<f64>,
+    /// R_Z law: fixed:DEG, poly:N (max degree), spline, point.
+    #[arg(long, default_value = "poly:4")]
+    pub rz: String,
+    /// Output folder (default out/<part name>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }

@@ -1,0 +1,56 @@
+//! Stage 5 — layer-by-layer optimisation of `R_Z` in the ROBOWAM
+//! part-carried cell: the hemisphere at Delta = 5 and 1 mm and the nozzle at
+//! Delta = 1 mm (500 points per layer). Target: under 0.5 s for the
+//! hemisphere at Delta = 1 on 2 cores (the thesis needed 92 s in Matlab for
+//! Delta = 5 at degree 1).
+
+use std::hint::black_box;
+use std::path::PathBuf;
+
+use criterion::Criterion;
+use waam_slicer::io::cell_file::read_cell_file;
+use waam_slicer::io::part_file::read_part_file;
+use waam_slicer::optimise::{layer_points, optimise, LayerPoints, OptimiseOptions};
+use waam_slicer::path::slice;
+use waam_slicer::robot::Cell;
+use waam_slicer::toolaxis::local_frames;
+
+fn parts_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("parts")
+}
+
+fn layers(part: &str, delta: f64) -> Vec<LayerPoints> {
+    let part = read_part_file(&parts_dir().join(part)).unwrap();
+    let mut so = part.slice_options();
+    so.delta_mm = delta;
+    let path = slice(&part.tube, &part.substrate, &so).unwrap();
+    let frames = local_frames(&path, &part.tube);
+    layer_points(&path, &frames)
+}
+
+/// Whole-part optimisation (default options: branch choice, degrees raised
+/// from the seed's until no gain, layers in parallel).
+pub fn whole_parts(c: &mut Criterion) {
+    let cell: Cell = read_cell_file(parts_dir().join("cells/robowam_part_carried.toml"))
+        .unwrap()
+        .cell
+        .unwrap();
+    let opts = OptimiseOptions::default();
+    let mut g = c.benchmark_group("optimise");
+    g.sample_size(10);
+    for (name, part, delta) in [
+        ("hemisphere_delta5", "hemisphere.toml", 5.0),
+        ("hemisphere_delta1", "hemisphere.toml", 1.0),
+        ("nozzle_delta1", "nozzle.toml", 1.0),
+    ] {
+        let l = layers(part, delta);
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let plan = optimise(black_box(&cell), black_box(&l), &opts).unwrap();
+                assert!(plan.is_feasible());
+                plan
+            })
+        });
+    }
+    g.finish();
+}

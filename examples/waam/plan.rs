@@ -1,0 +1,260 @@
+//! `waam plan`: part file + cell file → slice → tool axes → `R_Z`
+//! optimisation → joints; writes `joints.csv` and `summary.json`.
+//! Exit codes: 0 done, 1 bad input (the message names the file and field),
+//! 2 plan infeasible (summary written, no program).
+
+use crate::args::PlanArgs;
+use serde_json::json;
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+use waam_slicer::io::atomic::write_atomic;
+use waam_slicer::io::cell_file::read_cell_file;
+use waam_slicer::io::part_file::read_part_file;
+use waam_slicer::optimise::{
+    layer_points, optimise, Abscissa, OptimiseOptions, Parameterisation, Plan,
+};
+use waam_slicer::path::{slice, Discretisation};
+use waam_slicer::robot::Cell;
+use waam_slicer::toolaxis::local_frames;
+
+/// Header of `joints.csv` (degrees, part frame mm); `e1,e2` appended with a positioner.
+pub const JOINTS_HEADER: &str = "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6";
+
+fn parse_rz(s: &str) -> Result<Parameterisation, String> {
+    let bad = || format!("--rz `{s}`: expected fixed:DEG, poly:N (0..=8), spline or point");
+    match s.split_once(':') {
+        Some(("fixed", d)) => {
+            let deg: f64 = d.parse().map_err(|_| bad())?;
+            if !deg.is_finite() {
+                return Err(bad());
+            }
+            Ok(Parameterisation::Fixed {
+                r_z_rad: deg.to_radians(),
+            })
+        }
+        Some(("poly", n)) => {
+            let n: usize = n.parse().map_err(|_| bad())?;
+            if n > 8 {
+                return Err(bad());
+            }
+            Ok(Parameterisation::Polynomial {
+                max_degree: n,
+                abscissa: Abscissa::Auto,
+                stop_relative_gain: 1e-3,
+            })
+        }
+        None if s == "spline" => Ok(Parameterisation::SmoothingSpline { smoothness: 1.0 }),
+        None if s == "point" => Ok(Parameterisation::PointByPoint),
+        _ => Err(bad()),
+    }
+}
+
+/// Runs the command; prints errors itself and returns the exit code.
+pub fn run(a: &PlanArgs, quiet: bool) -> ExitCode {
+    match plan(a, quiet) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(2),
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// `Ok(feasible)`, `Err` for bad input.
+fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
+    let t0 = Instant::now();
+    let part = read_part_file(&a.part).map_err(|e| e.to_string())?;
+    let cell_file = read_cell_file(&a.cell).map_err(|e| e.to_string())?;
+    let cell: Cell = cell_file.cell.ok_or_else(|| {
+        format!(
+            "{}: no [part_carried] or [torch_carried] section: not a cell",
+            a.cell.display()
+        )
+    })?;
+    let opts = OptimiseOptions {
+        parameterisation: parse_rz(&a.rz)?,
+        ..OptimiseOptions::default()
+    };
+    opts.validate().map_err(|e| e.to_string())?;
+    let mut so = part.slice_options();
+    if let Some(d) = a.delta {
+        so.delta_mm = d;
+    }
+    if let Some(n) = a.points {
+        so.discretisation = Discretisation::Points(n);
+    }
+    if let Some(e) = a.chord {
+        so.discretisation = Discretisation::ChordError(e);
+    }
+    let t_read = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let path = slice(&part.tube, &part.substrate, &so)
+        .map_err(|e| format!("{}: {e}", a.part.display()))?;
+    let t_slice = t1.elapsed().as_secs_f64();
+    let t2 = Instant::now();
+    let frames = local_frames(&path, &part.tube);
+    let layers = layer_points(&path, &frames);
+    let t_axes = t2.elapsed().as_secs_f64();
+    let result = optimise(&cell, &layers, &opts).map_err(|e| e.to_string())?;
+
+    let dir: PathBuf = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(&part.name));
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let feasible = result.is_feasible();
+    let csv = dir.join("joints.csv");
+    write_atomic(&csv, |w| write_joints_csv(w, &layers, &result, &cell))
+        .map_err(|e| format!("{}: {e}", csv.display()))?;
+    let summary = summary_json(&part.name, a, &result, &opts, [t_read, t_slice, t_axes]);
+    let sj = dir.join("summary.json");
+    write_atomic(&sj, |w| {
+        serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
+        writeln!(w)
+    })
+    .map_err(|e| format!("{}: {e}", sj.display()))?;
+    // Program emission (FANUC .ls, KUKA, ABB) is the program stage's job
+    // (issue 8): it takes `result` and must write nothing when !feasible.
+    if !quiet {
+        println!(
+            "{}: {} layers, {} points, {} in {:.3} s -> {}",
+            part.name,
+            result.layers.len(),
+            layers.iter().map(|l| l.points.len()).sum::<usize>(),
+            if feasible { "feasible" } else { "INFEASIBLE" },
+            result.time_s,
+            dir.display()
+        );
+        for l in result.infeasible_layers() {
+            println!("  layer {}: {}", l.layer, l.status);
+        }
+    }
+    Ok(feasible)
+}
+
+fn write_joints_csv(
+    w: &mut dyn Write,
+    layers: &[waam_slicer::optimise::LayerPoints],
+    plan: &Plan,
+    cell: &Cell,
+) -> std::io::Result<()> {
+    let positioner = matches!(cell, Cell::TorchCarried(_));
+    write!(w, "{JOINTS_HEADER}")?;
+    writeln!(w, "{}", if positioner { ",e1,e2" } else { "" })?;
+    for (lp, l) in layers.iter().zip(&plan.layers) {
+        for (m, (cp, pp)) in lp.points.iter().zip(&l.points).enumerate() {
+            let p = cp.position_mm;
+            let t = cp.tool_axis;
+            write!(
+                w,
+                "{},{m},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
+                lp.layer,
+                p.x,
+                p.y,
+                p.z,
+                t.x,
+                t.y,
+                t.z,
+                pp.r_z.to_degrees()
+            )?;
+            match pp.joints {
+                Some(q) => {
+                    for v in q {
+                        write!(w, ",{:.6}", v.to_degrees())?;
+                    }
+                }
+                None => write!(w, ",,,,,,")?,
+            }
+            if positioner {
+                match pp.positioner {
+                    Some(e) => write!(w, ",{:.6},{:.6}", e[0].to_degrees(), e[1].to_degrees())?,
+                    None => write!(w, ",,")?,
+                }
+            }
+            writeln!(w)?;
+        }
+    }
+    Ok(())
+}
+
+fn deg6(q: &[f64; 6]) -> Vec<f64> {
+    q.iter().map(|v| v.to_degrees()).collect()
+}
+
+fn summary_json(
+    name: &str,
+    a: &PlanArgs,
+    plan: &Plan,
+    opts: &OptimiseOptions,
+    times: [f64; 3],
+) -> serde_json::Value {
+    let layers: Vec<_> = plan
+        .layers
+        .iter()
+        .map(|l| {
+            let q = &l.quality;
+            json!({
+                "layer": l.layer,
+                "status": l.status.to_string(),
+                "feasible": l.status.is_feasible(),
+                "configuration": l.configuration.chosen.to_string(),
+                "configuration_reason": l.configuration.reason,
+                "law": format!("{:?}", l.law),
+                "points": l.points.len(),
+                "objective": {
+                    "joint_displacement": l.objective.joint_displacement,
+                    "uncertainty_sum_sq_mm2": l.objective.uncertainty_sum_sq_mm2,
+                    "mean_uncertainty_mm": l.objective.mean_uncertainty_mm,
+                    "centring": l.objective.centring,
+                },
+                "quality": {
+                    "joint_travel_deg": deg6(&q.joint_travel_rad),
+                    "peak_speed_deg_s": deg6(&q.peak_speed_rad_s),
+                    "peak_acceleration_deg_s2": deg6(&q.peak_acceleration_rad_s2),
+                    "summed_acceleration_j1_j5_deg_s": q.summed_acceleration_rad_s.to_degrees(),
+                    "direction_reversals": q.direction_reversals,
+                    "min_dexterity": q.min_dexterity,
+                    "min_limit_distance_deg": q.min_limit_distance_rad.to_degrees(),
+                    "min_limit_distance_joint": q.min_limit_distance_joint,
+                    "max_hose_torsion_deg": q.max_hose_torsion_rad.to_degrees(),
+                },
+                "solver": {
+                    "iterations": l.solver.iterations,
+                    "qp_solves": l.solver.qp_solves,
+                    "qp_failures": l.solver.qp_failures,
+                    "branches_tried": l.solver.branches_tried,
+                    "time_s": l.solver.time_s,
+                },
+            })
+        })
+        .collect();
+    let violations: Vec<String> = plan.violations().map(|v| v.to_string()).collect();
+    json!({
+        "part": name,
+        "part_file": a.part.display().to_string(),
+        "cell_file": a.cell.display().to_string(),
+        "rz": a.rz,
+        "travel_speed_mm_s": opts.travel_speed_mm_s,
+        "feasible": plan.is_feasible(),
+        "infeasible_layers": plan.infeasible_layers().map(|l| l.layer).collect::<Vec<_>>(),
+        "violations": violations,
+        "layers": layers,
+        "transitions": plan.transitions.iter().map(|t| json!({
+            "from_layer": t.from_layer,
+            "to_layer": t.to_layer,
+            "joint_change_deg": deg6(&t.joint_change_rad),
+            "branch_change": t.branch_change,
+            "start_limit_distance_deg": t.start_limit_distance_rad.to_degrees(),
+        })).collect::<Vec<_>>(),
+        "program": serde_json::Value::Null,
+        "run_time_s": {
+            "read": times[0],
+            "slice": times[1],
+            "tool_axes": times[2],
+            "optimise": plan.time_s,
+        },
+    })
+}

@@ -1,0 +1,256 @@
+//! `R_Z` along a layer as a linear function of a few coefficients:
+//! `R = B c`, `B` the basis (points × coefficients). Polynomials in a scaled
+//! abscissa [eq. 4.1–4.2] and one value per point (smoothing spline) share
+//! this form, so the SQP sees only `B` (the chain rule `dq/dc = dq/dR_Z · B`).
+
+use std::f64::consts::TAU;
+
+use crate::math::Point3;
+
+/// Cylindrical angle of each point about the part Z axis (rad), unwrapped
+/// along the layer (continuous, starting in `(-π, π]`).
+pub fn cylindrical_angles(points: &[Point3]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(points.len());
+    let mut prev: Option<f64> = None;
+    for p in points {
+        let a = p.y.atan2(p.x);
+        let a = match prev {
+            Some(pr) => a + TAU * ((pr - a) / TAU).round(),
+            None => a,
+        };
+        out.push(a);
+        prev = Some(a);
+    }
+    out
+}
+
+/// `true` when the unwrapped angles run monotonically through at least half a
+/// turn (the layer turns about the part Z axis, as on a part of revolution).
+pub fn turns_about_z(theta: &[f64]) -> bool {
+    if theta.len() < 3 {
+        return false;
+    }
+    let d: Vec<f64> = theta.windows(2).map(|w| w[1] - w[0]).collect();
+    let monotone = d.iter().all(|x| *x > 0.0) || d.iter().all(|x| *x < 0.0);
+    monotone && (theta[theta.len() - 1] - theta[0]).abs() >= std::f64::consts::PI
+}
+
+/// The basis of a layer.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Basis {
+    /// Monomials `1, s, …, s^n` of the abscissa scaled to `s ∈ [-1, 1]`.
+    Polynomial {
+        /// Scaled abscissa per point.
+        s: Vec<f64>,
+        /// Abscissa at `s = -1` (point index or rad).
+        x_min: f64,
+        /// Abscissa at `s = +1`.
+        x_max: f64,
+        /// Number of coefficients (degree + 1).
+        coefficients: usize,
+    },
+    /// One coefficient per point.
+    PerPoint {
+        /// Number of points.
+        points: usize,
+    },
+}
+
+impl Basis {
+    /// Polynomial basis of `coefficients` terms on abscissa `x` (one per point).
+    pub fn polynomial(x: &[f64], coefficients: usize) -> Self {
+        let x_min = x.iter().copied().fold(f64::INFINITY, f64::min);
+        let x_max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let h = 0.5 * (x_max - x_min);
+        let s = x
+            .iter()
+            .map(|v| if h > 0.0 { (v - x_min) / h - 1.0 } else { 0.0 })
+            .collect();
+        Self::Polynomial {
+            s,
+            x_min,
+            x_max,
+            coefficients,
+        }
+    }
+
+    /// Number of coefficients.
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Polynomial { coefficients, .. } => *coefficients,
+            Self::PerPoint { points } => *points,
+        }
+    }
+
+    /// `true` with no coefficient.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Number of points.
+    pub fn points(&self) -> usize {
+        match self {
+            Self::Polynomial { s, .. } => s.len(),
+            Self::PerPoint { points } => *points,
+        }
+    }
+
+    /// Row `m` of `B` as `(coefficient, value)` pairs, into `out` (cleared).
+    pub fn row(&self, m: usize, out: &mut Vec<(usize, f64)>) {
+        out.clear();
+        match self {
+            Self::Polynomial {
+                s, coefficients, ..
+            } => {
+                let mut v = 1.0;
+                for i in 0..*coefficients {
+                    out.push((i, v));
+                    v *= s[m];
+                }
+            }
+            Self::PerPoint { .. } => out.push((m, 1.0)),
+        }
+    }
+
+    /// `max_m Σ_i |B_mi|`: a box `|δc_i| ≤ Δ / L` keeps every `|δR_m| ≤ Δ`.
+    pub fn row_l1_bound(&self) -> f64 {
+        match self {
+            Self::Polynomial { coefficients, .. } => *coefficients as f64,
+            Self::PerPoint { .. } => 1.0,
+        }
+    }
+
+    /// `R = B c` (rad).
+    pub fn eval(&self, c: &[f64]) -> Vec<f64> {
+        match self {
+            Self::Polynomial { s, .. } => s
+                .iter()
+                .map(|x| c.iter().rev().fold(0.0, |acc, ci| acc * x + ci))
+                .collect(),
+            Self::PerPoint { .. } => c.to_vec(),
+        }
+    }
+
+    /// Same polynomial, one more coefficient (zero): warm start of the next degree.
+    pub fn raised(&self) -> Option<Self> {
+        match self {
+            Self::Polynomial {
+                s,
+                x_min,
+                x_max,
+                coefficients,
+            } => Some(Self::Polynomial {
+                s: s.clone(),
+                x_min: *x_min,
+                x_max: *x_max,
+                coefficients: coefficients + 1,
+            }),
+            Self::PerPoint { .. } => None,
+        }
+    }
+
+    /// Least-squares coefficients reproducing the values `r` (rad) per point
+    /// (normal equations; exact when `r` is in the span).
+    pub fn fit(&self, r: &[f64]) -> Vec<f64> {
+        match self {
+            Self::PerPoint { .. } => r.to_vec(),
+            Self::Polynomial { coefficients, .. } => {
+                let k = *coefficients;
+                let mut ata = nalgebra::DMatrix::<f64>::zeros(k, k);
+                let mut atb = nalgebra::DVector::<f64>::zeros(k);
+                let mut row = Vec::new();
+                for (m, rm) in r.iter().enumerate() {
+                    self.row(m, &mut row);
+                    for &(i, a) in &row {
+                        atb[i] += a * rm;
+                        for &(j, b) in &row {
+                            ata[(i, j)] += a * b;
+                        }
+                    }
+                }
+                match ata.cholesky() {
+                    Some(ch) => ch.solve(&atb).iter().copied().collect(),
+                    None => {
+                        let mut c = vec![0.0; k];
+                        c[0] = r.iter().sum::<f64>() / r.len().max(1) as f64;
+                        c
+                    }
+                }
+            }
+        }
+    }
+
+    /// The polynomial in the thesis's form: coefficients of the unscaled
+    /// abscissa (point index `m` counted from 1 as in eq. 4.1, or the angle in
+    /// rad), highest power first, `R_Z` in degrees — `B_{C,n}` of eq. 4.1.
+    /// `None` for the per-point basis.
+    pub fn thesis_coefficients_deg(&self, c: &[f64], one_based_index: bool) -> Option<Vec<f64>> {
+        let Self::Polynomial { x_min, x_max, .. } = self else {
+            return None;
+        };
+        let h = 0.5 * (x_max - x_min);
+        if !(h > 0.0) {
+            return Some(vec![c.first().copied().unwrap_or(0.0).to_degrees()]);
+        }
+        // s = a x + b with x the unscaled abscissa
+        let shift = if one_based_index { 1.0 } else { 0.0 };
+        let a = 1.0 / h;
+        let b = -(x_min + shift) / h - 1.0;
+        // expand Σ c_i (a x + b)^i; out[p] = coefficient of x^p
+        let k = c.len();
+        let mut out = vec![0.0; k];
+        let mut pow = vec![1.0]; // coefficients of (a x + b)^i, ascending
+        for (i, ci) in c.iter().enumerate() {
+            if i > 0 {
+                let mut next = vec![0.0; pow.len() + 1];
+                for (p, v) in pow.iter().enumerate() {
+                    next[p] += v * b;
+                    next[p + 1] += v * a;
+                }
+                pow = next;
+            }
+            for (p, v) in pow.iter().enumerate() {
+                out[p] += ci * v;
+            }
+        }
+        Some(out.iter().rev().map(|v| v.to_degrees()).collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polynomial_basis_evaluates_and_converts_to_the_thesis_form() {
+        let x: Vec<f64> = (0..11).map(|m| m as f64).collect();
+        let b = Basis::polynomial(&x, 3);
+        // R(m) = 0.1 + 0.02 m − 0.003 m² (rad), m from 0
+        let r: Vec<f64> = x.iter().map(|m| 0.1 + 0.02 * m - 0.003 * m * m).collect();
+        let c = b.fit(&r);
+        for (a, e) in b.eval(&c).iter().zip(&r) {
+            assert!((a - e).abs() < 1e-12);
+        }
+        let t = b.thesis_coefficients_deg(&c, false).unwrap();
+        assert!((t[0] - (-0.003f64).to_degrees()).abs() < 1e-9);
+        assert!((t[1] - 0.02f64.to_degrees()).abs() < 1e-9);
+        assert!((t[2] - 0.1f64.to_degrees()).abs() < 1e-9);
+        let raised = b.raised().unwrap();
+        let mut c2 = c.clone();
+        c2.push(0.0);
+        assert_eq!(raised.eval(&c2), b.eval(&c));
+    }
+
+    #[test]
+    fn angles_unwrap_and_detect_turning() {
+        let pts: Vec<Point3> = (0..50)
+            .map(|k| {
+                let v = 3.0 + TAU * k as f64 / 50.0;
+                Point3::new(v.cos(), v.sin(), 0.0)
+            })
+            .collect();
+        let th = cylindrical_angles(&pts);
+        assert!(th.windows(2).all(|w| w[1] > w[0]));
+        assert!(turns_about_z(&th));
+    }
+}

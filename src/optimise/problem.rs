@@ -1,0 +1,417 @@
+//! The per-layer problem [SPEC §7, eq. 4.3–4.8, 4.13]: given the layer's
+//! points (part frame, mm), a cell and an IK branch, evaluate the joints for
+//! `R_Z` values (rad) with their analytic derivative `dq/dR_Z`, the objective
+//! as a sum of squared residuals and the constraints per point, and linearise
+//! both through the basis `R = B c` for the SQP.
+
+use nalgebra::{Matrix6, Vector6};
+
+use crate::optimise::options::Objective;
+use crate::optimise::outcome::{Binding, Constraint};
+use crate::optimise::parameterisation::Basis;
+use crate::robot::cell::{Cell, CellPoint};
+use crate::robot::ik::Configuration;
+use crate::robot::indices::{dexterity, positioning_uncertainty, UncertaintyFormula};
+use crate::robot::model::Joints;
+use crate::robot::positioner::PositionerJoints;
+use crate::robot::RobotError;
+
+/// Encoder resolutions of the ArcMate 120iC [table 4.2] (rad), used when the
+/// robot model has none.
+pub(crate) const ARCMATE_SIGMA_DEG: [f64; 6] =
+    [3.63e-8, 3.63e-8, 3.81e-8, 16.45e-8, 14.12e-8, 63.18e-8];
+
+/// Finite-difference step on `R_Z` for the dexterity and uncertainty slopes (rad).
+const FD_STEP_RAD: f64 = 1e-6;
+
+/// Everything fixed about one layer in one branch.
+#[derive(Debug, Clone)]
+pub(crate) struct LayerProblem<'a> {
+    pub cell: &'a Cell,
+    pub configuration: Configuration,
+    pub points: &'a [CellPoint],
+    /// Time from point m−1 to m at the travel speed (s); `dt[0] = 0`.
+    pub dt: Vec<f64>,
+    /// Dexterity floor per point (0 = none).
+    pub psi: Vec<f64>,
+    /// Weights `gamma_j = 1/range_j` (0 for unlimited joints).
+    pub gamma: [f64; 6],
+    /// Travel with the margin (rad; infinite when unlimited).
+    pub lower: [f64; 6],
+    pub upper: [f64; 6],
+    /// `|J5|` must stay above this on its branch's side (rad).
+    pub wrist_margin: f64,
+    pub hose: Option<f64>,
+    pub max_speed: [f64; 6],
+    /// Centring weight per point (already divided by the number of points).
+    pub centring: f64,
+    pub objective: Objective,
+    /// Joint resolutions (rad) for eq. 4.13, scaled to keep `I²` near 1.
+    pub sigma: [f64; 6],
+    /// Length scale of the dexterity (mm).
+    pub dex_scale: f64,
+}
+
+/// Joints and derivatives at every point for given `R_Z`.
+#[derive(Debug, Clone)]
+pub(crate) struct Evaluation {
+    pub r: Vec<f64>,
+    pub q: Vec<Joints>,
+    pub g: Vec<Joints>,
+    pub positioner: Vec<Option<PositionerJoints>>,
+    pub dex: Vec<f64>,
+    /// `I_m` (scaled units) when the objective needs it.
+    pub unc: Vec<f64>,
+}
+
+/// A point failed.
+#[derive(Debug, Clone)]
+pub(crate) struct PointFailure {
+    pub point: usize,
+    pub error: RobotError,
+}
+
+/// Receives one residual and its row over the coefficients.
+pub(crate) type ResidualSink<'s> = dyn FnMut(f64, &[(usize, f64)]) + 's;
+
+/// One linearised inequality `a · δc ≤ b`.
+#[derive(Debug, Clone)]
+pub(crate) struct Row {
+    pub a: Vec<(usize, f64)>,
+    pub b: f64,
+}
+
+impl<'a> LayerProblem<'a> {
+    /// Joints at one point for `r_z`, unwrapped towards `near`.
+    pub fn joints_at(
+        &self,
+        m: usize,
+        r_z: f64,
+        near: Option<&Joints>,
+        q8_hint: f64,
+    ) -> Result<(Joints, crate::robot::cell::CellPose), RobotError> {
+        let pose = self.cell.pose(&self.points[m], r_z, q8_hint)?;
+        let robot = self.cell.robot();
+        let q = match near {
+            Some(n) => robot.inverse_near(&pose.base_from_flange, self.configuration, n)?,
+            None => robot.inverse(&pose.base_from_flange, self.configuration)?,
+        };
+        Ok((q, pose))
+    }
+
+    fn dex_of(&self, q: &Joints) -> f64 {
+        dexterity(&self.cell.robot().jacobian(q), self.dex_scale)
+    }
+
+    fn unc_of(&self, q: &Joints) -> f64 {
+        positioning_uncertainty(
+            &self.cell.robot().jacobian(q),
+            &self.sigma,
+            UncertaintyFormula::RootTrace,
+        )
+    }
+
+    /// Evaluates the layer at `r` (one `R_Z` per point, rad). Joints are
+    /// unwrapped along the layer; the first point takes the representation
+    /// inside the travel.
+    #[allow(clippy::needless_range_loop)]
+    pub fn evaluate(&self, r: &[f64]) -> Result<Evaluation, PointFailure> {
+        let p = self.points.len();
+        let robot = self.cell.robot();
+        let mut q = Vec::with_capacity(p);
+        let mut g = Vec::with_capacity(p);
+        let mut pos = Vec::with_capacity(p);
+        let mut dex = Vec::with_capacity(p);
+        let mut unc = Vec::new();
+        let mut q8 = 0.0;
+        let mut prev: Option<Joints> = None;
+        for m in 0..p {
+            let fail = |error| PointFailure { point: m, error };
+            let (qm, pose) = self.joints_at(m, r[m], prev.as_ref(), q8).map_err(fail)?;
+            if let Some(qp) = pose.positioner {
+                q8 = qp[1];
+            }
+            let jac: Matrix6<f64> = robot.jacobian(&qm);
+            let tw: Vector6<f64> = pose.flange_twist_per_rz;
+            let sol = jac
+                .lu()
+                .solve(&tw)
+                .filter(|x| x.iter().all(|v| v.is_finite()));
+            let Some(sol) = sol else {
+                return Err(fail(RobotError::SingularJacobian {
+                    manipulability: crate::robot::indices::manipulability(&jac),
+                }));
+            };
+            g.push([sol[0], sol[1], sol[2], sol[3], sol[4], sol[5]]);
+            dex.push(dexterity(&jac, self.dex_scale));
+            if self.objective == Objective::PositioningUncertainty {
+                unc.push(positioning_uncertainty(
+                    &jac,
+                    &self.sigma,
+                    UncertaintyFormula::RootTrace,
+                ));
+            }
+            q.push(qm);
+            pos.push(pose.positioner);
+            prev = Some(qm);
+        }
+        Ok(Evaluation {
+            r: r.to_vec(),
+            q,
+            g,
+            positioner: pos,
+            dex,
+            unc,
+        })
+    }
+
+    /// Slope of a scalar function of the joints at point `m` along `R_Z`
+    /// (central difference through the IK).
+    fn slope(&self, e: &Evaluation, m: usize, f: impl Fn(&Self, &Joints) -> f64) -> f64 {
+        let q8 = e.positioner[m].map(|p| p[1]).unwrap_or(0.0);
+        let at = |d: f64| {
+            self.joints_at(m, e.r[m] + d, Some(&e.q[m]), q8)
+                .map(|(q, _)| f(self, &q))
+        };
+        match (at(FD_STEP_RAD), at(-FD_STEP_RAD)) {
+            (Ok(a), Ok(b)) => (a - b) / (2.0 * FD_STEP_RAD),
+            _ => 0.0,
+        }
+    }
+
+    /// The objective: sum of squared residuals (displacement or uncertainty)
+    /// plus the centring term; `smoothness` adds the spline penalty.
+    pub fn objective(&self, e: &Evaluation, smoothness: f64) -> f64 {
+        let mut f = 0.0;
+        self.residuals(e, smoothness, None, &mut |r, _| f += r * r);
+        f
+    }
+
+    /// Weighted joint displacement of eq. 4.3 (rad).
+    pub fn displacement(&self, e: &Evaluation) -> f64 {
+        let mut f = 0.0;
+        for m in 1..e.q.len() {
+            for j in 0..6 {
+                f += self.gamma[j] * (e.q[m][j] - e.q[m - 1][j]).powi(2);
+            }
+        }
+        f
+    }
+
+    /// Calls `sink(value, row)` for every residual; rows (through `basis`)
+    /// only when a basis is given.
+    pub fn residuals(
+        &self,
+        e: &Evaluation,
+        smoothness: f64,
+        basis: Option<&Basis>,
+        sink: &mut ResidualSink,
+    ) {
+        let p = e.q.len();
+        let mut row_m = Vec::new();
+        let mut row_p = Vec::new();
+        let mut a: Vec<(usize, f64)> = Vec::new();
+        let rows = |m: usize, out: &mut Vec<(usize, f64)>| {
+            if let Some(b) = basis {
+                b.row(m, out);
+            }
+        };
+        // sparse combination x·row_m + y·row_p into `a`
+        fn combine(
+            a: &mut Vec<(usize, f64)>,
+            x: f64,
+            rm: &[(usize, f64)],
+            y: f64,
+            rp: &[(usize, f64)],
+        ) {
+            a.clear();
+            for &(i, v) in rm {
+                a.push((i, x * v));
+            }
+            for &(i, v) in rp {
+                if let Some(e) = a.iter_mut().find(|e| e.0 == i) {
+                    e.1 += y * v;
+                } else {
+                    a.push((i, y * v));
+                }
+            }
+        }
+        match self.objective {
+            Objective::JointDisplacement => {
+                for m in 1..p {
+                    rows(m, &mut row_m);
+                    rows(m - 1, &mut row_p);
+                    for j in 0..6 {
+                        if self.gamma[j] == 0.0 {
+                            continue;
+                        }
+                        let w = self.gamma[j].sqrt();
+                        let r = w * (e.q[m][j] - e.q[m - 1][j]);
+                        combine(&mut a, w * e.g[m][j], &row_m, -w * e.g[m - 1][j], &row_p);
+                        sink(r, &a);
+                    }
+                }
+            }
+            Objective::PositioningUncertainty => {
+                for m in 0..p {
+                    rows(m, &mut row_m);
+                    let d = if basis.is_some() {
+                        self.slope(e, m, Self::unc_of)
+                    } else {
+                        0.0
+                    };
+                    combine(&mut a, d, &row_m, 0.0, &[]);
+                    sink(e.unc[m], &a);
+                }
+            }
+        }
+        if self.centring > 0.0 {
+            let w = self.centring.sqrt();
+            for m in 0..p {
+                rows(m, &mut row_m);
+                for j in 0..6 {
+                    if self.gamma[j] == 0.0 {
+                        continue;
+                    }
+                    let l = &self.cell.robot().limits[j];
+                    let s = w / l.range_rad();
+                    combine(&mut a, s * e.g[m][j], &row_m, 0.0, &[]);
+                    sink(s * (e.q[m][j] - l.mid_rad()), &a);
+                }
+            }
+        }
+        if smoothness > 0.0 && p >= 3 {
+            let w = smoothness.sqrt();
+            for m in 1..p - 1 {
+                let r = w * (e.r[m + 1] - 2.0 * e.r[m] + e.r[m - 1]);
+                a.clear();
+                if basis.is_some() {
+                    a.extend([(m - 1, w), (m, -2.0 * w), (m + 1, w)]);
+                }
+                sink(r, &a);
+            }
+        }
+    }
+
+    /// Wrist bounds of J5 on the current side (rad): `[lo, hi]`.
+    fn j5_bounds(&self, q5: f64) -> (f64, f64) {
+        if q5 >= 0.0 {
+            (self.lower[4].max(self.wrist_margin), self.upper[4])
+        } else {
+            (self.lower[4], self.upper[4].min(-self.wrist_margin))
+        }
+    }
+
+    /// Every constraint value `c ≤ 0` at `e` (rad, or relative for the
+    /// dexterity), calling `sink(point, constraint, value, gradient along R_Z
+    /// at point m and at m−1)`. Gradients of the dexterity are computed only
+    /// when `with_dex_slope` and the point is within a factor 1.5 of its floor.
+    pub fn constraints(
+        &self,
+        e: &Evaluation,
+        with_dex_slope: bool,
+        sink: &mut dyn FnMut(usize, Constraint, f64, f64, f64),
+    ) {
+        let p = e.q.len();
+        for m in 0..p {
+            let q = &e.q[m];
+            let g = &e.g[m];
+            for j in 0..6 {
+                let (lo, hi) = if j == 4 {
+                    self.j5_bounds(q[4])
+                } else {
+                    (self.lower[j], self.upper[j])
+                };
+                let c = Constraint::JointLimit { joint: j + 1 };
+                if hi.is_finite() {
+                    sink(m, c, q[j] - hi, g[j], 0.0);
+                }
+                if lo.is_finite() {
+                    sink(m, c, lo - q[j], -g[j], 0.0);
+                }
+            }
+            if let Some(h) = self.hose {
+                let t = q[3] + q[5];
+                let d = g[3] + g[5];
+                sink(m, Constraint::HoseTorsion, t - h, d, 0.0);
+                sink(m, Constraint::HoseTorsion, -t - h, -d, 0.0);
+            }
+            let psi = self.psi[m];
+            if psi > 0.0 {
+                let d = if with_dex_slope && e.dex[m] < 1.5 * psi {
+                    self.slope(e, m, Self::dex_of)
+                } else {
+                    0.0
+                };
+                sink(
+                    m,
+                    Constraint::Dexterity,
+                    (psi - e.dex[m]) / psi,
+                    -d / psi,
+                    0.0,
+                );
+            }
+            if m > 0 && self.dt[m] > 0.0 {
+                let qp = &e.q[m - 1];
+                let gp = &e.g[m - 1];
+                for j in 0..6 {
+                    let lim = self.max_speed[j] * self.dt[m];
+                    let c = Constraint::JointSpeed { joint: j + 1 };
+                    let dq = q[j] - qp[j];
+                    sink(m, c, dq - lim, g[j], -gp[j]);
+                    sink(m, c, -dq - lim, -g[j], gp[j]);
+                }
+            }
+        }
+    }
+
+    /// The most violated constraint at `e`, if any is violated by more than `tol`.
+    pub fn binding(&self, e: &Evaluation, tol: f64) -> Option<Binding> {
+        let mut worst: Option<Binding> = None;
+        self.constraints(e, false, &mut |m, c, v, _, _| {
+            if v > tol && worst.is_none_or(|w| v > w.violation) {
+                worst = Some(Binding {
+                    point: m,
+                    constraint: c,
+                    violation: v,
+                });
+            }
+        });
+        worst
+    }
+
+    /// Largest violation (0 when feasible).
+    pub fn max_violation(&self, e: &Evaluation) -> f64 {
+        let mut worst: f64 = 0.0;
+        self.constraints(e, false, &mut |_, _, v, _, _| worst = worst.max(v));
+        worst
+    }
+
+    /// Linearised constraint rows `a·δc ≤ b` that a step with `|δR| ≤ trust`
+    /// could violate (the others cannot, under the linear model).
+    pub fn constraint_rows(&self, e: &Evaluation, basis: &Basis, trust: f64) -> Vec<Row> {
+        let mut out = Vec::new();
+        let mut rm = Vec::new();
+        let mut rp = Vec::new();
+        self.constraints(e, true, &mut |m, _, v, d, dp| {
+            let reach = (d.abs() + dp.abs()) * trust;
+            if v + reach <= 0.0 || (d == 0.0 && dp == 0.0) {
+                return;
+            }
+            basis.row(m, &mut rm);
+            let mut a: Vec<(usize, f64)> = rm.iter().map(|&(i, x)| (i, d * x)).collect();
+            if dp != 0.0 {
+                basis.row(m - 1, &mut rp);
+                for &(i, x) in &rp {
+                    if let Some(e) = a.iter_mut().find(|e| e.0 == i) {
+                        e.1 += dp * x;
+                    } else {
+                        a.push((i, dp * x));
+                    }
+                }
+            }
+            out.push(Row { a, b: -v });
+        });
+        out
+    }
+}

@@ -1,0 +1,282 @@
+//! The sequential-QP driver of one layer: Gauss–Newton model of the
+//! objective, constraints linearised with the analytic `dq/dR_Z` through the
+//! basis, an l∞ elastic variable so that every QP is feasible (a layer that
+//! cannot be made feasible ends at the least violation instead of failing),
+//! and a trust region on the change of `R_Z` at any point. Each QP is solved
+//! with clarabel.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+
+use crate::optimise::options::SqpOptions;
+use crate::optimise::parameterisation::Basis;
+use crate::optimise::problem::{Evaluation, LayerProblem, PointFailure};
+
+/// Result of one SQP run.
+#[derive(Debug, Clone)]
+pub(crate) struct SqpResult {
+    pub c: Vec<f64>,
+    pub eval: Evaluation,
+    /// Objective (unscaled).
+    pub objective: f64,
+    /// Largest constraint violation (0 when feasible).
+    pub violation: f64,
+    pub iterations: usize,
+    pub qp_solves: usize,
+    pub qp_failures: usize,
+    pub converged: bool,
+}
+
+struct Qp {
+    x: Vec<f64>,
+    t: f64,
+}
+
+/// Solves `min ½ δᵀPδ + gᵀδ + ρ t` s.t. `a·δ − t ≤ b`, `t ≥ 0`, `|δ_i| ≤ box`.
+fn solve_qp(
+    k: usize,
+    p_dense: &[f64],
+    g: &[f64],
+    rows: &[crate::optimise::problem::Row],
+    rho: f64,
+    bound: f64,
+) -> Option<Qp> {
+    let n = k + 1;
+    // P: upper triangle, column-major
+    let mut colptr = vec![0usize; n + 1];
+    let mut rowval = Vec::new();
+    let mut nzval = Vec::new();
+    for j in 0..k {
+        for i in 0..=j {
+            let v = p_dense[i * k + j];
+            if v != 0.0 {
+                rowval.push(i);
+                nzval.push(v);
+            }
+        }
+        colptr[j + 1] = rowval.len();
+    }
+    colptr[n] = rowval.len();
+    let p = CscMatrix::new(n, n, colptr, rowval, nzval);
+    let mut q = g.to_vec();
+    q.push(rho);
+    let m = rows.len() + 1 + 2 * k;
+    let (mut ii, mut jj, mut vv) = (Vec::new(), Vec::new(), Vec::new());
+    let mut b = Vec::with_capacity(m);
+    for (r, row) in rows.iter().enumerate() {
+        for &(c, v) in &row.a {
+            if v != 0.0 {
+                ii.push(r);
+                jj.push(c);
+                vv.push(v);
+            }
+        }
+        ii.push(r);
+        jj.push(k);
+        vv.push(-1.0);
+        b.push(row.b);
+    }
+    let r0 = rows.len();
+    ii.push(r0);
+    jj.push(k);
+    vv.push(-1.0);
+    b.push(0.0);
+    for i in 0..k {
+        ii.extend([r0 + 1 + 2 * i, r0 + 2 + 2 * i]);
+        jj.extend([i, i]);
+        vv.extend([1.0, -1.0]);
+        b.extend([bound, bound]);
+    }
+    let a = CscMatrix::new_from_triplets(m, n, ii, jj, vv);
+    let cones = [SupportedConeT::NonnegativeConeT(m)];
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .presolve_enable(false)
+        .build()
+        .ok()?;
+    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).ok()?;
+    solver.solve();
+    match solver.solution.status {
+        SolverStatus::Solved | SolverStatus::AlmostSolved => {
+            let x = &solver.solution.x;
+            if x.iter().all(|v| v.is_finite()) {
+                Some(Qp {
+                    x: x[..k].to_vec(),
+                    t: x[k].max(0.0),
+                })
+            } else {
+                None
+            }
+        }
+        _ => None,
+    }
+}
+
+/// Runs the SQP from coefficients `c0`. `scale` divides the objective (keep
+/// it fixed for one layer so that merits compare). `Err` only when the start
+/// itself has no joint solution.
+pub(crate) fn solve(
+    problem: &LayerProblem,
+    basis: &Basis,
+    c0: Vec<f64>,
+    smoothness: f64,
+    scale: f64,
+    opts: &SqpOptions,
+) -> Result<SqpResult, PointFailure> {
+    let k = basis.len();
+    let rho = opts.penalty;
+    let mut c = c0;
+    let mut e = problem.evaluate(&basis.eval(&c))?;
+    let mut f = problem.objective(&e, smoothness);
+    let mut v = problem.max_violation(&e);
+    let mut merit = f / scale + rho * v;
+    let mut trust = opts.initial_trust_rad;
+    let l1 = basis.row_l1_bound();
+    let (mut iterations, mut qp_solves, mut qp_failures) = (0, 0, 0);
+    let mut converged = false;
+    let mut p_dense = vec![0.0; k * k];
+    let mut grad = vec![0.0; k];
+    while iterations < opts.max_iterations {
+        iterations += 1;
+        // Gauss–Newton model: f(δ) ≈ Σ (r + a·δ)²
+        p_dense.iter_mut().for_each(|x| *x = 0.0);
+        grad.iter_mut().for_each(|x| *x = 0.0);
+        problem.residuals(&e, smoothness, Some(basis), &mut |r, a| {
+            for &(i, ai) in a {
+                grad[i] += 2.0 * r * ai / scale;
+                for &(j, aj) in a {
+                    p_dense[i * k + j] += 2.0 * ai * aj / scale;
+                }
+            }
+        });
+        let rows = problem.constraint_rows(&e, basis, trust);
+        qp_solves += 1;
+        let Some(qp) = solve_qp(k, &p_dense, &grad, &rows, rho, trust / l1) else {
+            qp_failures += 1;
+            trust *= 0.25;
+            if trust < opts.min_trust_rad {
+                break;
+            }
+            continue;
+        };
+        let dc = &qp.x;
+        let mut quad = 0.0;
+        for i in 0..k {
+            quad += grad[i] * dc[i];
+            for j in 0..k {
+                quad += 0.5 * dc[i] * p_dense[i * k + j] * dc[j];
+            }
+        }
+        let predicted = -quad + rho * (v - qp.t);
+        let c_new: Vec<f64> = c.iter().zip(dc).map(|(a, b)| a + b).collect();
+        let r_new = basis.eval(&c_new);
+        let step = r_new
+            .iter()
+            .zip(&e.r)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        if !(predicted > 0.1 * opts.relative_tolerance * (1.0 + merit.abs()))
+            || step < opts.step_tolerance_rad
+        {
+            converged = true;
+            break;
+        }
+        let trial = problem.evaluate(&r_new);
+        let accepted = match trial {
+            Ok(e_new) => {
+                let f_new = problem.objective(&e_new, smoothness);
+                let v_new = problem.max_violation(&e_new);
+                let merit_new = f_new / scale + rho * v_new;
+                let ratio = (merit - merit_new) / predicted;
+                if ratio >= 1e-4 {
+                    let gain = merit - merit_new;
+                    if ratio > 0.75 && step > 0.8 * trust {
+                        trust = (2.0 * trust).min(std::f64::consts::PI);
+                    } else if ratio < 0.25 {
+                        trust = 0.5 * step;
+                    }
+                    c = c_new;
+                    e = e_new;
+                    f = f_new;
+                    v = v_new;
+                    merit = merit_new;
+                    if gain <= opts.relative_tolerance * (1.0 + merit.abs()) {
+                        converged = true;
+                    }
+                    true
+                } else {
+                    false
+                }
+            }
+            Err(_) => false,
+        };
+        if converged {
+            break;
+        }
+        if !accepted {
+            trust = 0.25 * step.min(trust);
+            if trust < opts.min_trust_rad {
+                converged = true;
+                break;
+            }
+        }
+    }
+    // Polish: with no constraint in reach, a few exact Gauss–Newton steps
+    // (Cholesky) settle the flat directions more precisely than the
+    // interior-point QPs (the centring tie-break of a part of revolution).
+    if v <= 0.0 && k <= 16 {
+        for _ in 0..4 {
+            if !problem.constraint_rows(&e, basis, 1e-3).is_empty() {
+                break;
+            }
+            let mut pm = nalgebra::DMatrix::<f64>::zeros(k, k);
+            let mut gv = nalgebra::DVector::<f64>::zeros(k);
+            problem.residuals(&e, smoothness, Some(basis), &mut |r, a| {
+                for &(i, ai) in a {
+                    gv[i] += r * ai;
+                    for &(j, aj) in a {
+                        pm[(i, j)] += ai * aj;
+                    }
+                }
+            });
+            let Some(ch) = pm.cholesky() else { break };
+            let dc = ch.solve(&(-gv));
+            let c_new: Vec<f64> = c.iter().zip(dc.iter()).map(|(a, b)| a + b).collect();
+            let r_new = basis.eval(&c_new);
+            let step = r_new
+                .iter()
+                .zip(&e.r)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            if step > 1e-3 {
+                break;
+            }
+            let Ok(e_new) = problem.evaluate(&r_new) else {
+                break;
+            };
+            let f_new = problem.objective(&e_new, smoothness);
+            let v_new = problem.max_violation(&e_new);
+            if v_new > 0.0 || f_new > f {
+                break;
+            }
+            c = c_new;
+            e = e_new;
+            f = f_new;
+            if step < 1e-12 {
+                break;
+            }
+        }
+    }
+    Ok(SqpResult {
+        c,
+        eval: e,
+        objective: f,
+        violation: v,
+        iterations,
+        qp_solves,
+        qp_failures,
+        converged,
+    })
+}

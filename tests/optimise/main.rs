@@ -1,0 +1,9 @@
+//! Integration tests of the optimisation stage (SPEC §7, thesis chapter 4).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod circle;
+mod cli;
+mod parts;
+mod support;
