@@ -73,6 +73,9 @@ pub struct SliceExtras {
     /// Spiral: travel toward decreasing profile angle.
     #[arg(long)]
     pub reverse: bool,
+    /// Process preset for the estimates in summary.json: cmt-steel (CMT ER70S-6) or pla (thesis table 3.1).
+    #[arg(long, default_value = "cmt-steel", value_parser = ["cmt-steel", "pla"])]
+    pub process: String,
     /// Bead width for wall.stl (mm; default Delta).
     #[arg(long, value_name = "MM")]
     pub bead_width: Option<f64>,

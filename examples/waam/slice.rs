@@ -70,6 +70,13 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     let csv = dir.join("path.csv");
     write_atomic(&csv, |w| write_path_csv(w, &path.layers, &frames))
         .map_err(|e| format!("{}: {e}", csv.display()))?;
+    let params = match more.process.as_str() {
+        "pla" => waam_slicer::process::ProcessParameters::pla_table_3_1(),
+        _ => waam_slicer::process::ProcessParameters::cmt_steel_er70s6(),
+    };
+    let process = waam_slicer::process::plan_process(&path, &params, &Default::default())
+        .map_err(|e| e.to_string())?;
+    let est = process.estimates;
     let stl = dir.join("wall.stl");
     let width = more.bead_width.unwrap_or(path.delta_mm);
     let triangles = waam_slicer::io::wall_stl::wall_triangles(&path, &frames, width);
@@ -123,6 +130,14 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
         "points": path.num_points(),
         "arc_starts": path.layers.len(),
         "length_mm": path.length_mm(),
+        "process": {
+            "preset": more.process,
+            "deposition_time_s": est.deposition_time_s,
+            "wire_length_mm": est.wire_length_mm,
+            "deposited_mass_g": est.deposited_mass_g,
+            "arc_starts": est.arc_starts,
+            "speed_window_violations": process.violation_count,
+        },
         "distance": {
             "overall": map.overall,
             "per_layer": map.per_layer,
