@@ -4,6 +4,7 @@
 use crate::geometry::GeometryError;
 use crate::io::cell_file::CellFileError;
 use crate::io::part_file::PartFileError;
+use crate::program::ProgramError;
 use crate::robot::RobotError;
 
 /// Any error of the library.
@@ -22,4 +23,7 @@ pub enum Error {
     /// A cell file could not be read.
     #[error(transparent)]
     CellFile(#[from] CellFileError),
+    /// Writing, reading back or checking a robot program failed.
+    #[error(transparent)]
+    Program(#[from] ProgramError),
 }

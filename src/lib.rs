@@ -25,6 +25,7 @@
 //! | 2. deposition paths: four strategies, distance map, truncation, seams | [`path`] | §3 |
 //! | 3. tool axes (local frames, build direction) | [`toolaxis`] | §4 |
 //! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
+//! | 7. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
 //!
 //! ## Units and frames
 //!
@@ -54,6 +55,7 @@ pub mod geometry;
 pub mod io;
 pub mod math;
 pub mod path;
+pub mod program;
 pub mod robot;
 pub mod toolaxis;
 
