@@ -22,7 +22,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
 use crate::program::fmt::{Deg, Mm, Unitless};
-use crate::program::{check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError};
+use crate::program::{
+    check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+};
 use crate::robot::orientation::abb_quaternion;
 use crate::robot::{Cell, Joints, RobotModel};
 
@@ -199,12 +201,14 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
                     }
                 }
             }
-            (ProcessControl::Arc { schedule }, ArcFlag::On) => {
-                writeln!(w, "    ArcL p{k}, {v}, seam1, weld{schedule}, {zone}, {tw};")?
-            }
-            (ProcessControl::Arc { schedule }, ArcFlag::End) => {
-                writeln!(w, "    ArcLEnd p{k}, {v}, seam1, weld{schedule}, fine, {tw};")?
-            }
+            (ProcessControl::Arc { schedule }, ArcFlag::On) => writeln!(
+                w,
+                "    ArcL p{k}, {v}, seam1, weld{schedule}, {zone}, {tw};"
+            )?,
+            (ProcessControl::Arc { schedule }, ArcFlag::End) => writeln!(
+                w,
+                "    ArcLEnd p{k}, {v}, seam1, weld{schedule}, fine, {tw};"
+            )?,
             (ProcessControl::Custom { .. }, ArcFlag::On) => {
                 writeln!(w, "    MoveL p{k}, {v}, {zone}, {tw};")?
             }

@@ -19,6 +19,14 @@
 //! Speeds are integers (mm/sec or cm/min), the only form a TP motion line
 //! takes without a register; modulated travel speeds are rounded to the
 //! nearest unit (prefer cm/min for a finer step).
+//!
+//! The programmed speed is the travel speed of the deposition point
+//! relative to the part (what the plan and the validator use). In the
+//! torch-carried cell with the torch as tool frame that is the controller's
+//! TCP speed. In the part-carried cell the controller's TCP (the flange)
+//! hardly moves while the part turns under the fixed torch: the controller
+//! must interpret the speed relative to the fixed torch (FANUC's remote-TCP
+//! motion option), which this emitter does not yet write.
 
 use std::io::Write;
 
@@ -27,7 +35,9 @@ use serde::{Deserialize, Serialize};
 use crate::math::Isometry3;
 use crate::program::fmt::{FanucDeg, FanucMm};
 use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
-use crate::program::{check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError};
+use crate::program::{
+    check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+};
 use crate::robot::orientation::FanucPose;
 use crate::robot::Cell;
 
@@ -122,10 +132,18 @@ impl FanucOptions {
             ));
         }
         if self.user_frame > 9 {
-            return Err(bad("user_frame", self.user_frame.to_string(), "must be in 0..=9"));
+            return Err(bad(
+                "user_frame",
+                self.user_frame.to_string(),
+                "must be in 0..=9",
+            ));
         }
         if !(1..=10).contains(&self.tool_frame) {
-            return Err(bad("tool_frame", self.tool_frame.to_string(), "must be in 1..=10"));
+            return Err(bad(
+                "tool_frame",
+                self.tool_frame.to_string(),
+                "must be in 1..=10",
+            ));
         }
         if self.point_limit == 0 {
             return Err(bad("point_limit", "0".into(), "must be >= 1"));
@@ -481,7 +499,11 @@ pub fn write_ls(w: &mut dyn Write, tp: &TpProgram) -> std::io::Result<()> {
     writeln!(w, "      BUSY_LAMP_OFF\t= 0,")?;
     writeln!(w, "      ABORT_REQUEST\t= 0,")?;
     writeln!(w, "      PAUSE_REQUEST\t= 0;")?;
-    let groups = if tp.groups >= 2 { "1,1,*,*,*" } else { "1,*,*,*,*" };
+    let groups = if tp.groups >= 2 {
+        "1,1,*,*,*"
+    } else {
+        "1,*,*,*,*"
+    };
     writeln!(w, "DEFAULT_GROUP\t= {groups};")?;
     writeln!(w, "CONTROL_CODE\t= 00000000 00000000;")?;
     if tp.arc_welding {
@@ -536,7 +558,12 @@ pub fn write_ls(w: &mut dyn Write, tp: &TpProgram) -> std::io::Result<()> {
         if let Some(g) = p.group2 {
             writeln!(w, "   GP2:")?;
             writeln!(w, "\tUF : {uf}, UT : {ut},\t")?;
-            writeln!(w, "\tJ1= {} deg,\tJ2= {} deg", FanucDeg(g[0]), FanucDeg(g[1]))?;
+            writeln!(
+                w,
+                "\tJ1= {} deg,\tJ2= {} deg",
+                FanucDeg(g[0]),
+                FanucDeg(g[1])
+            )?;
         }
         writeln!(w, "}};")?;
     }
@@ -548,7 +575,10 @@ pub fn write_ls(w: &mut dyn Write, tp: &TpProgram) -> std::io::Result<()> {
 ///
 /// # Errors
 /// As [`tp_programs`].
-pub fn fanuc_files(program: &Program, opts: &FanucOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+pub fn fanuc_files(
+    program: &Program,
+    opts: &FanucOptions,
+) -> Result<Vec<EmittedFile>, ProgramError> {
     tp_programs(program, opts)?
         .iter()
         .map(|tp| {

@@ -23,7 +23,9 @@ use serde::{Deserialize, Serialize};
 use crate::math::Isometry3;
 use crate::program::fanuc::PositionMode;
 use crate::program::fmt::{Deg, Mm};
-use crate::program::{check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError};
+use crate::program::{
+    check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+};
 use crate::robot::orientation::KukaAbc;
 use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel};
 
@@ -77,10 +79,18 @@ impl KukaOptions {
             reason,
         };
         if !(self.cdis_mm.is_finite() && self.cdis_mm > 0.0) {
-            return Err(bad("cdis_mm", self.cdis_mm.to_string(), "must be finite and > 0"));
+            return Err(bad(
+                "cdis_mm",
+                self.cdis_mm.to_string(),
+                "must be finite and > 0",
+            ));
         }
         if !(1..=100).contains(&self.ptp_percent) {
-            return Err(bad("ptp_percent", self.ptp_percent.to_string(), "must be in 1..=100"));
+            return Err(bad(
+                "ptp_percent",
+                self.ptp_percent.to_string(),
+                "must be in 1..=100",
+            ));
         }
         if !(1..=32).contains(&self.base) {
             return Err(bad("base", self.base.to_string(), "must be in 1..=32"));

@@ -47,7 +47,9 @@ use crate::robot::{Cell, Configuration, Joints};
 #[non_exhaustive]
 pub enum ProgramError {
     /// The plan has violations: no program is written for it.
-    #[error("refusing to write a program for an infeasible plan: {count} violation(s), first: {first}")]
+    #[error(
+        "refusing to write a program for an infeasible plan: {count} violation(s), first: {first}"
+    )]
     Infeasible {
         /// Number of violations.
         count: usize,
@@ -261,8 +263,8 @@ pub fn build_program(
             let d = (p.position_mm - prev.position_mm).norm();
             if d > 0.0 {
                 let dt = d / speeds[i];
-                for j in 0..6 {
-                    let s = (q[j] - prev.joints[j]).abs() / dt;
+                for (j, (qj, pj)) in q.iter().zip(prev.joints).enumerate() {
+                    let s = (qj - pj).abs() / dt;
                     if s > robot.max_speed_rad_s[j] {
                         return Err(ProgramError::Infeasible {
                             count: 1,

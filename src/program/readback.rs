@@ -180,7 +180,8 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
                 };
                 if l == "};" {
                     let p = current.take().expect("checked");
-                    tp.positions.push(finish(p).map_err(|(line, r)| err(line, r))?);
+                    tp.positions
+                        .push(finish(p).map_err(|(line, r)| err(line, r))?);
                 } else if l == "GP1:" {
                     p.group = 1;
                 } else if l == "GP2:" {
@@ -221,9 +222,9 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
                         if part.is_empty() {
                             continue;
                         }
-                        let (k, v) = part
-                            .split_once('=')
-                            .ok_or_else(|| err(n, format!("expected `KEY = value`, got `{part}`")))?;
+                        let (k, v) = part.split_once('=').ok_or_else(|| {
+                            err(n, format!("expected `KEY = value`, got `{part}`"))
+                        })?;
                         let v = v.trim();
                         let v = v
                             .strip_suffix("deg")
@@ -259,7 +260,12 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
                             (1, "W") => &mut p.cart[3],
                             (1, "P") => &mut p.cart[4],
                             (1, "R") => &mut p.cart[5],
-                            _ => return Err(err(n, format!("unexpected key `{k}` in group {}", p.group))),
+                            _ => {
+                                return Err(err(
+                                    n,
+                                    format!("unexpected key `{k}` in group {}", p.group),
+                                ))
+                            }
                         };
                         *slot = Some((x, n));
                     }
@@ -315,7 +321,9 @@ fn parse_op(body: &str) -> Result<Op, String> {
         _ => None,
     } {
         if tokens.len() != 4 {
-            return Err(format!("expected `J|L P[n] <speed> <FINE|CNTn>`, got `{body}`"));
+            return Err(format!(
+                "expected `J|L P[n] <speed> <FINE|CNTn>`, got `{body}`"
+            ));
         }
         let position = tokens[1]
             .strip_prefix("P[")
@@ -367,10 +375,18 @@ fn parse_op(body: &str) -> Result<Op, String> {
         return r.map(Op::ArcEnd);
     }
     if let Some(v) = body.strip_prefix("UFRAME_NUM=") {
-        return v.trim().parse().map(Op::UFrame).map_err(|_| format!("bad `{body}`"));
+        return v
+            .trim()
+            .parse()
+            .map(Op::UFrame)
+            .map_err(|_| format!("bad `{body}`"));
     }
     if let Some(v) = body.strip_prefix("UTOOL_NUM=") {
-        return v.trim().parse().map(Op::UTool).map_err(|_| format!("bad `{body}`"));
+        return v
+            .trim()
+            .parse()
+            .map(Op::UTool)
+            .map_err(|_| format!("bad `{body}`"));
     }
     if let Some(v) = body.strip_prefix("CALL ") {
         return Ok(Op::Call(v.trim().to_string()));
@@ -382,9 +398,10 @@ fn parse_op(body: &str) -> Result<Op, String> {
 }
 
 fn finish(p: Partial) -> Result<Position, (usize, String)> {
-    let uf_ut = p
-        .uf_ut
-        .ok_or((p.line, format!("P[{}]: no `UF : n, UT : n` in GP1", p.index)))?;
+    let uf_ut = p.uf_ut.ok_or((
+        p.line,
+        format!("P[{}]: no `UF : n, UT : n` in GP1", p.index),
+    ))?;
     let joints = p.values.iter().all(Option::is_some);
     let cart = p.cart.iter().all(Option::is_some);
     let (arm, value_lines) = if joints && p.cart.iter().all(Option::is_none) {
@@ -415,12 +432,7 @@ fn finish(p: Partial) -> Result<Position, (usize, String)> {
     let group2 = match p.group2 {
         [Some(a), Some(b)] => Some([a, b]),
         [None, None] => None,
-        _ => {
-            return Err((
-                p.line,
-                format!("P[{}]: GP2 needs J1 and J2", p.index),
-            ))
-        }
+        _ => return Err((p.line, format!("P[{}]: GP2 needs J1 and J2", p.index))),
     };
     Ok(Position {
         index: p.index,

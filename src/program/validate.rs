@@ -154,12 +154,18 @@ impl Validator<'_> {
             match &ins.op {
                 Op::Call(name) => {
                     if depth > 4 {
-                        self.problem(&tp.name, line, format!("CALL {name}: calls nested too deep"));
+                        self.problem(
+                            &tp.name,
+                            line,
+                            format!("CALL {name}: calls nested too deep"),
+                        );
                         continue;
                     }
                     match self.programs.iter().find(|p| &p.name == name) {
                         Some(sub) => self.run(sub, depth + 1),
-                        None => self.problem(&tp.name, line, format!("CALL {name}: no such program")),
+                        None => {
+                            self.problem(&tp.name, line, format!("CALL {name}: no such program"))
+                        }
                     }
                 }
                 op if *op == start => {
@@ -257,7 +263,11 @@ impl Validator<'_> {
                 let mut q = match robot.inverse(&base_from_flange, cfg) {
                     Ok(q) => q,
                     Err(e) => {
-                        self.problem(&tp.name, pos.value_lines[0], format!("P[{}]: {e}", pos.index));
+                        self.problem(
+                            &tp.name,
+                            pos.value_lines[0],
+                            format!("P[{}]: {e}", pos.index),
+                        );
                         return None;
                     }
                 };
@@ -270,7 +280,10 @@ impl Validator<'_> {
                     self.problem(
                         &tp.name,
                         pos.value_lines[0],
-                        format!("P[{}]: IK with '{config}' reaches {err:.4} mm away", pos.index),
+                        format!(
+                            "P[{}]: IK with '{config}' reaches {err:.4} mm away",
+                            pos.index
+                        ),
                     );
                 }
                 Some(q)

@@ -87,20 +87,15 @@ pub fn program(
 }
 
 #[test]
-fn which_hemisphere_layers_are_feasible() {
+fn the_test_layers_are_feasible_in_every_cell() {
     for file in [
         "robowam_part_carried.toml",
         "robowam_part_carried_second_position.toml",
         "robowam_torch_carried.toml",
     ] {
         let cell = cell(file);
-        let path = hemisphere(0..9, 24, law(&cell));
+        let path = hemisphere(0..4, 24, law(&cell));
         let tr = trajectory(&cell, &path);
-        let bad: std::collections::BTreeSet<usize> =
-            tr.report.violations.iter().map(|v| v.layer).collect();
-        eprintln!("{file}: infeasible layers {bad:?}");
-        if let Some(v) = tr.report.violations.first() {
-            eprintln!("  first: {v}");
-        }
+        assert!(tr.report.is_clean(), "{file}: {}", tr.report);
     }
 }

@@ -84,7 +84,10 @@ fn fanuc_torch_carried_golden_has_group_2() {
 
 #[test]
 fn kuka_golden() {
-    check_all("kuka_joint_", &kuka_files(&small(), &KukaOptions::default()).unwrap());
+    check_all(
+        "kuka_joint_",
+        &kuka_files(&small(), &KukaOptions::default()).unwrap(),
+    );
     let opts = KukaOptions {
         positions: PositionMode::Cartesian,
         ..Default::default()
@@ -95,7 +98,10 @@ fn kuka_golden() {
 
 #[test]
 fn abb_golden() {
-    check_all("abb_", &abb_files(&small(), &AbbOptions::default()).unwrap());
+    check_all(
+        "abb_",
+        &abb_files(&small(), &AbbOptions::default()).unwrap(),
+    );
 }
 
 #[test]

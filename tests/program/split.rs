@@ -61,12 +61,10 @@ fn split_at_n_points_concatenates_to_the_unsplit_program() {
             assert_eq!(parts.len(), 1);
         } else {
             assert_eq!(parts.len(), subs + 1, "N = {n}");
-            let calls: Vec<_> = parts[0]
-                .instructions
-                .iter()
-                .map(|i| i.op.clone())
+            let calls: Vec<_> = parts[0].instructions.iter().map(|i| i.op.clone()).collect();
+            let want: Vec<_> = (1..=subs)
+                .map(|k| Op::Call(format!("HEMI_{k:03}")))
                 .collect();
-            let want: Vec<_> = (1..=subs).map(|k| Op::Call(format!("HEMI_{k:03}"))).collect();
             assert_eq!(calls, want);
             for (k, sub) in parts[1..].iter().enumerate() {
                 assert_eq!(sub.name, format!("HEMI_{:03}", k + 1));

@@ -27,7 +27,12 @@ fn emitted(cell: &Cell, opts: &FanucOptions) -> (String, Vec<waam_slicer::math::
     )
 }
 
-fn check(text: &str, cell: &Cell, opts: &FanucOptions, planned: &[waam_slicer::math::Point3]) -> ValidationReport {
+fn check(
+    text: &str,
+    cell: &Cell,
+    opts: &FanucOptions,
+    planned: &[waam_slicer::math::Point3],
+) -> ValidationReport {
     let tp = parse_ls(text, "HEMI.ls").unwrap_or_else(|e| panic!("{e}"));
     validate_fanuc(&[tp], cell, opts, Some(planned))
 }
@@ -80,7 +85,11 @@ fn a_joint_pushed_out_of_range_is_named_by_its_line() {
         .find(|p| p.message.contains("J5 = 170.0000°"))
         .unwrap_or_else(|| panic!("{r}"));
     assert_eq!(p.line, j5_line, "{r}");
-    assert!(p.to_string().starts_with(&format!("HEMI:{j5_line}: P[3]: J5")), "{p}");
+    assert!(
+        p.to_string()
+            .starts_with(&format!("HEMI:{j5_line}: P[3]: J5")),
+        "{p}"
+    );
 }
 
 #[test]
@@ -94,7 +103,10 @@ fn a_dropped_arc_end_is_named_by_its_line() {
     lines.remove(end_line - 1);
     let raw = lines.join("\n") + "\n";
     let e = parse_ls(&raw, "HEMI.ls").unwrap_err();
-    assert!(matches!(e, ProgramError::Read { line, .. } if line == end_line), "{e}");
+    assert!(
+        matches!(e, ProgramError::Read { line, .. } if line == end_line),
+        "{e}"
+    );
     // consistent edit (renumbered): the validator names the next bead's start
     let mut tp: TpProgram = parse_ls(&text, "HEMI.ls").unwrap();
     let k = tp
@@ -166,7 +178,15 @@ fn an_overspeed_is_named_by_its_motion_line() {
     let (text, planned) = emitted(&cell, &opts);
     // the 5th linear move of the top layer at 2000 mm/s: J6 needs v / A rad/s
     let mut lines: Vec<String> = text.lines().map(String::from).collect();
-    let first_l = line_of(&text, ":L P[", line_of(&text, "Arc Start[1]", line_of(&text, "Arc End[1]", line_of(&text, "Arc End[1]", 0))));
+    let first_l = line_of(
+        &text,
+        ":L P[",
+        line_of(
+            &text,
+            "Arc Start[1]",
+            line_of(&text, "Arc End[1]", line_of(&text, "Arc End[1]", 0)),
+        ),
+    );
     let target = first_l + 4;
     lines[target - 1] = lines[target - 1].replace("36cm/min", "2000mm/sec");
     let bad = lines.join("\n") + "\n";
@@ -221,7 +241,9 @@ fn no_program_for_an_infeasible_plan() {
     let e = build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(TS_MM_S)).unwrap_err();
     let msg = e.to_string();
     assert!(
-        matches!(e, ProgramError::Infeasible { .. }) && msg.contains("refusing") && msg.contains("layer"),
+        matches!(e, ProgramError::Infeasible { .. })
+            && msg.contains("refusing")
+            && msg.contains("layer"),
         "{msg}"
     );
     // a speed the joints cannot follow is refused too, naming the joint
