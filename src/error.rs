@@ -6,6 +6,7 @@ use crate::io::cell_file::CellFileError;
 use crate::io::part_file::PartFileError;
 use crate::optimise::OptimiseError;
 use crate::process::ProcessError;
+use crate::program::ProgramError;
 use crate::robot::RobotError;
 use crate::toolaxis::ToolAxisError;
 
@@ -34,4 +35,7 @@ pub enum Error {
     /// The optimisation stage was given bad input.
     #[error(transparent)]
     Optimise(#[from] OptimiseError),
+    /// Writing, reading back or checking a robot program failed.
+    #[error(transparent)]
+    Program(#[from] ProgramError),
 }

@@ -22,11 +22,12 @@
 //! |---|---|---|
 //! | 0. read a part file | [`io::part_file`] | §2 |
 //! | 1. tube geometry: guide curves, frames, profile law, substrates | [`geometry`] | §2 |
-//! | 2. deposition paths: four strategies, distance map, truncation, seams | [`path`] | §3 |
+//! | 2. deposition paths: four strategies + spiral, distance map, truncation, seams, smoothing | [`path`] | §3 |
 //! | 3. tool axes (local frames, build direction) | [`toolaxis`] | §4 |
 //! | 3b. process: bead, travel speeds, estimates | [`process`] | §5 |
 //! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
 //! | 5. layer-by-layer optimisation of `R_Z` (branch, SQP, quality) | [`optimise`] | §7 |
+//! | 6. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
 //!
 //! ## Units and frames
 //!
@@ -58,6 +59,7 @@ pub mod math;
 pub mod optimise;
 pub mod path;
 pub mod process;
+pub mod program;
 pub mod robot;
 pub mod toolaxis;
 

@@ -1,0 +1,237 @@
+//! ABB RAPID module (`.mod`) [SPEC §8].
+//!
+//! * Positions as `robtarget`s (`[[x,y,z],[q1,q2,q3,q4],[cf1,cf4,cf6,cfx],
+//!   [e1..e6]]`: the tool in the work object, mm, quaternion `[w,x,y,z]`)
+//!   with `confdata` derived from the chosen joints (`cf1 cf4 cf6` the
+//!   quarter turn of J1, J4, J6, `floor(q / 90°)`; `cfx` 0–7 = front/back ×
+//!   elbow × sign of J5, ABB's table), and a `jointtarget` for the joint move
+//!   to every bead start; the torch-carried cell's positioner as external
+//!   axes `eax_a`, `eax_b` (deg), the others `9E+09`.
+//! * `ConfL \On` so that the controller keeps our branch on linear moves.
+//! * Arc process: `ArcLStart` (`fine`) / `ArcL` (`z1`) / `ArcLEnd` (`fine`)
+//!   with `seam1` and `weld<schedule>`, which must exist in the system;
+//!   custom process: `MoveL` with the user's instructions after the first
+//!   and after the last point of each bead. Speeds as inline `speeddata`
+//!   `[v_tcp mm/s, 500, 5000, 1000]`.
+//! * `tWaam` (the tool) and `wWaam` (the work object) are declared from the
+//!   options with a 1 kg placeholder load: set the real load before running.
+
+use std::io::Write;
+
+use serde::{Deserialize, Serialize};
+
+use crate::math::Isometry3;
+use crate::program::fmt::{Deg, Mm, Unitless};
+use crate::program::{
+    check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+};
+use crate::robot::orientation::abb_quaternion;
+use crate::robot::{Cell, Joints, RobotModel};
+
+/// Options of the ABB emitter. Plain data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AbbOptions {
+    /// Arc instructions or user-given instructions. Default `weld1`.
+    pub process: ProcessControl,
+    /// Joint move speed to bead starts (mm/s of the TCP, `v<n>`). Default 100.
+    pub approach_speed_mm_s: f64,
+    /// Zone inside beads (mm). Default 1 (`z1`).
+    pub zone_mm: u32,
+    /// Work object in the robot base frame (mm). Default identity.
+    pub base_from_user: Isometry3,
+    /// Tool on the flange (`tool0`) (mm); `None`: as the FANUC emitter.
+    pub flange_from_tool: Option<Isometry3>,
+}
+
+impl Default for AbbOptions {
+    fn default() -> Self {
+        Self {
+            process: ProcessControl::default(),
+            approach_speed_mm_s: 100.0,
+            zone_mm: 1,
+            base_from_user: Isometry3::identity(),
+            flange_from_tool: None,
+        }
+    }
+}
+
+impl AbbOptions {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`ProgramError::InvalidOptions`] naming the field.
+    pub fn validate(&self) -> Result<(), ProgramError> {
+        if !(self.approach_speed_mm_s.is_finite() && self.approach_speed_mm_s > 0.0) {
+            return Err(ProgramError::InvalidOptions {
+                field: "approach_speed_mm_s",
+                value: self.approach_speed_mm_s.to_string(),
+                reason: "must be finite and > 0",
+            });
+        }
+        self.process.validate()
+    }
+}
+
+/// ABB `confdata` `[cf1, cf4, cf6, cfx]` of joints `q` (module doc).
+pub fn confdata(robot: &RobotModel, q: &Joints) -> [i32; 4] {
+    let quarter = |v: f64| (v / std::f64::consts::FRAC_PI_2).floor() as i32;
+    let c = robot.configuration_of(q);
+    let side = matches!(c.side, crate::robot::ArmSide::Back) as i32;
+    let elbow = matches!(c.elbow, crate::robot::Elbow::Down) as i32;
+    let wrist = (q[4] < 0.0) as i32;
+    [
+        quarter(q[0]),
+        quarter(q[3]),
+        quarter(q[5]),
+        4 * side + 2 * elbow + wrist,
+    ]
+}
+
+fn pose_line(pose: &Isometry3) -> String {
+    let t = pose.translation.vector;
+    let q = abb_quaternion(&pose.rotation.to_rotation_matrix());
+    format!(
+        "[[{},{},{}],[{},{},{},{}]]",
+        Mm(t.x),
+        Mm(t.y),
+        Mm(t.z),
+        Unitless(q[0]),
+        Unitless(q[1]),
+        Unitless(q[2]),
+        Unitless(q[3])
+    )
+}
+
+fn extax(e: Option<[f64; 2]>) -> String {
+    match e {
+        Some(e) => format!(
+            "[{},{},9E+09,9E+09,9E+09,9E+09]",
+            Deg(e[0].to_degrees()),
+            Deg(e[1].to_degrees())
+        ),
+        None => "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]".into(),
+    }
+}
+
+/// Writes the `.mod` of `program`.
+///
+/// # Errors
+/// I/O errors of `w`.
+pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std::io::Result<()> {
+    let robot = program.cell.robot();
+    let tool = match (opts.flange_from_tool, &program.cell) {
+        (Some(t), _) => t,
+        (None, Cell::TorchCarried(c)) => c.flange_from_tcp,
+        (None, Cell::PartCarried(_)) => Isometry3::identity(),
+    };
+    let user_from_base = opts.base_from_user.inverse();
+    writeln!(w, "MODULE {}", program.name)?;
+    writeln!(
+        w,
+        "  ! waam-slicer: {}, {} points, {} beads",
+        program.cell.name(),
+        program.points.len(),
+        program.num_beads()
+    )?;
+    writeln!(
+        w,
+        "  PERS tooldata tWaam := [TRUE,{},[1,[0,0,1],[1,0,0,0],0,0,0]];",
+        pose_line(&tool)
+    )?;
+    writeln!(
+        w,
+        "  PERS wobjdata wWaam := [FALSE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];",
+        pose_line(&opts.base_from_user)
+    )?;
+    for (i, p) in program.points.iter().enumerate() {
+        let pose = user_from_base * robot.flange_pose(&p.joints) * tool;
+        let c = confdata(robot, &p.joints);
+        let pl = pose_line(&pose);
+        writeln!(
+            w,
+            "  CONST robtarget p{} := [{},[{},{},{},{}],{}];",
+            i + 1,
+            &pl[1..pl.len() - 1],
+            c[0],
+            c[1],
+            c[2],
+            c[3],
+            extax(p.positioner)
+        )?;
+        if p.arc == ArcFlag::Start {
+            let a = p.joints.map(f64::to_degrees);
+            writeln!(
+                w,
+                "  CONST jointtarget j{} := [[{},{},{},{},{},{}],{}];",
+                i + 1,
+                Deg(a[0]),
+                Deg(a[1]),
+                Deg(a[2]),
+                Deg(a[3]),
+                Deg(a[4]),
+                Deg(a[5]),
+                extax(p.positioner)
+            )?;
+        }
+    }
+    writeln!(w, "  PROC main()")?;
+    writeln!(w, "    ConfL \\On;")?;
+    let tw = "tWaam\\WObj:=wWaam";
+    let zone = format!("z{}", opts.zone_mm);
+    for (i, p) in program.points.iter().enumerate() {
+        let k = i + 1;
+        let v = format!("[{},500,5000,1000]", Mm(p.speed_mm_s));
+        match (&opts.process, p.arc) {
+            (_, ArcFlag::Start) => {
+                writeln!(w, "    ! bead {} (layer {})", p.layer, p.layer)?;
+                writeln!(
+                    w,
+                    "    MoveAbsJ j{k}, [{},500,5000,1000], fine, {tw};",
+                    Mm(opts.approach_speed_mm_s)
+                )?;
+                match &opts.process {
+                    ProcessControl::Arc { schedule } => writeln!(
+                        w,
+                        "    ArcLStart p{k}, {v}, seam1, weld{schedule}, fine, {tw};"
+                    )?,
+                    ProcessControl::Custom { start, .. } => {
+                        writeln!(w, "    MoveL p{k}, {v}, fine, {tw};")?;
+                        writeln!(w, "    {start};")?;
+                    }
+                }
+            }
+            (ProcessControl::Arc { schedule }, ArcFlag::On) => writeln!(
+                w,
+                "    ArcL p{k}, {v}, seam1, weld{schedule}, {zone}, {tw};"
+            )?,
+            (ProcessControl::Arc { schedule }, ArcFlag::End) => writeln!(
+                w,
+                "    ArcLEnd p{k}, {v}, seam1, weld{schedule}, fine, {tw};"
+            )?,
+            (ProcessControl::Custom { .. }, ArcFlag::On) => {
+                writeln!(w, "    MoveL p{k}, {v}, {zone}, {tw};")?
+            }
+            (ProcessControl::Custom { end, .. }, ArcFlag::End) => {
+                writeln!(w, "    MoveL p{k}, {v}, fine, {tw};")?;
+                writeln!(w, "    {end};")?;
+            }
+        }
+    }
+    writeln!(w, "  ENDPROC")?;
+    writeln!(w, "ENDMODULE")?;
+    Ok(())
+}
+
+/// The `.mod` file of `program`.
+///
+/// # Errors
+/// [`ProgramError::InvalidOptions`] for bad options or name.
+pub fn abb_files(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+    opts.validate()?;
+    check_name(&program.name)?;
+    Ok(vec![EmittedFile {
+        name: format!("{}.mod", program.name),
+        text: render(|w| write_mod(w, program, opts))?,
+    }])
+}

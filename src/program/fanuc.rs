@@ -1,0 +1,591 @@
+//! FANUC TP ASCII programs (`.ls`) [SPEC §8, thesis §3.1.2]: `/PROG`,
+//! `/ATTR`, `/APPL` (arc welding), `/MN`, `/POS`, `/END`.
+//!
+//! * Positions in joint representation (degrees, FANUC's J2/J3 convention,
+//!   which is the controller convention of [`RobotModel`](crate::robot::RobotModel))
+//!   or Cartesian `X Y Z W P R` (mm, deg, tool frame in the user frame) with
+//!   `CONFIG : 'F U T, t1, t4, t6'` derived from the chosen joints, so that
+//!   the controller reproduces our branch and turns.
+//! * Each bead: a joint move (`J P[n] 10% FINE`) to its first point with the
+//!   arc off, `Arc Start[s]` (or the user's start line), linear moves at the
+//!   travel speed blended with `CNT`, the last one `FINE` so that the arc
+//!   switching points are not moved, `Arc End[s]` (or the user's end line).
+//! * The torch-carried cell's positioner is motion group 2 (`GP2`, `J1 J2` =
+//!   `q7 q8` in degrees), `DEFAULT_GROUP = 1,1,*,*,*`.
+//! * Over [`FanucOptions::point_limit`] positions the program is split into
+//!   numbered sub-programs and a main program calling them in order
+//!   ([`split`](crate::program::split)).
+//!
+//! Speeds are integers (mm/sec or cm/min), the only form a TP motion line
+//! takes without a register; modulated travel speeds are rounded to the
+//! nearest unit (prefer cm/min for a finer step).
+//!
+//! The programmed speed is the travel speed of the deposition point
+//! relative to the part (what the plan and the validator use). In the
+//! torch-carried cell with the torch as tool frame that is the controller's
+//! TCP speed. In the part-carried cell the controller's TCP (the flange)
+//! hardly moves while the part turns under the fixed torch: the controller
+//! must interpret the speed relative to the fixed torch (FANUC's remote-TCP
+//! motion option), which this emitter does not yet write.
+
+use std::io::Write;
+
+use serde::{Deserialize, Serialize};
+
+use crate::math::Isometry3;
+use crate::program::fmt::{FanucDeg, FanucMm};
+use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
+use crate::program::{
+    check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+};
+use crate::robot::orientation::FanucPose;
+use crate::robot::Cell;
+
+/// How positions are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PositionMode {
+    /// `J1..J6` in degrees (the thesis's articular mode: the branch is ours).
+    #[default]
+    Joint,
+    /// `X Y Z W P R` with configuration string and turn numbers.
+    Cartesian,
+}
+
+/// Unit of linear speeds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpeedUnit {
+    /// `mm/sec`.
+    MmPerSec,
+    /// `cm/min` (the unit of the thesis's process tables).
+    #[default]
+    CmPerMin,
+}
+
+/// Options of the FANUC emitter. Plain data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FanucOptions {
+    /// Joint or Cartesian positions. Default joint.
+    pub positions: PositionMode,
+    /// Unit of the linear speeds. Default cm/min.
+    pub speed_unit: SpeedUnit,
+    /// `CNT` value (0–100) of the blended moves inside a bead. Default 100.
+    pub cnt: u8,
+    /// Joint speed of the move to each bead's first point (%, 1–100). Default 10.
+    pub approach_percent: u8,
+    /// Arc instructions or user-given start/end lines. Default `Arc Start[1]`.
+    pub process: ProcessControl,
+    /// `UFRAME_NUM` (0 = world). Default 0.
+    pub user_frame: u8,
+    /// `UTOOL_NUM` (1–10). Default 1.
+    pub tool_frame: u8,
+    /// The user frame's pose in the robot base frame, as stored in the
+    /// controller's `UFRAME[user_frame]` (mm). Default identity.
+    pub base_from_user: Isometry3,
+    /// The tool frame on the flange, as stored in `UTOOL[tool_frame]` (mm).
+    /// `None`: the cell's torch (`flange_from_tcp`) in the torch-carried
+    /// cell, the flange itself in the part-carried cell.
+    pub flange_from_tool: Option<Isometry3>,
+    /// Most positions in one program; more are split into sub-programs.
+    /// Default 15 000 (R-30iB Plus).
+    pub point_limit: usize,
+}
+
+impl Default for FanucOptions {
+    fn default() -> Self {
+        Self {
+            positions: PositionMode::Joint,
+            speed_unit: SpeedUnit::CmPerMin,
+            cnt: 100,
+            approach_percent: 10,
+            process: ProcessControl::default(),
+            user_frame: 0,
+            tool_frame: 1,
+            base_from_user: Isometry3::identity(),
+            flange_from_tool: None,
+            point_limit: DEFAULT_POINT_LIMIT,
+        }
+    }
+}
+
+impl FanucOptions {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`ProgramError::InvalidOptions`] naming the field.
+    pub fn validate(&self) -> Result<(), ProgramError> {
+        let bad = |field, value: String, reason| ProgramError::InvalidOptions {
+            field,
+            value,
+            reason,
+        };
+        if self.cnt > 100 {
+            return Err(bad("cnt", self.cnt.to_string(), "must be in 0..=100"));
+        }
+        if !(1..=100).contains(&self.approach_percent) {
+            return Err(bad(
+                "approach_percent",
+                self.approach_percent.to_string(),
+                "must be in 1..=100",
+            ));
+        }
+        if self.user_frame > 9 {
+            return Err(bad(
+                "user_frame",
+                self.user_frame.to_string(),
+                "must be in 0..=9",
+            ));
+        }
+        if !(1..=10).contains(&self.tool_frame) {
+            return Err(bad(
+                "tool_frame",
+                self.tool_frame.to_string(),
+                "must be in 1..=10",
+            ));
+        }
+        if self.point_limit == 0 {
+            return Err(bad("point_limit", "0".into(), "must be >= 1"));
+        }
+        self.process.validate()
+    }
+
+    /// The tool frame used for Cartesian positions in `cell` (mm).
+    pub fn tool_in(&self, cell: &Cell) -> Isometry3 {
+        match (self.flange_from_tool, cell) {
+            (Some(t), _) => t,
+            (None, Cell::TorchCarried(c)) => c.flange_from_tcp,
+            (None, Cell::PartCarried(_)) => Isometry3::identity(),
+        }
+    }
+}
+
+/// A motion's speed as written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Speed {
+    /// Joint move, percent of the maximum.
+    Percent(u32),
+    /// Linear, mm/sec.
+    MmPerSec(u32),
+    /// Linear, cm/min.
+    CmPerMin(u32),
+}
+
+impl Speed {
+    /// Linear speed (mm/s), `None` for a percentage.
+    pub fn mm_s(&self) -> Option<f64> {
+        match self {
+            Speed::Percent(_) => None,
+            Speed::MmPerSec(v) => Some(*v as f64),
+            Speed::CmPerMin(v) => Some(*v as f64 / 6.0),
+        }
+    }
+}
+
+impl std::fmt::Display for Speed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Speed::Percent(v) => write!(f, "{v}%"),
+            Speed::MmPerSec(v) => write!(f, "{v}mm/sec"),
+            Speed::CmPerMin(v) => write!(f, "{v}cm/min"),
+        }
+    }
+}
+
+/// Motion termination.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Termination {
+    /// Exact stop.
+    Fine,
+    /// Blended, `CNT0`–`CNT100`.
+    Cnt(u8),
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Termination::Fine => write!(f, "FINE"),
+            Termination::Cnt(c) => write!(f, "CNT{c}"),
+        }
+    }
+}
+
+/// Joint (`J`) or linear (`L`) move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MoveKind {
+    /// `J`.
+    Joint,
+    /// `L`.
+    Linear,
+}
+
+/// One `/MN` instruction.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Op {
+    /// `UFRAME_NUM=n`.
+    UFrame(u8),
+    /// `UTOOL_NUM=n`.
+    UTool(u8),
+    /// `J P[n] ...` / `L P[n] ...`; `position` is the `P[]` index in this program.
+    Move {
+        /// J or L.
+        kind: MoveKind,
+        /// `P[]` index (1-based) in this program.
+        position: usize,
+        /// Speed.
+        speed: Speed,
+        /// Termination.
+        term: Termination,
+    },
+    /// `Arc Start[n]`.
+    ArcStart(u32),
+    /// `Arc End[n]`.
+    ArcEnd(u32),
+    /// `CALL NAME`.
+    Call(String),
+    /// Any other instruction, as written (user-given start/end lines).
+    Other(String),
+}
+
+impl std::fmt::Display for Op {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Op::UFrame(n) => write!(f, "  UFRAME_NUM={n} ;"),
+            Op::UTool(n) => write!(f, "  UTOOL_NUM={n} ;"),
+            Op::Move {
+                kind,
+                position,
+                speed,
+                term,
+            } => {
+                let k = match kind {
+                    MoveKind::Joint => 'J',
+                    MoveKind::Linear => 'L',
+                };
+                write!(f, "{k} P[{position}] {speed} {term}    ;")
+            }
+            Op::ArcStart(n) => write!(f, "  Arc Start[{n}] ;"),
+            Op::ArcEnd(n) => write!(f, "  Arc End[{n}] ;"),
+            Op::Call(n) => write!(f, "  CALL {n}    ;"),
+            Op::Other(s) => write!(f, "  {s} ;"),
+        }
+    }
+}
+
+/// One instruction with the file line it was read from (0 when generated).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Instruction {
+    /// File line (1-based), 0 if generated.
+    pub line: usize,
+    /// The instruction.
+    pub op: Op,
+}
+
+/// Group 1 (the arm) of a position.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ArmPosition {
+    /// `J1..J6` (deg).
+    Joint([f64; 6]),
+    /// `X Y Z W P R` (mm, deg) of the tool frame in the user frame, and the
+    /// `CONFIG` string (`F U T, 0, 0, 1`).
+    Cartesian {
+        /// `[X, Y, Z, W, P, R]` (mm, deg).
+        xyzwpr: [f64; 6],
+        /// The configuration string without quotes.
+        config: String,
+    },
+}
+
+/// One `/POS` record.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Position {
+    /// `P[]` index (1-based).
+    pub index: usize,
+    /// `UF` and `UT` of group 1.
+    pub uf_ut: (u8, u8),
+    /// The arm.
+    pub arm: ArmPosition,
+    /// Group 2 (positioner) `J1 J2` (deg), if present.
+    pub group2: Option<[f64; 2]>,
+    /// File line of `P[n]{` (0 if generated).
+    pub line: usize,
+    /// File line of each of the six group-1 values (0 if generated).
+    pub value_lines: [usize; 6],
+    /// File line of group 2's values (0 if generated or absent).
+    pub group2_line: usize,
+}
+
+/// A TP program as data: what [`write_ls`] prints and
+/// [`parse_ls`](crate::program::readback::parse_ls) reads.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TpProgram {
+    /// `/PROG` name.
+    pub name: String,
+    /// `/ATTR COMMENT`.
+    pub comment: String,
+    /// Motion groups in use (1 or 2).
+    pub groups: usize,
+    /// `/APPL` arc welding section present.
+    pub arc_welding: bool,
+    /// `/MN`.
+    pub instructions: Vec<Instruction>,
+    /// `/POS`, in index order.
+    pub positions: Vec<Position>,
+}
+
+/// The FANUC programs of `program`: one program when it has at most
+/// `opts.point_limit` points, else the main program (first, named
+/// `program.name`) and its sub-programs `NAME_001`, `NAME_002`, ...
+///
+/// # Errors
+/// [`ProgramError::InvalidOptions`] for bad options or a name too long
+/// for the sub-program suffix.
+pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgram>, ProgramError> {
+    opts.validate()?;
+    check_name(&program.name)?;
+    let robot = program.cell.robot();
+    let tool = opts.tool_in(&program.cell);
+    let user_from_base = opts.base_from_user.inverse();
+    let groups = if program.points.iter().any(|p| p.positioner.is_some()) {
+        2
+    } else {
+        1
+    };
+    let arc_welding = matches!(opts.process, ProcessControl::Arc { .. });
+    let (start_op, end_op) = match &opts.process {
+        ProcessControl::Arc { schedule } => (Op::ArcStart(*schedule), Op::ArcEnd(*schedule)),
+        ProcessControl::Custom { start, end } => (Op::Other(start.clone()), Op::Other(end.clone())),
+    };
+    let linear_speed = |v: f64| match opts.speed_unit {
+        SpeedUnit::MmPerSec => Speed::MmPerSec((v.round() as u32).max(1)),
+        SpeedUnit::CmPerMin => Speed::CmPerMin(((v * 6.0).round() as u32).max(1)),
+    };
+    let ranges = chunks(program.points.len(), opts.point_limit);
+    let split = ranges.len() > 1;
+    let mut out = Vec::new();
+    if split {
+        let names: Vec<String> = (1..=ranges.len())
+            .map(|k| sub_name(&program.name, k))
+            .collect();
+        check_name(names.last().expect("at least two chunks"))?;
+        out.push(TpProgram {
+            name: program.name.clone(),
+            comment: format!("waam-slicer: {} sub-programs", ranges.len()),
+            groups,
+            arc_welding,
+            instructions: names
+                .into_iter()
+                .map(|n| Instruction {
+                    line: 0,
+                    op: Op::Call(n),
+                })
+                .collect(),
+            positions: Vec::new(),
+        });
+    }
+    for (k, range) in ranges.iter().enumerate() {
+        let mut ins = vec![
+            Instruction {
+                line: 0,
+                op: Op::UFrame(opts.user_frame),
+            },
+            Instruction {
+                line: 0,
+                op: Op::UTool(opts.tool_frame),
+            },
+        ];
+        let mut positions = Vec::with_capacity(range.len());
+        for (local, p) in program.points[range.clone()].iter().enumerate() {
+            let index = local + 1;
+            let arm = match opts.positions {
+                PositionMode::Joint => ArmPosition::Joint(p.joints.map(f64::to_degrees)),
+                PositionMode::Cartesian => {
+                    let pose = user_from_base * robot.flange_pose(&p.joints) * tool;
+                    ArmPosition::Cartesian {
+                        xyzwpr: FanucPose::from_isometry(&pose).to_xyzwpr_deg(),
+                        config: robot.fanuc_config(&p.joints).to_string(),
+                    }
+                }
+            };
+            positions.push(Position {
+                index,
+                uf_ut: (opts.user_frame, opts.tool_frame),
+                arm,
+                group2: p.positioner.map(|q| q.map(f64::to_degrees)),
+                line: 0,
+                value_lines: [0; 6],
+                group2_line: 0,
+            });
+            let mv = |kind, speed, term| Instruction {
+                line: 0,
+                op: Op::Move {
+                    kind,
+                    position: index,
+                    speed,
+                    term,
+                },
+            };
+            match p.arc {
+                ArcFlag::Start => {
+                    ins.push(mv(
+                        MoveKind::Joint,
+                        Speed::Percent(opts.approach_percent as u32),
+                        Termination::Fine,
+                    ));
+                    ins.push(Instruction {
+                        line: 0,
+                        op: start_op.clone(),
+                    });
+                }
+                ArcFlag::On => ins.push(mv(
+                    MoveKind::Linear,
+                    linear_speed(p.speed_mm_s),
+                    Termination::Cnt(opts.cnt),
+                )),
+                ArcFlag::End => {
+                    ins.push(mv(
+                        MoveKind::Linear,
+                        linear_speed(p.speed_mm_s),
+                        Termination::Fine,
+                    ));
+                    ins.push(Instruction {
+                        line: 0,
+                        op: end_op.clone(),
+                    });
+                }
+            }
+        }
+        out.push(TpProgram {
+            name: if split {
+                sub_name(&program.name, k + 1)
+            } else {
+                program.name.clone()
+            },
+            comment: if split {
+                format!("waam-slicer: part {} of {}", k + 1, ranges.len())
+            } else {
+                "waam-slicer".into()
+            },
+            groups,
+            arc_welding,
+            instructions: ins,
+            positions,
+        });
+    }
+    Ok(out)
+}
+
+/// Writes one TP program as ASCII `.ls`.
+///
+/// # Errors
+/// I/O errors of `w`.
+pub fn write_ls(w: &mut dyn Write, tp: &TpProgram) -> std::io::Result<()> {
+    writeln!(w, "/PROG  {}", tp.name)?;
+    writeln!(w, "/ATTR")?;
+    writeln!(w, "OWNER\t\t= MNEDITOR;")?;
+    writeln!(w, "COMMENT\t\t= \"{}\";", tp.comment)?;
+    writeln!(w, "PROG_SIZE\t= 0;")?;
+    writeln!(w, "CREATE\t\t= DATE 00-01-01  TIME 00:00:00;")?;
+    writeln!(w, "MODIFIED\t= DATE 00-01-01  TIME 00:00:00;")?;
+    writeln!(w, "FILE_NAME\t= ;")?;
+    writeln!(w, "VERSION\t\t= 0;")?;
+    writeln!(w, "LINE_COUNT\t= {};", tp.instructions.len())?;
+    writeln!(w, "MEMORY_SIZE\t= 0;")?;
+    writeln!(w, "PROTECT\t\t= READ_WRITE;")?;
+    writeln!(w, "TCD:  STACK_SIZE\t= 0,")?;
+    writeln!(w, "      TASK_PRIORITY\t= 50,")?;
+    writeln!(w, "      TIME_SLICE\t= 0,")?;
+    writeln!(w, "      BUSY_LAMP_OFF\t= 0,")?;
+    writeln!(w, "      ABORT_REQUEST\t= 0,")?;
+    writeln!(w, "      PAUSE_REQUEST\t= 0;")?;
+    let groups = if tp.groups >= 2 {
+        "1,1,*,*,*"
+    } else {
+        "1,*,*,*,*"
+    };
+    writeln!(w, "DEFAULT_GROUP\t= {groups};")?;
+    writeln!(w, "CONTROL_CODE\t= 00000000 00000000;")?;
+    if tp.arc_welding {
+        writeln!(w, "/APPL")?;
+        writeln!(w, "  ARC Welding Equipment : 1,*,*,*,*;")?;
+    }
+    writeln!(w, "/MN")?;
+    for (i, ins) in tp.instructions.iter().enumerate() {
+        writeln!(w, "{:>4}:{}", i + 1, ins.op)?;
+    }
+    writeln!(w, "/POS")?;
+    for p in &tp.positions {
+        writeln!(w, "P[{}]{{", p.index)?;
+        writeln!(w, "   GP1:")?;
+        let (uf, ut) = p.uf_ut;
+        match &p.arm {
+            ArmPosition::Joint(j) => {
+                writeln!(w, "\tUF : {uf}, UT : {ut},\t")?;
+                writeln!(
+                    w,
+                    "\tJ1= {} deg,\tJ2= {} deg,\tJ3= {} deg,",
+                    FanucDeg(j[0]),
+                    FanucDeg(j[1]),
+                    FanucDeg(j[2])
+                )?;
+                writeln!(
+                    w,
+                    "\tJ4= {} deg,\tJ5= {} deg,\tJ6= {} deg",
+                    FanucDeg(j[3]),
+                    FanucDeg(j[4]),
+                    FanucDeg(j[5])
+                )?;
+            }
+            ArmPosition::Cartesian { xyzwpr: v, config } => {
+                writeln!(w, "\tUF : {uf}, UT : {ut},\t\tCONFIG : '{config}',")?;
+                writeln!(
+                    w,
+                    "\tX = {}  mm,\tY = {}  mm,\tZ = {}  mm,",
+                    FanucMm(v[0]),
+                    FanucMm(v[1]),
+                    FanucMm(v[2])
+                )?;
+                writeln!(
+                    w,
+                    "\tW = {} deg,\tP = {} deg,\tR = {} deg",
+                    FanucDeg(v[3]),
+                    FanucDeg(v[4]),
+                    FanucDeg(v[5])
+                )?;
+            }
+        }
+        if let Some(g) = p.group2 {
+            writeln!(w, "   GP2:")?;
+            writeln!(w, "\tUF : {uf}, UT : {ut},\t")?;
+            writeln!(
+                w,
+                "\tJ1= {} deg,\tJ2= {} deg",
+                FanucDeg(g[0]),
+                FanucDeg(g[1])
+            )?;
+        }
+        writeln!(w, "}};")?;
+    }
+    writeln!(w, "/END")?;
+    Ok(())
+}
+
+/// The `.ls` files of `program` (main program first when split).
+///
+/// # Errors
+/// As [`tp_programs`].
+pub fn fanuc_files(
+    program: &Program,
+    opts: &FanucOptions,
+) -> Result<Vec<EmittedFile>, ProgramError> {
+    tp_programs(program, opts)?
+        .iter()
+        .map(|tp| {
+            Ok(EmittedFile {
+                name: format!("{}.ls", tp.name),
+                text: render(|w| write_ls(w, tp))?,
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,112 @@
+//! `Display` newtypes that own the number formatting of every emitter, so
+//! that the same value prints the same way everywhere and no `-0.000`
+//! reaches a controller.
+
+use std::fmt;
+
+/// A number with a fixed count of decimals, right-aligned in `width`
+/// characters (0: no padding). Negative zero after rounding prints as zero.
+#[derive(Debug, Clone, Copy)]
+pub struct Fixed {
+    /// The value.
+    pub value: f64,
+    /// Decimals.
+    pub decimals: usize,
+    /// Minimum width (characters).
+    pub width: usize,
+}
+
+impl Fixed {
+    /// `value` with `decimals` decimals, unpadded.
+    pub fn new(value: f64, decimals: usize) -> Self {
+        Self {
+            value,
+            decimals,
+            width: 0,
+        }
+    }
+
+    /// `value` with `decimals` decimals, right-aligned in `width` characters.
+    pub fn padded(value: f64, decimals: usize, width: usize) -> Self {
+        Self {
+            value,
+            decimals,
+            width,
+        }
+    }
+}
+
+impl fmt::Display for Fixed {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let scale = 10f64.powi(self.decimals as i32);
+        let mut v = self.value;
+        if (v * scale).round() == 0.0 {
+            v = 0.0;
+        }
+        write!(f, "{:>w$.d$}", v, w = self.width, d = self.decimals)
+    }
+}
+
+/// FANUC position lengths: mm, 3 decimals, width 9 (`X =  1045.747  mm`).
+#[derive(Debug, Clone, Copy)]
+pub struct FanucMm(pub f64);
+
+impl fmt::Display for FanucMm {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        Fixed::padded(self.0, 3, 9).fmt(f)
+    }
+}
+
+/// FANUC angles in degrees, 4 decimals (the controller's programming
+/// resolution, SPEC §6.1), width 10.
+#[derive(Debug, Clone, Copy)]
+pub struct FanucDeg(pub f64);
+
+impl fmt::Display for FanucDeg {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        Fixed::padded(self.0, 4, 10).fmt(f)
+    }
+}
+
+/// Lengths in other controllers' files and in CSV: mm, 4 decimals, unpadded.
+#[derive(Debug, Clone, Copy)]
+pub struct Mm(pub f64);
+
+impl fmt::Display for Mm {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        Fixed::new(self.0, 4).fmt(f)
+    }
+}
+
+/// Angles in other controllers' files and in CSV: degrees, 5 decimals, unpadded.
+#[derive(Debug, Clone, Copy)]
+pub struct Deg(pub f64);
+
+impl fmt::Display for Deg {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        Fixed::new(self.0, 5).fmt(f)
+    }
+}
+
+/// Unitless components (direction cosines, quaternions): 7 decimals.
+#[derive(Debug, Clone, Copy)]
+pub struct Unitless(pub f64);
+
+impl fmt::Display for Unitless {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        Fixed::new(self.0, 7).fmt(f)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_negative_zero_and_padding() {
+        assert_eq!(Fixed::new(-0.00004, 3).to_string(), "0.000");
+        assert_eq!(FanucMm(-630.155).to_string(), " -630.155");
+        assert_eq!(FanucDeg(1.0).to_string(), "    1.0000");
+        assert_eq!(Deg(-0.0).to_string(), "0.00000");
+    }
+}

@@ -1,0 +1,267 @@
+//! KUKA KRL programs: `.src` (motions) and `.dat` (positions) [SPEC §8].
+//!
+//! * Positions as `E6AXIS` (A1..A6 in degrees, KUKA convention of the
+//!   robot model) or `E6POS` (`X Y Z A B C`, mm and deg, `$TOOL` in `$BASE`)
+//!   with the Status `S` and Turn `T` bits derived from the chosen joints;
+//!   the torch-carried cell's positioner as external axes `E1 E2` (deg).
+//! * Each bead: `PTP` to its first point (exact stop), then `LIN` moves at
+//!   `$VEL.CP` (m/s) blended with `C_DIS` inside the bead, the last one
+//!   exact. The arc is switched by `TRIGGER WHEN DISTANCE=0` before the
+//!   first `LIN` (fires at the exact first point) and `TRIGGER WHEN
+//!   DISTANCE=1` before the last `LIN` (fires at its exact end point), so
+//!   blending never moves an arc switching point.
+//! * Arc process: output `$OUT[schedule]`; custom: the user's statements.
+//!
+//! Status bits (KUKA): bit 0 wrist centre behind the A1 axis (overhead
+//! area), bit 1 `A3 >= phi` (the branch with `cos gamma > 0` here: elbow up
+//! in front), bit 2 `A5 <= 0`. Turn bit `i` set when `A(i+1) < 0`.
+
+use std::io::Write;
+
+use serde::{Deserialize, Serialize};
+
+use crate::math::Isometry3;
+use crate::program::fanuc::PositionMode;
+use crate::program::fmt::{Deg, Mm};
+use crate::program::{
+    check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+};
+use crate::robot::orientation::KukaAbc;
+use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel};
+
+/// Options of the KUKA emitter. Plain data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct KukaOptions {
+    /// `E6AXIS` (joint) or `E6POS` (Cartesian) positions. Default joint.
+    pub positions: PositionMode,
+    /// Blending distance `$APO.CDIS` inside beads (mm, > 0). Default 0.5 mm.
+    pub cdis_mm: f64,
+    /// `BAS(#VEL_PTP, n)` of the moves to bead starts (%, 1–100). Default 10.
+    pub ptp_percent: u8,
+    /// Arc output or user-given statements. Default output 1.
+    pub process: ProcessControl,
+    /// `BASE_DATA[n]` (1–32). Default 1.
+    pub base: u8,
+    /// `TOOL_DATA[n]` (1–16). Default 1.
+    pub tool: u8,
+    /// `BASE_DATA[base]` in the robot base frame (mm). Default identity.
+    pub base_from_user: Isometry3,
+    /// `TOOL_DATA[tool]` on the flange (mm); `None`: as the FANUC emitter
+    /// (the cell's torch, or the flange in the part-carried cell).
+    pub flange_from_tool: Option<Isometry3>,
+}
+
+impl Default for KukaOptions {
+    fn default() -> Self {
+        Self {
+            positions: PositionMode::Joint,
+            cdis_mm: 0.5,
+            ptp_percent: 10,
+            process: ProcessControl::default(),
+            base: 1,
+            tool: 1,
+            base_from_user: Isometry3::identity(),
+            flange_from_tool: None,
+        }
+    }
+}
+
+impl KukaOptions {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`ProgramError::InvalidOptions`] naming the field.
+    pub fn validate(&self) -> Result<(), ProgramError> {
+        let bad = |field, value: String, reason| ProgramError::InvalidOptions {
+            field,
+            value,
+            reason,
+        };
+        if !(self.cdis_mm.is_finite() && self.cdis_mm > 0.0) {
+            return Err(bad(
+                "cdis_mm",
+                self.cdis_mm.to_string(),
+                "must be finite and > 0",
+            ));
+        }
+        if !(1..=100).contains(&self.ptp_percent) {
+            return Err(bad(
+                "ptp_percent",
+                self.ptp_percent.to_string(),
+                "must be in 1..=100",
+            ));
+        }
+        if !(1..=32).contains(&self.base) {
+            return Err(bad("base", self.base.to_string(), "must be in 1..=32"));
+        }
+        if !(1..=16).contains(&self.tool) {
+            return Err(bad("tool", self.tool.to_string(), "must be in 1..=16"));
+        }
+        self.process.validate()
+    }
+}
+
+/// KUKA Status bits of joints `q` (module doc).
+pub fn status(robot: &RobotModel, q: &Joints) -> u8 {
+    let c = robot.configuration_of(q);
+    let back = c.side == ArmSide::Back;
+    let positive_cos = (c.side == ArmSide::Front) == (c.elbow == Elbow::Up);
+    (back as u8) | ((positive_cos as u8) << 1) | (((q[4] <= 0.0) as u8) << 2)
+}
+
+/// KUKA Turn bits of joints `q`: bit `i` set when `A(i+1) < 0`.
+pub fn turn(q: &Joints) -> u8 {
+    q.iter()
+        .enumerate()
+        .fold(0, |t, (i, v)| t | (((*v < 0.0) as u8) << i))
+}
+
+fn tool_of(opts: &KukaOptions, cell: &Cell) -> Isometry3 {
+    match (opts.flange_from_tool, cell) {
+        (Some(t), _) => t,
+        (None, Cell::TorchCarried(c)) => c.flange_from_tcp,
+        (None, Cell::PartCarried(_)) => Isometry3::identity(),
+    }
+}
+
+fn switch_statements(opts: &KukaOptions) -> (String, String) {
+    match &opts.process {
+        ProcessControl::Arc { schedule } => (
+            format!("$OUT[{schedule}]=TRUE"),
+            format!("$OUT[{schedule}]=FALSE"),
+        ),
+        ProcessControl::Custom { start, end } => (start.clone(), end.clone()),
+    }
+}
+
+/// Writes the `.src` of `program`.
+///
+/// # Errors
+/// I/O errors of `w`.
+pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> std::io::Result<()> {
+    let (on, off) = switch_statements(opts);
+    writeln!(w, "&ACCESS RVP")?;
+    writeln!(w, "&REL 1")?;
+    writeln!(w, "DEF {}( )", program.name)?;
+    writeln!(
+        w,
+        "  ; waam-slicer: {}, {} points, {} beads",
+        program.cell.name(),
+        program.points.len(),
+        program.num_beads()
+    )?;
+    writeln!(w, "  ;FOLD INI")?;
+    writeln!(w, "  BAS (#INITMOV,0 )")?;
+    writeln!(w, "  ;ENDFOLD")?;
+    writeln!(w, "  $BWDSTART = FALSE")?;
+    writeln!(w, "  $TOOL = TOOL_DATA[{}]", opts.tool)?;
+    writeln!(w, "  $BASE = BASE_DATA[{}]", opts.base)?;
+    writeln!(w, "  $APO.CDIS = {}", Mm(opts.cdis_mm))?;
+    writeln!(w, "  BAS (#VEL_PTP,{} )", opts.ptp_percent)?;
+    let mut vel: Option<f64> = None;
+    for (i, p) in program.points.iter().enumerate() {
+        let name = format!("P{}", i + 1);
+        match p.arc {
+            ArcFlag::Start => {
+                writeln!(w, "  ; bead {} (layer {}), arc off", p.layer, p.layer)?;
+                writeln!(w, "  PTP {name}")?;
+            }
+            ArcFlag::On | ArcFlag::End => {
+                let v = p.speed_mm_s / 1000.0;
+                if vel != Some(v) {
+                    writeln!(w, "  $VEL.CP = {}", crate::program::fmt::Fixed::new(v, 6))?;
+                    vel = Some(v);
+                }
+                let prev_is_start = i > 0 && program.points[i - 1].arc == ArcFlag::Start;
+                if prev_is_start {
+                    writeln!(w, "  TRIGGER WHEN DISTANCE=0 DELAY=0 DO {on}")?;
+                }
+                if p.arc == ArcFlag::End {
+                    writeln!(w, "  TRIGGER WHEN DISTANCE=1 DELAY=0 DO {off}")?;
+                    writeln!(w, "  LIN {name}")?;
+                } else {
+                    writeln!(w, "  LIN {name} C_DIS")?;
+                }
+            }
+        }
+    }
+    writeln!(w, "END")?;
+    Ok(())
+}
+
+/// Writes the `.dat` of `program`.
+///
+/// # Errors
+/// I/O errors of `w`.
+pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> std::io::Result<()> {
+    let robot = program.cell.robot();
+    let tool = tool_of(opts, &program.cell);
+    let user_from_base = opts.base_from_user.inverse();
+    writeln!(w, "&ACCESS RVP")?;
+    writeln!(w, "&REL 1")?;
+    writeln!(w, "DEFDAT {}", program.name)?;
+    for (i, p) in program.points.iter().enumerate() {
+        let e = p.positioner.unwrap_or([0.0; 2]).map(f64::to_degrees);
+        let ext = format!(
+            "E1 {},E2 {},E3 0.0,E4 0.0,E5 0.0,E6 0.0",
+            Deg(e[0]),
+            Deg(e[1])
+        );
+        match opts.positions {
+            PositionMode::Joint => {
+                let a = p.joints.map(f64::to_degrees);
+                writeln!(
+                    w,
+                    "  DECL E6AXIS P{}={{A1 {},A2 {},A3 {},A4 {},A5 {},A6 {},{ext}}}",
+                    i + 1,
+                    Deg(a[0]),
+                    Deg(a[1]),
+                    Deg(a[2]),
+                    Deg(a[3]),
+                    Deg(a[4]),
+                    Deg(a[5])
+                )?;
+            }
+            PositionMode::Cartesian => {
+                let pose = user_from_base * robot.flange_pose(&p.joints) * tool;
+                let t = pose.translation.vector;
+                let abc = KukaAbc::from_rotation(&pose.rotation.to_rotation_matrix()).to_degrees();
+                writeln!(
+                    w,
+                    "  DECL E6POS P{}={{X {},Y {},Z {},A {},B {},C {},S {},T {},{ext}}}",
+                    i + 1,
+                    Mm(t.x),
+                    Mm(t.y),
+                    Mm(t.z),
+                    Deg(abc[0]),
+                    Deg(abc[1]),
+                    Deg(abc[2]),
+                    status(robot, &p.joints),
+                    turn(&p.joints)
+                )?;
+            }
+        }
+    }
+    writeln!(w, "ENDDAT")?;
+    Ok(())
+}
+
+/// The `.src` and `.dat` files of `program`.
+///
+/// # Errors
+/// [`ProgramError::InvalidOptions`] for bad options or name.
+pub fn kuka_files(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+    opts.validate()?;
+    check_name(&program.name)?;
+    Ok(vec![
+        EmittedFile {
+            name: format!("{}.src", program.name),
+            text: render(|w| write_src(w, program, opts))?,
+        },
+        EmittedFile {
+            name: format!("{}.dat", program.name),
+            text: render(|w| write_dat(w, program, opts))?,
+        },
+    ])
+}

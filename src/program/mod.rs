@@ -1,0 +1,433 @@
+//! **Stage 7 — robot programs.** Takes a planned [`JointTrajectory`] (joints
+//! per path point, rad), the path points it was computed for
+//! ([`PathPointInput`]: layer structure, part-frame positions (mm), tool axes,
+//! `R_Z`), the [`Cell`] and the travel speeds (mm/s), checks that the plan is
+//! buildable, and returns a [`Program`]: one bead per layer, every point
+//! carrying its arc flag. Emitters turn a [`Program`] into controller files;
+//! the FANUC output is read back and validated against the cell. SPEC §8,
+//! thesis §3.1.2.
+//!
+//! | piece | module | entry points |
+//! |---|---|---|
+//! | the program as data, feasibility check | this module | [`build_program`], [`Program`], [`ProgramPoint`], [`ArcFlag`] |
+//! | FANUC TP ASCII `.ls`, split at a point limit | [`fanuc`], [`split`] | [`fanuc::fanuc_files`], [`fanuc::write_ls`], [`split::chunks`] |
+//! | KUKA KRL `.src` + `.dat` | [`kuka`] | [`kuka::write_src`], [`kuka::write_dat`] |
+//! | ABB RAPID `.mod` | [`abb`] | [`abb::write_mod`] |
+//! | CSV of every point | [`csv`] | [`csv::write_csv`] |
+//! | reader of our FANUC output | [`readback`] | [`readback::parse_ls`] |
+//! | validator (file + cell) | [`validate`] | [`validate::validate_fanuc`] |
+//! | number formatting | [`fmt`] | [`fmt::Fixed`] |
+//!
+//! JSON of every point: [`Program`] implements `serde::Serialize`; serialise
+//! it with any serde format (the command-line tool uses `serde_json`).
+//!
+//! Files reach disk through [`write_files`] (atomic: temporary file, then
+//! rename).
+
+pub mod abb;
+pub mod csv;
+pub mod fanuc;
+pub mod fmt;
+pub mod kuka;
+pub mod readback;
+pub mod split;
+pub mod validate;
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::math::{Point3, UnitVector3};
+use crate::robot::positioner::PositionerJoints;
+use crate::robot::trajectory::{JointTrajectory, PathPointInput};
+use crate::robot::{Cell, Configuration, Joints};
+
+/// Errors of the program stage; each names the point, field or file at fault.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ProgramError {
+    /// The plan has violations: no program is written for it.
+    #[error(
+        "refusing to write a program for an infeasible plan: {count} violation(s), first: {first}"
+    )]
+    Infeasible {
+        /// Number of violations.
+        count: usize,
+        /// The first one, with its layer, point and joint.
+        first: String,
+    },
+    /// Path points, trajectory and speeds do not describe the same path.
+    #[error("input mismatch at index {index}: {reason}")]
+    Mismatch {
+        /// Index in the point list.
+        index: usize,
+        /// What differs.
+        reason: String,
+    },
+    /// An option is out of its domain.
+    #[error("program options: `{field}` = {value:?} is invalid ({reason})")]
+    InvalidOptions {
+        /// The field at fault.
+        field: &'static str,
+        /// The offending value.
+        value: String,
+        /// Why it is rejected.
+        reason: &'static str,
+    },
+    /// A file could not be written.
+    #[error("{path}: cannot write: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A program file could not be read back.
+    #[error("{file}:{line}: {reason}")]
+    Read {
+        /// The file (or program name).
+        file: String,
+        /// Line number, 1-based.
+        line: usize,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// Where a point stands in its bead (the arc switching flags, SPEC §8).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ArcFlag {
+    /// First point of a bead: reached with the arc off, exact stop, the arc
+    /// starts here.
+    Start,
+    /// Reached with the arc on (blended).
+    On,
+    /// Last point of a bead: reached with the arc on, exact stop, the arc
+    /// stops here.
+    End,
+}
+
+/// One point of a program.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ProgramPoint {
+    /// Layer index (= bead index of this layer).
+    pub layer: usize,
+    /// Point index within the layer.
+    pub point: usize,
+    /// Deposition point, part frame (mm).
+    pub position_mm: Point3,
+    /// Tool axis, part frame (unit).
+    pub tool_axis: UnitVector3,
+    /// Free angle about the tool axis `R_Z` (rad).
+    pub r_z: f64,
+    /// Robot joints, controller convention (rad).
+    pub joints: Joints,
+    /// Positioner joints `[q7, q8]` (rad), torch-carried cell only.
+    pub positioner: Option<PositionerJoints>,
+    /// Travel speed of the deposition point relative to the part on the way
+    /// to this point (mm/s); on a bead's first point, the travel speed of
+    /// its first segment.
+    pub speed_mm_s: f64,
+    /// Arc flag.
+    pub arc: ArcFlag,
+}
+
+/// A buildable program: points in path order, one bead per layer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Program {
+    /// Program name (controller-safe: letters, digits, `_`, starting with a letter).
+    pub name: String,
+    /// The cell the program is for.
+    pub cell: Cell,
+    /// The IK branch of every point.
+    pub configuration: Configuration,
+    /// The points.
+    pub points: Vec<ProgramPoint>,
+}
+
+impl Program {
+    /// Number of beads (arc starts).
+    pub fn num_beads(&self) -> usize {
+        self.points
+            .iter()
+            .filter(|p| p.arc == ArcFlag::Start)
+            .count()
+    }
+}
+
+/// Travel speeds of a program (mm/s).
+#[derive(Debug, Clone, PartialEq)]
+pub enum TravelSpeed {
+    /// The same speed everywhere (mm/s).
+    Constant(f64),
+    /// One speed per point, the speed on the way to it (modulated travel
+    /// speed, SPEC §5) (mm/s).
+    PerPoint(Vec<f64>),
+}
+
+/// Checks that the plan is buildable and assembles the program.
+///
+/// `points` and `trajectory` must be the same path in the same order (the
+/// trajectory computed for these points by
+/// [`joint_trajectory`](crate::robot::trajectory::joint_trajectory) or an
+/// optimiser); each layer becomes one bead of at least two points. Joint
+/// speeds are re-checked at the given travel speeds.
+///
+/// # Errors
+/// [`ProgramError::InvalidOptions`] for a bad name or speed,
+/// [`ProgramError::Mismatch`] when the inputs differ in length, layer or
+/// point indices, or a layer has one point, and [`ProgramError::Infeasible`]
+/// when the trajectory reports violations or a point has no joints, naming
+/// the first.
+pub fn build_program(
+    name: &str,
+    cell: &Cell,
+    points: &[PathPointInput],
+    trajectory: &JointTrajectory,
+    speed: &TravelSpeed,
+) -> Result<Program, ProgramError> {
+    check_name(name)?;
+    if points.len() != trajectory.points.len() {
+        return Err(ProgramError::Mismatch {
+            index: points.len().min(trajectory.points.len()),
+            reason: format!(
+                "{} path points but {} trajectory points",
+                points.len(),
+                trajectory.points.len()
+            ),
+        });
+    }
+    if points.is_empty() {
+        return Err(ProgramError::Mismatch {
+            index: 0,
+            reason: "empty path".into(),
+        });
+    }
+    let speeds: Vec<f64> = match speed {
+        TravelSpeed::Constant(v) => vec![*v; points.len()],
+        TravelSpeed::PerPoint(v) => {
+            if v.len() != points.len() {
+                return Err(ProgramError::Mismatch {
+                    index: v.len().min(points.len()),
+                    reason: format!("{} speeds for {} points", v.len(), points.len()),
+                });
+            }
+            v.clone()
+        }
+    };
+    for (i, v) in speeds.iter().enumerate() {
+        if !(v.is_finite() && *v > 0.0) {
+            return Err(ProgramError::InvalidOptions {
+                field: "travel_speed_mm_s",
+                value: format!("{v} (index {i})"),
+                reason: "must be finite and > 0",
+            });
+        }
+    }
+    if let Some(v) = trajectory.report.violations.first() {
+        return Err(ProgramError::Infeasible {
+            count: trajectory.report.violations.len(),
+            first: v.to_string(),
+        });
+    }
+    let robot = cell.robot();
+    let mut out: Vec<ProgramPoint> = Vec::with_capacity(points.len());
+    for (i, (p, jp)) in points.iter().zip(&trajectory.points).enumerate() {
+        if p.layer != jp.layer || p.point != jp.point {
+            return Err(ProgramError::Mismatch {
+                index: i,
+                reason: format!(
+                    "path point is layer {}, point {} but trajectory point is layer {}, point {}",
+                    p.layer, p.point, jp.layer, jp.point
+                ),
+            });
+        }
+        let Some(q) = jp.joints else {
+            return Err(ProgramError::Infeasible {
+                count: 1,
+                first: format!("layer {}, point {}: no joint solution", p.layer, p.point),
+            });
+        };
+        let first = i == 0 || points[i - 1].layer != p.layer;
+        let last = i + 1 == points.len() || points[i + 1].layer != p.layer;
+        if first && last {
+            return Err(ProgramError::Mismatch {
+                index: i,
+                reason: format!("layer {} has a single point: no bead", p.layer),
+            });
+        }
+        // speed re-check at the programmed speed (the trajectory used one TS)
+        if !first {
+            let prev = &out[i - 1];
+            let d = (p.position_mm - prev.position_mm).norm();
+            if d > 0.0 {
+                let dt = d / speeds[i];
+                for (j, (qj, pj)) in q.iter().zip(prev.joints).enumerate() {
+                    let s = (qj - pj).abs() / dt;
+                    if s > robot.max_speed_rad_s[j] {
+                        return Err(ProgramError::Infeasible {
+                            count: 1,
+                            first: format!(
+                                "layer {}, point {}: J{} needs {:.2}°/s at {} mm/s, maximum {:.1}°/s",
+                                p.layer,
+                                p.point,
+                                j + 1,
+                                s.to_degrees(),
+                                speeds[i],
+                                robot.max_speed_rad_s[j].to_degrees()
+                            ),
+                        });
+                    }
+                }
+            }
+        }
+        out.push(ProgramPoint {
+            layer: p.layer,
+            point: p.point,
+            position_mm: p.position_mm,
+            tool_axis: p.tool_axis,
+            r_z: p.r_z,
+            joints: q,
+            positioner: jp.positioner,
+            speed_mm_s: if first && !last {
+                speeds[i + 1]
+            } else {
+                speeds[i]
+            },
+            arc: if first {
+                ArcFlag::Start
+            } else if last {
+                ArcFlag::End
+            } else {
+                ArcFlag::On
+            },
+        });
+    }
+    Ok(Program {
+        name: name.to_string(),
+        cell: cell.clone(),
+        configuration: trajectory.configuration,
+        points: out,
+    })
+}
+
+/// Checks a controller program name: an ASCII letter first, then letters,
+/// digits or `_`, at most 32 characters (FANUC's `/PROG`, KRL's `DEF`,
+/// RAPID's `MODULE` all accept these).
+///
+/// # Errors
+/// [`ProgramError::InvalidOptions`] naming `name`.
+pub fn check_name(name: &str) -> Result<(), ProgramError> {
+    let ok = !name.is_empty()
+        && name.len() <= 32
+        && name.starts_with(|c: char| c.is_ascii_alphabetic())
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if ok {
+        Ok(())
+    } else {
+        Err(ProgramError::InvalidOptions {
+            field: "name",
+            value: name.to_string(),
+            reason: "a letter, then letters, digits or `_`, at most 32 characters",
+        })
+    }
+}
+
+/// How a bead is started and stopped (SPEC §8).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProcessControl {
+    /// Welding: the controller's arc instructions with weld schedule `schedule`
+    /// (FANUC `Arc Start[n]`/`Arc End[n]`, ABB `weld<n>`, KUKA output `n`).
+    Arc {
+        /// Weld schedule (procedure) number, ≥ 1.
+        schedule: u32,
+    },
+    /// User-given instruction lines (e.g. a polymer extruder's I/O), written
+    /// as they are where the bead starts and stops.
+    Custom {
+        /// Instruction starting a bead, e.g. `DO[1]=ON`.
+        start: String,
+        /// Instruction stopping a bead, e.g. `DO[1]=OFF`.
+        end: String,
+    },
+}
+
+impl Default for ProcessControl {
+    fn default() -> Self {
+        ProcessControl::Arc { schedule: 1 }
+    }
+}
+
+impl ProcessControl {
+    /// Checks the schedule number and that custom lines are single, non-empty lines.
+    ///
+    /// # Errors
+    /// [`ProgramError::InvalidOptions`] naming the field.
+    pub fn validate(&self) -> Result<(), ProgramError> {
+        match self {
+            ProcessControl::Arc { schedule } if *schedule == 0 => {
+                Err(ProgramError::InvalidOptions {
+                    field: "process.schedule",
+                    value: "0".into(),
+                    reason: "must be >= 1",
+                })
+            }
+            ProcessControl::Custom { start, end } => {
+                for (field, s) in [("process.start", start), ("process.end", end)] {
+                    if s.trim().is_empty() || s.contains(['\n', '\r', ';']) {
+                        return Err(ProgramError::InvalidOptions {
+                            field,
+                            value: s.clone(),
+                            reason: "must be one non-empty line without `;`",
+                        });
+                    }
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// One emitted file: its name (with extension) and its content.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct EmittedFile {
+    /// File name, e.g. `HEMI.ls`.
+    pub name: String,
+    /// Content.
+    pub text: String,
+}
+
+/// Writes every file into `dir`, each atomically (temporary file, then rename).
+///
+/// # Errors
+/// [`ProgramError::Io`] naming the file.
+pub fn write_files(dir: &Path, files: &[EmittedFile]) -> Result<(), ProgramError> {
+    for f in files {
+        let path = dir.join(&f.name);
+        crate::io::atomic::write_atomic(&path, |w| w.write_all(f.text.as_bytes())).map_err(
+            |source| ProgramError::Io {
+                path: path.display().to_string(),
+                source,
+            },
+        )?;
+    }
+    Ok(())
+}
+
+/// Renders a writer function into a `String`.
+pub(crate) fn render(
+    f: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> Result<String, ProgramError> {
+    let mut buf: Vec<u8> = Vec::new();
+    f(&mut buf).map_err(|source| ProgramError::Io {
+        path: "<memory>".into(),
+        source,
+    })?;
+    String::from_utf8(buf).map_err(|e| ProgramError::Io {
+        path: "<memory>".into(),
+        source: std::io::Error::other(e),
+    })
+}

@@ -1,0 +1,446 @@
+//! Reader of our own FANUC TP ASCII output (the subset [`write_ls`]
+//! writes), so that every emitted program can be re-read and checked
+//! [SPEC §8]. Errors name the file and line; a file without `/END`
+//! (truncated) is an error.
+//!
+//! [`write_ls`]: crate::program::fanuc::write_ls
+
+use crate::program::fanuc::{
+    ArmPosition, Instruction, MoveKind, Op, Position, Speed, Termination, TpProgram,
+};
+use crate::program::ProgramError;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Section {
+    Start,
+    Attr,
+    Appl,
+    Mn,
+    Pos,
+    End,
+}
+
+#[derive(Debug, Default)]
+struct Partial {
+    index: usize,
+    line: usize,
+    group: u8,
+    uf_ut: Option<(u8, u8)>,
+    config: Option<String>,
+    values: [Option<(f64, usize)>; 6],
+    cart: [Option<(f64, usize)>; 6],
+    group2: [Option<f64>; 2],
+    group2_line: usize,
+}
+
+/// Parses one `.ls` file written by [`write_ls`](crate::program::fanuc::write_ls).
+/// `file` names it in errors.
+///
+/// # Errors
+/// [`ProgramError::Read`] with the line: missing or misplaced section, bad
+/// instruction or value, a move to a position without record, `LINE_COUNT`
+/// different from the `/MN` lines, and a file ending before `/END`.
+pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
+    let err = |line: usize, reason: String| ProgramError::Read {
+        file: file.to_string(),
+        line,
+        reason,
+    };
+    let mut tp = TpProgram {
+        name: String::new(),
+        comment: String::new(),
+        groups: 1,
+        arc_welding: false,
+        instructions: Vec::new(),
+        positions: Vec::new(),
+    };
+    let mut section = Section::Start;
+    let mut line_count: Option<(usize, usize)> = None;
+    let mut mn_line = 0;
+    let mut current: Option<Partial> = None;
+    let mut last_line = 0;
+    for (i, raw) in text.lines().enumerate() {
+        let n = i + 1;
+        last_line = n;
+        let l = raw.trim();
+        if l.is_empty() {
+            continue;
+        }
+        if section == Section::End {
+            return Err(err(n, "text after /END".into()));
+        }
+        if let Some(name) = l.strip_prefix("/PROG") {
+            if section != Section::Start {
+                return Err(err(n, "/PROG not on the first line".into()));
+            }
+            tp.name = name.trim().to_string();
+            if tp.name.is_empty() {
+                return Err(err(n, "/PROG without a name".into()));
+            }
+            section = Section::Attr;
+            continue;
+        }
+        if section == Section::Start {
+            return Err(err(n, "expected /PROG".into()));
+        }
+        match l {
+            "/ATTR" => continue,
+            "/APPL" => {
+                tp.arc_welding = true;
+                section = Section::Appl;
+                continue;
+            }
+            "/MN" => {
+                section = Section::Mn;
+                mn_line = n;
+                continue;
+            }
+            "/POS" => {
+                if section != Section::Mn {
+                    return Err(err(n, "/POS before /MN".into()));
+                }
+                section = Section::Pos;
+                continue;
+            }
+            "/END" => {
+                if let Some(p) = &current {
+                    return Err(err(
+                        n,
+                        format!("/END inside P[{}] (opened at line {})", p.index, p.line),
+                    ));
+                }
+                if section != Section::Pos {
+                    return Err(err(n, "/END before /POS".into()));
+                }
+                section = Section::End;
+                continue;
+            }
+            _ => {}
+        }
+        match section {
+            Section::Attr => {
+                if let Some(v) = attr_value(l, "COMMENT") {
+                    tp.comment = v.trim_matches('"').to_string();
+                } else if let Some(v) = attr_value(l, "DEFAULT_GROUP") {
+                    tp.groups = v.split(',').filter(|g| g.trim() == "1").count();
+                } else if let Some(v) = attr_value(l, "LINE_COUNT") {
+                    let c = v
+                        .parse()
+                        .map_err(|_| err(n, format!("bad LINE_COUNT `{v}`")))?;
+                    line_count = Some((c, n));
+                }
+            }
+            Section::Appl => {}
+            Section::Mn => {
+                let (num, body) = l
+                    .split_once(':')
+                    .ok_or_else(|| err(n, format!("expected `<n>:<instruction> ;`, got `{l}`")))?;
+                let num: usize = num
+                    .trim()
+                    .parse()
+                    .map_err(|_| err(n, format!("bad line number `{num}`")))?;
+                if num != tp.instructions.len() + 1 {
+                    return Err(err(
+                        n,
+                        format!(
+                            "instruction number {num}, expected {}",
+                            tp.instructions.len() + 1
+                        ),
+                    ));
+                }
+                let body = body
+                    .trim_end()
+                    .strip_suffix(';')
+                    .ok_or_else(|| err(n, "instruction without `;`".into()))?
+                    .trim();
+                let op = parse_op(body).map_err(|r| err(n, r))?;
+                tp.instructions.push(Instruction { line: n, op });
+            }
+            Section::Pos => {
+                if let Some(rest) = l.strip_prefix("P[") {
+                    if let Some(p) = &current {
+                        return Err(err(
+                            n,
+                            format!("P[{}] opened at line {} not closed", p.index, p.line),
+                        ));
+                    }
+                    let idx = rest
+                        .strip_suffix("]{")
+                        .and_then(|s| s.parse::<usize>().ok())
+                        .ok_or_else(|| err(n, format!("bad position header `{l}`")))?;
+                    current = Some(Partial {
+                        index: idx,
+                        line: n,
+                        ..Default::default()
+                    });
+                    continue;
+                }
+                let Some(p) = current.as_mut() else {
+                    return Err(err(n, format!("`{l}` outside a position record")));
+                };
+                if l == "};" {
+                    let p = current.take().expect("checked");
+                    tp.positions
+                        .push(finish(p).map_err(|(line, r)| err(line, r))?);
+                } else if l == "GP1:" {
+                    p.group = 1;
+                } else if l == "GP2:" {
+                    p.group = 2;
+                } else if l.starts_with("UF") {
+                    let mut rest = l.to_string();
+                    if let Some(start) = l.find("CONFIG") {
+                        let q: Vec<&str> = l[start..].split('\'').collect();
+                        if q.len() < 3 {
+                            return Err(err(n, "CONFIG without a quoted string".into()));
+                        }
+                        p.config = Some(q[1].to_string());
+                        rest = l[..start].to_string();
+                    }
+                    let mut uf = None;
+                    let mut ut = None;
+                    for part in rest.split(',') {
+                        if let Some((k, v)) = part.split_once(':') {
+                            let v: u8 = v
+                                .trim()
+                                .parse()
+                                .map_err(|_| err(n, format!("bad frame number in `{part}`")))?;
+                            match k.trim() {
+                                "UF" => uf = Some(v),
+                                "UT" => ut = Some(v),
+                                k => return Err(err(n, format!("unknown key `{k}`"))),
+                            }
+                        }
+                    }
+                    match (uf, ut) {
+                        (Some(a), Some(b)) if p.group == 1 => p.uf_ut = Some((a, b)),
+                        (Some(_), Some(_)) => {}
+                        _ => return Err(err(n, "expected `UF : n, UT : n`".into())),
+                    }
+                } else {
+                    for part in l.split(',') {
+                        let part = part.trim();
+                        if part.is_empty() {
+                            continue;
+                        }
+                        let (k, v) = part.split_once('=').ok_or_else(|| {
+                            err(n, format!("expected `KEY = value`, got `{part}`"))
+                        })?;
+                        let v = v.trim();
+                        let v = v
+                            .strip_suffix("deg")
+                            .or_else(|| v.strip_suffix("mm"))
+                            .ok_or_else(|| err(n, format!("value without unit: `{part}`")))?
+                            .trim();
+                        let x: f64 = v
+                            .parse()
+                            .ok()
+                            .filter(|x: &f64| x.is_finite())
+                            .ok_or_else(|| err(n, format!("bad number `{v}`")))?;
+                        let k = k.trim();
+                        let slot = match (p.group, k) {
+                            (2, "J1") => {
+                                p.group2[0] = Some(x);
+                                p.group2_line = n;
+                                continue;
+                            }
+                            (2, "J2") => {
+                                p.group2[1] = Some(x);
+                                p.group2_line = n;
+                                continue;
+                            }
+                            (1, "J1") => &mut p.values[0],
+                            (1, "J2") => &mut p.values[1],
+                            (1, "J3") => &mut p.values[2],
+                            (1, "J4") => &mut p.values[3],
+                            (1, "J5") => &mut p.values[4],
+                            (1, "J6") => &mut p.values[5],
+                            (1, "X") => &mut p.cart[0],
+                            (1, "Y") => &mut p.cart[1],
+                            (1, "Z") => &mut p.cart[2],
+                            (1, "W") => &mut p.cart[3],
+                            (1, "P") => &mut p.cart[4],
+                            (1, "R") => &mut p.cart[5],
+                            _ => {
+                                return Err(err(
+                                    n,
+                                    format!("unexpected key `{k}` in group {}", p.group),
+                                ))
+                            }
+                        };
+                        *slot = Some((x, n));
+                    }
+                }
+            }
+            Section::Start | Section::End => unreachable!("handled above"),
+        }
+    }
+    if section != Section::End {
+        let where_ = match (&current, section) {
+            (Some(p), _) => format!(" inside P[{}] (opened at line {})", p.index, p.line),
+            (None, Section::Mn) => " inside /MN".into(),
+            (None, Section::Pos) => " inside /POS".into(),
+            _ => String::new(),
+        };
+        return Err(err(
+            last_line,
+            format!("file ends{where_} without /END (truncated?)"),
+        ));
+    }
+    if let Some((c, line)) = line_count {
+        if c != tp.instructions.len() {
+            return Err(err(
+                line,
+                format!(
+                    "LINE_COUNT = {c} but /MN (line {mn_line}) has {} instructions",
+                    tp.instructions.len()
+                ),
+            ));
+        }
+    }
+    for ins in &tp.instructions {
+        if let Op::Move { position, .. } = ins.op {
+            if !tp.positions.iter().any(|p| p.index == position) {
+                return Err(err(ins.line, format!("P[{position}] has no /POS record")));
+            }
+        }
+    }
+    Ok(tp)
+}
+
+fn attr_value<'a>(l: &'a str, key: &str) -> Option<&'a str> {
+    let rest = l.strip_prefix(key)?;
+    let rest = rest.trim_start().strip_prefix('=')?;
+    Some(rest.trim().trim_end_matches(';').trim())
+}
+
+fn parse_op(body: &str) -> Result<Op, String> {
+    let tokens: Vec<&str> = body.split_whitespace().collect();
+    if let Some(kind) = match tokens.first() {
+        Some(&"J") => Some(MoveKind::Joint),
+        Some(&"L") => Some(MoveKind::Linear),
+        _ => None,
+    } {
+        if tokens.len() != 4 {
+            return Err(format!(
+                "expected `J|L P[n] <speed> <FINE|CNTn>`, got `{body}`"
+            ));
+        }
+        let position = tokens[1]
+            .strip_prefix("P[")
+            .and_then(|s| s.strip_suffix(']'))
+            .and_then(|s| s.parse::<usize>().ok())
+            .ok_or_else(|| format!("bad position `{}`", tokens[1]))?;
+        let s = tokens[2];
+        let num = |t: &str| t.parse::<u32>().map_err(|_| format!("bad speed `{s}`"));
+        let speed = if let Some(v) = s.strip_suffix('%') {
+            Speed::Percent(num(v)?)
+        } else if let Some(v) = s.strip_suffix("mm/sec") {
+            Speed::MmPerSec(num(v)?)
+        } else if let Some(v) = s.strip_suffix("cm/min") {
+            Speed::CmPerMin(num(v)?)
+        } else {
+            return Err(format!("bad speed `{s}`"));
+        };
+        if matches!(speed, Speed::Percent(_)) != (kind == MoveKind::Joint) {
+            return Err(format!("speed `{s}` does not fit a {kind:?} move"));
+        }
+        let term = match tokens[3] {
+            "FINE" => Termination::Fine,
+            t => Termination::Cnt(
+                t.strip_prefix("CNT")
+                    .and_then(|c| c.parse::<u8>().ok())
+                    .filter(|c| *c <= 100)
+                    .ok_or_else(|| format!("bad termination `{t}`"))?,
+            ),
+        };
+        return Ok(Op::Move {
+            kind,
+            position,
+            speed,
+            term,
+        });
+    }
+    let bracket = |prefix: &str| -> Option<Result<u32, String>> {
+        let rest = body.strip_prefix(prefix)?;
+        Some(
+            rest.strip_suffix(']')
+                .and_then(|s| s.parse().ok())
+                .ok_or_else(|| format!("bad `{body}`")),
+        )
+    };
+    if let Some(r) = bracket("Arc Start[") {
+        return r.map(Op::ArcStart);
+    }
+    if let Some(r) = bracket("Arc End[") {
+        return r.map(Op::ArcEnd);
+    }
+    if let Some(v) = body.strip_prefix("UFRAME_NUM=") {
+        return v
+            .trim()
+            .parse()
+            .map(Op::UFrame)
+            .map_err(|_| format!("bad `{body}`"));
+    }
+    if let Some(v) = body.strip_prefix("UTOOL_NUM=") {
+        return v
+            .trim()
+            .parse()
+            .map(Op::UTool)
+            .map_err(|_| format!("bad `{body}`"));
+    }
+    if let Some(v) = body.strip_prefix("CALL ") {
+        return Ok(Op::Call(v.trim().to_string()));
+    }
+    if body.is_empty() {
+        return Err("empty instruction".into());
+    }
+    Ok(Op::Other(body.to_string()))
+}
+
+fn finish(p: Partial) -> Result<Position, (usize, String)> {
+    let uf_ut = p.uf_ut.ok_or((
+        p.line,
+        format!("P[{}]: no `UF : n, UT : n` in GP1", p.index),
+    ))?;
+    let joints = p.values.iter().all(Option::is_some);
+    let cart = p.cart.iter().all(Option::is_some);
+    let (arm, value_lines) = if joints && p.cart.iter().all(Option::is_none) {
+        let v = p.values.map(|x| x.expect("checked"));
+        (ArmPosition::Joint(v.map(|x| x.0)), v.map(|x| x.1))
+    } else if cart && p.values.iter().all(Option::is_none) {
+        let v = p.cart.map(|x| x.expect("checked"));
+        let config = p.config.ok_or((
+            p.line,
+            format!("P[{}]: Cartesian position without CONFIG", p.index),
+        ))?;
+        (
+            ArmPosition::Cartesian {
+                xyzwpr: v.map(|x| x.0),
+                config,
+            },
+            v.map(|x| x.1),
+        )
+    } else {
+        return Err((
+            p.line,
+            format!(
+                "P[{}]: expected all of J1..J6 or all of X Y Z W P R in GP1",
+                p.index
+            ),
+        ));
+    };
+    let group2 = match p.group2 {
+        [Some(a), Some(b)] => Some([a, b]),
+        [None, None] => None,
+        _ => return Err((p.line, format!("P[{}]: GP2 needs J1 and J2", p.index))),
+    };
+    Ok(Position {
+        index: p.index,
+        uf_ut,
+        arm,
+        group2,
+        line: p.line,
+        value_lines,
+        group2_line: p.group2_line,
+    })
+}

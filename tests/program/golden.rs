@@ -1,0 +1,134 @@
+//! Golden files of every emitter on two layers of the hemisphere (8 points
+//! per layer). Reviewed by eye once, then pinned: a missing golden file is
+//! written; `UPDATE_GOLDEN=1` rewrites them all.
+
+use std::path::PathBuf;
+
+use waam_slicer::program::abb::{abb_files, AbbOptions};
+use waam_slicer::program::csv::write_csv;
+use waam_slicer::program::fanuc::{fanuc_files, FanucOptions, PositionMode, SpeedUnit};
+use waam_slicer::program::kuka::{kuka_files, KukaOptions};
+use waam_slicer::program::{EmittedFile, ProcessControl, Program};
+
+use crate::fixture::{cell, part_carried, program};
+
+fn golden_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/program/golden")
+}
+
+pub fn check_golden(name: &str, text: &str) {
+    let path = golden_dir().join(name);
+    if std::env::var_os("UPDATE_GOLDEN").is_some() || !path.exists() {
+        std::fs::write(&path, text).unwrap();
+        return;
+    }
+    let want = std::fs::read_to_string(&path).unwrap();
+    if want != text {
+        let line = want
+            .lines()
+            .zip(text.lines())
+            .position(|(a, b)| a != b)
+            .map(|i| i + 1)
+            .unwrap_or(want.lines().count().min(text.lines().count()) + 1);
+        panic!("{name} differs from its golden file from line {line} (UPDATE_GOLDEN=1 to re-pin)");
+    }
+}
+
+fn check_all(prefix: &str, files: &[EmittedFile]) {
+    for f in files {
+        check_golden(&format!("{prefix}{}", f.name), &f.text);
+    }
+}
+
+fn small() -> Program {
+    program(&part_carried(), 0..2, 8).0
+}
+
+#[test]
+fn fanuc_joint_golden() {
+    let files = fanuc_files(&small(), &FanucOptions::default()).unwrap();
+    assert_eq!(files.len(), 1);
+    check_all("fanuc_joint_", &files);
+}
+
+#[test]
+fn fanuc_cartesian_mm_s_golden() {
+    let opts = FanucOptions {
+        positions: PositionMode::Cartesian,
+        speed_unit: SpeedUnit::MmPerSec,
+        ..Default::default()
+    };
+    check_all("fanuc_cartesian_", &fanuc_files(&small(), &opts).unwrap());
+}
+
+#[test]
+fn fanuc_polymer_golden() {
+    let opts = FanucOptions {
+        process: ProcessControl::Custom {
+            start: "DO[1]=ON".into(),
+            end: "DO[1]=OFF".into(),
+        },
+        ..Default::default()
+    };
+    check_all("fanuc_polymer_", &fanuc_files(&small(), &opts).unwrap());
+}
+
+#[test]
+fn fanuc_torch_carried_golden_has_group_2() {
+    let (prog, _) = program(&cell("robowam_torch_carried.toml"), 0..2, 8);
+    let files = fanuc_files(&prog, &FanucOptions::default()).unwrap();
+    assert!(files[0].text.contains("DEFAULT_GROUP\t= 1,1,*,*,*;"));
+    assert!(files[0].text.contains("   GP2:"));
+    check_all("fanuc_torch_", &files);
+}
+
+#[test]
+fn kuka_golden() {
+    check_all(
+        "kuka_joint_",
+        &kuka_files(&small(), &KukaOptions::default()).unwrap(),
+    );
+    let opts = KukaOptions {
+        positions: PositionMode::Cartesian,
+        ..Default::default()
+    };
+    let files = kuka_files(&small(), &opts).unwrap();
+    check_golden("kuka_cartesian_HEMI.dat", &files[1].text);
+}
+
+#[test]
+fn abb_golden() {
+    check_all(
+        "abb_",
+        &abb_files(&small(), &AbbOptions::default()).unwrap(),
+    );
+}
+
+#[test]
+fn csv_golden() {
+    let mut buf = Vec::new();
+    write_csv(&mut buf, &small()).unwrap();
+    let text = String::from_utf8(buf).unwrap();
+    assert_eq!(text.lines().count(), 1 + 16);
+    check_golden("HEMI.csv", &text);
+}
+
+#[test]
+fn json_of_every_point_through_serde() {
+    let v = serde_json::to_value(small()).unwrap();
+    let pts = v["points"].as_array().unwrap();
+    assert_eq!(pts.len(), 16);
+    assert_eq!(pts[0]["arc"], "start");
+    assert_eq!(pts[15]["arc"], "end");
+    assert!(pts[3]["joints"].as_array().unwrap().len() == 6);
+}
+
+#[test]
+fn files_reach_disk_atomically() {
+    let dir = tempfile::tempdir().unwrap();
+    let files = fanuc_files(&small(), &FanucOptions::default()).unwrap();
+    waam_slicer::program::write_files(dir.path(), &files).unwrap();
+    let back = std::fs::read_to_string(dir.path().join("HEMI.ls")).unwrap();
+    assert_eq!(back, files[0].text);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}

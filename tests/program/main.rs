@@ -1,0 +1,8 @@
+//! Integration tests of the program stage (SPEC §8): golden files per
+//! emitter, read-back and validation of our FANUC output, corrupted files,
+//! splitting at a point limit, refusal of infeasible plans.
+
+mod fixture;
+mod golden;
+mod split;
+mod validate;

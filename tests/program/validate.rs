@@ -1,0 +1,257 @@
+//! The validator accepts our programs and rejects corrupted files, naming
+//! the line; the program stage refuses infeasible plans.
+
+use waam_slicer::program::fanuc::{
+    fanuc_files, write_ls, FanucOptions, Op, PositionMode, TpProgram,
+};
+use waam_slicer::program::readback::parse_ls;
+use waam_slicer::program::validate::{validate_fanuc, ValidationReport};
+use waam_slicer::program::{build_program, ProgramError, TravelSpeed};
+use waam_slicer::robot::Cell;
+
+use crate::fixture::{cell, hemisphere, part_carried, program, trajectory, TS_MM_S};
+
+const CELLS: [&str; 3] = [
+    "robowam_part_carried.toml",
+    "robowam_part_carried_second_position.toml",
+    "robowam_torch_carried.toml",
+];
+
+fn emitted(cell: &Cell, opts: &FanucOptions) -> (String, Vec<waam_slicer::math::Point3>) {
+    let (prog, path) = program(cell, 0..4, 24);
+    let files = fanuc_files(&prog, opts).unwrap();
+    assert_eq!(files.len(), 1);
+    (
+        files[0].text.clone(),
+        path.iter().map(|p| p.position_mm).collect(),
+    )
+}
+
+fn check(
+    text: &str,
+    cell: &Cell,
+    opts: &FanucOptions,
+    planned: &[waam_slicer::math::Point3],
+) -> ValidationReport {
+    let tp = parse_ls(text, "HEMI.ls").unwrap_or_else(|e| panic!("{e}"));
+    validate_fanuc(&[tp], cell, opts, Some(planned))
+}
+
+fn line_of(text: &str, needle: &str, after: usize) -> usize {
+    text.lines()
+        .enumerate()
+        .skip(after)
+        .find(|(_, l)| l.contains(needle))
+        .map(|(i, _)| i + 1)
+        .unwrap_or_else(|| panic!("`{needle}` not found"))
+}
+
+#[test]
+fn validator_accepts_our_programs_in_every_feasible_cell() {
+    for file in CELLS {
+        let cell = cell(file);
+        for positions in [PositionMode::Joint, PositionMode::Cartesian] {
+            let opts = FanucOptions {
+                positions,
+                ..Default::default()
+            };
+            let (text, planned) = emitted(&cell, &opts);
+            let r = check(&text, &cell, &opts, &planned);
+            assert!(r.is_ok(), "{file} {positions:?}:\n{r}");
+            assert_eq!(r.motions, 96);
+            assert_eq!(r.beads, 4);
+        }
+    }
+}
+
+#[test]
+fn a_joint_pushed_out_of_range_is_named_by_its_line() {
+    let cell = part_carried();
+    let opts = FanucOptions::default();
+    let (text, planned) = emitted(&cell, &opts);
+    let p3 = line_of(&text, "P[3]{", 0);
+    let j5_line = line_of(&text, "J5=", p3);
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let l = &lines[j5_line - 1];
+    let start = l.find("J5=").unwrap();
+    let end = start + l[start..].find("deg").unwrap();
+    lines[j5_line - 1] = format!("{}J5=  170.0000 {}", &l[..start], &l[end..]);
+    let bad = lines.join("\n") + "\n";
+    let r = check(&bad, &cell, &opts, &planned);
+    assert!(!r.is_ok());
+    let p = r
+        .problems
+        .iter()
+        .find(|p| p.message.contains("J5 = 170.0000°"))
+        .unwrap_or_else(|| panic!("{r}"));
+    assert_eq!(p.line, j5_line, "{r}");
+    assert!(
+        p.to_string()
+            .starts_with(&format!("HEMI:{j5_line}: P[3]: J5")),
+        "{p}"
+    );
+}
+
+#[test]
+fn a_dropped_arc_end_is_named_by_its_line() {
+    let cell = part_carried();
+    let opts = FanucOptions::default();
+    let (text, planned) = emitted(&cell, &opts);
+    // raw edit: the numbering no longer follows, the reader names the line
+    let end_line = line_of(&text, "Arc End[1]", 0);
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines.remove(end_line - 1);
+    let raw = lines.join("\n") + "\n";
+    let e = parse_ls(&raw, "HEMI.ls").unwrap_err();
+    assert!(
+        matches!(e, ProgramError::Read { line, .. } if line == end_line),
+        "{e}"
+    );
+    // consistent edit (renumbered): the validator names the next bead's start
+    let mut tp: TpProgram = parse_ls(&text, "HEMI.ls").unwrap();
+    let k = tp
+        .instructions
+        .iter()
+        .position(|i| i.op == Op::ArcEnd(1))
+        .unwrap();
+    tp.instructions.remove(k);
+    let mut buf = Vec::new();
+    write_ls(&mut buf, &tp).unwrap();
+    let edited = String::from_utf8(buf).unwrap();
+    let r = check(&edited, &cell, &opts, &planned);
+    let second_start = {
+        let first = line_of(&edited, "Arc Start[1]", 0);
+        line_of(&edited, "Arc Start[1]", first)
+    };
+    let p = r
+        .problems
+        .iter()
+        .find(|p| p.message.contains("missing Arc End"))
+        .unwrap_or_else(|| panic!("{r}"));
+    assert_eq!(p.line, second_start, "{r}");
+    // and the last bead: dropping the final Arc End is reported at its start
+    let mut tp2: TpProgram = parse_ls(&text, "HEMI.ls").unwrap();
+    let k = tp2
+        .instructions
+        .iter()
+        .rposition(|i| i.op == Op::ArcEnd(1))
+        .unwrap();
+    tp2.instructions.remove(k);
+    let r = validate_fanuc(&[tp2.clone()], &cell, &opts, Some(&planned));
+    let last_start = tp2
+        .instructions
+        .iter()
+        .rev()
+        .find(|i| i.op == Op::ArcStart(1))
+        .unwrap()
+        .line;
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.line == last_start && p.message.contains("never stops")),
+        "{r}"
+    );
+}
+
+#[test]
+fn a_truncated_file_is_named_by_its_last_line() {
+    let cell = part_carried();
+    let opts = FanucOptions::default();
+    let (text, _) = emitted(&cell, &opts);
+    let lines: Vec<&str> = text.lines().collect();
+    for keep in [lines.len() / 3, lines.len() / 2, lines.len() - 1] {
+        let cut = lines[..keep].join("\n") + "\n";
+        let e = parse_ls(&cut, "HEMI.ls").unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with(&format!("HEMI.ls:{keep}: ")) && msg.contains("without /END"),
+            "{msg}"
+        );
+    }
+    let _ = cell;
+}
+
+#[test]
+fn an_overspeed_is_named_by_its_motion_line() {
+    let cell = part_carried();
+    let opts = FanucOptions::default();
+    let (text, planned) = emitted(&cell, &opts);
+    // the 5th linear move of the top layer at 2000 mm/s: J6 needs v / A rad/s
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let first_l = line_of(
+        &text,
+        ":L P[",
+        line_of(
+            &text,
+            "Arc Start[1]",
+            line_of(&text, "Arc End[1]", line_of(&text, "Arc End[1]", 0)),
+        ),
+    );
+    let target = first_l + 4;
+    lines[target - 1] = lines[target - 1].replace("36cm/min", "2000mm/sec");
+    let bad = lines.join("\n") + "\n";
+    let r = check(&bad, &cell, &opts, &planned);
+    let p = r
+        .problems
+        .iter()
+        .find(|p| p.message.contains("J6 needs"))
+        .unwrap_or_else(|| panic!("{r}"));
+    assert_eq!(p.line, target, "{r}");
+}
+
+#[test]
+fn a_configuration_flip_in_a_cartesian_file_is_named() {
+    let cell = part_carried();
+    let opts = FanucOptions {
+        positions: PositionMode::Cartesian,
+        ..Default::default()
+    };
+    let (text, planned) = emitted(&cell, &opts);
+    let p5 = line_of(&text, "P[5]{", 0);
+    let cfg = line_of(&text, "CONFIG", p5);
+    let bad = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i + 1 == cfg {
+                l.replace("'F U T", "'N U T")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n";
+    let r = check(&bad, &cell, &opts, &planned);
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.line == cfg && p.message.contains("configuration flip")),
+        "{r}"
+    );
+}
+
+#[test]
+fn no_program_for_an_infeasible_plan() {
+    // constant R_Z = 0: J5 leaves its ±135° travel (SPEC §7)
+    let cell = part_carried();
+    let path = hemisphere(0..12, 24, |_| 0.0);
+    let tr = trajectory(&cell, &path);
+    assert!(!tr.report.is_clean());
+    let e = build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(TS_MM_S)).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(e, ProgramError::Infeasible { .. })
+            && msg.contains("refusing")
+            && msg.contains("layer"),
+        "{msg}"
+    );
+    // a speed the joints cannot follow is refused too, naming the joint
+    let path = hemisphere(8..9, 24, |v| -v);
+    let tr = trajectory(&cell, &path);
+    let e = build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(5000.0)).unwrap_err();
+    assert!(e.to_string().contains("J6 needs"), "{e}");
+    // and bad names
+    let e = build_program("9LIVES", &cell, &path, &tr, &TravelSpeed::Constant(6.0)).unwrap_err();
+    assert!(e.to_string().contains("`name`"), "{e}");
+}
