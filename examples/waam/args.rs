@@ -36,6 +36,9 @@ pub enum StrategyArg {
 pub enum Command {
     /// Slice a part: writes path.csv and summary.json in --out.
     Slice(SliceArgs),
+    /// Check a FANUC program (.ls, following its CALLs) against a cell: limits,
+    /// speeds, reachability, configuration, beads. Exit 0 valid, 2 problems, 1 unreadable.
+    Check(CheckArgs),
     /// Plan a part in a cell: slice, tool axes, R_Z optimisation, joints;
     /// writes joints.csv and summary.json in --out (exit 2 if infeasible).
     Plan(PlanArgs),
@@ -126,10 +129,23 @@ pub struct PlanArgs {
     /// Max chord error in mm.
     #[arg(long)]
     pub chord: Option<f64>,
+    /// Robot program format written when the plan is feasible.
+    #[arg(long, default_value = "fanuc", value_parser = ["fanuc", "kuka", "abb"])]
+    pub format: String,
     /// R_Z law: fixed:DEG, poly:N (max degree), spline, point.
     #[arg(long, default_value = "poly:4")]
     pub rz: String,
     /// Output folder (default out/<part name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
+}
+
+/// Arguments of `check`.
+#[derive(Debug, clap::Args)]
+pub struct CheckArgs {
+    /// The main FANUC program (.ls); sub-programs it calls are read from the same folder.
+    pub program: PathBuf,
+    /// The cell file (TOML, parts/cells/).
+    #[arg(long)]
+    pub cell: PathBuf,
 }

@@ -29,6 +29,7 @@ fn main() -> ExitCode {
     };
     let result = match &args.command {
         Command::Plan(a) => return plan::run(a, args.quiet),
+        Command::Check(a) => return plan::check(a, args.quiet),
         Command::Parts { dir } => list_parts(dir),
         Command::Geometry { part, points } => geometry(part, *points, args.quiet),
         Command::Slice(cmd) => slice::run(cmd, args.quiet),

@@ -74,8 +74,11 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
             a.cell.display()
         )
     })?;
+    // One IK branch for the whole part (the cell's): a program must not
+    // reconfigure the arm between layers.
     let opts = OptimiseOptions {
         parameterisation: parse_rz(&a.rz)?,
+        configuration: waam_slicer::optimise::ConfigurationChoice::Cell,
         ..OptimiseOptions::default()
     };
     opts.validate().map_err(|e| e.to_string())?;
@@ -116,8 +119,32 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
         writeln!(w)
     })
     .map_err(|e| format!("{}: {e}", sj.display()))?;
-    // Program emission (FANUC .ls, KUKA, ABB) is the program stage's job
-    // (issue 8): it takes `result` and must write nothing when !feasible.
+    // The robot program, only for a feasible plan; the program stage checks
+    // again and refuses (exit 2) if the trajectory it rebuilds breaks a limit.
+    let feasible = if feasible {
+        match emit_program(
+            &part.name,
+            &a.format,
+            &cell,
+            &layers,
+            &result,
+            opts.travel_speed_mm_s,
+            &dir,
+        ) {
+            Ok(files) => {
+                if !quiet {
+                    println!("  program: {}", files.join(", "));
+                }
+                true
+            }
+            Err(why) => {
+                eprintln!("no program written: {why}");
+                false
+            }
+        }
+    } else {
+        false
+    };
     if !quiet {
         println!(
             "{}: {} layers, {} points, {} in {:.3} s -> {}",
@@ -257,4 +284,135 @@ fn summary_json(
             "optimise": plan.time_s,
         },
     })
+}
+
+/// Builds the joint trajectory of the optimised `R_Z`, the program, and
+/// writes its files; returns their names.
+fn emit_program(
+    part: &str,
+    format: &str,
+    cell: &Cell,
+    layers: &[waam_slicer::optimise::LayerPoints],
+    plan: &waam_slicer::optimise::Plan,
+    speed_mm_s: f64,
+    dir: &std::path::Path,
+) -> Result<Vec<String>, String> {
+    use waam_slicer::program::{build_program, write_files, TravelSpeed};
+    use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
+    let inputs: Vec<PathPointInput> = layers
+        .iter()
+        .zip(&plan.layers)
+        .flat_map(|(lp, pl)| {
+            lp.points
+                .iter()
+                .zip(&pl.points)
+                .enumerate()
+                .map(move |(i, (cp, pp))| PathPointInput {
+                    layer: lp.layer,
+                    point: i,
+                    position_mm: cp.position_mm,
+                    tool_axis: cp.tool_axis,
+                    build_direction: cp.build_direction,
+                    r_z: pp.r_z,
+                })
+        })
+        .collect();
+    let traj = joint_trajectory(cell, &inputs, speed_mm_s, &TrajectoryOptions::default())
+        .map_err(|e| e.to_string())?;
+    let name: String = {
+        let mut n: String = part
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() {
+                    c.to_ascii_uppercase()
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        if !n.starts_with(|c: char| c.is_ascii_alphabetic()) {
+            n.insert(0, 'P');
+        }
+        n.truncate(24);
+        n
+    };
+    let program = build_program(
+        &name,
+        cell,
+        &inputs,
+        &traj,
+        &TravelSpeed::Constant(speed_mm_s),
+    )
+    .map_err(|e| e.to_string())?;
+    let files = match format {
+        "kuka" => waam_slicer::program::kuka::kuka_files(&program, &Default::default()),
+        "abb" => waam_slicer::program::abb::abb_files(&program, &Default::default()),
+        _ => waam_slicer::program::fanuc::fanuc_files(&program, &Default::default()),
+    }
+    .map_err(|e| e.to_string())?;
+    write_files(dir, &files).map_err(|e| e.to_string())?;
+    Ok(files.iter().map(|f| f.name.clone()).collect())
+}
+
+/// `waam check`: reads a FANUC program and the sub-programs it calls, and
+/// validates them against the cell.
+pub fn check(a: &crate::args::CheckArgs, quiet: bool) -> ExitCode {
+    use waam_slicer::program::fanuc::FanucOptions;
+    use waam_slicer::program::readback::parse_ls;
+    use waam_slicer::program::validate::validate_fanuc;
+    let run = || -> Result<bool, String> {
+        let cell_file = read_cell_file(&a.cell).map_err(|e| e.to_string())?;
+        let cell = cell_file
+            .cell
+            .ok_or_else(|| format!("{}: not a cell", a.cell.display()))?;
+        let dir = a
+            .program
+            .parent()
+            .map(std::path::Path::to_path_buf)
+            .unwrap_or_default();
+        let read = |p: &std::path::Path| -> Result<waam_slicer::program::fanuc::TpProgram, String> {
+            let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
+            parse_ls(&text, &p.display().to_string()).map_err(|e| e.to_string())
+        };
+        let main = read(&a.program)?;
+        let mut programs = vec![main];
+        let mut k = 0;
+        while k < programs.len() {
+            let calls: Vec<String> = programs[k]
+                .instructions
+                .iter()
+                .filter_map(|i| match &i.op {
+                    waam_slicer::program::fanuc::Op::Call(n) => Some(n.clone()),
+                    _ => None,
+                })
+                .collect();
+            for called in calls {
+                if !programs.iter().any(|p| p.name == called) {
+                    programs.push(read(&dir.join(format!("{called}.ls")))?);
+                }
+            }
+            k += 1;
+        }
+        let report = validate_fanuc(&programs, &cell, &FanucOptions::default(), None);
+        for p in &report.problems {
+            eprintln!("{p}");
+        }
+        if !quiet {
+            println!(
+                "{}: {} motions checked, {} problem(s)",
+                a.program.display(),
+                report.motions,
+                report.problems.len()
+            );
+        }
+        Ok(report.problems.is_empty())
+    };
+    match run() {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(2),
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::from(1)
+        }
+    }
 }

@@ -121,3 +121,50 @@ fn path_csv_reader_names_the_bad_line() {
     assert!(e.to_string().contains("layer 0 after layer 1"));
     assert!(read_path_csv("a,b\n", "p.csv").is_err());
 }
+
+/// `plan` writes a FANUC program for a feasible plan, `check` accepts it, and
+/// rejects it once a joint is pushed out of range (exit 2, naming the line).
+#[test]
+fn plan_writes_a_program_that_check_accepts_and_a_corrupted_one_it_rejects() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("plan");
+    let cell = crate::common::part_path("cells/robowam_part_carried.toml");
+    let status = waam()
+        .args(["--quiet", "plan"])
+        .arg(part_path("hemisphere.toml"))
+        .arg("--cell")
+        .arg(&cell)
+        .args(["--points", "60", "--rz", "poly:1", "--out"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(0));
+    let ls = out.join("HEMISPHERE.ls");
+    let ok = waam()
+        .args(["--quiet", "check"])
+        .arg(&ls)
+        .arg("--cell")
+        .arg(&cell)
+        .status()
+        .unwrap();
+    assert_eq!(ok.code(), Some(0));
+    let text = std::fs::read_to_string(&ls).unwrap();
+    let bad = text.replacen("J5=   ", "J5=   17", 1); // e.g. 119.3 deg becomes 17119.3 deg
+    let corrupt = dir.path().join("BAD.ls");
+    std::fs::write(&corrupt, bad.replace("/PROG  HEMISPHERE", "/PROG  BAD")).unwrap();
+    let out = waam()
+        .args(["check"])
+        .arg(&corrupt)
+        .arg("--cell")
+        .arg(&cell)
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("J5 = 17119") && err.contains("BAD:"), "{err}"); // file:line: what
+}
