@@ -56,6 +56,33 @@ fn list_parts(dir: &std::path::Path) -> Result<(), String> {
             Err(e) => println!("{:<40} INVALID: {e}", f.display()),
         }
     }
+    let cells_dir = dir.join("cells");
+    let mut cells: Vec<_> = std::fs::read_dir(&cells_dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect()
+        })
+        .unwrap_or_default();
+    cells.sort();
+    for f in cells {
+        match waam_slicer::io::cell_file::read_cell_file(&f) {
+            Ok(c) => {
+                let kind = if c.cell.is_some() {
+                    "cell"
+                } else {
+                    "robot only"
+                };
+                println!(
+                    "{:<40} {} ({kind}, robot {})",
+                    f.display(),
+                    c.name,
+                    c.robot.name
+                )
+            }
+            Err(e) => println!("{:<40} INVALID: {e}", f.display()),
+        }
+    }
     Ok(())
 }
 
