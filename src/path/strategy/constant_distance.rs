@@ -31,7 +31,7 @@ pub fn next_t(
     // Always descend from the column's own segment, so that the function is
     // deterministic (a bracket found stays a bracket).
     let delta_at = |t: f64| below.nearest_from(&tube.point(t, v), hint).distance;
-    let x_tol = 1e-13 * (1.0 + t_below.abs());
+    let x_tol = 1e-12 * (1.0 + t_below.abs());
     let found = forward_root(
         |t| delta_at(t) - delta_mm,
         t_below,
@@ -39,7 +39,7 @@ pub fn next_t(
         step0,
         t_hi,
         x_tol,
-        1e-11 * delta_mm,
+        1e-10 * delta_mm,
     )?;
     let Some((t, evaluations, _)) = found else {
         return Ok(Step::End);
@@ -71,7 +71,7 @@ pub fn next_t(
         step0,
         t_hi,
         x_tol,
-        1e-11 * delta_mm,
+        1e-10 * delta_mm,
     )? {
         Some((t, more, residual)) => Ok(Step::Point {
             t,
