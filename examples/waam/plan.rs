@@ -112,6 +112,14 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
     let csv = dir.join("joints.csv");
     write_atomic(&csv, |w| write_joints_csv(w, &layers, &result, &cell))
         .map_err(|e| format!("{}: {e}", csv.display()))?;
+    draw_joint_plots(
+        &dir,
+        &part.name,
+        &cell,
+        &layers,
+        &result,
+        opts.travel_speed_mm_s,
+    )?;
     let summary = summary_json(&part.name, a, &result, &opts, [t_read, t_slice, t_axes]);
     let sj = dir.join("summary.json");
     write_atomic(&sj, |w| {
@@ -415,4 +423,68 @@ pub fn check(a: &crate::args::CheckArgs, quiet: bool) -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// joints.svg (joint angles against the point index, limits in red) and
+/// speeds.svg (joint speeds at the travel speed against their maxima).
+fn draw_joint_plots(
+    dir: &std::path::Path,
+    name: &str,
+    cell: &Cell,
+    layers: &[waam_slicer::optimise::LayerPoints],
+    plan: &waam_slicer::optimise::Plan,
+    speed_mm_s: f64,
+) -> Result<(), String> {
+    let robot = cell.robot();
+    let mut angles: [Vec<(f64, f64)>; 6] = Default::default();
+    let mut speeds: [Vec<(f64, f64)>; 6] = Default::default();
+    let mut k = 0usize;
+    for (lp, pl) in layers.iter().zip(&plan.layers) {
+        let mut prev: Option<(waam_slicer::math::Point3, [f64; 6])> = None;
+        for (cp, pp) in lp.points.iter().zip(&pl.points) {
+            if let Some(q) = pp.joints {
+                for j in 0..6 {
+                    angles[j].push((k as f64, q[j].to_degrees()));
+                }
+                if let Some((p0, q0)) = prev {
+                    let dt = (cp.position_mm - p0).norm() / speed_mm_s;
+                    if dt > 0.0 {
+                        for j in 0..6 {
+                            speeds[j].push((k as f64, ((q[j] - q0[j]) / dt).abs().to_degrees()));
+                        }
+                    }
+                }
+                prev = Some((cp.position_mm, q));
+            }
+            k += 1;
+        }
+    }
+    let limits = robot
+        .limits
+        .map(|l| (l.lower_rad.to_degrees(), l.upper_rad.to_degrees()));
+    let max_speed = robot
+        .max_speed_rad_s
+        .map(|v| (f64::NEG_INFINITY, v.to_degrees()));
+    for (file, title, unit, series, bounds) in [
+        (
+            "joints.svg",
+            format!("{name}: joint angles (limits in red)"),
+            "deg",
+            &angles,
+            limits,
+        ),
+        (
+            "speeds.svg",
+            format!("{name}: joint speeds at the travel speed (maxima in red)"),
+            "deg/s",
+            &speeds,
+            max_speed,
+        ),
+    ] {
+        let tmp = dir.join(format!(".{file}.tmp"));
+        crate::plots::joint_panels(&title, unit, series, bounds, &tmp)?;
+        std::fs::rename(&tmp, dir.join(file))
+            .map_err(|e| format!("{}: {e}", dir.join(file).display()))?;
+    }
+    Ok(())
 }

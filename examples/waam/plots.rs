@@ -174,3 +174,61 @@ pub fn distance_plot(
         .map_err(err(file))?;
     root.present().map_err(err(file))
 }
+
+/// Six panels (J1..J6) of a quantity against the point index, with the
+/// allowed band drawn as red lines (infinite bounds are not drawn).
+pub fn joint_panels(
+    title: &str,
+    y_unit: &str,
+    series: &[Vec<(f64, f64)>; 6],
+    bounds: [(f64, f64); 6],
+    file: &FsPath,
+) -> Result<(), String> {
+    let whole = SVGBackend::new(file, (1200, 900)).into_drawing_area();
+    whole.fill(&WHITE).map_err(err(file))?;
+    let whole = whole.titled(title, ("sans-serif", 22)).map_err(err(file))?;
+    let panels = whole.split_evenly((3, 2));
+    for (j, area) in panels.iter().enumerate() {
+        let data = &series[j];
+        let x_max = data.last().map_or(1.0, |p| p.0).max(1.0);
+        let (mut lo, mut hi) = data
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+        let (blo, bhi) = bounds[j];
+        if blo.is_finite() {
+            lo = lo.min(blo);
+        }
+        if bhi.is_finite() {
+            hi = hi.max(bhi);
+        }
+        if !(lo.is_finite() && hi.is_finite()) {
+            lo = -1.0;
+            hi = 1.0;
+        }
+        let pad = 0.05 * (hi - lo).max(1e-6);
+        let mut chart = ChartBuilder::on(area)
+            .caption(format!("J{}", j + 1), ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(30)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0.0..x_max, (lo - pad)..(hi + pad))
+            .map_err(err(file))?;
+        chart
+            .configure_mesh()
+            .x_desc("point")
+            .y_desc(y_unit)
+            .draw()
+            .map_err(err(file))?;
+        for b in [blo, bhi] {
+            if b.is_finite() {
+                chart
+                    .draw_series(LineSeries::new([(0.0, b), (x_max, b)], RED.stroke_width(2)))
+                    .map_err(err(file))?;
+            }
+        }
+        chart
+            .draw_series(LineSeries::new(data.iter().copied(), BLUE.stroke_width(1)))
+            .map_err(err(file))?;
+    }
+    whole.present().map_err(err(file))
+}

@@ -139,6 +139,9 @@ fn plan_writes_a_program_that_check_accepts_and_a_corrupted_one_it_rejects() {
         .status()
         .unwrap();
     assert_eq!(status.code(), Some(0));
+    for f in ["joints.csv", "summary.json", "joints.svg", "speeds.svg"] {
+        assert!(out.join(f).exists(), "{f}");
+    }
     let ls = out.join("HEMISPHERE.ls");
     let ok = waam()
         .args(["--quiet", "check"])
