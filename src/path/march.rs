@@ -8,7 +8,7 @@ use super::index::{SegmentId, SegmentIndex};
 use super::strategy::{constant_distance, iso_parametric, normal_to_guide, planar_z, Step};
 use super::*;
 use crate::geometry::{Substrate, Tube};
-use crate::math::RootFailure;
+use crate::math::{Point3, RootFailure};
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
@@ -41,8 +41,12 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
     };
     let open_layers_allowed = matches!(opts.strategy, Strategy::Planar | Strategy::Perpendicular);
 
-    let mut raw: Vec<Vec<Option<f64>>> = vec![t_first.iter().map(|&t| Some(t)).collect()];
+    // Each computed layer: per column, its t and position (computed once).
+    let mut raw: Vec<Vec<Option<(f64, Point3)>>> =
+        vec![first.iter().map(|p| Some((p.t, p.position))).collect()];
     let mut cursor = t_first.clone();
+    // Each column's last step in t (first guess of the next root find).
+    let mut last_step: Vec<Option<f64>> = vec![None; grid];
     let mut alive = vec![true; grid];
     let mut report = SliceReport {
         root_finds: 0,
@@ -67,7 +71,7 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
             break;
         }
         let below = raw.last().expect("first layer present");
-        let (index, hints) = below_index(tube, &vs, below);
+        let (index, hints) = below_index(below);
         let layer_t = match opts.strategy {
             Strategy::Perpendicular => tube.t_at_arc_length(s_base + n as f64 * opts.delta_mm),
             _ => f64::NAN,
@@ -82,9 +86,16 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
                 let (v, t0) = (vs[i], cursor[i]);
                 match opts.strategy {
                     Strategy::Constant => match hints[i] {
-                        Some(h) => {
-                            constant_distance::next_t(tube, &index, h, v, t0, opts.delta_mm, t_hi)
-                        }
+                        Some(h) => constant_distance::next_t(
+                            tube,
+                            &index,
+                            h,
+                            v,
+                            t0,
+                            opts.delta_mm,
+                            t_hi,
+                            last_step[i],
+                        ),
                         None => Ok(Step::End),
                     },
                     Strategy::Iso => iso_parametric::next_t(tube, v, t0, opts.delta_mm, t_hi),
@@ -174,13 +185,16 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
                 break;
             }
         }
+        // Positions of the new points, computed once (reused as the layer
+        // below and in the output).
+        let mut positions: Vec<Option<Point3>> = layer
+            .par_iter()
+            .zip(&vs)
+            .map(|(t, &v)| t.map(|t| tube.point(t, v)))
+            .collect();
         if opts.strategy == Strategy::Constant && layer.iter().all(Option::is_some) {
             let mut ts: Vec<f64> = layer.iter().map(|t| t.expect("all present")).collect();
-            let pts: Vec<_> = ts
-                .iter()
-                .zip(&vs)
-                .map(|(&t, &v)| tube.point(t, v))
-                .collect();
+            let pts: Vec<Point3> = positions.iter().map(|p| p.expect("all present")).collect();
             let before = super::smooth::turning_angles(&pts, true)
                 .into_iter()
                 .fold(0.0, f64::max);
@@ -233,11 +247,17 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
                 for (slot, t) in layer.iter_mut().zip(&ts) {
                     *slot = Some(*t);
                 }
+                positions = layer
+                    .par_iter()
+                    .zip(&vs)
+                    .map(|(t, &v)| t.map(|t| tube.point(t, v)))
+                    .collect();
             }
             report.max_turn_after_rad = report.max_turn_after_rad.max(after);
         }
         for (i, t) in layer.iter().enumerate() {
             if let Some(t) = t {
+                last_step[i] = Some(*t - cursor[i]);
                 cursor[i] = *t;
             }
         }
@@ -248,7 +268,12 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
                 layer: n,
             });
         }
-        raw.push(layer);
+        let with_positions: Vec<Option<(f64, Point3)>> = layer
+            .iter()
+            .zip(&positions)
+            .map(|(t, p)| t.zip(*p))
+            .collect();
+        raw.push(with_positions);
     }
     if raw.len() < 2 {
         return Err(PathError::DeltaTooLarge {
@@ -256,7 +281,7 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
             length_mm,
         });
     }
-    let mut layers = assemble(tube, &vs, &raw, opts, &mut report);
+    let mut layers = assemble(&vs, &raw, opts, &mut report);
     align_seams(&mut layers, opts);
     let mut path = Path {
         strategy: opts.strategy,
@@ -383,18 +408,14 @@ fn grid_size(tube: &Tube, opts: &SliceOptions) -> usize {
 
 /// Index over the valid points of the layer below, and for each column the
 /// segment next to its point there.
-fn below_index(
-    tube: &Tube,
-    vs: &[f64],
-    below: &[Option<f64>],
-) -> (SegmentIndex, Vec<Option<SegmentId>>) {
+fn below_index(below: &[Option<(f64, Point3)>]) -> (SegmentIndex, Vec<Option<SegmentId>>) {
     let runs = runs(below);
     let mut hints = vec![None; below.len()];
     let mut polylines = Vec::with_capacity(runs.len());
     for (k, (cols, closed)) in runs.iter().enumerate() {
         let pts = cols
             .iter()
-            .map(|&i| tube.point(below[i].expect("run holds valid points"), vs[i]))
+            .map(|&i| below[i].expect("run holds valid points").1)
             .collect();
         for (j, &i) in cols.iter().enumerate() {
             let seg = if !closed && j + 1 == cols.len() && j > 0 {
@@ -440,9 +461,8 @@ pub(crate) fn runs<T>(layer: &[Option<T>]) -> Vec<(Vec<usize>, bool)> {
 
 /// Output layers: truncation, splitting into polylines, decimation.
 fn assemble(
-    tube: &Tube,
     vs: &[f64],
-    raw: &[Vec<Option<f64>>],
+    raw: &[Vec<Option<(f64, Point3)>>],
     opts: &SliceOptions,
     report: &mut SliceReport,
 ) -> Vec<Layer> {
@@ -451,11 +471,11 @@ fn assemble(
         let mut pts: Vec<Option<PathPoint>> = cols
             .iter()
             .zip(vs)
-            .map(|(t, &v)| {
-                t.map(|t| PathPoint {
+            .map(|(tp, &v)| {
+                tp.map(|(t, position)| PathPoint {
                     t,
                     v,
-                    position: tube.point(t, v),
+                    position,
                     delta: None,
                 })
             })

@@ -11,6 +11,9 @@ use crate::path::index::{SegmentId, SegmentIndex};
 /// Next `t` of the column at profile angle `v` whose point on the layer below
 /// is at `t_below`; `hint` is a segment of the layer below next to that point
 /// (speeds up nearest-segment queries; the result is confirmed exactly).
+/// `last_step` is the column's previous step in `t`, if any: layers change
+/// slowly, so it is the first guess (else one is made from `dM/dt`).
+#[allow(clippy::too_many_arguments)]
 pub fn next_t(
     tube: &Tube,
     below: &SegmentIndex,
@@ -19,15 +22,21 @@ pub fn next_t(
     t_below: f64,
     delta_mm: f64,
     t_hi: f64,
+    last_step: Option<f64>,
 ) -> Result<Step, RootFailure> {
-    // First step from the rate at which the distance grows: the part of
-    // dM/dt across the layer below (the layer is tilted on overhangs).
-    let d_dt = tube.surface(t_below, v).d_dt;
-    let along = below.segment_direction(hint);
-    let across = (d_dt - along * d_dt.dot(&along))
-        .norm()
-        .max(1e-3 * d_dt.norm());
-    let step0 = 0.999 * delta_mm / across;
+    let step0 = match last_step {
+        Some(dt) if dt.is_finite() && dt > 0.0 => 0.999 * dt,
+        _ => {
+            // From the rate at which the distance grows: the part of dM/dt
+            // across the layer below (the layer is tilted on overhangs).
+            let d_dt = tube.surface(t_below, v).d_dt;
+            let along = below.segment_direction(hint);
+            let across = (d_dt - along * d_dt.dot(&along))
+                .norm()
+                .max(1e-3 * d_dt.norm());
+            0.999 * delta_mm / across
+        }
+    };
     // Always descend from the column's own segment, so that the function is
     // deterministic (a bracket found stays a bracket).
     let delta_at = |t: f64| below.nearest_from(&tube.point(t, v), hint).distance;
