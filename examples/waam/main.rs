@@ -10,6 +10,7 @@
 mod args;
 mod plan;
 mod plots;
+mod progress;
 mod slice;
 
 use args::{Args, Command};

@@ -94,14 +94,22 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
     }
     let t_read = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
+    let spinner = crate::progress::Stage::start(quiet, "slicing");
     let path = slice(&part.tube, &part.substrate, &so)
         .map_err(|e| format!("{}: {e}", a.part.display()))?;
+    drop(spinner);
     let t_slice = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
     let frames = local_frames(&path, &part.tube);
     let layers = layer_points(&path, &frames);
     let t_axes = t2.elapsed().as_secs_f64();
-    let result = optimise(&cell, &layers, &opts).map_err(|e| e.to_string())?;
+    let result = {
+        let _spinner = crate::progress::Stage::start(
+            quiet,
+            &format!("optimising R_Z on {} layers", layers.len()),
+        );
+        optimise(&cell, &layers, &opts).map_err(|e| e.to_string())?
+    };
 
     let dir: PathBuf = a
         .out

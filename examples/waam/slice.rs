@@ -53,8 +53,10 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     opts.spiral_reverse = more.reverse;
     opts.max_layers = more.max_layers.or(opts.max_layers);
     let t1 = Instant::now();
+    let spinner = crate::progress::Stage::start(quiet, "slicing");
     let path = slice(&part.tube, &part.substrate, &opts)
         .map_err(|e| format!("{}: {e}", part_file.display()))?;
+    drop(spinner);
     let t_slice = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
     let map = distance_map(&path);
