@@ -13,6 +13,14 @@ use std::f64::consts::TAU;
 /// Largest STL file accepted (bytes): 256 MiB, about 5 million triangles.
 pub const MAX_STL_BYTES: u64 = 256 * 1024 * 1024;
 
+/// Steps of the scan along an iso-`v` line from the lowest evaluable `t` to
+/// `t_max`: about 0.5 mm of guide length each, 64..=4096 of them.
+fn scan_steps(tube: &Tube) -> usize {
+    let range = tube.range();
+    let length = tube.arc_length(range.t_max) - tube.arc_length(range.eval_min());
+    ((length / 0.5).ceil() as usize).clamp(64, 4096)
+}
+
 /// A triangle-mesh substrate (part frame, mm).
 #[derive(Clone)]
 pub struct MeshSubstrate {
@@ -250,11 +258,12 @@ impl Substrate {
     /// # Errors
     /// [`GeometryError::SubstrateMiss`] naming `v` when the line never meets it.
     pub fn first_layer_t(&self, tube: &Tube, v: f64) -> Result<f64, GeometryError> {
+        self.first_layer_t_in(tube, v, scan_steps(tube))
+    }
+
+    fn first_layer_t_in(&self, tube: &Tube, v: f64, steps: usize) -> Result<f64, GeometryError> {
         let range = tube.range();
         let (lo, hi) = (range.eval_min(), range.t_max);
-        // Scan step: about 0.5 mm of guide length, 64..=4096 steps.
-        let length = tube.arc_length(hi) - tube.arc_length(lo);
-        let steps = ((length / 0.5).ceil() as usize).clamp(64, 4096);
         let dt = (hi - lo) / steps as f64;
         let miss = |reason: &str| GeometryError::SubstrateMiss {
             v,
@@ -328,10 +337,11 @@ impl Substrate {
                 reason: format!("a layer needs at least 3 points, got {n}"),
             });
         }
+        let steps = scan_steps(tube);
         (0..n)
             .map(|k| {
                 let v = TAU * k as f64 / n as f64;
-                let t = self.first_layer_t(tube, v)?;
+                let t = self.first_layer_t_in(tube, v, steps)?;
                 Ok(CurvePoint {
                     t,
                     v,

@@ -49,14 +49,8 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
     let mut last_step: Vec<Option<f64>> = vec![None; grid];
     let mut alive = vec![true; grid];
     let mut report = SliceReport {
-        root_finds: 0,
-        evaluations: 0,
-        max_residual_mm: 0.0,
-        truncated_points: 0,
         grid_points: grid,
-        stop: StopReason::NoMorePoints,
-        max_turn_before_rad: 0.0,
-        max_turn_after_rad: 0.0,
+        ..SliceReport::default()
     };
     let z_base = first.iter().map(|p| p.position.z).fold(f64::MIN, f64::max);
     let s_base = t_first
@@ -355,14 +349,12 @@ fn spiral_path(
         root_finds: points.len(),
         evaluations: spiral.evaluations,
         max_residual_mm: spiral.max_residual_mm,
-        truncated_points: 0,
         grid_points: n,
-        max_turn_before_rad: 0.0,
-        max_turn_after_rad: 0.0,
         stop: match spiral.end {
             SpiralEnd::RampDown => StopReason::ReachedEnd,
             SpiralEnd::MaxTurns => StopReason::MaxLayers,
         },
+        ..SliceReport::default()
     };
     let mut path = Path {
         strategy: Strategy::Spiral,

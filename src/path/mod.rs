@@ -229,7 +229,8 @@ pub enum StopReason {
     MaxLayers,
 }
 
-/// What the slicer did, for reports.
+/// What the slicer did, for reports. `Default` is an empty report (for paths
+/// built elsewhere).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SliceReport {
     /// Root finds run.
@@ -259,6 +260,21 @@ pub struct SpiralInfo {
     /// Index (in the spiral layer) of the first point of the ramp-down turn,
     /// if the spiral closes with one.
     pub ramp_down_from: Option<usize>,
+}
+
+impl Default for SliceReport {
+    fn default() -> Self {
+        Self {
+            root_finds: 0,
+            evaluations: 0,
+            max_residual_mm: 0.0,
+            truncated_points: 0,
+            grid_points: 0,
+            stop: StopReason::NoMorePoints,
+            max_turn_before_rad: 0.0,
+            max_turn_after_rad: 0.0,
+        }
+    }
 }
 
 /// A deposition path: layers in order.

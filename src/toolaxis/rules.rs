@@ -280,19 +280,7 @@ pub(crate) fn slerp(a: &Vector3, b: &Vector3, fraction: f64) -> Vector3 {
 /// Largest angular rate of consecutive axes (rad/mm); pairs of coincident
 /// points are skipped.
 pub fn max_rate(positions: &[Point3], axes: &[Vector3], closed: bool) -> f64 {
-    let n = positions.len();
-    let pairs = if closed && n > 2 {
-        n
-    } else {
-        n.saturating_sub(1)
-    };
-    (0..pairs)
-        .filter_map(|i| {
-            let j = (i + 1) % n;
-            let d = (positions[j] - positions[i]).norm();
-            (d > 1e-12).then(|| angle(&axes[i], &axes[j]) / d)
-        })
-        .fold(0.0, f64::max)
+    max_pair_rate(positions, closed, |i, j| angle(&axes[i], &axes[j]))
 }
 
 /// Smooths the lead/tilt angles `(theta_n, theta_t)` (rad) of a layer so that
@@ -361,6 +349,14 @@ pub fn smooth_angles(
 /// Largest rate of change of the lead/tilt pair between consecutive points
 /// (rad/mm, Euclidean norm of the pair).
 pub fn max_angle_rate(positions: &[Point3], angles: &[(f64, f64)], closed: bool) -> f64 {
+    max_pair_rate(positions, closed, |i, j| {
+        (angles[j].0 - angles[i].0).hypot(angles[j].1 - angles[i].1)
+    })
+}
+
+/// Largest `change(i, j) / |p_j − p_i|` over consecutive points (wrapping when
+/// `closed`); pairs of coincident points are skipped.
+fn max_pair_rate(positions: &[Point3], closed: bool, change: impl Fn(usize, usize) -> f64) -> f64 {
     let n = positions.len();
     let pairs = if closed && n > 2 {
         n
@@ -371,7 +367,7 @@ pub fn max_angle_rate(positions: &[Point3], angles: &[(f64, f64)], closed: bool)
         .filter_map(|i| {
             let j = (i + 1) % n;
             let d = (positions[j] - positions[i]).norm();
-            (d > 1e-12).then(|| (angles[j].0 - angles[i].0).hypot(angles[j].1 - angles[i].1) / d)
+            (d > 1e-12).then(|| change(i, j) / d)
         })
         .fold(0.0, f64::max)
 }

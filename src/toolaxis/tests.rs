@@ -141,14 +141,8 @@ fn tiny_path(layers: Vec<Vec<Point3>>) -> Path {
             })
             .collect(),
         report: SliceReport {
-            root_finds: 0,
-            evaluations: 0,
-            max_residual_mm: 0.0,
-            truncated_points: 0,
-            grid_points: 0,
             stop: StopReason::ReachedEnd,
-            max_turn_before_rad: 0.0,
-            max_turn_after_rad: 0.0,
+            ..SliceReport::default()
         },
         spiral: None,
     }

@@ -27,3 +27,78 @@ pub const SAMPLE_PARTS: [&str; 8] = [
     "elbow.toml",
     "helix.toml",
 ];
+
+/// A straight cylinder of the given radius and height on a plate, as part-file
+/// text: the smallest valid part, for tests that edit one field.
+pub fn cylinder_part_text(name: &str, radius: f64, height: f64, delta: f64) -> String {
+    format!(
+        r#"
+name = "{name}"
+[guide]
+kind = "line"
+origin = [0, 0, 0]
+direction = [0, 0, 1]
+[profile]
+kind = "constant"
+radius = {radius}
+[range]
+t_min = 0
+t_max = {height}
+[substrate]
+kind = "plane"
+point = [0, 0, 0]
+normal = [0, 0, 1]
+[slicing]
+delta_mm = {delta}
+"#
+    )
+}
+
+/// The `waam` example binary, built by `cargo test` next to the test executables.
+pub fn waam() -> std::process::Command {
+    let exe = std::env::current_exe().expect("test executable path");
+    let dir = exe
+        .parent()
+        .and_then(|d| d.parent())
+        .expect("target folder");
+    let bin = dir
+        .join("examples")
+        .join(format!("waam{}", std::env::consts::EXE_SUFFIX));
+    assert!(bin.exists(), "example not built at {}", bin.display());
+    std::process::Command::new(bin)
+}
+
+/// Hemisphere R_s = 45 mm, layers at constant meridian arc spacing Delta = 5 mm
+/// from Z = 0 (closed form of SPEC §2.1), as cell input points: layer `l` at
+/// latitude `phi = l Delta / R_s`, `points` per layer at `v = 2 pi k / points`,
+/// tool axis = the meridian tangent pointing up, `R_Z = r_z(layer, v)`.
+pub fn hemisphere_cell_points(
+    layers: std::ops::Range<usize>,
+    points: usize,
+    r_z: impl Fn(usize, f64) -> f64,
+) -> Vec<waam_slicer::robot::trajectory::PathPointInput> {
+    use waam_slicer::math::{Point3, UnitVector3, Vector3};
+    let (r_s, delta) = (45.0_f64, 5.0_f64);
+    let mut out = Vec::new();
+    for layer in layers {
+        let phi = layer as f64 * delta / r_s;
+        assert!(
+            phi < std::f64::consts::FRAC_PI_2,
+            "layer {layer} is past the pole"
+        );
+        let (a, z) = (r_s * phi.cos(), r_s * phi.sin());
+        for k in 0..points {
+            let v = std::f64::consts::TAU * k as f64 / points as f64;
+            let t = Vector3::new(-phi.sin() * v.cos(), -phi.sin() * v.sin(), phi.cos());
+            out.push(waam_slicer::robot::trajectory::PathPointInput {
+                layer,
+                point: k,
+                position_mm: Point3::new(a * v.cos(), a * v.sin(), z),
+                tool_axis: UnitVector3::new_normalize(t),
+                build_direction: None,
+                r_z: r_z(layer, v),
+            });
+        }
+    }
+    out
+}

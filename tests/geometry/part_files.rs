@@ -7,25 +7,10 @@ use waam_slicer::io::part_file::{
     parse_part, read_part_file, Discretisation, PartFileError, Strategy,
 };
 
-const GOOD: &str = r#"
-name = "t"
-[guide]
-kind = "line"
-origin = [0, 0, 0]
-direction = [0, 0, 1]
-[profile]
-kind = "constant"
-radius = 10
-[range]
-t_min = 0
-t_max = 20
-[substrate]
-kind = "plane"
-point = [0, 0, 0]
-normal = [0, 0, 1]
-[slicing]
-delta_mm = 2
-"#;
+/// The smallest valid part file; each test breaks one field of it.
+fn good() -> String {
+    crate::common::cylinder_part_text("t", 10.0, 20.0, 2.0)
+}
 
 fn err(text: &str) -> PartFileError {
     match parse_part(text, "bad.toml", Path::new(".")) {
@@ -61,34 +46,34 @@ fn every_sample_part_reads() {
 
 #[test]
 fn the_minimal_file_is_accepted() {
-    let part = parse_part(GOOD, "good.toml", Path::new(".")).unwrap();
+    let part = parse_part(&good(), "good.toml", Path::new(".")).unwrap();
     assert_eq!(part.slicing.discretisation, Discretisation::Points(500));
 }
 
 #[test]
 fn syntax_error_names_file_and_line() {
-    let e = err(&GOOD.replace("t_max = 20", "t_max = = 20"));
+    let e = err(&good().replace("t_max = 20", "t_max = = 20"));
     assert!(matches!(e, PartFileError::Syntax { .. }));
     assert_names(&e, &["line"]);
 }
 
 #[test]
 fn truncated_file_is_an_error() {
-    let e = err(&GOOD[..GOOD.len() / 2]);
+    let e = err(&good()[..good().len() / 2]);
     assert_names(&e, &[]);
 }
 
 #[test]
 fn unknown_field_is_named() {
-    let e = err(&GOOD.replace("radius = 10", "radius = 10\nradiuss = 3"));
+    let e = err(&good().replace("radius = 10", "radius = 10\nradiuss = 3"));
     assert_names(&e, &["radiuss"]);
-    let e = err(&GOOD.replace("name = \"t\"", "name = \"t\"\ncolour = 1"));
+    let e = err(&good().replace("name = \"t\"", "name = \"t\"\ncolour = 1"));
     assert_names(&e, &["colour"]);
 }
 
 #[test]
 fn missing_guide_is_named() {
-    let text = GOOD.replace(
+    let text = good().replace(
         "[guide]\nkind = \"line\"\norigin = [0, 0, 0]\ndirection = [0, 0, 1]\n",
         "",
     );
@@ -98,9 +83,9 @@ fn missing_guide_is_named() {
 
 #[test]
 fn negative_radius_is_named() {
-    let e = err(&GOOD.replace("radius = 10", "radius = -3"));
+    let e = err(&good().replace("radius = 10", "radius = -3"));
     assert_names(&e, &["profile.radius", "positive"]);
-    let e = err(&GOOD.replace(
+    let e = err(&good().replace(
         "kind = \"constant\"\nradius = 10",
         "kind = \"expr\"\nradius = \"5 - t\"",
     ));
@@ -110,12 +95,12 @@ fn negative_radius_is_named() {
 
 #[test]
 fn unparsable_expression_is_named() {
-    let e = err(&GOOD.replace(
+    let e = err(&good().replace(
         "kind = \"constant\"\nradius = 10",
         "kind = \"expr\"\nradius = \"5 + cos(t\"",
     ));
     assert_names(&e, &["profile.radius", "5 + cos(t"]);
-    let e = err(&GOOD.replace(
+    let e = err(&good().replace(
         "kind = \"constant\"\nradius = 10",
         "kind = \"expr\"\nradius = \"5 + k * t\"",
     ));
@@ -124,19 +109,19 @@ fn unparsable_expression_is_named() {
 
 #[test]
 fn empty_t_range_is_named() {
-    let e = err(&GOOD.replace("t_max = 20", "t_max = 0"));
+    let e = err(&good().replace("t_max = 20", "t_max = 0"));
     assert_names(&e, &["range", "empty t-range"]);
 }
 
 #[test]
 fn wrong_type_and_non_finite_numbers_are_named() {
-    let e = err(&GOOD.replace("t_max = 20", "t_max = [1]"));
+    let e = err(&good().replace("t_max = 20", "t_max = [1]"));
     assert_names(&e, &["t_max"]);
-    let e = err(&GOOD.replace("t_max = 20", "t_max = nan"));
+    let e = err(&good().replace("t_max = 20", "t_max = nan"));
     assert_names(&e, &["range.t_max", "finite"]);
-    let e = err(&GOOD.replace("delta_mm = 2", "delta_mm = inf"));
+    let e = err(&good().replace("delta_mm = 2", "delta_mm = inf"));
     assert_names(&e, &["slicing.delta_mm"]);
-    let e = err(&GOOD.replace("delta_mm = 2", "delta_mm = -1"));
+    let e = err(&good().replace("delta_mm = 2", "delta_mm = -1"));
     assert_names(&e, &["slicing.delta_mm"]);
 }
 
@@ -174,7 +159,7 @@ fn self_folding_tube_names_t() {
 
 #[test]
 fn zero_derivative_guide_names_t() {
-    let text = GOOD.replace(
+    let text = good().replace(
         "kind = \"line\"\norigin = [0, 0, 0]\ndirection = [0, 0, 1]",
         "kind = \"expr\"\nx = \"0\"\ny = \"0\"\nz = \"(t - 10)^3 + 10\"",
     );
@@ -200,15 +185,15 @@ fn unicode_garbage_and_missing_file_are_errors() {
 
 #[test]
 fn conflicting_discretisations_are_named() {
-    let e = err(&GOOD.replace("delta_mm = 2", "delta_mm = 2\npoints = 100\nchord_mm = 0.1"));
+    let e = err(&good().replace("delta_mm = 2", "delta_mm = 2\npoints = 100\nchord_mm = 0.1"));
     assert_names(&e, &["slicing", "only one"]);
-    let e = err(&GOOD.replace("delta_mm = 2", "delta_mm = 2\npoints = 2"));
+    let e = err(&good().replace("delta_mm = 2", "delta_mm = 2\npoints = 2"));
     assert_names(&e, &["slicing.points"]);
 }
 
 #[test]
 fn missing_stl_substrate_names_the_field() {
-    let e = err(&GOOD.replace(
+    let e = err(&good().replace(
         "kind = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 1]",
         "kind = \"mesh\"\nfile = \"nope.stl\"",
     ));

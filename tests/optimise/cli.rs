@@ -1,18 +1,6 @@
 //! The `waam plan` command of the CLI example.
 
-use crate::common::part_path;
-use std::path::PathBuf;
-use std::process::Command;
-
-fn waam() -> Command {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap();
-    let bin: PathBuf = dir
-        .join("examples")
-        .join(format!("waam{}", std::env::consts::EXE_SUFFIX));
-    assert!(bin.exists(), "example not built at {}", bin.display());
-    Command::new(bin)
-}
+use crate::common::{part_path, waam};
 
 fn plan(rz: &str, out: &std::path::Path) -> std::process::ExitStatus {
     waam()

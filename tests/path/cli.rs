@@ -2,22 +2,9 @@
 //! contract's columns for every strategy; reading it back gives the same
 //! distance map (so anyone can check the figures from outside).
 
-use crate::common::part_path;
-use std::path::PathBuf;
-use std::process::Command;
+use crate::common::{part_path, waam};
 use waam_slicer::io::path_csv::{read_path_csv, HEADER};
 use waam_slicer::path::distance_map::distance_map_of;
-
-/// The example binary, built by `cargo test` next to the test executables.
-fn waam() -> Command {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap();
-    let bin: PathBuf = dir
-        .join("examples")
-        .join(format!("waam{}", std::env::consts::EXE_SUFFIX));
-    assert!(bin.exists(), "example not built at {}", bin.display());
-    Command::new(bin)
-}
 
 #[test]
 fn slice_writes_path_csv_for_every_strategy() {

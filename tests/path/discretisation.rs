@@ -6,28 +6,12 @@ use std::path::Path;
 use waam_slicer::io::part_file::parse_part;
 use waam_slicer::path::{slice, Discretisation, SliceOptions, Strategy};
 
-const CYLINDER: &str = r#"
-name = "cylinder-600"
-[guide]
-kind = "line"
-origin = [0, 0, 0]
-direction = [0, 0, 1]
-[profile]
-kind = "constant"
-radius = 300
-[range]
-t_min = 0
-t_max = 10
-[substrate]
-kind = "plane"
-point = [0, 0, 0]
-normal = [0, 0, 1]
-[slicing]
-delta_mm = 2
-"#;
+fn cylinder() -> String {
+    crate::common::cylinder_part_text("cylinder-600", 300.0, 10.0, 2.0)
+}
 
 fn points_per_layer(d: Discretisation) -> Vec<usize> {
-    let part = parse_part(CYLINDER, "cylinder.toml", Path::new(".")).unwrap();
+    let part = parse_part(&cylinder(), "cylinder.toml", Path::new(".")).unwrap();
     let mut o = SliceOptions::new(Strategy::Constant, 2.0);
     o.discretisation = d;
     let path = slice(&part.tube, &part.substrate, &o).unwrap();
@@ -51,7 +35,7 @@ fn chord_error_matches_the_thesis_circle_check() {
 
 #[test]
 fn max_spacing_and_point_count_are_respected() {
-    let part = parse_part(CYLINDER, "cylinder.toml", Path::new(".")).unwrap();
+    let part = parse_part(&cylinder(), "cylinder.toml", Path::new(".")).unwrap();
     let mut o = SliceOptions::new(Strategy::Constant, 2.0);
     o.discretisation = Discretisation::MaxSpacing(5.0);
     let path = slice(&part.tube, &part.substrate, &o).unwrap();

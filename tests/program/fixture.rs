@@ -2,18 +2,13 @@
 //! of SPEC §2.1) in the ROBOWAM cells, with `R_Z = c − v` (J1–J5 still
 //! within a layer in the part-carried cell).
 
-use std::f64::consts::{FRAC_PI_2, TAU};
-
 use waam_slicer::io::cell_file::read_cell_file;
-use waam_slicer::math::{Point3, UnitVector3, Vector3};
 use waam_slicer::program::{build_program, Program, TravelSpeed};
 use waam_slicer::robot::trajectory::{
     joint_trajectory, JointTrajectory, PathPointInput, TrajectoryOptions,
 };
 use waam_slicer::robot::Cell;
 
-pub const R_S: f64 = 45.0;
-pub const DELTA: f64 = 5.0;
 /// TS 36 cm/min = 6 mm/s [thesis table 3.1].
 pub const TS_MM_S: f64 = 6.0;
 
@@ -23,26 +18,7 @@ pub fn hemisphere(
     points: usize,
     r_z: impl Fn(f64) -> f64,
 ) -> Vec<PathPointInput> {
-    let mut out = Vec::new();
-    for layer in layers {
-        let phi = layer as f64 * DELTA / R_S;
-        assert!(phi < FRAC_PI_2);
-        let a = R_S * phi.cos();
-        let z = R_S * phi.sin();
-        for k in 0..points {
-            let v = TAU * k as f64 / points as f64;
-            let t = Vector3::new(-phi.sin() * v.cos(), -phi.sin() * v.sin(), phi.cos());
-            out.push(PathPointInput {
-                layer,
-                point: k,
-                position_mm: Point3::new(a * v.cos(), a * v.sin(), z),
-                tool_axis: UnitVector3::new_normalize(t),
-                build_direction: None,
-                r_z: r_z(v),
-            });
-        }
-    }
-    out
+    crate::shared::hemisphere_cell_points(layers, points, |_, v| r_z(v))
 }
 
 /// A cell from `parts/cells/`.

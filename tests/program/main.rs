@@ -4,5 +4,7 @@
 
 mod fixture;
 mod golden;
+#[path = "../common/mod.rs"]
+mod shared;
 mod split;
 mod validate;

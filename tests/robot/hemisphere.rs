@@ -3,7 +3,7 @@
 
 use std::f64::consts::{FRAC_PI_2, TAU};
 
-use waam_slicer::math::{Point3, UnitVector3, Vector3};
+use waam_slicer::math::Point3;
 use waam_slicer::robot::trajectory::{
     joint_trajectory, PathPointInput, TrajectoryOptions, ViolationKind,
 };
@@ -15,32 +15,11 @@ pub const DELTA: f64 = 5.0;
 pub const POINTS: usize = 100;
 
 /// Layers at constant meridian arc spacing from Z = 0, stopping below the pole.
-/// `r_z(v)` gives R_Z at layer angle v.
+/// `r_z(layer, v)` gives R_Z at layer angle v.
 pub fn hemisphere(r_z: impl Fn(usize, f64) -> f64) -> Vec<PathPointInput> {
-    let mut out = Vec::new();
-    let mut layer = 0;
-    loop {
-        let phi = layer as f64 * DELTA / R_S;
-        if phi >= FRAC_PI_2 - 1e-9 {
-            break;
-        }
-        let a = R_S * phi.cos();
-        let z = R_S * phi.sin();
-        for k in 0..POINTS {
-            let v = TAU * k as f64 / POINTS as f64;
-            let t = Vector3::new(-phi.sin() * v.cos(), -phi.sin() * v.sin(), phi.cos());
-            out.push(PathPointInput {
-                layer,
-                point: k,
-                position_mm: Point3::new(a * v.cos(), a * v.sin(), z),
-                tool_axis: UnitVector3::new_normalize(t),
-                build_direction: None,
-                r_z: r_z(layer, v),
-            });
-        }
-        layer += 1;
-    }
-    out
+    // Every layer whose latitude l Delta / R_s stays below pi/2.
+    let layers = ((FRAC_PI_2 - 1e-9) * R_S / DELTA).floor() as usize + 1;
+    crate::shared::hemisphere_cell_points(0..layers, POINTS, r_z)
 }
 
 /// ROBOWAM part-carried cell at D_R of §3.3, J5 ±135° (table A.1 note 1).

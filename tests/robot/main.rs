@@ -11,3 +11,5 @@ mod jacobian;
 mod kinematics;
 mod orientation;
 mod positioner;
+#[path = "../common/mod.rs"]
+mod shared;

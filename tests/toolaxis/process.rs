@@ -33,14 +33,8 @@ fn squares(deltas: [f64; 4]) -> Path {
         delta_mm: 5.0,
         layers: vec![square(0.0, None), square(5.0, Some(deltas))],
         report: SliceReport {
-            root_finds: 0,
-            evaluations: 0,
-            max_residual_mm: 0.0,
-            truncated_points: 0,
-            grid_points: 0,
             stop: StopReason::ReachedEnd,
-            max_turn_before_rad: 0.0,
-            max_turn_after_rad: 0.0,
+            ..SliceReport::default()
         },
         spiral: None,
     }

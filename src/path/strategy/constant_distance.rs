@@ -5,7 +5,7 @@
 
 use super::{forward_root, Step};
 use crate::geometry::Tube;
-use crate::math::RootFailure;
+use crate::math::{Point3, RootFailure};
 use crate::path::index::{SegmentId, SegmentIndex};
 
 /// Next `t` of the column at profile angle `v` whose point on the layer below
@@ -37,51 +37,40 @@ pub fn next_t(
             0.999 * delta_mm / across
         }
     };
-    // Always descend from the column's own segment, so that the function is
-    // deterministic (a bracket found stays a bracket).
-    let delta_at = |t: f64| below.nearest_from(&tube.point(t, v), hint).distance;
+    // The local search always descends from the column's own segment, so the
+    // function is deterministic (a bracket found stays a bracket); the exact
+    // query (any segment) confirms the root, and is used throughout if the
+    // local descent stopped at a local minimum.
+    let local = |p: &Point3| below.nearest_from(p, hint).distance;
+    let exact = |p: &Point3| {
+        below
+            .nearest_hinted(p, Some(hint))
+            .map_or(f64::INFINITY, |n| n.distance)
+    };
     let x_tol = 1e-12 * (1.0 + t_below.abs());
-    let found = forward_root(
-        |t| delta_at(t) - delta_mm,
-        t_below,
-        -delta_mm,
-        step0,
-        t_hi,
-        x_tol,
-        1e-10 * delta_mm,
-    )?;
-    let Some((t, evaluations, _)) = found else {
+    let solve = |dist: &dyn Fn(&Point3) -> f64| {
+        forward_root(
+            |t| dist(&tube.point(t, v)) - delta_mm,
+            t_below,
+            -delta_mm,
+            step0,
+            t_hi,
+            x_tol,
+            1e-10 * delta_mm,
+        )
+    };
+    let Some((t, evaluations, _)) = solve(&local)? else {
         return Ok(Step::End);
     };
-    // Confirm with the exact nearest segment (the local descent could have
-    // stopped at a local minimum); redo the root find with exact queries if not.
-    let p = tube.point(t, v);
-    let local = below.nearest_from(&p, hint);
-    let exact = below
-        .nearest_hinted(&p, Some(local.id))
-        .map_or(f64::INFINITY, |n| n.distance);
-    if (exact - delta_mm).abs() <= 1e-9 * delta_mm {
+    let residual = (exact(&tube.point(t, v)) - delta_mm).abs();
+    if residual <= 1e-9 * delta_mm {
         return Ok(Step::Point {
             t,
             evaluations,
-            residual: (exact - delta_mm).abs(),
+            residual,
         });
     }
-    let exact_delta = |t: f64| {
-        below
-            .nearest(&tube.point(t, v))
-            .map_or(f64::INFINITY, |n| n.distance)
-            - delta_mm
-    };
-    match forward_root(
-        exact_delta,
-        t_below,
-        -delta_mm,
-        step0,
-        t_hi,
-        x_tol,
-        1e-10 * delta_mm,
-    )? {
+    match solve(&exact)? {
         Some((t, more, residual)) => Ok(Step::Point {
             t,
             evaluations: evaluations + more,
