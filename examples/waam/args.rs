@@ -76,15 +76,39 @@ pub struct SliceExtras {
     /// Spiral: travel toward decreasing profile angle.
     #[arg(long)]
     pub reverse: bool,
-    /// Process preset for the estimates in summary.json: cmt-steel (CMT ER70S-6) or pla (thesis table 3.1).
-    #[arg(long, default_value = "cmt-steel", value_parser = ["cmt-steel", "pla"])]
-    pub process: String,
     /// Bead width for wall.stl (mm; default Delta).
     #[arg(long, value_name = "MM")]
     pub bead_width: Option<f64>,
     /// Stop after N layers (or spiral turns).
     #[arg(long, value_name = "N")]
     pub max_layers: Option<usize>,
+}
+
+/// Tool-axis and process settings shared by `slice` and `plan`; each
+/// overrides the part file's `[tool_axis]` / `[process]` value.
+#[derive(Debug, Clone, clap::Args)]
+pub struct AxisArgs {
+    /// Constant lead angle of the torch (degrees, feed plane).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub lead: Option<f64>,
+    /// Constant tilt angle of the torch (degrees, normal plane).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub tilt: Option<f64>,
+    /// The 50° rule with this angle: the torch never leans more than DEG from the part's Z.
+    #[arg(long, value_name = "DEG")]
+    pub max_lean: Option<f64>,
+    /// Bound the turning rate of the torch axis along a layer (degrees per mm of path).
+    #[arg(long, value_name = "DEG_PER_MM")]
+    pub max_axis_rate: Option<f64>,
+    /// Tool axis along the build direction, ignoring the part file's lead, tilt, lean rule and rate bounds.
+    #[arg(long, conflicts_with_all = ["lead", "tilt", "max_lean", "max_axis_rate"])]
+    pub plain_axes: bool,
+    /// Process preset: cmt-steel (CMT ER70S-6), pla (thesis table 3.1) or mag-steel.
+    #[arg(long, value_name = "PRESET")]
+    pub process: Option<waam_slicer::process::ProcessPreset>,
+    /// Travel speed (mm/s): the programmed torch speed over the part.
+    #[arg(long, value_name = "MM_S")]
+    pub travel_speed: Option<f64>,
 }
 
 /// Arguments of `waam slice`.
@@ -110,6 +134,9 @@ pub struct SliceArgs {
     /// Extra slicing settings.
     #[command(flatten)]
     pub more: SliceExtras,
+    /// Tool axis and process.
+    #[command(flatten)]
+    pub axes: AxisArgs,
 }
 
 /// Arguments of `plan`.
@@ -135,6 +162,9 @@ pub struct PlanArgs {
     /// R_Z law: fixed:DEG, poly:N (max degree), spline, point.
     #[arg(long, default_value = "poly:4")]
     pub rz: String,
+    /// Tool axis and process.
+    #[command(flatten)]
+    pub axes: AxisArgs,
     /// Output folder (default out/<part name>).
     #[arg(long)]
     pub out: Option<PathBuf>,

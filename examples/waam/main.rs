@@ -12,6 +12,7 @@ mod plan;
 mod plots;
 mod progress;
 mod slice;
+mod stages;
 
 use args::{Args, Command};
 use clap::Parser;

@@ -15,9 +15,8 @@ use waam_slicer::io::part_file::read_part_file;
 use waam_slicer::optimise::{
     layer_points, optimise, Abscissa, OptimiseOptions, Parameterisation, Plan,
 };
-use waam_slicer::path::{slice, Discretisation};
+use waam_slicer::path::{distance_map, slice, Discretisation};
 use waam_slicer::robot::Cell;
-use waam_slicer::toolaxis::local_frames;
 
 /// Header of `joints.csv` (degrees, part frame mm); `e1,e2` appended with a positioner.
 pub const JOINTS_HEADER: &str = "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6";
@@ -76,8 +75,10 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
     })?;
     // One IK branch for the whole part (the cell's): a program must not
     // reconfigure the arm between layers.
+    let process = crate::stages::process_parameters(&part, &a.axes)?;
     let opts = OptimiseOptions {
         parameterisation: parse_rz(&a.rz)?,
+        travel_speed_mm_s: process.travel_speed_mm_s,
         configuration: waam_slicer::optimise::ConfigurationChoice::Cell,
         ..OptimiseOptions::default()
     };
@@ -100,8 +101,9 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
     drop(spinner);
     let t_slice = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
-    let frames = local_frames(&path, &part.tube);
-    let layers = layer_points(&path, &frames);
+    let axes = crate::stages::axes_of(&part, &path, &a.axes, &a.part)?;
+    let layers = layer_points(&path, &axes.frames);
+    let shared = crate::stages::path_summary(&path, &distance_map(&path), &process, &axes)?;
     let t_axes = t2.elapsed().as_secs_f64();
     let result = {
         let _spinner = crate::progress::Stage::start(
@@ -128,7 +130,8 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
         &result,
         opts.travel_speed_mm_s,
     )?;
-    let summary = summary_json(&part.name, a, &result, &opts, [t_read, t_slice, t_axes]);
+    let mut summary = summary_json(&part.name, a, &result, &opts, [t_read, t_slice, t_axes]);
+    crate::stages::merge(&mut summary, shared);
     let sj = dir.join("summary.json");
     write_atomic(&sj, |w| {
         serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
@@ -284,7 +287,7 @@ fn summary_json(
         "feasible": plan.is_feasible(),
         "infeasible_layers": plan.infeasible_layers().map(|l| l.layer).collect::<Vec<_>>(),
         "violations": violations,
-        "layers": layers,
+        "layer_plans": layers,
         "transitions": plan.transitions.iter().map(|t| json!({
             "from_layer": t.from_layer,
             "to_layer": t.to_layer,

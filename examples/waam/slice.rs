@@ -9,7 +9,6 @@ use waam_slicer::io::part_file::read_part_file;
 use waam_slicer::io::path_csv::write_path_csv;
 use waam_slicer::path::smooth::Smoothing;
 use waam_slicer::path::{distance_map, slice, Discretisation, Strategy};
-use waam_slicer::toolaxis::local_frames;
 
 pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     let part_file = args.part.as_path();
@@ -62,7 +61,8 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     let map = distance_map(&path);
     let t_map = t2.elapsed().as_secs_f64();
     let t3 = Instant::now();
-    let frames = local_frames(&path, &part.tube);
+    let axes = crate::stages::axes_of(&part, &path, &args.axes, part_file)?;
+    let frames = &axes.frames;
     let t_axes = t3.elapsed().as_secs_f64();
 
     let dir: PathBuf = out
@@ -70,18 +70,13 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
         .unwrap_or_else(|| PathBuf::from("out").join(&part.name));
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let csv = dir.join("path.csv");
-    write_atomic(&csv, |w| write_path_csv(w, &path.layers, &frames))
+    write_atomic(&csv, |w| write_path_csv(w, &path.layers, frames))
         .map_err(|e| format!("{}: {e}", csv.display()))?;
-    let params = match more.process.as_str() {
-        "pla" => waam_slicer::process::ProcessParameters::pla_table_3_1(),
-        _ => waam_slicer::process::ProcessParameters::cmt_steel_er70s6(),
-    };
-    let process = waam_slicer::process::plan_process(&path, &params, &Default::default())
-        .map_err(|e| e.to_string())?;
-    let est = process.estimates;
+    let params = crate::stages::process_parameters(&part, &args.axes)?;
+    let shared = crate::stages::path_summary(&path, &map, &params, &axes)?;
     let stl = dir.join("wall.stl");
     let width = more.bead_width.unwrap_or(path.delta_mm);
-    let triangles = waam_slicer::io::wall_stl::wall_triangles(&path, &frames, width);
+    let triangles = waam_slicer::io::wall_stl::wall_triangles(&path, frames, width);
     write_atomic(&stl, |w| {
         waam_slicer::io::wall_stl::write_stl(w, &triangles)
     })
@@ -122,28 +117,9 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             .map_err(|e| format!("{}: {e}", dir.join(name).display()))?;
     }
     let t_plots = t4.elapsed().as_secs_f64();
-    let summary = json!({
+    let mut summary = json!({
         "part": part.name,
         "part_file": part_file.display().to_string(),
-        "strategy": path.strategy.name(),
-        "delta_mm": path.delta_mm,
-        "layers": path.layers.len(),
-        "slices": path.num_slices(),
-        "points": path.num_points(),
-        "arc_starts": path.layers.len(),
-        "length_mm": path.length_mm(),
-        "process": {
-            "preset": more.process,
-            "deposition_time_s": est.deposition_time_s,
-            "wire_length_mm": est.wire_length_mm,
-            "deposited_mass_g": est.deposited_mass_g,
-            "arc_starts": est.arc_starts,
-            "speed_window_violations": process.violation_count,
-        },
-        "distance": {
-            "overall": map.overall,
-            "per_layer": map.per_layer,
-        },
         "slicer": {
             "grid_points": path.report.grid_points,
             "root_finds": path.report.root_finds,
@@ -156,6 +132,7 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
         },
         "run_time_s": { "read": t_read, "slice": t_slice, "distance_map": t_map, "tool_axes": t_axes, "pictures": t_plots },
     });
+    crate::stages::merge(&mut summary, shared);
     let summary_file = dir.join("summary.json");
     write_atomic(&summary_file, |w| {
         serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;

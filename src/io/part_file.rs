@@ -12,6 +12,8 @@ use crate::geometry::{
 use crate::math::{Point3, UnitVector3, Vector3};
 pub use crate::path::{Discretisation, Strategy};
 use crate::path::{EndRule, SliceOptions};
+use crate::process::{ProcessParameters, ProcessPreset};
+use crate::toolaxis::{AxisRule, NormalMethod, ToolAxisOptions};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -276,6 +278,56 @@ pub struct SlicingSpec {
     pub max_spacing_mm: Option<f64>,
 }
 
+/// How the torch axis is set, as written (`[tool_axis]`, degrees; SPEC §4).
+/// Every field is optional: the default is the tool axis along the build
+/// direction with analytic normals.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToolAxisSpec {
+    /// `auto` (default), `analytic` or `numeric`.
+    #[serde(default)]
+    pub normals: NormalMethod,
+    /// Constant lead angle (deg, feed plane, positive toward the feed).
+    pub lead_deg: Option<Scalar>,
+    /// Constant tilt angle (deg, normal plane, positive toward the outside).
+    pub tilt_deg: Option<Scalar>,
+    /// The 50° rule (thesis eq. 3.20–3.21) with this angle (deg, in (0, 90)):
+    /// the tool axis never leans more than it from `lean_axis`.
+    pub max_lean_deg: Option<Scalar>,
+    /// Axis of the lean cone (part frame; default `[0, 0, 1]`).
+    pub lean_axis: Option<Vec3Field>,
+    /// Project every build direction into the plane with this normal (part
+    /// frame; thesis §3.3.1 uses `[1, 0, 0]` for the torus on a cylinder).
+    pub project_build: Option<Vec3Field>,
+    /// First layer's build direction along the substrate normal (§2.4.2).
+    #[serde(default)]
+    pub first_layer_along_substrate: bool,
+    /// Bound on the rate of the lead/tilt angles along a layer (deg per mm).
+    pub max_rate_deg_per_mm: Option<Scalar>,
+    /// Bound on the turning rate of the tool axis itself along a layer (deg
+    /// per mm, part frame): spreads the jumps of the build direction at the
+    /// cusps of constant-distance layers so that the wrist can follow.
+    pub max_axis_rate_deg_per_mm: Option<Scalar>,
+}
+
+/// Deposition parameters, as written (`[process]`): a preset and optional
+/// overrides (SPEC §5).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProcessSpec {
+    /// `cmt-steel` (default), `pla` or `mag-steel`.
+    #[serde(default)]
+    pub preset: ProcessPreset,
+    /// Nominal travel speed (mm/s); also the programmed speed of the robot.
+    pub travel_speed_mm_s: Option<Scalar>,
+    /// Wire feed speed (mm/s).
+    pub wire_feed_speed_mm_s: Option<Scalar>,
+    /// Slowest admissible travel speed (mm/s).
+    pub travel_speed_min_mm_s: Option<Scalar>,
+    /// Fastest admissible travel speed (mm/s).
+    pub travel_speed_max_mm_s: Option<Scalar>,
+}
+
 /// A part file as written (before validation).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -306,6 +358,10 @@ pub struct PartSpec {
     pub end_plane: Option<PlaneSpec>,
     /// Default slicing settings.
     pub slicing: SlicingSpec,
+    /// How the tool axis is set (optional).
+    pub tool_axis: Option<ToolAxisSpec>,
+    /// Deposition parameters (optional; CMT steel when absent).
+    pub process: Option<ProcessSpec>,
 }
 
 /// Validated slicing settings.
@@ -336,6 +392,10 @@ pub struct Part {
     pub end_plane: Option<Plane>,
     /// Default slicing settings.
     pub slicing: Slicing,
+    /// Tool-axis settings (`[tool_axis]`; defaults when absent), validated.
+    pub tool_axis: ToolAxisOptions,
+    /// Deposition parameters (`[process]`; CMT steel when absent), validated.
+    pub process: ProcessParameters,
     /// The part as written.
     pub spec: PartSpec,
 }
@@ -455,6 +515,8 @@ pub fn build_part(spec: PartSpec, file: &str, base_dir: &Path) -> Result<Part, P
         None => None,
     };
     let slicing = cx.slicing(&spec.slicing)?;
+    let tool_axis = cx.tool_axis(&spec.tool_axis.clone().unwrap_or_default())?;
+    let process = cx.process(&spec.process.clone().unwrap_or_default())?;
     Ok(Part {
         name: spec.name.clone(),
         description: spec.description.clone(),
@@ -463,6 +525,8 @@ pub fn build_part(spec: PartSpec, file: &str, base_dir: &Path) -> Result<Part, P
         substrate,
         end_plane,
         slicing,
+        tool_axis,
+        process,
         spec,
     })
 }
@@ -763,5 +827,112 @@ impl Ctx<'_> {
             delta_mm: s.delta_mm,
             discretisation,
         })
+    }
+
+    fn tool_axis(&self, s: &ToolAxisSpec) -> Result<ToolAxisOptions, PartFileError> {
+        let angle = |field: &str, v: &Option<Scalar>| -> Result<f64, PartFileError> {
+            match v {
+                Some(v) => {
+                    let d = self.scalar(field, v)?;
+                    if d.abs() >= 90.0 {
+                        return Err(self
+                            .field(field, &format!("must be within (-90, 90) degrees, got {d}")));
+                    }
+                    Ok(d.to_radians())
+                }
+                None => Ok(0.0),
+            }
+        };
+        let rule = match &s.max_lean_deg {
+            Some(v) => {
+                let d = self.positive("tool_axis.max_lean_deg", v)?;
+                if d >= 90.0 {
+                    return Err(self.field(
+                        "tool_axis.max_lean_deg",
+                        &format!("must be below 90 degrees, got {d}"),
+                    ));
+                }
+                let axis = match &s.lean_axis {
+                    Some(a) => self.unit("tool_axis.lean_axis", a)?.into_inner(),
+                    None => Vector3::z(),
+                };
+                AxisRule::MaxAngleFromAxis {
+                    axis: axis.into(),
+                    max_angle_rad: d.to_radians(),
+                }
+            }
+            None if s.lean_axis.is_some() => {
+                return Err(self.field(
+                    "tool_axis.lean_axis",
+                    "has no effect without `max_lean_deg`",
+                ))
+            }
+            None => AxisRule::None,
+        };
+        let opts = ToolAxisOptions {
+            normals: s.normals,
+            lead_rad: angle("tool_axis.lead_deg", &s.lead_deg)?,
+            tilt_rad: angle("tool_axis.tilt_deg", &s.tilt_deg)?,
+            rule,
+            project_build: match &s.project_build {
+                Some(n) => Some(self.unit("tool_axis.project_build", n)?.into_inner().into()),
+                None => None,
+            },
+            first_layer_along_substrate: s.first_layer_along_substrate,
+            max_rate_rad_per_mm: match &s.max_rate_deg_per_mm {
+                Some(v) => Some(
+                    self.positive("tool_axis.max_rate_deg_per_mm", v)?
+                        .to_radians(),
+                ),
+                None => None,
+            },
+            max_axis_rate_rad_per_mm: match &s.max_axis_rate_deg_per_mm {
+                Some(v) => Some(
+                    self.positive("tool_axis.max_axis_rate_deg_per_mm", v)?
+                        .to_radians(),
+                ),
+                None => None,
+            },
+        };
+        opts.validate()
+            .map_err(|e| self.field("tool_axis", &e.to_string()))?;
+        Ok(opts)
+    }
+
+    fn process(&self, s: &ProcessSpec) -> Result<ProcessParameters, PartFileError> {
+        let mut p = s.preset.parameters();
+        for (name, value, slot) in [
+            (
+                "travel_speed_mm_s",
+                &s.travel_speed_mm_s,
+                &mut p.travel_speed_mm_s,
+            ),
+            (
+                "wire_feed_speed_mm_s",
+                &s.wire_feed_speed_mm_s,
+                &mut p.wire_feed_speed_mm_s,
+            ),
+            (
+                "travel_speed_min_mm_s",
+                &s.travel_speed_min_mm_s,
+                &mut p.travel_speed_min_mm_s,
+            ),
+            (
+                "travel_speed_max_mm_s",
+                &s.travel_speed_max_mm_s,
+                &mut p.travel_speed_max_mm_s,
+            ),
+        ] {
+            if let Some(v) = value {
+                *slot = self.positive(&format!("process.{name}"), v)?;
+            }
+        }
+        p.validate().map_err(|e| match e {
+            crate::process::ProcessError::InvalidParameter { field, reason } => {
+                self.field(&format!("process.{field}"), &reason)
+            }
+            other => self.field("process", &other.to_string()),
+        })?;
+        Ok(p)
     }
 }

@@ -28,6 +28,60 @@ use serde::{Deserialize, Serialize};
 /// (thesis §1.2.3, Adebayo et al. [61]), in mm/s.
 pub const HUMPING_LIMIT_CMT_STEEL_MM_S: f64 = 60.0 * MM_S_PER_CM_MIN;
 
+/// The named parameter sets: the `preset` of a part file's `[process]` table
+/// and the CLI's `--process`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ProcessPreset {
+    /// [`ProcessParameters::pla_table_3_1`]: the thesis's polymer tests, 6 mm/s.
+    Pla,
+    /// [`ProcessParameters::cmt_steel_er70s6`]: CMT ER70S-6, 8.33 mm/s (the default).
+    #[default]
+    CmtSteel,
+    /// [`ProcessParameters::mag_steel_xiong`]: MAG ER70S, 5 mm/s.
+    MagSteel,
+}
+
+impl ProcessPreset {
+    /// Every preset, in the order the CLI lists them.
+    pub const ALL: [ProcessPreset; 3] = [Self::CmtSteel, Self::Pla, Self::MagSteel];
+
+    /// The name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Pla => "pla",
+            Self::CmtSteel => "cmt-steel",
+            Self::MagSteel => "mag-steel",
+        }
+    }
+
+    /// The preset's parameters.
+    pub fn parameters(self) -> ProcessParameters {
+        match self {
+            Self::Pla => ProcessParameters::pla_table_3_1(),
+            Self::CmtSteel => ProcessParameters::cmt_steel_er70s6(),
+            Self::MagSteel => ProcessParameters::mag_steel_xiong(),
+        }
+    }
+}
+
+impl std::str::FromStr for ProcessPreset {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Self::ALL.iter().map(|p| p.name()).collect();
+                format!(
+                    "unknown process preset `{s}`; expected one of {}",
+                    names.join(", ")
+                )
+            })
+    }
+}
+
 /// Deposition parameters. Plain data with serde (a `[process]` table of a
 /// part file can hold it); [`ProcessParameters::validate`] names the field.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -108,6 +108,13 @@ pub struct ToolAxisOptions {
     /// relative to the local frame (the frame's own turn comes on top; a rule's
     /// cone is not re-imposed — check the report).
     pub max_rate_rad_per_mm: Option<f64>,
+    /// Bound on the angular rate of `T` itself along a layer (rad per mm of
+    /// path, part frame), enforced last by [`smooth_layer`]: where the build
+    /// direction jumps (the cusps of constant-distance layers), the torch turns
+    /// over a window split evenly before and after the jump instead of at
+    /// once, so that the robot's wrist can follow. `None` leaves `T` as
+    /// computed.
+    pub max_axis_rate_rad_per_mm: Option<f64>,
 }
 
 impl Default for ToolAxisOptions {
@@ -120,6 +127,7 @@ impl Default for ToolAxisOptions {
             project_build: None,
             first_layer_along_substrate: false,
             max_rate_rad_per_mm: None,
+            max_axis_rate_rad_per_mm: None,
         }
     }
 }
@@ -171,12 +179,14 @@ impl ToolAxisOptions {
                 );
             }
         }
-        if let Some(r) = self.max_rate_rad_per_mm {
-            if !(r.is_finite() && r > 0.0) {
-                return bad(
-                    "max_rate_rad_per_mm",
-                    format!("must be positive and finite, got {r}"),
-                );
+        for (field, rate) in [
+            ("max_rate_rad_per_mm", self.max_rate_rad_per_mm),
+            ("max_axis_rate_rad_per_mm", self.max_axis_rate_rad_per_mm),
+        ] {
+            if let Some(r) = rate {
+                if !(r.is_finite() && r > 0.0) {
+                    return bad(field, format!("must be positive and finite, got {r}"));
+                }
             }
         }
         self.rule.validate()
@@ -386,6 +396,21 @@ pub fn tool_axes(
             if moved > 0 {
                 for (f, &(lead, tilt)) in frames[li].iter_mut().zip(&angles[li]) {
                     f.tool = tool_axis(f, lead, tilt);
+                }
+            }
+        }
+    }
+    // 5. Bound on the rate of T itself.
+    if let Some(rate) = opts.max_axis_rate_rad_per_mm {
+        for (li, layer) in path.layers.iter().enumerate() {
+            let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
+            let mut axes: Vec<Vector3> = frames[li].iter().map(|f| f.tool).collect();
+            let moved = smooth_layer(&positions, &mut axes, layer.closed, rate);
+            report.smoothed_points += moved;
+            if moved > 0 {
+                for ((f, t), a) in frames[li].iter_mut().zip(axes).zip(angles[li].iter_mut()) {
+                    f.tool = t;
+                    *a = lead_tilt_of(f, &t);
                 }
             }
         }

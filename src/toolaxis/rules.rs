@@ -373,10 +373,11 @@ fn max_pair_rate(positions: &[Point3], closed: bool, change: impl Fn(usize, usiz
 }
 
 /// Smooths unit tool axes along a layer in absolute terms (best effort) so that the angle between consecutive
-/// axes is at most `max_rate_rad_per_mm` times their distance (mm): forward
-/// and backward slew-rate limiting (rotating an axis toward its neighbour),
-/// then symmetric relaxation of the pairs still violating the bound (at most
-/// 2000 sweeps), wrapping on a closed layer. Rotating toward a neighbour stays inside any cone of half-angle
+/// axes is at most `max_rate_rad_per_mm` times their distance (mm): around
+/// each pair over the bound, the axes of the narrowest symmetric window whose
+/// end axes can be joined within the bound are put on the great-circle arc
+/// joining them (evenly in path length); pairs still violating the bound get
+/// symmetric relaxation (at most 2000 sweeps), wrapping on a closed layer. Rotating toward a neighbour stays inside any cone of half-angle
 /// < 90° holding both (so the 50° rule survives). Returns the number of
 /// axes moved.
 ///
@@ -395,25 +396,68 @@ pub fn smooth_layer(
         return 0;
     }
     let original: Vec<Vector3> = axes.to_vec();
-    let limit = |axes: &mut [Vector3], from: usize, to: usize| {
-        let d = (positions[to] - positions[from]).norm();
-        let max = max_rate_rad_per_mm * d;
-        let a = angle(&axes[from], &axes[to]);
-        if a > max * (1.0 + 1e-12) + 1e-15 {
-            axes[to] = slerp(&axes[from], &axes[to], max / a);
-        }
+    // Symmetric windows first: around the worst pair still over the bound,
+    // widen a window one point each side until the great-circle arc from its
+    // first to its last axis, spread over the path length between them,
+    // meets the bound, and put the inside on that arc. A jump (the cusp of a
+    // constant-distance layer) is thus split evenly before and after it.
+    let m = n as isize;
+    let wrap = |i: isize| -> usize { i.rem_euclid(m) as usize };
+    let mut s = vec![0.0; n + 1];
+    for i in 1..=n {
+        s[i] = s[i - 1] + (positions[i % n] - positions[i - 1]).norm();
+    }
+    // Path length from index a to b (a <= b, unwrapped indices).
+    let length = |a: isize, b: isize| -> f64 {
+        let (ta, tb) = (a.div_euclid(m), b.div_euclid(m));
+        let (ia, ib) = (wrap(a), wrap(b));
+        s[ib] - s[ia] + (tb - ta) as f64 * s[n]
     };
-    // Forward and backward sweeps propagate the bound quickly; on a closed
-    // layer the wrap pair can leave them cycling, so symmetric relaxation
-    // (both ends of a violating pair move halfway, aiming slightly inside the
-    // bound) finishes the job.
-    for i in 1..n {
-        limit(axes, i - 1, i);
-    }
-    for i in (0..n - 1).rev() {
-        limit(axes, i + 1, i);
-    }
     let pairs = if closed && n > 2 { n } else { n - 1 };
+    for _ in 0..n {
+        let mut worst = None;
+        let mut worst_excess = 1.0 + 1e-9;
+        for i in 0..pairs {
+            let j = (i + 1) % n;
+            let d = (positions[j] - positions[i]).norm();
+            if d > 1e-12 {
+                let excess = angle(&axes[i], &axes[j]) / (max_rate_rad_per_mm * d);
+                if excess > worst_excess {
+                    worst_excess = excess;
+                    worst = Some(i as isize);
+                }
+            }
+        }
+        let Some(i) = worst else { break };
+        let (mut a, mut b) = (i, i + 1);
+        let fits = |a: isize, b: isize| {
+            angle(&axes[wrap(a)], &axes[wrap(b)]) <= max_rate_rad_per_mm * length(a, b)
+        };
+        while !fits(a, b) {
+            let (can_down, can_up) = if closed {
+                (b - a + 2 < m, b - a + 1 < m)
+            } else {
+                (a > 0, b < m - 1)
+            };
+            match (can_down, can_up) {
+                (true, true) => {
+                    a -= 1;
+                    b += 1;
+                }
+                (true, false) => a -= 1,
+                (false, true) => b += 1,
+                (false, false) => break,
+            }
+        }
+        let total = length(a, b);
+        if !(fits(a, b) && total > 0.0) {
+            break; // the bound cannot be met here; the relaxation below does its best
+        }
+        let (first, last) = (axes[wrap(a)], axes[wrap(b)]);
+        for k in a + 1..b {
+            axes[wrap(k)] = slerp(&first, &last, length(a, k) / total);
+        }
+    }
     for _ in 0..2000 {
         if max_rate(positions, axes, closed) <= max_rate_rad_per_mm * (1.0 + 1e-9) {
             break;
