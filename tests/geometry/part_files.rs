@@ -199,3 +199,63 @@ fn missing_stl_substrate_names_the_field() {
     ));
     assert_names(&e, &["substrate.file", "nope.stl"]);
 }
+
+/// `[tool_axis]` and `[process]`: read into the library's options (degrees
+/// to radians, preset plus overrides), and each bad value names its field.
+#[test]
+fn tool_axis_and_process_tables() {
+    let text = format!(
+        "{}\n[tool_axis]\nlead_deg = 5\ntilt_deg = -3\nmax_lean_deg = 50\nproject_build = [1, 0, 0]\nmax_axis_rate_deg_per_mm = 10\n\n[process]\npreset = \"pla\"\ntravel_speed_mm_s = 5\n",
+        good()
+    );
+    let part = parse_part(&text, "good.toml", Path::new(".")).unwrap();
+    let o = &part.tool_axis;
+    assert!((o.lead_rad - 5f64.to_radians()).abs() < 1e-15);
+    assert!((o.tilt_rad + 3f64.to_radians()).abs() < 1e-15);
+    assert_eq!(o.rule, waam_slicer::toolaxis::AxisRule::thesis_50_deg());
+    assert_eq!(o.project_build, Some([1.0, 0.0, 0.0]));
+    assert!((o.max_axis_rate_rad_per_mm.unwrap() - 10f64.to_radians()).abs() < 1e-15);
+    assert_eq!(part.process.material, "PLA");
+    assert_eq!(part.process.travel_speed_mm_s, 5.0);
+    // Absent tables: T = b, CMT steel.
+    let plain = parse_part(&good(), "good.toml", Path::new(".")).unwrap();
+    assert_eq!(
+        plain.tool_axis,
+        waam_slicer::toolaxis::ToolAxisOptions::default()
+    );
+    assert_eq!(
+        plain.process,
+        waam_slicer::process::ProcessParameters::cmt_steel_er70s6()
+    );
+    for (table, bad, field) in [
+        ("tool_axis", "max_lean_deg = 95", "tool_axis.max_lean_deg"),
+        ("tool_axis", "lead_deg = 90", "tool_axis.lead_deg"),
+        ("tool_axis", "lean_axis = [0, 0, 1]", "tool_axis.lean_axis"),
+        (
+            "tool_axis",
+            "project_build = [0, 0, 0]",
+            "tool_axis.project_build",
+        ),
+        (
+            "tool_axis",
+            "max_axis_rate_deg_per_mm = -1",
+            "tool_axis.max_axis_rate_deg_per_mm",
+        ),
+        ("tool_axis", "normals = \"magic\"", "normals"),
+        ("process", "preset = \"gold\"", "preset"),
+        (
+            "process",
+            "travel_speed_mm_s = 0",
+            "process.travel_speed_mm_s",
+        ),
+        (
+            "process",
+            "travel_speed_mm_s = 100",
+            "process.travel_speed_mm_s",
+        ),
+        ("process", "voltage = 3", "voltage"),
+    ] {
+        let e = err(&format!("{}\n[{table}]\n{bad}\n", good()));
+        assert_names(&e, &[field]);
+    }
+}

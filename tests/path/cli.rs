@@ -158,3 +158,56 @@ fn plan_writes_a_program_that_check_accepts_and_a_corrupted_one_it_rejects() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("J5 = 17119") && err.contains("BAD:"), "{err}"); // file:line: what
 }
+
+/// The tool-axis and process flags reach the outputs: `--max-lean 50` keeps
+/// every tool axis of path.csv within 50° of Z (the hemisphere's `b` reaches
+/// 86°), `--plain-axes` drops the quarter torus's rate bound (its cusps come
+/// back), `--process pla --travel-speed 5` changes the time estimate by the
+/// speed ratio.
+#[test]
+fn slice_applies_the_tool_axis_and_process_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |part: &str, out: &str, extra: &[&str]| -> serde_json::Value {
+        let out = dir.path().join(out);
+        let status = waam()
+            .args(["--quiet", "slice"])
+            .arg(part_path(part))
+            .args(["--points", "120", "--out"])
+            .arg(&out)
+            .args(extra)
+            .status()
+            .unwrap();
+        assert!(status.success(), "{part} {extra:?}");
+        let text = std::fs::read_to_string(out.join("path.csv")).unwrap();
+        let mut lean: f64 = 0.0;
+        for line in text.lines().skip(1) {
+            let tz: f64 = line.split(',').nth(16).unwrap().parse().unwrap();
+            lean = lean.max(tz.clamp(-1.0, 1.0).acos().to_degrees());
+        }
+        let mut s: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        s["lean_from_csv_deg"] = lean.into();
+        s
+    };
+    let plain = run("hemisphere.toml", "h0", &[]);
+    let ruled = run("hemisphere.toml", "h50", &["--max-lean", "50"]);
+    assert!(plain["lean_from_csv_deg"].as_f64().unwrap() > 80.0);
+    assert!(ruled["lean_from_csv_deg"].as_f64().unwrap() <= 50.0 + 1e-4);
+    assert!(ruled["tool_axes"]["rule_active_points"].as_u64().unwrap() > 0);
+    assert_eq!(plain["process"]["material"], "PLA");
+
+    let bounded = run("quarter-torus.toml", "t", &[]);
+    let cusps = run("quarter-torus.toml", "t0", &["--plain-axes"]);
+    let rate = |s: &serde_json::Value| s["tool_axes"]["max_rate_deg_per_mm"].as_f64().unwrap();
+    assert!(rate(&bounded) <= 10.0 * (1.0 + 1e-6), "{}", rate(&bounded));
+    assert!(rate(&cusps) > 30.0, "{}", rate(&cusps));
+
+    let slow = run(
+        "quarter-torus.toml",
+        "t5",
+        &["--process", "pla", "--travel-speed", "3"],
+    );
+    let time = |s: &serde_json::Value| s["process"]["deposition_time_s"].as_f64().unwrap();
+    assert!((time(&slow) / time(&bounded) - 2.0).abs() < 1e-9);
+}
