@@ -20,6 +20,7 @@ use crate::robot::ik::wrap_pi;
 use crate::robot::kinematics::{rot_y, rot_z};
 use crate::robot::model::JointLimit;
 use crate::robot::RobotError;
+use std::f64::consts::TAU;
 
 /// A two-axis tilt-and-turn positioner, as data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -113,8 +114,10 @@ impl Positioner {
     /// Angles `[q7, q8]` (rad) turning the build direction `b` (table frame)
     /// onto `up` (positioner frame; `+Z` for a level positioner). Of the two
     /// tilt solutions the one inside the travel with the smaller `|q7|` is
-    /// returned; when `b` is along the table normal `q8` is free and
-    /// `q8_hint` (rad) is returned for it.
+    /// returned; `q8` is the turn angle inside its travel nearest `q8_hint`
+    /// (rad; pass the previous point's, so that the table turns continuously
+    /// past ±180°), and when `b` is along the table normal `q8` is free and
+    /// `q8_hint` is returned for it.
     ///
     /// When `up` is not in the positioner's XZ plane (a positioner mounted
     /// slightly out of level, like table 3.7's `W = 0.412°`) some directions
@@ -152,8 +155,19 @@ impl Positioner {
         for q7 in [wrap_pi(alpha + delta), wrap_pi(alpha - delta)] {
             let (s7, c7) = q7.sin_cos();
             let w = rot_y(-s7, c7) * up.into_inner();
+            // The turn is a rotary table: of the angles 2π apart, take the
+            // one inside the travel nearest the hint (the previous point's),
+            // so that a layer going round a part of revolution turns the
+            // table continuously instead of jumping back by 360°.
             let q8 = if b_xy > 1e-12 {
-                wrap_pi(w.y.atan2(w.x) - b.y.atan2(b.x))
+                let a = wrap_pi(w.y.atan2(w.x) - b.y.atan2(b.x));
+                let k = ((q8_hint - a) / TAU).round();
+                [k, k - 1.0, k + 1.0]
+                    .into_iter()
+                    .map(|k| a + k * TAU)
+                    .filter(|q| self.limits[1].contains(*q))
+                    .min_by(|x, y| (x - q8_hint).abs().total_cmp(&(y - q8_hint).abs()))
+                    .unwrap_or(a)
             } else {
                 q8_hint
             };
