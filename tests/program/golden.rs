@@ -109,7 +109,7 @@ fn csv_golden() {
     let mut buf = Vec::new();
     write_csv(&mut buf, &small()).unwrap();
     let text = String::from_utf8(buf).unwrap();
-    assert_eq!(text.lines().count(), 1 + 16);
+    assert_eq!(text.lines().count(), 1 + 16 + 4);
     check_golden("HEMI.csv", &text);
 }
 
@@ -117,9 +117,11 @@ fn csv_golden() {
 fn json_of_every_point_through_serde() {
     let v = serde_json::to_value(small()).unwrap();
     let pts = v["points"].as_array().unwrap();
-    assert_eq!(pts.len(), 16);
-    assert_eq!(pts[0]["arc"], "start");
-    assert_eq!(pts[15]["arc"], "end");
+    assert_eq!(pts.len(), 20);
+    assert_eq!(pts[0]["arc"], "approach");
+    assert_eq!(pts[1]["arc"], "start");
+    assert_eq!(pts[8]["arc"], "end");
+    assert_eq!(pts[9]["arc"], "retract");
     assert!(pts[3]["joints"].as_array().unwrap().len() == 6);
 }
 
