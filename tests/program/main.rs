@@ -3,6 +3,8 @@
 //! splitting at a point limit, refusal of infeasible plans.
 
 mod fixture;
+mod formats;
+mod parts;
 mod golden;
 #[path = "../common/mod.rs"]
 mod shared;
