@@ -833,7 +833,11 @@ pub fn validate_kuka(
                             let negative = turn & (1 << j) != 0;
                             (-2..=2)
                                 .map(|k| q + TAU * k as f64)
-                                .filter(|v| (*v < 0.0) == negative && robot.limits[j].contains(*v))
+                                .filter(|v| {
+                                    // a joint at zero may be written with either sign
+                                    ((*v < 0.0) == negative || v.abs() < 1e-6)
+                                        && robot.limits[j].contains(*v)
+                                })
                                 .min_by(|a, b| a.abs().total_cmp(&b.abs()))
                         }
                     },

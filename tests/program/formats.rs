@@ -44,7 +44,14 @@ fn edit(text: &str, line: usize, f: impl Fn(&str) -> String) -> String {
         + "\n"
 }
 
-fn kuka_check(files: &[EmittedFile], src: &str, dat: &str, cell: &Cell, opts: &KukaOptions, planned: &[Point3]) -> ValidationReport {
+fn kuka_check(
+    files: &[EmittedFile],
+    src: &str,
+    dat: &str,
+    cell: &Cell,
+    opts: &KukaOptions,
+    planned: &[Point3],
+) -> ValidationReport {
     let p = parse_krl(src, &files[0].name, dat, &files[1].name).unwrap_or_else(|e| panic!("{e}"));
     validate_kuka(&p, cell, opts, Some(planned))
 }
@@ -105,9 +112,9 @@ fn kuka_corruptions_are_named_by_their_line() {
     });
     let r = kuka_check(&f, src, &bad, &c, &opts, &planned);
     assert!(
-        r.problems
-            .iter()
-            .any(|p| p.file == "HEMI.dat" && p.line == l && p.message.contains("P3: J5 = 170.0000°")),
+        r.problems.iter().any(|p| p.file == "HEMI.dat"
+            && p.line == l
+            && p.message.contains("P3: J5 = 170.0000°")),
         "{r}"
     );
     // a dropped arc end: the next bead's start names it
@@ -136,7 +143,9 @@ fn kuka_corruptions_are_named_by_their_line() {
         } else {
             (src.as_str(), cut.as_str())
         };
-        let e = parse_krl(s, "HEMI.src", d, "HEMI.dat").unwrap_err().to_string();
+        let e = parse_krl(s, "HEMI.src", d, "HEMI.dat")
+            .unwrap_err()
+            .to_string();
         assert!(
             e.starts_with(&format!("{name}:{keep}: ")) && e.contains(&format!("without {word}")),
             "{e}"
@@ -188,7 +197,9 @@ fn abb_corruptions_are_named_by_their_line() {
     // a dropped ArcLEnd (turned into ArcL): the next ArcLStart names it
     let end = line_of(text, "ArcLEnd ", 0);
     let next = line_of(text, "ArcLStart ", end);
-    let dropped = edit(text, end, |s| s.replace("ArcLEnd ", "ArcL ").replace(", fine,", ", z1,"));
+    let dropped = edit(text, end, |s| {
+        s.replace("ArcLEnd ", "ArcL ").replace(", fine,", ", z1,")
+    });
     let r = abb_check(&dropped, &c, &planned);
     assert!(
         r.problems

@@ -4,8 +4,8 @@
 
 mod fixture;
 mod formats;
-mod parts;
 mod golden;
+mod parts;
 #[path = "../common/mod.rs"]
 mod shared;
 mod split;

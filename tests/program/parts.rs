@@ -47,7 +47,10 @@ fn plan_program(part: &str, cell: &Cell) -> Result<Program, String> {
     let opts = OptimiseOptions::default();
     let plan = optimise(cell, &layers, &opts).map_err(|e| e.to_string())?;
     if !plan.is_feasible() {
-        let l = plan.infeasible_layers().next().expect("an infeasible layer");
+        let l = plan
+            .infeasible_layers()
+            .next()
+            .expect("an infeasible layer");
         return Err(format!("layer {}: {}", l.layer, l.status));
     }
     let inputs: Vec<PathPointInput> = layers
@@ -71,7 +74,8 @@ fn plan_program(part: &str, cell: &Cell) -> Result<Program, String> {
     let ts = opts.travel_speed_mm_s;
     let traj = joint_trajectory(cell, &inputs, ts, &TrajectoryOptions::default())
         .map_err(|e| e.to_string())?;
-    build_program("PART", cell, &inputs, &traj, &TravelSpeed::Constant(ts)).map_err(|e| e.to_string())
+    build_program("PART", cell, &inputs, &traj, &TravelSpeed::Constant(ts))
+        .map_err(|e| e.to_string())
 }
 
 /// Emits, reads back and validates `prog` in every format; panics naming
@@ -119,6 +123,12 @@ fn the_validator_accepts_our_programs_for_every_feasible_part_and_cell() {
     for file in CELLS {
         let c = cell(file);
         for part in SAMPLE_PARTS {
+            // the helix is infeasible in the part-carried cells (J4/J6
+            // speeds, being worked on by the lead) and takes a minute to
+            // find so: left out there
+            if part == "helix.toml" && file != "robowam_torch_carried.toml" {
+                continue;
+            }
             let t = Instant::now();
             let what = format!("{part} in {file}");
             match plan_program(part, &c) {
@@ -145,6 +155,40 @@ fn the_validator_accepts_our_programs_for_every_feasible_part_and_cell() {
             }
         }
     }
-    let want: Vec<(&str, &str)> = vec![];
+    let pc = "robowam_part_carried.toml";
+    let pc2 = "robowam_part_carried_second_position.toml";
+    let tc = "robowam_torch_carried.toml";
+    let mut want: Vec<(&str, &str)> = Vec::new();
+    for (cell, parts) in [
+        (
+            pc,
+            &[
+                "hemisphere.toml",
+                "nozzle.toml",
+                "half-catenoid.toml",
+                "quarter-torus.toml",
+                // the kinked layer that makes it infeasible is past layer 3
+                "general-tube.toml",
+                "torus-on-cylinder.toml",
+                "elbow.toml",
+            ][..],
+        ),
+        (
+            pc2,
+            &[
+                "hemisphere.toml",
+                "nozzle.toml",
+                "half-catenoid.toml",
+                "quarter-torus.toml",
+                "general-tube.toml",
+                // torus-on-cylinder: the plan is feasible but its joint
+                // trajectory has J5 = 135.08° (layer 2): refused
+                "elbow.toml",
+            ][..],
+        ),
+        (tc, &SAMPLE_PARTS[..]),
+    ] {
+        want.extend(parts.iter().map(|p| (*p, cell)));
+    }
     assert_eq!(feasible, want, "{report}");
 }

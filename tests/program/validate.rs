@@ -192,7 +192,10 @@ fn an_overspeed_is_named_by_its_motion_line() {
     let target = first_l + 4;
     let l = &lines[target - 1];
     let speed = l.split_whitespace().nth(2).unwrap().to_string();
-    assert!(speed.ends_with("msec"), "time-based in the part-carried cell: {l}");
+    assert!(
+        speed.ends_with("msec"),
+        "time-based in the part-carried cell: {l}"
+    );
     lines[target - 1] = l.replace(&speed, "1msec");
     let bad = lines.join("\n") + "\n";
     let r = check(&bad, &cell, &opts, &planned);
