@@ -479,8 +479,8 @@ fn clearance_point(
         )));
     }
     let dt = opts.clearance_mm / opts.approach_speed_mm_s;
-    for j in 0..6 {
-        let s = (q[j] - p.joints[j]).abs() / dt;
+    for (j, (qj, pj)) in q.iter().zip(p.joints).enumerate() {
+        let s = (qj - pj).abs() / dt;
         if s > robot.max_speed_rad_s[j] {
             return Err(infeasible(format!(
                 "J{} needs {:.2}°/s at {} mm/s, maximum {:.1}°/s",

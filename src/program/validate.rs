@@ -123,7 +123,7 @@ pub struct Motion {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Step {
     /// A motion.
-    Motion(Motion),
+    Motion(Box<Motion>),
     /// The process (arc) starts here.
     ProcessOn {
         /// File.
@@ -468,7 +468,7 @@ pub(crate) fn wrist_of_j5(robot: &RobotModel, j5_positive: bool) -> Wrist {
 /// The arm side and elbow of `front`/`positive_cos` (KUKA Status bits 0, 1).
 pub(crate) fn arm_of(back: bool, positive_cos: bool) -> (ArmSide, Elbow) {
     let side = if back { ArmSide::Back } else { ArmSide::Front };
-    let elbow = if positive_cos == !back {
+    let elbow = if positive_cos != back {
         Elbow::Up
     } else {
         Elbow::Down
@@ -627,7 +627,7 @@ fn fanuc_steps(
                         (q, true)
                     }
                 };
-                steps.push(Step::Motion(Motion {
+                steps.push(Step::Motion(Box::new(Motion {
                     file: file.clone(),
                     line,
                     label,
@@ -643,7 +643,7 @@ fn fanuc_steps(
                         (None, Some(t)) => MotionSpeed::Time(t),
                         _ => MotionSpeed::Joint,
                     },
-                }));
+                })));
             }
         }
     }
@@ -850,7 +850,7 @@ pub fn validate_kuka(
             }
         };
         prev_q = joints.or(prev_q);
-        steps.push(Step::Motion(Motion {
+        steps.push(Step::Motion(Box::new(Motion {
             file: src.clone(),
             line,
             label: pos.name.clone(),
@@ -867,7 +867,7 @@ pub fn validate_kuka(
                 MoveKind::Joint
             },
             speed,
-        }));
+        })));
         steps.extend(after);
     }
     for (_, action, l) in pending {
@@ -1072,7 +1072,7 @@ pub fn validate_abb(
                 continue;
             }
         };
-        steps.push(Step::Motion(Motion {
+        steps.push(Step::Motion(Box::new(Motion {
             file: file.clone(),
             line,
             label: t.name.clone(),
@@ -1084,7 +1084,7 @@ pub fn validate_abb(
             positioner: t.external.map(|e| e.map(f64::to_radians)),
             kind,
             speed,
-        }));
+        })));
         match event {
             Some(true) => steps.push(Step::ProcessOn {
                 file: file.clone(),
