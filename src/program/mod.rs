@@ -3,9 +3,10 @@
 //! ([`PathPointInput`]: layer structure, part-frame positions (mm), tool axes,
 //! `R_Z`), the [`Cell`] and the travel speeds (mm/s), checks that the plan is
 //! buildable, and returns a [`Program`]: one bead per layer, every point
-//! carrying its arc flag. Emitters turn a [`Program`] into controller files;
-//! the FANUC output is read back and validated against the cell. SPEC §8,
-//! thesis §3.1.2.
+//! carrying its arc flag, with an approach point before and a retract point
+//! after each bead. Emitters turn a [`Program`] into controller files; every
+//! format is read back and validated against the cell. SPEC §8, thesis
+//! §3.1.2.
 //!
 //! | piece | module | entry points |
 //! |---|---|---|
@@ -14,8 +15,9 @@
 //! | KUKA KRL `.src` + `.dat` | [`kuka`] | [`kuka::write_src`], [`kuka::write_dat`] |
 //! | ABB RAPID `.mod` | [`abb`] | [`abb::write_mod`] |
 //! | CSV of every point | [`csv`] | [`csv::write_csv`] |
-//! | reader of our FANUC output | [`readback`] | [`readback::parse_ls`] |
-//! | validator (file + cell) | [`validate`] | [`validate::validate_fanuc`] |
+//! | readers of our FANUC, KUKA and ABB output | [`readback`] | [`readback::parse_ls`], [`readback::kuka::parse_krl`], [`readback::abb::parse_mod`] |
+//! | validator (file + cell) | [`validate`] | [`validate::validate_fanuc`], [`validate::validate_kuka`], [`validate::validate_abb`] |
+//! | approach and retract points | this module | [`build_program_with`], [`ProgramOptions`] |
 //! | number formatting | [`fmt`] | [`fmt::Fixed`] |
 //!
 //! JSON of every point: [`Program`] implements `serde::Serialize`; serialise
