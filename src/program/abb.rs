@@ -15,6 +15,22 @@
 //!   `[v_tcp mm/s, 500, 5000, 1000]`.
 //! * `tWaam` (the tool) and `wWaam` (the work object) are declared from the
 //!   options with a 1 kg placeholder load: set the real load before running.
+//! * With approach and retract points: `MoveAbsJ` to the approach point's
+//!   `jointtarget`, `ArcLStart` (or `MoveL`) into the bead's first point at
+//!   the approach speed (the arc is off while it moves and ignites there),
+//!   the bead, then `MoveL` out to the retract point.
+//! * **Part-carried cell: stationary tool.** RAPID speeds are TCP speeds
+//!   relative to the work object. In the part-carried cell the torch is
+//!   declared as a stationary tool (`tooldata` `robhold` FALSE, `tframe` the
+//!   fixed torch in the world frame, at `D_R` pointing down unless given)
+//!   and the part as a robot-held work object (`wobjdata` `robhold` TRUE,
+//!   `uframe` = the cell's `flange_from_part`): the speeds are then the
+//!   torch's over the part, as planned, and `robtarget`s are the torch in
+//!   the part frame.
+//! * Weld speed: ArcWare takes the speed of the arc-on moves (`ArcL`,
+//!   `ArcLEnd`) from `weld<n>.weld_speed`; the inline `speeddata` (the planned
+//!   speed) applies when welding is blocked. The weld data must give the
+//!   planned travel speed (a modulated speed needs one `welddata` per value).
 
 use std::io::Write;
 
@@ -40,8 +56,15 @@ pub struct AbbOptions {
     pub zone_mm: u32,
     /// Work object in the robot base frame (mm). Default identity.
     pub base_from_user: Isometry3,
-    /// Tool on the flange (`tool0`) (mm); `None`: as the FANUC emitter.
+    /// Tool on the flange (`tool0`) (mm); `None`: the cell's torch; with a
+    /// stationary tool the part on the flange (`flange_from_part`).
     pub flange_from_tool: Option<Isometry3>,
+    /// Stationary tool and robot-held work object; `None`: in the
+    /// part-carried cell only (module doc).
+    pub stationary_tool: Option<bool>,
+    /// With a stationary tool, the torch in the world (= robot base) frame
+    /// (mm); `None`: at the cell's `D_R`, z down.
+    pub fixed_tool: Option<Isometry3>,
 }
 
 impl Default for AbbOptions {
@@ -52,11 +75,92 @@ impl Default for AbbOptions {
             zone_mm: 1,
             base_from_user: Isometry3::identity(),
             flange_from_tool: None,
+            stationary_tool: None,
+            fixed_tool: None,
+        }
+    }
+}
+
+/// The frames of a RAPID program (robot base = world frame, mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AbbFrames {
+    /// Robot-held tool `flange_from_tool`, fixed work object `base_from_wobj`.
+    Held {
+        /// `tWaam.tframe`.
+        flange_from_tool: Isometry3,
+        /// `wWaam.uframe`.
+        base_from_wobj: Isometry3,
+    },
+    /// Stationary tool `base_from_tool`, robot-held work object `flange_from_wobj`.
+    Stationary {
+        /// `tWaam.tframe`.
+        base_from_tool: Isometry3,
+        /// `wWaam.uframe`.
+        flange_from_wobj: Isometry3,
+    },
+}
+
+impl AbbFrames {
+    /// The `robtarget` pose (tool in work object) at flange pose `base_from_flange`.
+    pub fn target(&self, base_from_flange: &Isometry3) -> Isometry3 {
+        match self {
+            AbbFrames::Held {
+                flange_from_tool,
+                base_from_wobj,
+            } => base_from_wobj.inverse() * base_from_flange * flange_from_tool,
+            AbbFrames::Stationary {
+                base_from_tool,
+                flange_from_wobj,
+            } => (base_from_flange * flange_from_wobj).inverse() * base_from_tool,
+        }
+    }
+
+    /// The flange pose reaching `robtarget` pose `target`.
+    pub fn flange(&self, target: &Isometry3) -> Isometry3 {
+        match self {
+            AbbFrames::Held {
+                flange_from_tool,
+                base_from_wobj,
+            } => base_from_wobj * target * flange_from_tool.inverse(),
+            AbbFrames::Stationary {
+                base_from_tool,
+                flange_from_wobj,
+            } => base_from_tool * target.inverse() * flange_from_wobj.inverse(),
         }
     }
 }
 
 impl AbbOptions {
+    /// The frames written for `cell`.
+    pub fn frames(&self, cell: &Cell) -> AbbFrames {
+        let stationary = self
+            .stationary_tool
+            .unwrap_or(matches!(cell, Cell::PartCarried(_)));
+        if stationary {
+            AbbFrames::Stationary {
+                base_from_tool: self.fixed_tool.unwrap_or_else(|| match cell {
+                    Cell::PartCarried(c) => {
+                        crate::program::kuka::fixed_torch_at(&c.deposition_point_mm)
+                    }
+                    Cell::TorchCarried(_) => Isometry3::identity(),
+                }),
+                flange_from_wobj: self.flange_from_tool.unwrap_or(match cell {
+                    Cell::PartCarried(c) => c.flange_from_part,
+                    Cell::TorchCarried(_) => Isometry3::identity(),
+                }),
+            }
+        } else {
+            AbbFrames::Held {
+                flange_from_tool: match (self.flange_from_tool, cell) {
+                    (Some(t), _) => t,
+                    (None, Cell::TorchCarried(c)) => c.flange_from_tcp,
+                    (None, Cell::PartCarried(_)) => Isometry3::identity(),
+                },
+                base_from_wobj: self.base_from_user,
+            }
+        }
+    }
+
     /// Checks every field.
     ///
     /// # Errors
@@ -120,12 +224,7 @@ fn extax(e: Option<[f64; 2]>) -> String {
 /// I/O errors of `w`.
 pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std::io::Result<()> {
     let robot = program.cell.robot();
-    let tool = match (opts.flange_from_tool, &program.cell) {
-        (Some(t), _) => t,
-        (None, Cell::TorchCarried(c)) => c.flange_from_tcp,
-        (None, Cell::PartCarried(_)) => Isometry3::identity(),
-    };
-    let user_from_base = opts.base_from_user.inverse();
+    let frames = opts.frames(&program.cell);
     writeln!(w, "MODULE {}", program.name)?;
     writeln!(
         w,
@@ -134,18 +233,34 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         program.points.len(),
         program.num_beads()
     )?;
+    let (tool_held, tool, wobj_held, wobj) = match frames {
+        AbbFrames::Held {
+            flange_from_tool,
+            base_from_wobj,
+        } => ("TRUE", flange_from_tool, "FALSE", base_from_wobj),
+        AbbFrames::Stationary {
+            base_from_tool,
+            flange_from_wobj,
+        } => {
+            writeln!(
+                w,
+                "  ! stationary torch (tWaam), part held by the robot (wWaam): speeds are the torch's over the part"
+            )?;
+            ("FALSE", base_from_tool, "TRUE", flange_from_wobj)
+        }
+    };
     writeln!(
         w,
-        "  PERS tooldata tWaam := [TRUE,{},[1,[0,0,1],[1,0,0,0],0,0,0]];",
+        "  PERS tooldata tWaam := [{tool_held},{},[1,[0,0,1],[1,0,0,0],0,0,0]];",
         pose_line(&tool)
     )?;
     writeln!(
         w,
-        "  PERS wobjdata wWaam := [FALSE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];",
-        pose_line(&opts.base_from_user)
+        "  PERS wobjdata wWaam := [{wobj_held},TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];",
+        pose_line(&wobj)
     )?;
     for (i, p) in program.points.iter().enumerate() {
-        let pose = user_from_base * robot.flange_pose(&p.joints) * tool;
+        let pose = frames.target(&robot.flange_pose(&p.joints));
         let c = confdata(robot, &p.joints);
         let pl = pose_line(&pose);
         writeln!(
@@ -159,7 +274,10 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             c[3],
             extax(p.positioner)
         )?;
-        if p.arc == ArcFlag::Start {
+        let prev = i.checked_sub(1).map(|k| program.points[k].arc);
+        if p.arc == ArcFlag::Approach
+            || (p.arc == ArcFlag::Start && prev != Some(ArcFlag::Approach))
+        {
             let a = p.joints.map(f64::to_degrees);
             writeln!(
                 w,
@@ -179,17 +297,36 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     writeln!(w, "    ConfL \\On;")?;
     let tw = "tWaam\\WObj:=wWaam";
     let zone = format!("z{}", opts.zone_mm);
+    let abs_j = |w: &mut dyn Write, k: usize| {
+        writeln!(
+            w,
+            "    MoveAbsJ j{k}, [{},500,5000,1000], fine, {tw};",
+            Mm(opts.approach_speed_mm_s)
+        )
+    };
     for (i, p) in program.points.iter().enumerate() {
         let k = i + 1;
+        let prev = i.checked_sub(1).map(|k| &program.points[k]);
         let v = format!("[{},500,5000,1000]", Mm(p.speed_mm_s));
         match (&opts.process, p.arc) {
+            (_, ArcFlag::Approach) => {
+                writeln!(w, "    ! bead {} (layer {}): approach", p.layer, p.layer)?;
+                abs_j(w, k)?;
+            }
+            (_, ArcFlag::Retract) => writeln!(w, "    MoveL p{k}, {v}, fine, {tw};")?,
             (_, ArcFlag::Start) => {
-                writeln!(w, "    ! bead {} (layer {})", p.layer, p.layer)?;
-                writeln!(
-                    w,
-                    "    MoveAbsJ j{k}, [{},500,5000,1000], fine, {tw};",
-                    Mm(opts.approach_speed_mm_s)
-                )?;
+                // into the bead: from the approach point at its speed, else
+                // a joint move to the first point
+                let v = match prev {
+                    Some(a) if a.arc == ArcFlag::Approach => {
+                        format!("[{},500,5000,1000]", Mm(a.speed_mm_s))
+                    }
+                    _ => {
+                        writeln!(w, "    ! bead {} (layer {})", p.layer, p.layer)?;
+                        abs_j(w, k)?;
+                        v
+                    }
+                };
                 match &opts.process {
                     ProcessControl::Arc { schedule } => writeln!(
                         w,

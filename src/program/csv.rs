@@ -20,9 +20,11 @@ pub fn write_csv(w: &mut dyn Write, program: &Program) -> std::io::Result<()> {
     writeln!(w, "{HEADER}")?;
     for p in &program.points {
         let arc = match p.arc {
+            ArcFlag::Approach => "approach",
             ArcFlag::Start => "start",
             ArcFlag::On => "on",
             ArcFlag::End => "end",
+            ArcFlag::Retract => "retract",
         };
         write!(
             w,

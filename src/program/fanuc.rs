@@ -16,17 +16,37 @@
 //!   numbered sub-programs and a main program calling them in order
 //!   ([`split`](crate::program::split)).
 //!
-//! Speeds are integers (mm/sec or cm/min), the only form a TP motion line
-//! takes without a register; modulated travel speeds are rounded to the
+//! * With approach and retract points ([`ArcFlag::Approach`],
+//!   [`ArcFlag::Retract`]) a bead is `J P[a] 10% FINE` (approach point, arc
+//!   off), `L P[s] ... FINE` (into the bead), `Arc Start`, the bead, `Arc
+//!   End`, `L P[r] ... FINE` (retract); the joint move from one layer's
+//!   retract point to the next layer's approach point is the arc-off
+//!   transition.
+//!
+//! Speeds are integers (mm/sec, cm/min or msec), the only form a TP motion
+//! line takes without a register; modulated travel speeds are rounded to the
 //! nearest unit (prefer cm/min for a finer step).
 //!
-//! The programmed speed is the travel speed of the deposition point
-//! relative to the part (what the plan and the validator use). In the
-//! torch-carried cell with the torch as tool frame that is the controller's
-//! TCP speed. In the part-carried cell the controller's TCP (the flange)
-//! hardly moves while the part turns under the fixed torch: the controller
-//! must interpret the speed relative to the fixed torch (FANUC's remote-TCP
-//! motion option), which this emitter does not yet write.
+//! **What the speed means.** The planned speed is the travel speed of the
+//! deposition point relative to the part (what the plan and the validator
+//! use). In the torch-carried cell with the torch as tool frame that is the
+//! controller's TCP speed, and linear moves carry it in `mm/sec` or `cm/min`.
+//! In the part-carried cell the controller's TCP (the flange, or the part
+//! frame on it) is not the point that must travel at that speed: the fixed
+//! torch is, relative to the part, while the flange mostly turns. A `mm/sec`
+//! speed would be applied to the wrong point (and a turn of the part about
+//! the torch would run at the controller's rotation speed limit). FANUC's
+//! remote-TCP motion (the `RTCP` motion option, a paid software option whose
+//! position data are written differently) would fix the reference point;
+//! instead, by default ([`MotionTiming::Auto`]), linear moves in the
+//! part-carried cell are **time-based**: `L P[n] 167msec CNT100`, the time
+//! being the segment's length in the part frame divided by the planned
+//! speed. This needs no option, keeps the positions as they are, and makes
+//! every segment take exactly the planned time (1 ms resolution), so the
+//! torch travels over the part at the planned speed on average over each
+//! segment (exactly at the points; between them the controller interpolates
+//! the flange pose, which for the short segments of a bead keeps the
+//! deposition point within a fraction of a millimetre of the chord).
 
 use std::io::Write;
 
@@ -40,6 +60,9 @@ use crate::program::{
 };
 use crate::robot::orientation::FanucPose;
 use crate::robot::Cell;
+
+/// The remark opening a program with time-based linear moves (≤ 32 characters).
+pub const TIME_BASED_REMARK: &str = "TIMED: TORCH SPEED OVER PART";
 
 /// How positions are written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -63,6 +86,22 @@ pub enum SpeedUnit {
     CmPerMin,
 }
 
+/// How linear moves carry their speed (module doc, "What the speed means").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MotionTiming {
+    /// Time-based (`msec`) in the part-carried cell, TCP speed in the
+    /// torch-carried cell.
+    #[default]
+    Auto,
+    /// TCP speed (`mm/sec` or `cm/min`) everywhere: only right in the
+    /// part-carried cell if the controller moves relative to the fixed torch
+    /// (remote TCP).
+    TcpSpeed,
+    /// Segment times (`msec`) everywhere.
+    Time,
+}
+
 /// Options of the FANUC emitter. Plain data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -71,9 +110,13 @@ pub struct FanucOptions {
     pub positions: PositionMode,
     /// Unit of the linear speeds. Default cm/min.
     pub speed_unit: SpeedUnit,
+    /// Speeds or segment times on linear moves. Default
+    /// [`MotionTiming::Auto`].
+    pub timing: MotionTiming,
     /// `CNT` value (0–100) of the blended moves inside a bead. Default 100.
     pub cnt: u8,
-    /// Joint speed of the move to each bead's first point (%, 1–100). Default 10.
+    /// Joint speed of the move to each bead's approach point (or first point
+    /// without approach points) (%, 1–100). Default 10.
     pub approach_percent: u8,
     /// Arc instructions or user-given start/end lines. Default `Arc Start[1]`.
     pub process: ProcessControl,
@@ -98,6 +141,7 @@ impl Default for FanucOptions {
         Self {
             positions: PositionMode::Joint,
             speed_unit: SpeedUnit::CmPerMin,
+            timing: MotionTiming::Auto,
             cnt: 100,
             approach_percent: 10,
             process: ProcessControl::default(),
@@ -151,6 +195,15 @@ impl FanucOptions {
         self.process.validate()
     }
 
+    /// `true` when linear moves are written as segment times in `cell`.
+    pub fn time_based(&self, cell: &Cell) -> bool {
+        match self.timing {
+            MotionTiming::Auto => matches!(cell, Cell::PartCarried(_)),
+            MotionTiming::TcpSpeed => false,
+            MotionTiming::Time => true,
+        }
+    }
+
     /// The tool frame used for Cartesian positions in `cell` (mm).
     pub fn tool_in(&self, cell: &Cell) -> Isometry3 {
         match (self.flange_from_tool, cell) {
@@ -170,15 +223,25 @@ pub enum Speed {
     MmPerSec(u32),
     /// Linear, cm/min.
     CmPerMin(u32),
+    /// Time-based, the move takes this many milliseconds.
+    Msec(u32),
 }
 
 impl Speed {
-    /// Linear speed (mm/s), `None` for a percentage.
+    /// Linear speed (mm/s), `None` for a percentage or a time.
     pub fn mm_s(&self) -> Option<f64> {
         match self {
-            Speed::Percent(_) => None,
+            Speed::Percent(_) | Speed::Msec(_) => None,
             Speed::MmPerSec(v) => Some(*v as f64),
             Speed::CmPerMin(v) => Some(*v as f64 / 6.0),
+        }
+    }
+
+    /// Duration of a time-based move (s).
+    pub fn time_s(&self) -> Option<f64> {
+        match self {
+            Speed::Msec(v) => Some(*v as f64 / 1000.0),
+            _ => None,
         }
     }
 }
@@ -189,6 +252,7 @@ impl std::fmt::Display for Speed {
             Speed::Percent(v) => write!(f, "{v}%"),
             Speed::MmPerSec(v) => write!(f, "{v}mm/sec"),
             Speed::CmPerMin(v) => write!(f, "{v}cm/min"),
+            Speed::Msec(v) => write!(f, "{v}msec"),
         }
     }
 }
@@ -244,6 +308,8 @@ pub enum Op {
     ArcEnd(u32),
     /// `CALL NAME`.
     Call(String),
+    /// `! remark` (a comment line).
+    Remark(String),
     /// Any other instruction, as written (user-given start/end lines).
     Other(String),
 }
@@ -268,6 +334,7 @@ impl std::fmt::Display for Op {
             Op::ArcStart(n) => write!(f, "  Arc Start[{n}] ;"),
             Op::ArcEnd(n) => write!(f, "  Arc End[{n}] ;"),
             Op::Call(n) => write!(f, "  CALL {n}    ;"),
+            Op::Remark(s) => write!(f, "  ! {s} ;"),
             Op::Other(s) => write!(f, "  {s} ;"),
         }
     }
@@ -357,9 +424,22 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
         ProcessControl::Arc { schedule } => (Op::ArcStart(*schedule), Op::ArcEnd(*schedule)),
         ProcessControl::Custom { start, end } => (Op::Other(start.clone()), Op::Other(end.clone())),
     };
-    let linear_speed = |v: f64| match opts.speed_unit {
-        SpeedUnit::MmPerSec => Speed::MmPerSec((v.round() as u32).max(1)),
-        SpeedUnit::CmPerMin => Speed::CmPerMin(((v * 6.0).round() as u32).max(1)),
+    let time_based = opts.time_based(&program.cell);
+    // the speed of the linear move into point `i` at `v` mm/s
+    let linear_speed = |i: usize, v: f64| {
+        if time_based {
+            let d = if i == 0 {
+                0.0
+            } else {
+                (program.points[i].position_mm - program.points[i - 1].position_mm).norm()
+            };
+            Speed::Msec(((1000.0 * d / v).round() as u32).max(1))
+        } else {
+            match opts.speed_unit {
+                SpeedUnit::MmPerSec => Speed::MmPerSec((v.round() as u32).max(1)),
+                SpeedUnit::CmPerMin => Speed::CmPerMin(((v * 6.0).round() as u32).max(1)),
+            }
+        }
     };
     let ranges = chunks(program.points.len(), opts.point_limit);
     let split = ranges.len() > 1;
@@ -395,9 +475,17 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
                 op: Op::UTool(opts.tool_frame),
             },
         ];
+        if time_based {
+            ins.push(Instruction {
+                line: 0,
+                op: Op::Remark(TIME_BASED_REMARK.into()),
+            });
+        }
         let mut positions = Vec::with_capacity(range.len());
         for (local, p) in program.points[range.clone()].iter().enumerate() {
             let index = local + 1;
+            let global = range.start + local;
+            let prev = global.checked_sub(1).map(|g| &program.points[g]);
             let arm = match opts.positions {
                 PositionMode::Joint => ArmPosition::Joint(p.joints.map(f64::to_degrees)),
                 PositionMode::Cartesian => {
@@ -426,13 +514,24 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
                     term,
                 },
             };
+            let joint_move = || {
+                mv(
+                    MoveKind::Joint,
+                    Speed::Percent(opts.approach_percent as u32),
+                    Termination::Fine,
+                )
+            };
             match p.arc {
+                ArcFlag::Approach => ins.push(joint_move()),
                 ArcFlag::Start => {
-                    ins.push(mv(
-                        MoveKind::Joint,
-                        Speed::Percent(opts.approach_percent as u32),
-                        Termination::Fine,
-                    ));
+                    ins.push(match prev {
+                        Some(a) if a.arc == ArcFlag::Approach => mv(
+                            MoveKind::Linear,
+                            linear_speed(global, a.speed_mm_s),
+                            Termination::Fine,
+                        ),
+                        _ => joint_move(),
+                    });
                     ins.push(Instruction {
                         line: 0,
                         op: start_op.clone(),
@@ -440,13 +539,13 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
                 }
                 ArcFlag::On => ins.push(mv(
                     MoveKind::Linear,
-                    linear_speed(p.speed_mm_s),
+                    linear_speed(global, p.speed_mm_s),
                     Termination::Cnt(opts.cnt),
                 )),
                 ArcFlag::End => {
                     ins.push(mv(
                         MoveKind::Linear,
-                        linear_speed(p.speed_mm_s),
+                        linear_speed(global, p.speed_mm_s),
                         Termination::Fine,
                     ));
                     ins.push(Instruction {
@@ -454,6 +553,11 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
                         op: end_op.clone(),
                     });
                 }
+                ArcFlag::Retract => ins.push(mv(
+                    MoveKind::Linear,
+                    linear_speed(global, p.speed_mm_s),
+                    Termination::Fine,
+                )),
             }
         }
         out.push(TpProgram {

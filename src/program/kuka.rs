@@ -11,6 +11,18 @@
 //!   DISTANCE=1` before the last `LIN` (fires at its exact end point), so
 //!   blending never moves an arc switching point.
 //! * Arc process: output `$OUT[schedule]`; custom: the user's statements.
+//! * With approach and retract points: `PTP` to the approach point, `LIN`
+//!   into the bead's first point (exact), the bead, `LIN` out to the retract
+//!   point, all at `$VEL.CP` = the program's approach speed.
+//! * **Part-carried cell: external TCP.** `$VEL.CP` is the speed of the TCP;
+//!   the planned speed is the torch's relative to the part. In the
+//!   part-carried cell the emitter switches to KUKA's fixed-tool mode,
+//!   `$IPO_MODE = #TCP`, with `$TOOL` = the part on the flange
+//!   (`TOOL_DATA[tool]`, the cell's `flange_from_part`) and `$BASE` = the
+//!   fixed torch (`BASE_DATA[base]`, at `D_R` with z pointing down at the
+//!   part unless given): the controller then moves the part so that the
+//!   fixed torch travels over it at `$VEL.CP`, and `E6POS` positions are the
+//!   part frame in the torch frame ([`KukaOptions::external_tcp`]).
 //!
 //! Status bits (KUKA): bit 0 wrist centre behind the A1 axis (overhead
 //! area), bit 1 `A3 >= phi` (the branch with `cos gamma > 0` here: elbow up
@@ -47,9 +59,16 @@ pub struct KukaOptions {
     pub tool: u8,
     /// `BASE_DATA[base]` in the robot base frame (mm). Default identity.
     pub base_from_user: Isometry3,
-    /// `TOOL_DATA[tool]` on the flange (mm); `None`: as the FANUC emitter
-    /// (the cell's torch, or the flange in the part-carried cell).
+    /// `TOOL_DATA[tool]` on the flange (mm); `None`: the cell's torch, or
+    /// with an external TCP the part (`flange_from_part`).
     pub flange_from_tool: Option<Isometry3>,
+    /// Fixed-tool mode (`$IPO_MODE = #TCP`); `None`: in the part-carried
+    /// cell only (module doc).
+    pub external_tcp: Option<bool>,
+    /// With an external TCP, `BASE_DATA[base]`: the fixed torch in the robot
+    /// base frame (mm); `None`: at the cell's `D_R`, z down (towards the
+    /// part), x along the robot's X.
+    pub fixed_tool: Option<Isometry3>,
 }
 
 impl Default for KukaOptions {
@@ -63,11 +82,38 @@ impl Default for KukaOptions {
             tool: 1,
             base_from_user: Isometry3::identity(),
             flange_from_tool: None,
+            external_tcp: None,
+            fixed_tool: None,
         }
     }
 }
 
 impl KukaOptions {
+    /// `true` when `$IPO_MODE = #TCP` is written for `cell`.
+    pub fn uses_external_tcp(&self, cell: &Cell) -> bool {
+        self.external_tcp
+            .unwrap_or(matches!(cell, Cell::PartCarried(_)))
+    }
+
+    /// `($BASE, $TOOL)` in `cell` (robot base frame, flange frame; mm): the
+    /// frames Cartesian positions are written in, `$BASE · pos = flange ·
+    /// $TOOL`.
+    pub fn frames(&self, cell: &Cell) -> (Isometry3, Isometry3) {
+        if self.uses_external_tcp(cell) {
+            let fixed = self.fixed_tool.unwrap_or_else(|| match cell {
+                Cell::PartCarried(c) => fixed_torch_at(&c.deposition_point_mm),
+                Cell::TorchCarried(_) => Isometry3::identity(),
+            });
+            let part = self.flange_from_tool.unwrap_or(match cell {
+                Cell::PartCarried(c) => c.flange_from_part,
+                Cell::TorchCarried(_) => Isometry3::identity(),
+            });
+            (fixed, part)
+        } else {
+            (self.base_from_user, tool_of(self, cell))
+        }
+    }
+
     /// Checks every field.
     ///
     /// # Errors
@@ -117,6 +163,18 @@ pub fn turn(q: &Joints) -> u8 {
         .fold(0, |t, (i, v)| t | (((*v < 0.0) as u8) << i))
 }
 
+/// A fixed torch at `d` (robot base frame, mm): z down (its approach
+/// direction, towards the part), x along the base X, y along −Y.
+pub fn fixed_torch_at(d: &crate::math::Point3) -> Isometry3 {
+    Isometry3::from_parts(
+        nalgebra::Translation3::from(d.coords),
+        nalgebra::UnitQuaternion::from_axis_angle(
+            &crate::math::Vector3::x_axis(),
+            std::f64::consts::PI,
+        ),
+    )
+}
+
 fn tool_of(opts: &KukaOptions, cell: &Cell) -> Isometry3 {
     match (opts.flange_from_tool, cell) {
         (Some(t), _) => t,
@@ -125,7 +183,7 @@ fn tool_of(opts: &KukaOptions, cell: &Cell) -> Isometry3 {
     }
 }
 
-fn switch_statements(opts: &KukaOptions) -> (String, String) {
+pub(crate) fn switch_statements(opts: &KukaOptions) -> (String, String) {
     match &opts.process {
         ProcessControl::Arc { schedule } => (
             format!("$OUT[{schedule}]=TRUE"),
@@ -155,26 +213,53 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     writeln!(w, "  BAS (#INITMOV,0 )")?;
     writeln!(w, "  ;ENDFOLD")?;
     writeln!(w, "  $BWDSTART = FALSE")?;
+    if opts.uses_external_tcp(&program.cell) {
+        writeln!(
+            w,
+            "  ; external TCP: $TOOL = the part on the flange, $BASE = the fixed torch"
+        )?;
+        writeln!(w, "  $IPO_MODE = #TCP")?;
+    } else {
+        writeln!(w, "  $IPO_MODE = #BASE")?;
+    }
     writeln!(w, "  $TOOL = TOOL_DATA[{}]", opts.tool)?;
     writeln!(w, "  $BASE = BASE_DATA[{}]", opts.base)?;
     writeln!(w, "  $APO.CDIS = {}", Mm(opts.cdis_mm))?;
     writeln!(w, "  BAS (#VEL_PTP,{} )", opts.ptp_percent)?;
     let mut vel: Option<f64> = None;
+    let mut set_vel = |w: &mut dyn Write, mm_s: f64| -> std::io::Result<()> {
+        let v = mm_s / 1000.0;
+        if vel != Some(v) {
+            writeln!(w, "  $VEL.CP = {}", crate::program::fmt::Fixed::new(v, 6))?;
+            vel = Some(v);
+        }
+        Ok(())
+    };
     for (i, p) in program.points.iter().enumerate() {
         let name = format!("P{}", i + 1);
+        let prev = i.checked_sub(1).map(|k| &program.points[k]);
         match p.arc {
-            ArcFlag::Start => {
-                writeln!(w, "  ; bead {} (layer {}), arc off", p.layer, p.layer)?;
+            ArcFlag::Approach => {
+                writeln!(
+                    w,
+                    "  ; bead {} (layer {}): approach, arc off",
+                    p.layer, p.layer
+                )?;
                 writeln!(w, "  PTP {name}")?;
             }
-            ArcFlag::On | ArcFlag::End => {
-                let v = p.speed_mm_s / 1000.0;
-                if vel != Some(v) {
-                    writeln!(w, "  $VEL.CP = {}", crate::program::fmt::Fixed::new(v, 6))?;
-                    vel = Some(v);
+            ArcFlag::Start => match prev {
+                Some(a) if a.arc == ArcFlag::Approach => {
+                    set_vel(w, a.speed_mm_s)?;
+                    writeln!(w, "  LIN {name}")?;
                 }
-                let prev_is_start = i > 0 && program.points[i - 1].arc == ArcFlag::Start;
-                if prev_is_start {
+                _ => {
+                    writeln!(w, "  ; bead {} (layer {}), arc off", p.layer, p.layer)?;
+                    writeln!(w, "  PTP {name}")?;
+                }
+            },
+            ArcFlag::On | ArcFlag::End => {
+                set_vel(w, p.speed_mm_s)?;
+                if prev.is_some_and(|q| q.arc == ArcFlag::Start) {
                     writeln!(w, "  TRIGGER WHEN DISTANCE=0 DELAY=0 DO {on}")?;
                 }
                 if p.arc == ArcFlag::End {
@@ -183,6 +268,10 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                 } else {
                     writeln!(w, "  LIN {name} C_DIS")?;
                 }
+            }
+            ArcFlag::Retract => {
+                set_vel(w, p.speed_mm_s)?;
+                writeln!(w, "  LIN {name}")?;
             }
         }
     }
@@ -196,8 +285,8 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
 /// I/O errors of `w`.
 pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> std::io::Result<()> {
     let robot = program.cell.robot();
-    let tool = tool_of(opts, &program.cell);
-    let user_from_base = opts.base_from_user.inverse();
+    let (base, tool) = opts.frames(&program.cell);
+    let user_from_base = base.inverse();
     writeln!(w, "&ACCESS RVP")?;
     writeln!(w, "&REL 1")?;
     writeln!(w, "DEFDAT {}", program.name)?;

@@ -3,9 +3,10 @@
 //! ([`PathPointInput`]: layer structure, part-frame positions (mm), tool axes,
 //! `R_Z`), the [`Cell`] and the travel speeds (mm/s), checks that the plan is
 //! buildable, and returns a [`Program`]: one bead per layer, every point
-//! carrying its arc flag. Emitters turn a [`Program`] into controller files;
-//! the FANUC output is read back and validated against the cell. SPEC §8,
-//! thesis §3.1.2.
+//! carrying its arc flag, with an approach point before and a retract point
+//! after each bead. Emitters turn a [`Program`] into controller files; every
+//! format is read back and validated against the cell. SPEC §8, thesis
+//! §3.1.2.
 //!
 //! | piece | module | entry points |
 //! |---|---|---|
@@ -14,8 +15,9 @@
 //! | KUKA KRL `.src` + `.dat` | [`kuka`] | [`kuka::write_src`], [`kuka::write_dat`] |
 //! | ABB RAPID `.mod` | [`abb`] | [`abb::write_mod`] |
 //! | CSV of every point | [`csv`] | [`csv::write_csv`] |
-//! | reader of our FANUC output | [`readback`] | [`readback::parse_ls`] |
-//! | validator (file + cell) | [`validate`] | [`validate::validate_fanuc`] |
+//! | readers of our FANUC, KUKA and ABB output | [`readback`] | [`readback::parse_ls`], [`readback::kuka::parse_krl`], [`readback::abb::parse_mod`] |
+//! | validator (file + cell) | [`validate`] | [`validate::validate_fanuc`], [`validate::validate_kuka`], [`validate::validate_abb`] |
+//! | approach and retract points | this module | [`build_program_with`], [`ProgramOptions`] |
 //! | number formatting | [`fmt`] | [`fmt::Fixed`] |
 //!
 //! JSON of every point: [`Program`] implements `serde::Serialize`; serialise
@@ -38,6 +40,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::math::{Point3, UnitVector3};
+use crate::robot::cell::CellPoint;
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::trajectory::{JointTrajectory, PathPointInput};
 use crate::robot::{Cell, Configuration, Joints};
@@ -94,10 +97,17 @@ pub enum ProgramError {
     },
 }
 
-/// Where a point stands in its bead (the arc switching flags, SPEC §8).
+/// What a point is for: a bead point with its arc switching meaning, or a
+/// transit point with the arc off (rs-opw's `PathFlags`: approach, trace,
+/// retract) [SPEC §8].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ArcFlag {
+    /// Clearance point before a bead: the bead's first point moved away from
+    /// the part along the tool axis by [`ProgramOptions::clearance_mm`],
+    /// same orientation; reached by a joint move with the arc off, then left
+    /// by a linear move to the bead's first point. Not a bead point.
+    Approach,
     /// First point of a bead: reached with the arc off, exact stop, the arc
     /// starts here.
     Start,
@@ -106,6 +116,19 @@ pub enum ArcFlag {
     /// Last point of a bead: reached with the arc on, exact stop, the arc
     /// stops here.
     End,
+    /// Clearance point after a bead: its last point moved away from the part
+    /// along the tool axis; reached by a linear move with the arc off. The
+    /// arc-off transition to the next layer goes from here to the next
+    /// [`ArcFlag::Approach`] by a joint move. Not a bead point.
+    Retract,
+}
+
+impl ArcFlag {
+    /// `true` for the points of a bead (start, on, end), `false` for the
+    /// approach and retract points.
+    pub fn is_bead(&self) -> bool {
+        matches!(self, ArcFlag::Start | ArcFlag::On | ArcFlag::End)
+    }
 }
 
 /// One point of a program.
@@ -113,9 +136,11 @@ pub enum ArcFlag {
 pub struct ProgramPoint {
     /// Layer index (= bead index of this layer).
     pub layer: usize,
-    /// Point index within the layer.
+    /// Point index within the layer (approach and retract points: the index
+    /// of the bead point they are offset from).
     pub point: usize,
-    /// Deposition point, part frame (mm).
+    /// Deposition point, part frame (mm); for approach and retract points
+    /// the torch tip, `clearance` away from the part along the tool axis.
     pub position_mm: Point3,
     /// Tool axis, part frame (unit).
     pub tool_axis: UnitVector3,
@@ -127,7 +152,9 @@ pub struct ProgramPoint {
     pub positioner: Option<PositionerJoints>,
     /// Travel speed of the deposition point relative to the part on the way
     /// to this point (mm/s); on a bead's first point, the travel speed of
-    /// its first segment.
+    /// its first segment; on approach and retract points the linear speed
+    /// of the moves into and out of the bead (approach point → first point,
+    /// last point → retract point), [`ProgramOptions::approach_speed_mm_s`].
     pub speed_mm_s: f64,
     /// Arc flag.
     pub arc: ArcFlag,
@@ -147,6 +174,11 @@ pub struct Program {
 }
 
 impl Program {
+    /// The bead points (approach and retract points left out), in order.
+    pub fn bead_points(&self) -> impl Iterator<Item = &ProgramPoint> {
+        self.points.iter().filter(|p| p.arc.is_bead())
+    }
+
     /// Number of beads (arc starts).
     pub fn num_beads(&self) -> usize {
         self.points
@@ -187,6 +219,83 @@ pub fn build_program(
     trajectory: &JointTrajectory,
     speed: &TravelSpeed,
 ) -> Result<Program, ProgramError> {
+    build_program_with(
+        name,
+        cell,
+        points,
+        trajectory,
+        speed,
+        &ProgramOptions::default(),
+    )
+}
+
+/// Options of [`build_program_with`]. Plain data.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ProgramOptions {
+    /// Distance of the approach and retract points from the part along the
+    /// tool axis (mm, ≥ 0; 0: no approach or retract points, each bead is
+    /// reached by a joint move to its first point). Default 20 mm.
+    pub clearance_mm: f64,
+    /// Linear speed of the moves into and out of a bead (approach point →
+    /// first point, last point → retract point), relative to the part
+    /// (mm/s, > 0). Default 20 mm/s.
+    pub approach_speed_mm_s: f64,
+}
+
+impl Default for ProgramOptions {
+    fn default() -> Self {
+        Self {
+            clearance_mm: 20.0,
+            approach_speed_mm_s: 20.0,
+        }
+    }
+}
+
+impl ProgramOptions {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`ProgramError::InvalidOptions`] naming the field.
+    pub fn validate(&self) -> Result<(), ProgramError> {
+        if !(self.clearance_mm.is_finite() && self.clearance_mm >= 0.0) {
+            return Err(ProgramError::InvalidOptions {
+                field: "clearance_mm",
+                value: self.clearance_mm.to_string(),
+                reason: "must be finite and >= 0",
+            });
+        }
+        if !(self.approach_speed_mm_s.is_finite() && self.approach_speed_mm_s > 0.0) {
+            return Err(ProgramError::InvalidOptions {
+                field: "approach_speed_mm_s",
+                value: self.approach_speed_mm_s.to_string(),
+                reason: "must be finite and > 0",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// [`build_program`] with approach and retract points as `opts` say: before
+/// each bead an [`ArcFlag::Approach`] point `clearance_mm` away from the part
+/// along the tool axis (same orientation, same positioner joints), after it
+/// an [`ArcFlag::Retract`] point, both checked like the bead points (joint
+/// limits, and joint speeds of the linear moves into and out of the bead at
+/// `approach_speed_mm_s`).
+///
+/// # Errors
+/// As [`build_program`]; [`ProgramError::InvalidOptions`] for bad options;
+/// [`ProgramError::Infeasible`] when an approach or retract point cannot be
+/// reached, naming the layer.
+pub fn build_program_with(
+    name: &str,
+    cell: &Cell,
+    points: &[PathPointInput],
+    trajectory: &JointTrajectory,
+    speed: &TravelSpeed,
+    opts: &ProgramOptions,
+) -> Result<Program, ProgramError> {
+    opts.validate()?;
     check_name(name)?;
     if points.len() != trajectory.points.len() {
         return Err(ProgramError::Mismatch {
@@ -304,11 +413,93 @@ pub fn build_program(
             },
         });
     }
+    if opts.clearance_mm > 0.0 {
+        let mut all = Vec::with_capacity(out.len() + 2 * trajectory.points.len().min(out.len()));
+        for (p, input) in out.iter().zip(points) {
+            if p.arc == ArcFlag::Start {
+                all.push(clearance_point(cell, p, input, ArcFlag::Approach, opts)?);
+            }
+            all.push(*p);
+            if p.arc == ArcFlag::End {
+                all.push(clearance_point(cell, p, input, ArcFlag::Retract, opts)?);
+            }
+        }
+        out = all;
+    }
     Ok(Program {
         name: name.to_string(),
         cell: cell.clone(),
         configuration: trajectory.configuration,
         points: out,
+    })
+}
+
+/// The approach or retract point of bead point `p`: `clearance_mm` along the
+/// tool axis, same orientation and positioner joints, joints unwrapped
+/// towards `p`'s; refused if a joint leaves its travel or the linear move
+/// between it and `p` outruns a joint at the approach speed.
+fn clearance_point(
+    cell: &Cell,
+    p: &ProgramPoint,
+    input: &PathPointInput,
+    flag: ArcFlag,
+    opts: &ProgramOptions,
+) -> Result<ProgramPoint, ProgramError> {
+    let what = if flag == ArcFlag::Approach {
+        "approach"
+    } else {
+        "retract"
+    };
+    let infeasible = |msg: String| ProgramError::Infeasible {
+        count: 1,
+        first: format!(
+            "layer {}, {what} point ({} mm from point {} along the tool axis): {msg}",
+            p.layer, opts.clearance_mm, p.point
+        ),
+    };
+    let position_mm = p.position_mm + p.tool_axis.into_inner() * opts.clearance_mm;
+    let cp = CellPoint {
+        position_mm,
+        tool_axis: p.tool_axis,
+        build_direction: input.build_direction,
+    };
+    let q8 = p.positioner.map_or(0.0, |q| q[1]);
+    let (q, pose) = cell
+        .joints(&cp, p.r_z, Some(&p.joints), q8)
+        .map_err(|e| infeasible(e.to_string()))?;
+    if let (Some(a), Some(b)) = (pose.positioner, p.positioner) {
+        if (a[0] - b[0]).abs() > 1e-9 || (a[1] - b[1]).abs() > 1e-9 {
+            return Err(infeasible("the positioner would have to move".into()));
+        }
+    }
+    let robot = cell.robot();
+    if let Some((j, v)) = robot.limit_violations(&q).next() {
+        return Err(infeasible(format!(
+            "J{} = {:.3}° outside its travel",
+            j + 1,
+            v.to_degrees()
+        )));
+    }
+    let dt = opts.clearance_mm / opts.approach_speed_mm_s;
+    for (j, (qj, pj)) in q.iter().zip(p.joints).enumerate() {
+        let s = (qj - pj).abs() / dt;
+        if s > robot.max_speed_rad_s[j] {
+            return Err(infeasible(format!(
+                "J{} needs {:.2}°/s at {} mm/s, maximum {:.1}°/s",
+                j + 1,
+                s.to_degrees(),
+                opts.approach_speed_mm_s,
+                robot.max_speed_rad_s[j].to_degrees()
+            )));
+        }
+    }
+    Ok(ProgramPoint {
+        position_mm,
+        joints: q,
+        positioner: pose.positioner,
+        speed_mm_s: opts.approach_speed_mm_s,
+        arc: flag,
+        ..*p
     })
 }
 

@@ -3,7 +3,12 @@
 //! [SPEC §8]. Errors name the file and line; a file without `/END`
 //! (truncated) is an error.
 //!
+//! KUKA and ABB output are read by [`kuka`] and [`abb`].
+//!
 //! [`write_ls`]: crate::program::fanuc::write_ls
+
+pub mod abb;
+pub mod kuka;
 
 use crate::program::fanuc::{
     ArmPosition, Instruction, MoveKind, Op, Position, Speed, Termination, TpProgram,
@@ -338,10 +343,14 @@ fn parse_op(body: &str) -> Result<Op, String> {
             Speed::MmPerSec(num(v)?)
         } else if let Some(v) = s.strip_suffix("cm/min") {
             Speed::CmPerMin(num(v)?)
+        } else if let Some(v) = s.strip_suffix("msec") {
+            Speed::Msec(num(v)?)
         } else {
             return Err(format!("bad speed `{s}`"));
         };
-        if matches!(speed, Speed::Percent(_)) != (kind == MoveKind::Joint) {
+        if matches!(speed, Speed::Percent(_)) != (kind == MoveKind::Joint)
+            || (kind == MoveKind::Joint && speed.time_s().is_some())
+        {
             return Err(format!("speed `{s}` does not fit a {kind:?} move"));
         }
         let term = match tokens[3] {
@@ -387,6 +396,9 @@ fn parse_op(body: &str) -> Result<Op, String> {
             .parse()
             .map(Op::UTool)
             .map_err(|_| format!("bad `{body}`"));
+    }
+    if let Some(v) = body.strip_prefix('!') {
+        return Ok(Op::Remark(v.trim().to_string()));
     }
     if let Some(v) = body.strip_prefix("CALL ") {
         return Ok(Op::Call(v.trim().to_string()));

@@ -1,6 +1,43 @@
 //! Golden files of every emitter on two layers of the hemisphere (8 points
-//! per layer). Reviewed by eye once, then pinned: a missing golden file is
-//! written; `UPDATE_GOLDEN=1` rewrites them all.
+//! per layer, with approach and retract points). Reviewed by eye once, then
+//! pinned: a missing golden file is written; `UPDATE_GOLDEN=1` rewrites them
+//! all.
+//!
+//! What the review checked, against which (third-party, public) source:
+//! * FANUC `.ls`: section order `/PROG`, `/ATTR` (OWNER … LINE_COUNT …
+//!   DEFAULT_GROUP, CONTROL_CODE in that order), `/MN` numbered from 1 with
+//!   `n:` and instructions ending ` ;`, `/POS` records `P[n]{ GP1: UF : u,
+//!   UT : t, CONFIG : 'F U T, 0, 0, 0', X = … mm, … R = … deg };`, `/END`:
+//!   against controller-exported TP files (the highlight.js TP sample
+//!   program, the `crs_application` `surface.ls` tool path, which also shows
+//!   `UFRAME_NUM=0`/`UTOOL_NUM=1` lines and `J P[1] 100% …`/`L P[2]
+//!   200mm/sec CNT60`). Time-based speeds `100msec`/`100.0sec` on J and L
+//!   moves and `!` remark lines: the same highlight.js TP sample; `L …
+//!   1msec CNT100` in a controller program (a press-brake follow program).
+//!   Group 2 as `GP2: UF : …, UT : …, J1 = … deg, J2 = … deg` and
+//!   `DEFAULT_GROUP = 1,1,*,*,*`: a generated two-group WAAM program
+//!   (Creearc/welding_project `layer_*.ls`, not controller-written).
+//!   `CONTROL_CODE = 00000000 00000000` for programs without remote TCP:
+//!   robot-forum thread "CONTROL_CODE explanation". `/APPL` `ARC Welding
+//!   Equipment` and `Arc Start[n]`/`Arc End[n]`: thesis §3.1.2 and the same
+//!   WAAM program (`: Arc Start[1];`); not checked against an ArcTool
+//!   export.
+//! * KUKA `.src`/`.dat`: `DEF`/`END`, `DEFDAT`/`ENDDAT`, `DECL E6AXIS
+//!   P1={A1 …,E1 …}`, `DECL E6POS P1={X …,A …,B …,C …,S …,T …,E1 …}`,
+//!   `$VEL.CP` in m/s, `$APO.CDIS` with `LIN … C_DIS`, `TRIGGER WHEN
+//!   DISTANCE=0|1 DELAY=0 DO …`, `$IPO_MODE = #TCP` for a fixed tool: from
+//!   memory of the KUKA system software manuals (no KRL source was found in
+//!   the search corpora during this review); A,B,C = Rz·Ry·Rx (SPEC §6.3).
+//! * ABB `.mod`: `robtarget [[x,y,z],[q1..q4],[cf1,cf4,cf6,cfx],[extax]]`
+//!   with q1 = w, `jointtarget`, `tooldata [robhold, tframe, tload]`,
+//!   `wobjdata [robhold, ufprog, ufmec, uframe, oframe]`, `MoveAbsJ`,
+//!   `MoveL`, `ArcLStart/ArcL/ArcLEnd … seam1, weld1, zone, tool\WObj`,
+//!   `ConfL \On`, inline `speeddata` `[v_tcp, v_ori, v_leax, v_reax]` in
+//!   mm/s: from memory of the RAPID reference manual, not against a source
+//!   found here. Units: FANUC mm/sec (or cm/min, msec), KUKA m/s, ABB mm/s.
+//!
+//! Not verified: that a controller loads these files (no controller or
+//! simulator was available).
 
 use std::path::PathBuf;
 
@@ -109,7 +146,7 @@ fn csv_golden() {
     let mut buf = Vec::new();
     write_csv(&mut buf, &small()).unwrap();
     let text = String::from_utf8(buf).unwrap();
-    assert_eq!(text.lines().count(), 1 + 16);
+    assert_eq!(text.lines().count(), 1 + 16 + 4);
     check_golden("HEMI.csv", &text);
 }
 
@@ -117,9 +154,11 @@ fn csv_golden() {
 fn json_of_every_point_through_serde() {
     let v = serde_json::to_value(small()).unwrap();
     let pts = v["points"].as_array().unwrap();
-    assert_eq!(pts.len(), 16);
-    assert_eq!(pts[0]["arc"], "start");
-    assert_eq!(pts[15]["arc"], "end");
+    assert_eq!(pts.len(), 20);
+    assert_eq!(pts[0]["arc"], "approach");
+    assert_eq!(pts[1]["arc"], "start");
+    assert_eq!(pts[8]["arc"], "end");
+    assert_eq!(pts[9]["arc"], "retract");
     assert!(pts[3]["joints"].as_array().unwrap().len() == 6);
 }
 

@@ -3,7 +3,9 @@
 //! splitting at a point limit, refusal of infeasible plans.
 
 mod fixture;
+mod formats;
 mod golden;
+mod parts;
 #[path = "../common/mod.rs"]
 mod shared;
 mod split;

@@ -14,7 +14,7 @@ fn flatten(files: &[TpProgram]) -> Vec<String> {
         for ins in &tp.instructions {
             match &ins.op {
                 Op::Call(n) => walk(all.iter().find(|p| &p.name == n).unwrap(), all, out),
-                Op::UFrame(_) | Op::UTool(_) => {}
+                Op::UFrame(_) | Op::UTool(_) | Op::Remark(_) => {}
                 Op::Move {
                     kind,
                     position,
@@ -50,13 +50,15 @@ fn split_at_n_points_concatenates_to_the_unsplit_program() {
     };
     let whole = read(&FanucOptions::default());
     assert_eq!(whole.len(), 1);
-    for n in [1usize, 7, 10, 29, 30, 31] {
+    for n in [1usize, 7, 10, 35, 36, 37] {
         let opts = FanucOptions {
             point_limit: n,
             ..Default::default()
         };
         let parts = read(&opts);
-        let subs = 30usize.div_ceil(n);
+        // 30 bead points and an approach and a retract point per bead
+        assert_eq!(prog.points.len(), 36);
+        let subs = 36usize.div_ceil(n);
         if subs == 1 {
             assert_eq!(parts.len(), 1);
         } else {

@@ -58,7 +58,8 @@ fn validator_accepts_our_programs_in_every_feasible_cell() {
             let (text, planned) = emitted(&cell, &opts);
             let r = check(&text, &cell, &opts, &planned);
             assert!(r.is_ok(), "{file} {positions:?}:\n{r}");
-            assert_eq!(r.motions, 96);
+            // 96 bead points, an approach and a retract point per bead
+            assert_eq!(r.motions, 96 + 2 * 4);
             assert_eq!(r.beads, 4);
         }
     }
@@ -176,7 +177,7 @@ fn an_overspeed_is_named_by_its_motion_line() {
     let cell = part_carried();
     let opts = FanucOptions::default();
     let (text, planned) = emitted(&cell, &opts);
-    // the 5th linear move of the top layer at 2000 mm/s: J6 needs v / A rad/s
+    // a linear move of the top layer's bead in 1 ms: J6 needs 15° / 1 ms
     let mut lines: Vec<String> = text.lines().map(String::from).collect();
     let first_l = line_of(
         &text,
@@ -187,8 +188,15 @@ fn an_overspeed_is_named_by_its_motion_line() {
             line_of(&text, "Arc End[1]", line_of(&text, "Arc End[1]", 0)),
         ),
     );
+    // the first L after Arc Start is the bead's second point: +4 is its 6th
     let target = first_l + 4;
-    lines[target - 1] = lines[target - 1].replace("36cm/min", "2000mm/sec");
+    let l = &lines[target - 1];
+    let speed = l.split_whitespace().nth(2).unwrap().to_string();
+    assert!(
+        speed.ends_with("msec"),
+        "time-based in the part-carried cell: {l}"
+    );
+    lines[target - 1] = l.replace(&speed, "1msec");
     let bad = lines.join("\n") + "\n";
     let r = check(&bad, &cell, &opts, &planned);
     let p = r

@@ -7,7 +7,7 @@ CREATE		= DATE 00-01-01  TIME 00:00:00;
 MODIFIED	= DATE 00-01-01  TIME 00:00:00;
 FILE_NAME	= ;
 VERSION		= 0;
-LINE_COUNT	= 22;
+LINE_COUNT	= 27;
 MEMORY_SIZE	= 0;
 PROTECT		= READ_WRITE;
 TCD:  STACK_SIZE	= 0,
@@ -23,121 +23,150 @@ CONTROL_CODE	= 00000000 00000000;
 /MN
    1:  UFRAME_NUM=0 ;
    2:  UTOOL_NUM=1 ;
-   3:J P[1] 10% FINE    ;
-   4:  Arc Start[1] ;
-   5:L P[2] 6mm/sec CNT100    ;
-   6:L P[3] 6mm/sec CNT100    ;
-   7:L P[4] 6mm/sec CNT100    ;
-   8:L P[5] 6mm/sec CNT100    ;
-   9:L P[6] 6mm/sec CNT100    ;
-  10:L P[7] 6mm/sec CNT100    ;
-  11:L P[8] 6mm/sec FINE    ;
-  12:  Arc End[1] ;
-  13:J P[9] 10% FINE    ;
-  14:  Arc Start[1] ;
-  15:L P[10] 6mm/sec CNT100    ;
-  16:L P[11] 6mm/sec CNT100    ;
-  17:L P[12] 6mm/sec CNT100    ;
-  18:L P[13] 6mm/sec CNT100    ;
-  19:L P[14] 6mm/sec CNT100    ;
-  20:L P[15] 6mm/sec CNT100    ;
-  21:L P[16] 6mm/sec FINE    ;
-  22:  Arc End[1] ;
+   3:  ! TIMED: TORCH SPEED OVER PART ;
+   4:J P[1] 10% FINE    ;
+   5:L P[2] 1000msec FINE    ;
+   6:  Arc Start[1] ;
+   7:L P[3] 5740msec CNT100    ;
+   8:L P[4] 5740msec CNT100    ;
+   9:L P[5] 5740msec CNT100    ;
+  10:L P[6] 5740msec CNT100    ;
+  11:L P[7] 5740msec CNT100    ;
+  12:L P[8] 5740msec CNT100    ;
+  13:L P[9] 5740msec FINE    ;
+  14:  Arc End[1] ;
+  15:L P[10] 1000msec FINE    ;
+  16:J P[11] 10% FINE    ;
+  17:L P[12] 1000msec FINE    ;
+  18:  Arc Start[1] ;
+  19:L P[13] 5705msec CNT100    ;
+  20:L P[14] 5705msec CNT100    ;
+  21:L P[15] 5705msec CNT100    ;
+  22:L P[16] 5705msec CNT100    ;
+  23:L P[17] 5705msec CNT100    ;
+  24:L P[18] 5705msec CNT100    ;
+  25:L P[19] 5705msec FINE    ;
+  26:  Arc End[1] ;
+  27:L P[20] 1000msec FINE    ;
 /POS
 P[1]{
+   GP1:
+	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 0',
+	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   633.167  mm,
+	W =     0.0000 deg,	P =     0.0000 deg,	R =     0.0000 deg
+};
+P[2]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 0',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =     0.0000 deg,	R =     0.0000 deg
 };
-P[2]{
+P[3]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =     0.0000 deg,	R =   -45.0000 deg
 };
-P[3]{
+P[4]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =     0.0000 deg,	R =   -90.0000 deg
 };
-P[4]{
+P[5]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =     0.0000 deg,	R =  -135.0000 deg
 };
-P[5]{
+P[6]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =     0.0000 deg,	R =  -180.0000 deg
 };
-P[6]{
+P[7]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =     0.0000 deg,	R =   135.0000 deg
 };
-P[7]{
+P[8]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =     0.0000 deg,	R =    90.0000 deg
 };
-P[8]{
+P[9]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =     0.0000 deg,	R =    45.0000 deg
 };
-P[9]{
+P[10]{
+   GP1:
+	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
+	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   633.167  mm,
+	W =     0.0000 deg,	P =     0.0000 deg,	R =    45.0000 deg
+};
+P[11]{
+   GP1:
+	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 0',
+	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   633.167  mm,
+	W =     0.0000 deg,	P =     6.3662 deg,	R =     0.0000 deg
+};
+P[12]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 0',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =     6.3662 deg,	R =     0.0000 deg
 };
-P[10]{
+P[13]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =    -4.5109 deg,	P =     4.4969 deg,	R =   -45.1772 deg
 };
-P[11]{
+P[14]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =    -6.3662 deg,	P =     0.0000 deg,	R =   -90.0000 deg
 };
-P[12]{
+P[15]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =    -4.5109 deg,	P =    -4.4969 deg,	R =  -134.8228 deg
 };
-P[13]{
+P[16]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     0.0000 deg,	P =    -6.3662 deg,	R =  -180.0000 deg
 };
-P[14]{
+P[17]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     4.5109 deg,	P =    -4.4969 deg,	R =   134.8228 deg
 };
-P[15]{
+P[18]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
 	W =     6.3662 deg,	P =     0.0000 deg,	R =    90.0000 deg
 };
-P[16]{
+P[19]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
 	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   653.167  mm,
+	W =     4.5109 deg,	P =     4.4969 deg,	R =    45.1772 deg
+};
+P[20]{
+   GP1:
+	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 1',
+	X =  1000.747  mm,	Y =  -630.155  mm,	Z =   633.167  mm,
 	W =     4.5109 deg,	P =     4.4969 deg,	R =    45.1772 deg
 };
 /END

@@ -7,7 +7,7 @@ CREATE		= DATE 00-01-01  TIME 00:00:00;
 MODIFIED	= DATE 00-01-01  TIME 00:00:00;
 FILE_NAME	= ;
 VERSION		= 0;
-LINE_COUNT	= 22;
+LINE_COUNT	= 27;
 MEMORY_SIZE	= 0;
 PROTECT		= READ_WRITE;
 TCD:  STACK_SIZE	= 0,
@@ -23,121 +23,150 @@ CONTROL_CODE	= 00000000 00000000;
 /MN
    1:  UFRAME_NUM=0 ;
    2:  UTOOL_NUM=1 ;
-   3:J P[1] 10% FINE    ;
-   4:  Arc Start[1] ;
-   5:L P[2] 36cm/min CNT100    ;
-   6:L P[3] 36cm/min CNT100    ;
-   7:L P[4] 36cm/min CNT100    ;
-   8:L P[5] 36cm/min CNT100    ;
-   9:L P[6] 36cm/min CNT100    ;
-  10:L P[7] 36cm/min CNT100    ;
-  11:L P[8] 36cm/min FINE    ;
-  12:  Arc End[1] ;
-  13:J P[9] 10% FINE    ;
-  14:  Arc Start[1] ;
-  15:L P[10] 36cm/min CNT100    ;
-  16:L P[11] 36cm/min CNT100    ;
-  17:L P[12] 36cm/min CNT100    ;
-  18:L P[13] 36cm/min CNT100    ;
-  19:L P[14] 36cm/min CNT100    ;
-  20:L P[15] 36cm/min CNT100    ;
-  21:L P[16] 36cm/min FINE    ;
-  22:  Arc End[1] ;
+   3:  ! TIMED: TORCH SPEED OVER PART ;
+   4:J P[1] 10% FINE    ;
+   5:L P[2] 1000msec FINE    ;
+   6:  Arc Start[1] ;
+   7:L P[3] 5740msec CNT100    ;
+   8:L P[4] 5740msec CNT100    ;
+   9:L P[5] 5740msec CNT100    ;
+  10:L P[6] 5740msec CNT100    ;
+  11:L P[7] 5740msec CNT100    ;
+  12:L P[8] 5740msec CNT100    ;
+  13:L P[9] 5740msec FINE    ;
+  14:  Arc End[1] ;
+  15:L P[10] 1000msec FINE    ;
+  16:J P[11] 10% FINE    ;
+  17:L P[12] 1000msec FINE    ;
+  18:  Arc Start[1] ;
+  19:L P[13] 5705msec CNT100    ;
+  20:L P[14] 5705msec CNT100    ;
+  21:L P[15] 5705msec CNT100    ;
+  22:L P[16] 5705msec CNT100    ;
+  23:L P[17] 5705msec CNT100    ;
+  24:L P[18] 5705msec CNT100    ;
+  25:L P[19] 5705msec FINE    ;
+  26:  Arc End[1] ;
+  27:L P[20] 1000msec FINE    ;
 /POS
 P[1]{
    GP1:
 	UF : 0, UT : 1,	
-	J1=   -32.1980 deg,	J2=    13.7468 deg,	J3=   -30.8941 deg,
-	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   147.8020 deg
+	J1=   -32.1980 deg,	J2=    14.1189 deg,	J3=   -32.1703 deg,
+	J4=     0.0000 deg,	J5=   122.1703 deg,	J6=   147.8020 deg
 };
 P[2]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.1980 deg,	J2=    13.7468 deg,	J3=   -30.8941 deg,
-	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   192.8020 deg
+	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   147.8020 deg
 };
 P[3]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.1980 deg,	J2=    13.7468 deg,	J3=   -30.8941 deg,
-	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   237.8020 deg
+	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   192.8020 deg
 };
 P[4]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.1980 deg,	J2=    13.7468 deg,	J3=   -30.8941 deg,
-	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   282.8020 deg
+	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   237.8020 deg
 };
 P[5]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.1980 deg,	J2=    13.7468 deg,	J3=   -30.8941 deg,
-	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   327.8020 deg
+	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   282.8020 deg
 };
 P[6]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.1980 deg,	J2=    13.7468 deg,	J3=   -30.8941 deg,
-	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   372.8020 deg
+	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   327.8020 deg
 };
 P[7]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.1980 deg,	J2=    13.7468 deg,	J3=   -30.8941 deg,
-	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   417.8020 deg
+	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   372.8020 deg
 };
 P[8]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.1980 deg,	J2=    13.7468 deg,	J3=   -30.8941 deg,
-	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   462.8020 deg
+	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   417.8020 deg
 };
 P[9]{
    GP1:
 	UF : 0, UT : 1,	
-	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
-	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   149.3098 deg
+	J1=   -32.1980 deg,	J2=    13.7468 deg,	J3=   -30.8941 deg,
+	J4=     0.0000 deg,	J5=   120.8941 deg,	J6=   462.8020 deg
 };
 P[10]{
    GP1:
 	UF : 0, UT : 1,	
-	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
-	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   194.3098 deg
+	J1=   -32.1980 deg,	J2=    14.1189 deg,	J3=   -32.1703 deg,
+	J4=     0.0000 deg,	J5=   122.1703 deg,	J6=   462.8020 deg
 };
 P[11]{
    GP1:
 	UF : 0, UT : 1,	
-	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
-	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   239.3098 deg
+	J1=   -32.4865 deg,	J2=    13.4520 deg,	J3=   -32.2777 deg,
+	J4=     3.8274 deg,	J5=   116.8498 deg,	J6=   149.4045 deg
 };
 P[12]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
-	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   284.3098 deg
+	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   149.3098 deg
 };
 P[13]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
-	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   329.3098 deg
+	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   194.3098 deg
 };
 P[14]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
-	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   374.3098 deg
+	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   239.3098 deg
 };
 P[15]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
-	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   419.3098 deg
+	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   284.3098 deg
 };
 P[16]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
+	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   329.3098 deg
+};
+P[17]{
+   GP1:
+	UF : 0, UT : 1,	
+	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
+	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   374.3098 deg
+};
+P[18]{
+   GP1:
+	UF : 0, UT : 1,	
+	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
+	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   419.3098 deg
+};
+P[19]{
+   GP1:
+	UF : 0, UT : 1,	
+	J1=   -32.4865 deg,	J2=    13.0772 deg,	J3=   -30.9975 deg,
 	J4=     3.7856 deg,	J5=   115.5724 deg,	J6=   464.3098 deg
+};
+P[20]{
+   GP1:
+	UF : 0, UT : 1,	
+	J1=   -32.4865 deg,	J2=    13.4520 deg,	J3=   -32.2777 deg,
+	J4=     3.8274 deg,	J5=   116.8498 deg,	J6=   464.4045 deg
 };
 /END

@@ -7,7 +7,7 @@ CREATE		= DATE 00-01-01  TIME 00:00:00;
 MODIFIED	= DATE 00-01-01  TIME 00:00:00;
 FILE_NAME	= ;
 VERSION		= 0;
-LINE_COUNT	= 22;
+LINE_COUNT	= 26;
 MEMORY_SIZE	= 0;
 PROTECT		= READ_WRITE;
 TCD:  STACK_SIZE	= 0,
@@ -24,27 +24,40 @@ CONTROL_CODE	= 00000000 00000000;
    1:  UFRAME_NUM=0 ;
    2:  UTOOL_NUM=1 ;
    3:J P[1] 10% FINE    ;
-   4:  Arc Start[1] ;
-   5:L P[2] 36cm/min CNT100    ;
+   4:L P[2] 120cm/min FINE    ;
+   5:  Arc Start[1] ;
    6:L P[3] 36cm/min CNT100    ;
    7:L P[4] 36cm/min CNT100    ;
    8:L P[5] 36cm/min CNT100    ;
    9:L P[6] 36cm/min CNT100    ;
   10:L P[7] 36cm/min CNT100    ;
-  11:L P[8] 36cm/min FINE    ;
-  12:  Arc End[1] ;
-  13:J P[9] 10% FINE    ;
-  14:  Arc Start[1] ;
-  15:L P[10] 36cm/min CNT100    ;
-  16:L P[11] 36cm/min CNT100    ;
-  17:L P[12] 36cm/min CNT100    ;
+  11:L P[8] 36cm/min CNT100    ;
+  12:L P[9] 36cm/min FINE    ;
+  13:  Arc End[1] ;
+  14:L P[10] 120cm/min FINE    ;
+  15:J P[11] 10% FINE    ;
+  16:L P[12] 120cm/min FINE    ;
+  17:  Arc Start[1] ;
   18:L P[13] 36cm/min CNT100    ;
   19:L P[14] 36cm/min CNT100    ;
   20:L P[15] 36cm/min CNT100    ;
-  21:L P[16] 36cm/min FINE    ;
-  22:  Arc End[1] ;
+  21:L P[16] 36cm/min CNT100    ;
+  22:L P[17] 36cm/min CNT100    ;
+  23:L P[18] 36cm/min CNT100    ;
+  24:L P[19] 36cm/min FINE    ;
+  25:  Arc End[1] ;
+  26:L P[20] 120cm/min FINE    ;
 /POS
 P[1]{
+   GP1:
+	UF : 0, UT : 1,	
+	J1=    49.4148 deg,	J2=    13.8743 deg,	J3=   -43.2969 deg,
+	J4=    53.2973 deg,	J5=   -33.3337 deg,	J6=   -91.8162 deg
+   GP2:
+	UF : 0, UT : 1,	
+	J1=     0.1310 deg,	J2=     0.0000 deg
+};
+P[2]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=    49.4222 deg,	J2=    14.5576 deg,	J3=   -44.6050 deg,
@@ -53,7 +66,7 @@ P[1]{
 	UF : 0, UT : 1,	
 	J1=     0.1310 deg,	J2=     0.0000 deg
 };
-P[2]{
+P[3]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=    51.1143 deg,	J2=    13.8746 deg,	J3=   -44.7602 deg,
@@ -62,7 +75,7 @@ P[2]{
 	UF : 0, UT : 1,	
 	J1=     0.1310 deg,	J2=     0.0000 deg
 };
-P[3]{
+P[4]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=    51.9891 deg,	J2=    11.8755 deg,	J3=   -45.2117 deg,
@@ -71,7 +84,7 @@ P[3]{
 	UF : 0, UT : 1,	
 	J1=     0.1310 deg,	J2=     0.0000 deg
 };
-P[4]{
+P[5]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=    51.4823 deg,	J2=     9.6638 deg,	J3=   -45.6461 deg,
@@ -80,7 +93,7 @@ P[4]{
 	UF : 0, UT : 1,	
 	J1=     0.1310 deg,	J2=     0.0000 deg
 };
-P[5]{
+P[6]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=    49.8034 deg,	J2=     8.5789 deg,	J3=   -45.8416 deg,
@@ -89,7 +102,7 @@ P[5]{
 	UF : 0, UT : 1,	
 	J1=     0.1310 deg,	J2=     0.0000 deg
 };
-P[6]{
+P[7]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=    47.9959 deg,	J2=     9.3314 deg,	J3=   -45.7373 deg,
@@ -98,7 +111,7 @@ P[6]{
 	UF : 0, UT : 1,	
 	J1=     0.1310 deg,	J2=     0.0000 deg
 };
-P[7]{
+P[8]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=    47.2046 deg,	J2=    11.4248 deg,	J3=   -45.3541 deg,
@@ -107,7 +120,7 @@ P[7]{
 	UF : 0, UT : 1,	
 	J1=     0.1310 deg,	J2=     0.0000 deg
 };
-P[8]{
+P[9]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=    47.8267 deg,	J2=    13.5674 deg,	J3=   -44.8692 deg,
@@ -116,32 +129,23 @@ P[8]{
 	UF : 0, UT : 1,	
 	J1=     0.1310 deg,	J2=     0.0000 deg
 };
-P[9]{
-   GP1:
-	UF : 0, UT : 1,	
-	J1=    49.9041 deg,	J2=     7.5470 deg,	J3=   -46.1479 deg,
-	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
-   GP2:
-	UF : 0, UT : 1,	
-	J1=    -6.2219 deg,	J2=  -176.2818 deg
-};
 P[10]{
    GP1:
 	UF : 0, UT : 1,	
-	J1=    49.9041 deg,	J2=     7.5470 deg,	J3=   -46.1479 deg,
-	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
+	J1=    47.8192 deg,	J2=    12.8748 deg,	J3=   -43.5484 deg,
+	J4=    53.6370 deg,	J5=   -32.2527 deg,	J6=   -90.9156 deg
    GP2:
 	UF : 0, UT : 1,	
-	J1=    -6.2219 deg,	J2=   138.7182 deg
+	J1=     0.1310 deg,	J2=     0.0000 deg
 };
 P[11]{
    GP1:
 	UF : 0, UT : 1,	
-	J1=    49.9041 deg,	J2=     7.5470 deg,	J3=   -46.1479 deg,
-	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
+	J1=    49.9041 deg,	J2=     6.7959 deg,	J3=   -44.7449 deg,
+	J4=    55.5798 deg,	J5=   -33.0295 deg,	J6=   -94.5972 deg
    GP2:
 	UF : 0, UT : 1,	
-	J1=    -6.2219 deg,	J2=    93.7182 deg
+	J1=    -6.2219 deg,	J2=  -176.2818 deg
 };
 P[12]{
    GP1:
@@ -150,7 +154,7 @@ P[12]{
 	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
    GP2:
 	UF : 0, UT : 1,	
-	J1=    -6.2219 deg,	J2=    48.7182 deg
+	J1=    -6.2219 deg,	J2=  -176.2818 deg
 };
 P[13]{
    GP1:
@@ -159,7 +163,7 @@ P[13]{
 	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
    GP2:
 	UF : 0, UT : 1,	
-	J1=    -6.2219 deg,	J2=     3.7182 deg
+	J1=    -6.2219 deg,	J2=   138.7182 deg
 };
 P[14]{
    GP1:
@@ -168,7 +172,7 @@ P[14]{
 	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
    GP2:
 	UF : 0, UT : 1,	
-	J1=    -6.2219 deg,	J2=   -41.2818 deg
+	J1=    -6.2219 deg,	J2=    93.7182 deg
 };
 P[15]{
    GP1:
@@ -177,13 +181,49 @@ P[15]{
 	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
    GP2:
 	UF : 0, UT : 1,	
-	J1=    -6.2219 deg,	J2=   -86.2818 deg
+	J1=    -6.2219 deg,	J2=    48.7182 deg
 };
 P[16]{
    GP1:
 	UF : 0, UT : 1,	
 	J1=    49.9041 deg,	J2=     7.5470 deg,	J3=   -46.1479 deg,
 	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
+   GP2:
+	UF : 0, UT : 1,	
+	J1=    -6.2219 deg,	J2=     3.7182 deg
+};
+P[17]{
+   GP1:
+	UF : 0, UT : 1,	
+	J1=    49.9041 deg,	J2=     7.5470 deg,	J3=   -46.1479 deg,
+	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
+   GP2:
+	UF : 0, UT : 1,	
+	J1=    -6.2219 deg,	J2=   -41.2818 deg
+};
+P[18]{
+   GP1:
+	UF : 0, UT : 1,	
+	J1=    49.9041 deg,	J2=     7.5470 deg,	J3=   -46.1479 deg,
+	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
+   GP2:
+	UF : 0, UT : 1,	
+	J1=    -6.2219 deg,	J2=   -86.2818 deg
+};
+P[19]{
+   GP1:
+	UF : 0, UT : 1,	
+	J1=    49.9041 deg,	J2=     7.5470 deg,	J3=   -46.1479 deg,
+	J4=    57.4063 deg,	J5=   -32.2548 deg,	J6=   -96.7662 deg
+   GP2:
+	UF : 0, UT : 1,	
+	J1=    -6.2219 deg,	J2=  -131.2818 deg
+};
+P[20]{
+   GP1:
+	UF : 0, UT : 1,	
+	J1=    49.9041 deg,	J2=     6.7959 deg,	J3=   -44.7449 deg,
+	J4=    55.5798 deg,	J5=   -33.0295 deg,	J6=   -94.5972 deg
    GP2:
 	UF : 0, UT : 1,	
 	J1=    -6.2219 deg,	J2=  -131.2818 deg

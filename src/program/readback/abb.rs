@@ -1,0 +1,432 @@
+//! Reader of our own ABB RAPID output (the subset
+//! [`write_mod`](crate::program::abb::write_mod) writes): the tool and work
+//! object declarations, `robtarget`s and `jointtarget`s, and the motion and
+//! process instructions of `main`. Errors name the file and line; a module
+//! without `ENDMODULE` (truncated) is an error.
+
+use crate::math::{Isometry3, Vector3};
+use crate::program::ProgramError;
+use crate::robot::orientation::rotation_from_abb_quaternion;
+
+/// A bracketed RAPID aggregate, parsed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Node {
+    /// `[a, b, ...]`.
+    List(Vec<Node>),
+    /// A scalar as written (`1.5`, `TRUE`, `""`, `9E+09`).
+    Atom(String),
+}
+
+impl Node {
+    fn list(&self) -> Result<&[Node], String> {
+        match self {
+            Node::List(v) => Ok(v),
+            Node::Atom(a) => Err(format!("expected `[...]`, got `{a}`")),
+        }
+    }
+
+    fn num(&self) -> Result<f64, String> {
+        match self {
+            Node::Atom(a) => a
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("bad number `{a}`")),
+            Node::List(_) => Err("expected a number, got `[...]`".into()),
+        }
+    }
+
+    fn bool(&self) -> Result<bool, String> {
+        match self {
+            Node::Atom(a) if a == "TRUE" => Ok(true),
+            Node::Atom(a) if a == "FALSE" => Ok(false),
+            _ => Err("expected TRUE or FALSE".into()),
+        }
+    }
+
+    fn nums<const N: usize>(&self) -> Result<[f64; N], String> {
+        let v = self.list()?;
+        if v.len() != N {
+            return Err(format!("expected {N} values, got {}", v.len()));
+        }
+        let mut out = [0.0; N];
+        for (o, n) in out.iter_mut().zip(v) {
+            *o = n.num()?;
+        }
+        Ok(out)
+    }
+
+    /// A pose `[[x, y, z], [q1, q2, q3, q4]]` (mm, quaternion `w x y z`).
+    fn pose(&self) -> Result<Isometry3, String> {
+        let v = self.list()?;
+        if v.len() != 2 {
+            return Err("expected `[[x,y,z],[q1,q2,q3,q4]]`".into());
+        }
+        pose_of(&v[0], &v[1])
+    }
+}
+
+fn pose_of(t: &Node, q: &Node) -> Result<Isometry3, String> {
+    let t = t.nums::<3>()?;
+    let q = q.nums::<4>()?;
+    let n = (q.iter().map(|x| x * x).sum::<f64>()).sqrt();
+    if (n - 1.0).abs() > 1e-4 {
+        return Err(format!("quaternion of norm {n:.6}, not 1"));
+    }
+    let r = rotation_from_abb_quaternion(q).ok_or("bad quaternion")?;
+    Ok(Isometry3::from_parts(
+        nalgebra::Translation3::from(Vector3::new(t[0], t[1], t[2])),
+        nalgebra::UnitQuaternion::from_rotation_matrix(&r),
+    ))
+}
+
+/// Parses one aggregate `[...]` (the whole of `s`).
+pub fn parse_aggregate(s: &str) -> Result<Node, String> {
+    let chars: Vec<char> = s.trim().chars().collect();
+    let mut i = 0;
+    let n = parse_node(&chars, &mut i)?;
+    if i != chars.len() {
+        return Err(format!("text after the aggregate: `{}`", s.trim()));
+    }
+    Ok(n)
+}
+
+fn parse_node(c: &[char], i: &mut usize) -> Result<Node, String> {
+    while *i < c.len() && c[*i].is_whitespace() {
+        *i += 1;
+    }
+    if c.get(*i) == Some(&'[') {
+        *i += 1;
+        let mut items = Vec::new();
+        loop {
+            items.push(parse_node(c, i)?);
+            while *i < c.len() && c[*i].is_whitespace() {
+                *i += 1;
+            }
+            match c.get(*i) {
+                Some(',') => *i += 1,
+                Some(']') => {
+                    *i += 1;
+                    return Ok(Node::List(items));
+                }
+                _ => return Err("unbalanced `[`".into()),
+            }
+        }
+    }
+    let start = *i;
+    while *i < c.len() && !matches!(c[*i], ',' | ']' | '[') {
+        *i += 1;
+    }
+    let a: String = c[start..*i].iter().collect::<String>().trim().to_string();
+    if a.is_empty() {
+        return Err("empty value".into());
+    }
+    Ok(Node::Atom(a))
+}
+
+/// Splits at the commas outside brackets and quotes.
+fn split_top(s: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut depth = 0i32;
+    let mut quoted = false;
+    let mut cur = String::new();
+    for ch in s.chars() {
+        match ch {
+            '"' => quoted = !quoted,
+            '[' if !quoted => depth += 1,
+            ']' if !quoted => depth -= 1,
+            ',' if depth == 0 && !quoted => {
+                out.push(cur.trim().to_string());
+                cur.clear();
+                continue;
+            }
+            _ => {}
+        }
+        cur.push(ch);
+    }
+    out.push(cur.trim().to_string());
+    out
+}
+
+/// A `tooldata` or `wobjdata` declaration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidFrame {
+    /// Declaration line.
+    pub line: usize,
+    /// `robhold`.
+    pub robhold: bool,
+    /// `tframe` (tool) or `uframe · oframe` (work object) (mm).
+    pub pose: Isometry3,
+}
+
+/// A target.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RapidTargetValue {
+    /// `robtarget`: pose (mm) and `confdata`.
+    Rob {
+        /// `[[x,y,z],[q1..q4]]` as a transform (mm).
+        pose: Isometry3,
+        /// `[cf1, cf4, cf6, cfx]`.
+        conf: [i32; 4],
+    },
+    /// `jointtarget` (deg).
+    Joint([f64; 6]),
+}
+
+/// A `CONST robtarget` / `CONST jointtarget`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidTarget {
+    /// Name.
+    pub name: String,
+    /// Line.
+    pub line: usize,
+    /// Value.
+    pub value: RapidTargetValue,
+    /// External axes `eax_a`, `eax_b` (deg), `None` when `9E+09`.
+    pub external: Option<[f64; 2]>,
+}
+
+/// One instruction of `main`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RapidOp {
+    /// `MoveAbsJ target, speed, ...`.
+    MoveAbsJ {
+        /// Target.
+        target: String,
+    },
+    /// `MoveL`, `ArcLStart`, `ArcL`, `ArcLEnd`: instruction name, target and
+    /// `v_tcp` (mm/s).
+    Linear {
+        /// `MoveL`, `ArcLStart`, `ArcL` or `ArcLEnd`.
+        instruction: String,
+        /// Target.
+        target: String,
+        /// `v_tcp` of the speeddata (mm/s).
+        speed_mm_s: f64,
+        /// Weld data name for arc instructions (`weld1`).
+        weld: Option<String>,
+    },
+    /// `ConfL \On` (`true`) or `\Off`.
+    ConfL(bool),
+    /// Any other statement, as written without `;`.
+    Other(String),
+}
+
+/// An instruction with its line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidInstruction {
+    /// Line.
+    pub line: usize,
+    /// Instruction.
+    pub op: RapidOp,
+}
+
+/// A RAPID module as read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidModule {
+    /// Module name.
+    pub name: String,
+    /// File name (for messages).
+    pub file: String,
+    /// `tWaam`.
+    pub tool: Option<RapidFrame>,
+    /// `wWaam`.
+    pub wobj: Option<RapidFrame>,
+    /// Targets.
+    pub targets: Vec<RapidTarget>,
+    /// `main`'s instructions.
+    pub instructions: Vec<RapidInstruction>,
+}
+
+/// Parses one `.mod` written by [`write_mod`](crate::program::abb::write_mod).
+///
+/// # Errors
+/// [`ProgramError::Read`] with the line: missing `MODULE`, bad declaration
+/// or instruction, and a file ending before `ENDMODULE`.
+pub fn parse_mod(text: &str, file: &str) -> Result<RapidModule, ProgramError> {
+    let err = |line: usize, reason: String| ProgramError::Read {
+        file: file.into(),
+        line,
+        reason,
+    };
+    let mut m = RapidModule {
+        name: String::new(),
+        file: file.into(),
+        tool: None,
+        wobj: None,
+        targets: Vec::new(),
+        instructions: Vec::new(),
+    };
+    let mut started = false;
+    let mut in_main = false;
+    let mut ended = false;
+    let mut last = 0;
+    for (i, raw) in text.lines().enumerate() {
+        let n = i + 1;
+        last = n;
+        let l = raw.trim();
+        if l.is_empty() || l.starts_with('!') {
+            continue;
+        }
+        if ended {
+            return Err(err(n, "text after ENDMODULE".into()));
+        }
+        if !started {
+            let name = l
+                .strip_prefix("MODULE ")
+                .ok_or_else(|| err(n, format!("expected `MODULE name`, got `{l}`")))?;
+            m.name = name.trim().to_string();
+            started = true;
+            continue;
+        }
+        if l == "ENDMODULE" {
+            if in_main {
+                return Err(err(n, "ENDMODULE inside PROC main (no ENDPROC)".into()));
+            }
+            ended = true;
+            continue;
+        }
+        if l.starts_with("PROC ") {
+            in_main = true;
+            continue;
+        }
+        if l == "ENDPROC" {
+            in_main = false;
+            continue;
+        }
+        let stmt = l
+            .strip_suffix(';')
+            .ok_or_else(|| err(n, "statement without `;`".into()))?
+            .trim();
+        if in_main {
+            let op = parse_instruction(stmt).map_err(|r| err(n, r))?;
+            m.instructions.push(RapidInstruction { line: n, op });
+        } else {
+            parse_declaration(stmt, n, &mut m).map_err(|r| err(n, r))?;
+        }
+    }
+    if !ended {
+        let where_ = if in_main { " inside PROC main" } else { "" };
+        return Err(err(
+            last,
+            format!("file ends{where_} without ENDMODULE (truncated?)"),
+        ));
+    }
+    Ok(m)
+}
+
+fn parse_declaration(stmt: &str, line: usize, m: &mut RapidModule) -> Result<(), String> {
+    let (head, value) = stmt
+        .split_once(":=")
+        .ok_or_else(|| format!("expected a declaration `... := [...]`, got `{stmt}`"))?;
+    let words: Vec<&str> = head.split_whitespace().collect();
+    let [_, ty, name] = words.as_slice() else {
+        return Err(format!("bad declaration `{head}`"));
+    };
+    let v = parse_aggregate(value)?;
+    let items = v.list()?;
+    let ext = |n: &Node| -> Result<Option<[f64; 2]>, String> {
+        let e = n.nums::<6>()?;
+        Ok((e[0] < 8.9e9).then_some([e[0], e[1]]))
+    };
+    match *ty {
+        "tooldata" => {
+            if items.len() != 3 {
+                return Err("tooldata: expected [robhold, tframe, tload]".into());
+            }
+            m.tool = Some(RapidFrame {
+                line,
+                robhold: items[0].bool()?,
+                pose: items[1].pose()?,
+            });
+        }
+        "wobjdata" => {
+            if items.len() != 5 {
+                return Err("wobjdata: expected [robhold, ufprog, ufmec, uframe, oframe]".into());
+            }
+            m.wobj = Some(RapidFrame {
+                line,
+                robhold: items[0].bool()?,
+                pose: items[3].pose()? * items[4].pose()?,
+            });
+        }
+        "robtarget" => {
+            if items.len() != 4 {
+                return Err("robtarget: expected [trans, rot, robconf, extax]".into());
+            }
+            let c = items[2].nums::<4>()?;
+            if c.iter().any(|x| x.fract() != 0.0) {
+                return Err("confdata: not integers".into());
+            }
+            m.targets.push(RapidTarget {
+                name: name.to_string(),
+                line,
+                value: RapidTargetValue::Rob {
+                    pose: pose_of(&items[0], &items[1])?,
+                    conf: c.map(|x| x as i32),
+                },
+                external: ext(&items[3])?,
+            });
+        }
+        "jointtarget" => {
+            if items.len() != 2 {
+                return Err("jointtarget: expected [robax, extax]".into());
+            }
+            m.targets.push(RapidTarget {
+                name: name.to_string(),
+                line,
+                value: RapidTargetValue::Joint(items[0].nums::<6>()?),
+                external: ext(&items[1])?,
+            });
+        }
+        _ => return Err(format!("unsupported type `{ty}`")),
+    }
+    Ok(())
+}
+
+fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
+    if let Some(v) = stmt.strip_prefix("ConfL") {
+        return match v.trim() {
+            "\\On" => Ok(RapidOp::ConfL(true)),
+            "\\Off" => Ok(RapidOp::ConfL(false)),
+            _ => Err(format!("bad `{stmt}`")),
+        };
+    }
+    let (name, rest) = stmt.split_once(' ').unwrap_or((stmt, ""));
+    let args = split_top(rest);
+    match name {
+        "MoveAbsJ" => {
+            if args.len() < 4 {
+                return Err(format!(
+                    "MoveAbsJ: expected target, speed, zone, tool: `{stmt}`"
+                ));
+            }
+            Ok(RapidOp::MoveAbsJ {
+                target: args[0].clone(),
+            })
+        }
+        "MoveL" | "ArcLStart" | "ArcL" | "ArcLEnd" => {
+            let arc = name != "MoveL";
+            let want = if arc { 6 } else { 4 };
+            if args.len() != want {
+                return Err(format!(
+                    "{name}: expected {want} arguments, got {}",
+                    args.len()
+                ));
+            }
+            let speed = parse_aggregate(&args[1])
+                .and_then(|n| n.nums::<4>())
+                .map_err(|e| format!("{name}: speeddata: {e}"))?;
+            if !(speed[0] > 0.0) {
+                return Err(format!("{name}: v_tcp {} must be > 0", speed[0]));
+            }
+            Ok(RapidOp::Linear {
+                instruction: name.to_string(),
+                target: args[0].clone(),
+                speed_mm_s: speed[0],
+                weld: arc.then(|| args[3].clone()),
+            })
+        }
+        _ => Ok(RapidOp::Other(stmt.to_string())),
+    }
+}

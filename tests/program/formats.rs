@@ -1,0 +1,235 @@
+//! KUKA and ABB: our programs read back and validate in every cell; files
+//! we corrupt (a joint pushed out of range, a dropped arc end, a truncated
+//! file, a configuration flip) are rejected with a message naming the line.
+
+use waam_slicer::math::Point3;
+use waam_slicer::program::abb::{abb_files, AbbOptions};
+use waam_slicer::program::fanuc::PositionMode;
+use waam_slicer::program::kuka::{kuka_files, KukaOptions};
+use waam_slicer::program::readback::abb::parse_mod;
+use waam_slicer::program::readback::kuka::parse_krl;
+use waam_slicer::program::validate::{validate_abb, validate_kuka, ValidationReport};
+use waam_slicer::program::{EmittedFile, Program};
+use waam_slicer::robot::Cell;
+
+use crate::fixture::{cell, part_carried, program};
+
+const CELLS: [&str; 3] = [
+    "robowam_part_carried.toml",
+    "robowam_part_carried_second_position.toml",
+    "robowam_torch_carried.toml",
+];
+
+fn hemi(cell: &Cell) -> (Program, Vec<Point3>) {
+    let (prog, _) = program(cell, 0..4, 24);
+    let planned = prog.bead_points().map(|p| p.position_mm).collect();
+    (prog, planned)
+}
+
+fn line_of(text: &str, needle: &str, after: usize) -> usize {
+    text.lines()
+        .enumerate()
+        .skip(after)
+        .find(|(_, l)| l.contains(needle))
+        .map(|(i, _)| i + 1)
+        .unwrap_or_else(|| panic!("`{needle}` not found"))
+}
+
+fn edit(text: &str, line: usize, f: impl Fn(&str) -> String) -> String {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| if i + 1 == line { f(l) } else { l.to_string() })
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
+}
+
+fn kuka_check(
+    files: &[EmittedFile],
+    src: &str,
+    dat: &str,
+    cell: &Cell,
+    opts: &KukaOptions,
+    planned: &[Point3],
+) -> ValidationReport {
+    let p = parse_krl(src, &files[0].name, dat, &files[1].name).unwrap_or_else(|e| panic!("{e}"));
+    validate_kuka(&p, cell, opts, Some(planned))
+}
+
+fn abb_check(text: &str, cell: &Cell, planned: &[Point3]) -> ValidationReport {
+    let m = parse_mod(text, "HEMI.mod").unwrap_or_else(|e| panic!("{e}"));
+    validate_abb(&m, cell, &AbbOptions::default(), Some(planned))
+}
+
+#[test]
+fn kuka_and_abb_programs_read_back_and_validate_in_every_cell() {
+    for file in CELLS {
+        let c = cell(file);
+        let (prog, planned) = hemi(&c);
+        for positions in [PositionMode::Joint, PositionMode::Cartesian] {
+            let opts = KukaOptions {
+                positions,
+                ..Default::default()
+            };
+            let f = kuka_files(&prog, &opts).unwrap();
+            let r = kuka_check(&f, &f[0].text, &f[1].text, &c, &opts, &planned);
+            assert!(r.is_ok(), "{file} KUKA {positions:?}:\n{r}");
+            assert_eq!((r.motions, r.beads), (96 + 8, 4));
+        }
+        let f = abb_files(&prog, &AbbOptions::default()).unwrap();
+        let r = abb_check(&f[0].text, &c, &planned);
+        assert!(r.is_ok(), "{file} ABB:\n{r}");
+        assert_eq!((r.motions, r.beads), (96 + 8, 4));
+    }
+}
+
+#[test]
+fn part_carried_cell_uses_external_tcp_and_stationary_tool() {
+    let (prog, _) = hemi(&part_carried());
+    let k = kuka_files(&prog, &KukaOptions::default()).unwrap();
+    assert!(k[0].text.contains("$IPO_MODE = #TCP"));
+    let a = abb_files(&prog, &AbbOptions::default()).unwrap();
+    assert!(a[0].text.contains("PERS tooldata tWaam := [FALSE,"));
+    assert!(a[0].text.contains("PERS wobjdata wWaam := [TRUE,"));
+    let (prog, _) = hemi(&cell("robowam_torch_carried.toml"));
+    let k = kuka_files(&prog, &KukaOptions::default()).unwrap();
+    assert!(k[0].text.contains("$IPO_MODE = #BASE"));
+}
+
+#[test]
+fn kuka_corruptions_are_named_by_their_line() {
+    let c = part_carried();
+    let (prog, planned) = hemi(&c);
+    let opts = KukaOptions::default();
+    let f = kuka_files(&prog, &opts).unwrap();
+    let (src, dat) = (&f[0].text, &f[1].text);
+    // a joint pushed out of range (J5 travel ±135°)
+    let l = line_of(dat, "DECL E6AXIS P3=", 0);
+    let bad = edit(dat, l, |s| {
+        let a = s.find("A5 ").unwrap();
+        let b = a + s[a..].find(',').unwrap();
+        format!("{}A5 170.0{}", &s[..a], &s[b..])
+    });
+    let r = kuka_check(&f, src, &bad, &c, &opts, &planned);
+    assert!(
+        r.problems.iter().any(|p| p.file == "HEMI.dat"
+            && p.line == l
+            && p.message.contains("P3: J5 = 170.0000°")),
+        "{r}"
+    );
+    // a dropped arc end: the next bead's start names it
+    let end = line_of(src, "DISTANCE=1", 0);
+    let next_start = line_of(src, "DISTANCE=0", end);
+    let dropped: String = src
+        .lines()
+        .enumerate()
+        .filter(|(i, _)| i + 1 != end)
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    let r = kuka_check(&f, &dropped, dat, &c, &opts, &planned);
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.line == next_start - 1 && p.message.contains("still on")),
+        "{r}"
+    );
+    // truncated files
+    for (text, name, word) in [(src, "HEMI.src", "END"), (dat, "HEMI.dat", "ENDDAT")] {
+        let lines: Vec<&str> = text.lines().collect();
+        let keep = lines.len() * 2 / 3;
+        let cut = lines[..keep].join("\n") + "\n";
+        let (s, d) = if name.ends_with("src") {
+            (cut.as_str(), dat.as_str())
+        } else {
+            (src.as_str(), cut.as_str())
+        };
+        let e = parse_krl(s, "HEMI.src", d, "HEMI.dat")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&format!("{name}:{keep}: ")) && e.contains(&format!("without {word}")),
+            "{e}"
+        );
+    }
+    // a configuration flip in an E6POS (Status bit 2: the sign of A5)
+    let copts = KukaOptions {
+        positions: PositionMode::Cartesian,
+        ..Default::default()
+    };
+    let f = kuka_files(&prog, &copts).unwrap();
+    let l = line_of(&f[1].text, "DECL E6POS P5=", 0);
+    let flipped = edit(&f[1].text, l, |s| {
+        let a = s.find(",S ").unwrap() + 3;
+        let b = a + s[a..].find(',').unwrap();
+        let v: u8 = s[a..b].parse().unwrap();
+        format!("{}{}{}", &s[..a], v ^ 4, &s[b..])
+    });
+    let r = kuka_check(&f, &f[0].text, &flipped, &c, &copts, &planned);
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.line == l && p.message.contains("configuration flip")),
+        "{r}"
+    );
+}
+
+#[test]
+fn abb_corruptions_are_named_by_their_line() {
+    let c = part_carried();
+    let (prog, planned) = hemi(&c);
+    let text = &abb_files(&prog, &AbbOptions::default()).unwrap()[0].text;
+    // a joint pushed out of range in the approach jointtarget
+    let l = line_of(text, "CONST jointtarget j1 :=", 0);
+    let bad = edit(text, l, |s| {
+        let inner = s.find("[[").unwrap() + 2;
+        let end = inner + s[inner..].find(']').unwrap();
+        let mut v: Vec<String> = s[inner..end].split(',').map(String::from).collect();
+        v[4] = "170.0".into();
+        format!("{}{}{}", &s[..inner], v.join(","), &s[end..])
+    });
+    let r = abb_check(&bad, &c, &planned);
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.line == l && p.message.contains("j1: J5 = 170.0000°")),
+        "{r}"
+    );
+    // a dropped ArcLEnd (turned into ArcL): the next ArcLStart names it
+    let end = line_of(text, "ArcLEnd ", 0);
+    let next = line_of(text, "ArcLStart ", end);
+    let dropped = edit(text, end, |s| {
+        s.replace("ArcLEnd ", "ArcL ").replace(", fine,", ", z1,")
+    });
+    let r = abb_check(&dropped, &c, &planned);
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.line == next && p.message.contains("still on")),
+        "{r}"
+    );
+    // truncated
+    let lines: Vec<&str> = text.lines().collect();
+    let keep = lines.len() - 3;
+    let cut = lines[..keep].join("\n") + "\n";
+    let e = parse_mod(&cut, "HEMI.mod").unwrap_err().to_string();
+    assert!(
+        e.starts_with(&format!("HEMI.mod:{keep}: ")) && e.contains("without ENDMODULE"),
+        "{e}"
+    );
+    // a configuration flip: cfx with the other elbow
+    let l = line_of(text, "CONST robtarget p5 :=", 0);
+    let flipped = edit(text, l, |s| {
+        let parts: Vec<&str> = s.split("],[").collect();
+        // [..trans],[quat],[cf1,cf4,cf6,cfx],[ext]
+        let conf: Vec<i32> = parts[2].split(',').map(|x| x.parse().unwrap()).collect();
+        let new = format!("{},{},{},{}", conf[0], conf[1], conf[2], conf[3] ^ 2);
+        s.replacen(parts[2], &new, 1)
+    });
+    let r = abb_check(&flipped, &c, &planned);
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.line == l && p.message.contains("configuration flip")),
+        "{r}"
+    );
+}

@@ -1,0 +1,194 @@
+//! Every sample part in every ROBOWAM cell: slice (Delta = 5 mm), optimise,
+//! and for the feasible combinations build the program, emit FANUC (joint
+//! and Cartesian), KUKA and ABB, read each back and validate it against the
+//! cell and the planned points. The list of feasible combinations is
+//! asserted so that a regression (or a fix) shows up.
+
+use std::time::Instant;
+
+use waam_slicer::math::Point3;
+use waam_slicer::optimise::{layer_points, optimise, OptimiseOptions};
+use waam_slicer::path::slice;
+use waam_slicer::program::abb::{abb_files, AbbOptions};
+use waam_slicer::program::fanuc::{fanuc_files, FanucOptions, PositionMode};
+use waam_slicer::program::kuka::{kuka_files, KukaOptions};
+use waam_slicer::program::readback::abb::parse_mod;
+use waam_slicer::program::readback::kuka::parse_krl;
+use waam_slicer::program::readback::parse_ls;
+use waam_slicer::program::validate::{validate_abb, validate_fanuc, validate_kuka};
+use waam_slicer::program::{build_program, Program, TravelSpeed};
+use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
+use waam_slicer::robot::Cell;
+use waam_slicer::toolaxis::local_frames;
+
+use crate::fixture::cell;
+use crate::shared::{load_part, SAMPLE_PARTS};
+
+/// Layers planned per part (the first ones): the whole parts take minutes
+/// each in the dev profile.
+const LAYERS: usize = 3;
+
+const CELLS: [&str; 3] = [
+    "robowam_part_carried.toml",
+    "robowam_part_carried_second_position.toml",
+    "robowam_torch_carried.toml",
+];
+
+/// The program of `part` in `cell`, or why there is none.
+fn plan_program(part: &str, cell: &Cell) -> Result<Program, String> {
+    let p = load_part(part);
+    let mut so = p.slice_options();
+    so.delta_mm = 5.0;
+    let path = slice(&p.tube, &p.substrate, &so).map_err(|e| e.to_string())?;
+    let frames = local_frames(&path, &p.tube);
+    let mut layers = layer_points(&path, &frames);
+    // dev-profile CI budget: the first LAYERS layers only
+    layers.truncate(LAYERS);
+    let opts = OptimiseOptions::default();
+    let plan = optimise(cell, &layers, &opts).map_err(|e| e.to_string())?;
+    if !plan.is_feasible() {
+        let l = plan
+            .infeasible_layers()
+            .next()
+            .expect("an infeasible layer");
+        return Err(format!("layer {}: {}", l.layer, l.status));
+    }
+    let inputs: Vec<PathPointInput> = layers
+        .iter()
+        .zip(&plan.layers)
+        .flat_map(|(lp, pl)| {
+            lp.points
+                .iter()
+                .zip(&pl.points)
+                .enumerate()
+                .map(move |(i, (cp, pp))| PathPointInput {
+                    layer: lp.layer,
+                    point: i,
+                    position_mm: cp.position_mm,
+                    tool_axis: cp.tool_axis,
+                    build_direction: cp.build_direction,
+                    r_z: pp.r_z,
+                })
+        })
+        .collect();
+    let ts = opts.travel_speed_mm_s;
+    let traj = joint_trajectory(cell, &inputs, ts, &TrajectoryOptions::default())
+        .map_err(|e| e.to_string())?;
+    build_program("PART", cell, &inputs, &traj, &TravelSpeed::Constant(ts))
+        .map_err(|e| e.to_string())
+}
+
+/// Emits, reads back and validates `prog` in every format; panics naming
+/// the first problem.
+fn check_all_formats(what: &str, prog: &Program, cell: &Cell) {
+    let planned: Vec<Point3> = prog.bead_points().map(|p| p.position_mm).collect();
+    let beads = prog.num_beads();
+    let motions = prog.points.len();
+    for positions in [PositionMode::Joint, PositionMode::Cartesian] {
+        let opts = FanucOptions {
+            positions,
+            ..Default::default()
+        };
+        let tps: Vec<_> = fanuc_files(prog, &opts)
+            .unwrap()
+            .iter()
+            .map(|f| parse_ls(&f.text, &f.name).unwrap_or_else(|e| panic!("{what}: {e}")))
+            .collect();
+        let r = validate_fanuc(&tps, cell, &opts, Some(&planned));
+        assert!(r.is_ok(), "{what}, FANUC {positions:?}:\n{r}");
+        assert_eq!((r.motions, r.beads), (motions, beads), "{what}");
+        let kopts = KukaOptions {
+            positions,
+            ..Default::default()
+        };
+        let k = kuka_files(prog, &kopts).unwrap();
+        let krl = parse_krl(&k[0].text, &k[0].name, &k[1].text, &k[1].name)
+            .unwrap_or_else(|e| panic!("{what}: {e}"));
+        let r = validate_kuka(&krl, cell, &kopts, Some(&planned));
+        assert!(r.is_ok(), "{what}, KUKA {positions:?}:\n{r}");
+        assert_eq!((r.motions, r.beads), (motions, beads), "{what}");
+    }
+    let aopts = AbbOptions::default();
+    let a = abb_files(prog, &aopts).unwrap();
+    let m = parse_mod(&a[0].text, &a[0].name).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let r = validate_abb(&m, cell, &aopts, Some(&planned));
+    assert!(r.is_ok(), "{what}, ABB:\n{r}");
+    assert_eq!((r.motions, r.beads), (motions, beads), "{what}");
+}
+
+#[test]
+fn the_validator_accepts_our_programs_for_every_feasible_part_and_cell() {
+    let mut feasible = Vec::new();
+    let mut report = String::new();
+    for file in CELLS {
+        let c = cell(file);
+        for part in SAMPLE_PARTS {
+            // the helix is infeasible in the part-carried cells (J4/J6
+            // speeds, being worked on by the lead) and takes a minute to
+            // find so: left out there
+            if part == "helix.toml" && file != "robowam_torch_carried.toml" {
+                continue;
+            }
+            let t = Instant::now();
+            let what = format!("{part} in {file}");
+            match plan_program(part, &c) {
+                Ok(prog) => {
+                    check_all_formats(&what, &prog, &c);
+                    feasible.push((part, file));
+                    let line = format!(
+                        "{what}: {} points, {} beads, {:.1} s\n",
+                        prog.points.len(),
+                        prog.num_beads(),
+                        t.elapsed().as_secs_f64()
+                    );
+                    eprint!("{line}");
+                    report += &line;
+                }
+                Err(e) => {
+                    let line = format!(
+                        "{what}: infeasible ({e}), {:.1} s\n",
+                        t.elapsed().as_secs_f64()
+                    );
+                    eprint!("{line}");
+                    report += &line;
+                }
+            }
+        }
+    }
+    let pc = "robowam_part_carried.toml";
+    let pc2 = "robowam_part_carried_second_position.toml";
+    let tc = "robowam_torch_carried.toml";
+    let mut want: Vec<(&str, &str)> = Vec::new();
+    for (cell, parts) in [
+        (
+            pc,
+            &[
+                "hemisphere.toml",
+                "nozzle.toml",
+                "half-catenoid.toml",
+                "quarter-torus.toml",
+                // the kinked layer that makes it infeasible is past layer 3
+                "general-tube.toml",
+                "torus-on-cylinder.toml",
+                "elbow.toml",
+            ][..],
+        ),
+        (
+            pc2,
+            &[
+                "hemisphere.toml",
+                "nozzle.toml",
+                "half-catenoid.toml",
+                "quarter-torus.toml",
+                "general-tube.toml",
+                // torus-on-cylinder: the plan is feasible but its joint
+                // trajectory has J5 = 135.08° (layer 2): refused
+                "elbow.toml",
+            ][..],
+        ),
+        (tc, &SAMPLE_PARTS[..]),
+    ] {
+        want.extend(parts.iter().map(|p| (*p, cell)));
+    }
+    assert_eq!(feasible, want, "{report}");
+}
