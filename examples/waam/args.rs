@@ -36,8 +36,8 @@ pub enum StrategyArg {
 pub enum Command {
     /// Slice a part: writes path.csv and summary.json in --out.
     Slice(SliceArgs),
-    /// Check a FANUC program (.ls, following its CALLs) against a cell: limits,
-    /// speeds, reachability, configuration, beads. Exit 0 valid, 2 problems, 1 unreadable.
+    /// Check a robot program against a cell — FANUC .ls (following its CALLs), KUKA .src + .dat,
+    /// ABB .mod: limits, speeds, reachability, configuration, beads. Exit 0 valid, 2 problems, 1 unreadable.
     Check(CheckArgs),
     /// Plan a part in a cell: slice, tool axes, R_Z optimisation, joints;
     /// writes joints.csv and summary.json in --out (exit 2 if infeasible).
@@ -173,7 +173,7 @@ pub struct PlanArgs {
 /// Arguments of `check`.
 #[derive(Debug, clap::Args)]
 pub struct CheckArgs {
-    /// The main FANUC program (.ls); sub-programs it calls are read from the same folder.
+    /// The program: FANUC main .ls (sub-programs it calls are read from the same folder), KUKA .src (its .dat beside it) or ABB .mod.
     pub program: PathBuf,
     /// The cell file (TOML, parts/cells/).
     #[arg(long)]

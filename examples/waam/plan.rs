@@ -373,8 +373,8 @@ fn emit_program(
     Ok(files.iter().map(|f| f.name.clone()).collect())
 }
 
-/// `waam check`: reads a FANUC program and the sub-programs it calls, and
-/// validates them against the cell.
+/// `waam check`: reads a FANUC program and the sub-programs it calls, a KUKA
+/// `.src` + `.dat` pair or an ABB module, and validates it against the cell.
 pub fn check(a: &crate::args::CheckArgs, quiet: bool) -> ExitCode {
     use waam_slicer::program::fanuc::FanucOptions;
     use waam_slicer::program::readback::parse_ls;
@@ -393,7 +393,48 @@ pub fn check(a: &crate::args::CheckArgs, quiet: bool) -> ExitCode {
             let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
             parse_ls(&text, &p.display().to_string()).map_err(|e| e.to_string())
         };
-        let main = read(&a.program)?;
+        let ext = a
+            .program
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        let text_of = |p: &std::path::Path| {
+            std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))
+        };
+        let report = match ext.as_str() {
+            "src" | "dat" => {
+                let src = a.program.with_extension("src");
+                let dat = a.program.with_extension("dat");
+                let program = waam_slicer::program::readback::kuka::parse_krl(
+                    &text_of(&src)?,
+                    &src.display().to_string(),
+                    &text_of(&dat)?,
+                    &dat.display().to_string(),
+                )
+                .map_err(|e| e.to_string())?;
+                waam_slicer::program::validate::validate_kuka(
+                    &program,
+                    &cell,
+                    &Default::default(),
+                    None,
+                )
+            }
+            "mod" => {
+                let module = waam_slicer::program::readback::abb::parse_mod(
+                    &text_of(&a.program)?,
+                    &a.program.display().to_string(),
+                )
+                .map_err(|e| e.to_string())?;
+                waam_slicer::program::validate::validate_abb(
+                    &module,
+                    &cell,
+                    &Default::default(),
+                    None,
+                )
+            }
+            "ls" => {
+                let main = read(&a.program)?;
         let mut programs = vec![main];
         let mut k = 0;
         while k < programs.len() {
@@ -412,7 +453,15 @@ pub fn check(a: &crate::args::CheckArgs, quiet: bool) -> ExitCode {
             }
             k += 1;
         }
-        let report = validate_fanuc(&programs, &cell, &FanucOptions::default(), None);
+        validate_fanuc(&programs, &cell, &FanucOptions::default(), None)
+            }
+            other => {
+                return Err(format!(
+                    "{}: unknown program type `.{other}`; expected .ls (FANUC), .src/.dat (KUKA) or .mod (ABB)",
+                    a.program.display()
+                ))
+            }
+        };
         for p in &report.problems {
             eprintln!("{p}");
         }

@@ -211,3 +211,61 @@ fn slice_applies_the_tool_axis_and_process_settings() {
     let time = |s: &serde_json::Value| s["process"]["deposition_time_s"].as_f64().unwrap();
     assert!((time(&slow) / time(&bounded) - 2.0).abs() < 1e-9);
 }
+
+/// KUKA and ABB end to end: the nozzle planned in the example KUKA
+/// torch-carried cell (`--format kuka`) and the example ABB part-carried
+/// cell (`--format abb`) gives programs that `check` accepts; a joint pushed
+/// out of its travel in the KUKA `.dat` is named by file and line (exit 2).
+#[test]
+fn kuka_and_abb_plans_pass_check() {
+    let dir = tempfile::tempdir().unwrap();
+    for (format, cell, program) in [
+        ("kuka", "cells/kuka_kr16_2_torch_carried.toml", "NOZZLE.src"),
+        ("abb", "cells/abb_irb2600_part_carried.toml", "NOZZLE.mod"),
+    ] {
+        let out = dir.path().join(format);
+        let cell = part_path(cell);
+        let status = waam()
+            .args(["--quiet", "plan"])
+            .arg(part_path("nozzle.toml"))
+            .arg("--cell")
+            .arg(&cell)
+            .args([
+                "--delta", "5", "--points", "60", "--format", format, "--out",
+            ])
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert_eq!(status.code(), Some(0), "{format}");
+        let check = |file: &std::path::Path| {
+            waam()
+                .args(["check"])
+                .arg(file)
+                .arg("--cell")
+                .arg(&cell)
+                .output()
+                .unwrap()
+        };
+        let ok = check(&out.join(program));
+        assert_eq!(
+            ok.status.code(),
+            Some(0),
+            "{format}: {}",
+            String::from_utf8_lossy(&ok.stderr)
+        );
+        if format == "kuka" {
+            let dat = out.join("NOZZLE.dat");
+            let text = std::fs::read_to_string(&dat).unwrap();
+            let at = text.find("A5 ").expect("an E6AXIS or E6POS with A5") + 3;
+            let end = at + text[at..].find([',', '}']).unwrap();
+            std::fs::write(&dat, format!("{}175.0{}", &text[..at], &text[end..])).unwrap();
+            let bad = check(&out.join(program));
+            let err = String::from_utf8_lossy(&bad.stderr);
+            assert_eq!(bad.status.code(), Some(2), "{err}");
+            assert!(
+                err.contains("NOZZLE.dat:") && err.contains("J5 = 175"),
+                "{err}"
+            );
+        }
+    }
+}
