@@ -131,7 +131,11 @@ pub fn expression(role: u8, text: &str) {
         point: Point3::origin(),
         normal: UnitVector3::new_normalize(Vector3::z()),
     };
-    slice_a_little(&tube, &substrate, SliceOptions::new(Strategy::Constant, 4.0));
+    slice_a_little(
+        &tube,
+        &substrate,
+        SliceOptions::new(Strategy::Constant, 4.0),
+    );
 }
 
 /// STL target: bytes → mesh substrate; if it reads, find the first layer of

@@ -306,3 +306,14 @@ fn binary_stl_with_wrong_triangle_count_names_both_counts() {
         MeshSubstrate::from_stl_bytes(&good_stl[..good_stl.len() - 1], "short.stl").unwrap_err();
     assert_mentions(&e.to_string(), &["short.stl", "announces 2 triangles"]);
 }
+
+#[cfg(unix)]
+#[test]
+fn endless_device_files_are_refused_at_the_size_limit() {
+    // `/dev/zero` reports a length of 0 and never ends: reading must stop at
+    // the limit instead of filling the memory.
+    let e = MeshSubstrate::from_stl_file(Path::new("/dev/zero")).unwrap_err();
+    assert_mentions(&e.to_string(), &["/dev/zero", "more than 268435456 bytes"]);
+    let e = read_part_file(Path::new("/dev/zero")).unwrap_err();
+    assert_mentions(&e.to_string(), &["/dev/zero", "more than 4194304 bytes"]);
+}
