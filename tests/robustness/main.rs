@@ -6,6 +6,7 @@
 mod common;
 
 mod hostile_inputs;
+mod regressions;
 
 use proptest::prelude::*;
 use std::path::Path;
