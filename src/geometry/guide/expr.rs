@@ -80,6 +80,52 @@ fn shape(text: &str, param: &str) -> Shape {
     out
 }
 
+/// Stack of the thread that differentiates: the derivatives are built by
+/// recursion as deep as the expression (within the limits above, several MiB
+/// in a debug build; more than a 2 MiB test or worker thread has).
+const DIFFERENTIATION_STACK_BYTES: usize = 64 << 20;
+
+/// `[f, f', f'', f''']` with respect to variable `k`, computed on a thread
+/// with a stack of [`DIFFERENTIATION_STACK_BYTES`]; refuses an expression whose
+/// next derivative would exceed the work bound.
+fn derivatives(f: FlatEx<f64>, k: usize, param: &str) -> Result<Vec<FlatEx<f64>>, String> {
+    let run = move || -> Result<Vec<FlatEx<f64>>, String> {
+        let mut chain = vec![f];
+        for order in 1..=3 {
+            let last = chain.last().cloned().expect("chain starts non-empty");
+            let size = last.unparse().len();
+            let work = size.saturating_mul(shape(last.unparse(), param).tokens);
+            if work > DERIVATIVE_WORK_LIMIT {
+                return Err(format!(
+                    "too complex to differentiate {order} times: derivative {} has {size} \
+                     characters (characters x tokens = {work}, the limit is {DERIVATIVE_WORK_LIMIT})",
+                    order - 1
+                ));
+            }
+            let d = last
+                .partial(k)
+                .map_err(|e| format!("cannot differentiate: {e}"))?;
+            chain.push(d);
+        }
+        let size = chain[3].unparse().len();
+        if size > MAX_DERIVATIVE_LEN {
+            return Err(format!(
+                "too complex: its third derivative has {size} characters; the limit is {MAX_DERIVATIVE_LEN}"
+            ));
+        }
+        Ok(chain)
+    };
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .name("waam-expression-derivatives".into())
+            .stack_size(DIFFERENTIATION_STACK_BYTES)
+            .spawn_scoped(scope, run)
+            .map_err(|e| format!("cannot start the differentiation thread: {e}"))?
+            .join()
+            .map_err(|_| "the expression library failed while differentiating".to_string())?
+    })
+}
+
 /// A scalar expression of one parameter (`t` by default) and named constants,
 /// with its first three derivatives computed symbolically once, at parse time.
 ///
@@ -170,31 +216,10 @@ impl Expression {
                 )));
             }
         }
-        let mut chain = vec![f];
-        if let Some(k) = slot {
-            for order in 1..=3 {
-                let last = chain.last().cloned().expect("chain starts non-empty");
-                let size = last.unparse().len();
-                let work = size.saturating_mul(shape(last.unparse(), param).tokens);
-                if work > DERIVATIVE_WORK_LIMIT {
-                    return Err(err(format!(
-                        "too complex to differentiate {order} times: derivative {} has {size} \
-                         characters (characters x tokens = {work}, the limit is {DERIVATIVE_WORK_LIMIT})",
-                        order - 1
-                    )));
-                }
-                let d = last
-                    .partial(k)
-                    .map_err(|e| err(format!("cannot differentiate: {e}")))?;
-                chain.push(d);
-            }
-            let size = chain[3].unparse().len();
-            if size > MAX_DERIVATIVE_LEN {
-                return Err(err(format!(
-                    "too complex: its third derivative has {size} characters; the limit is {MAX_DERIVATIVE_LEN}"
-                )));
-            }
-        }
+        let chain = match slot {
+            Some(k) => derivatives(f, k, param).map_err(err)?,
+            None => vec![f],
+        };
         Ok(Self {
             text: text.to_string(),
             chain,
