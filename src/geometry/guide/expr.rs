@@ -154,8 +154,12 @@ impl Expression {
     /// `constants` substituted by value.
     ///
     /// # Errors
-    /// [`GeometryError::Expression`] when the text is too long, does not parse,
-    /// uses an unknown variable or function, or cannot be differentiated.
+    /// [`GeometryError::Expression`] when the text is too long, nests too deep,
+    /// has too many tokens or uses of the parameter (the limits are
+    /// [`MAX_EXPRESSION_LEN`], [`MAX_EXPRESSION_NESTING`],
+    /// [`MAX_EXPRESSION_TOKENS`], [`MAX_PARAMETER_USES`]), does not parse, uses
+    /// an unknown variable or function, or its derivatives would grow too large
+    /// to compute (each message says which, with the limit).
     pub fn parse(
         text: &str,
         param: &str,
