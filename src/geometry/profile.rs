@@ -31,10 +31,11 @@ impl ProfileLaw {
             ProfileLaw::Constant(_) => None,
             ProfileLaw::Expression(e) => Some(e),
             ProfileLaw::Piecewise(pieces) => {
+                // No pieces: no radius (NaN), which `Tube::new` refuses.
                 let i = pieces
                     .partition_point(|p| p.until < t)
-                    .min(pieces.len() - 1);
-                Some(&pieces[i].radius)
+                    .min(pieces.len().saturating_sub(1));
+                pieces.get(i).map(|p| &p.radius)
             }
         }
     }

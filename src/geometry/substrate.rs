@@ -144,7 +144,22 @@ impl MeshSubstrate {
                 meta.len()
             )));
         }
-        let bytes = std::fs::read(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+        // Read at most one byte past the limit: a device or pipe reports a
+        // length of 0 and would otherwise be read for ever.
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(
+            &mut std::io::Read::take(
+                std::fs::File::open(path).map_err(|e| bad(format!("cannot open: {e}")))?,
+                MAX_STL_BYTES + 1,
+            ),
+            &mut bytes,
+        )
+        .map_err(|e| bad(format!("cannot read: {e}")))?;
+        if bytes.len() as u64 > MAX_STL_BYTES {
+            return Err(bad(format!(
+                "more than {MAX_STL_BYTES} bytes, the limit for an STL file"
+            )));
+        }
         Self::from_stl_bytes(&bytes, &source)
     }
 

@@ -435,7 +435,22 @@ pub fn read_part_file(path: &Path) -> Result<Part, PartFileError> {
             ),
         });
     }
-    let bytes = std::fs::read(path).map_err(io)?;
+    // At most one byte past the limit: a device or pipe reports length 0.
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(
+            std::fs::File::open(path).map_err(io)?,
+            MAX_PART_FILE_BYTES + 1,
+        ),
+        &mut bytes,
+    )
+    .map_err(io)?;
+    if bytes.len() as u64 > MAX_PART_FILE_BYTES {
+        return Err(PartFileError::Io {
+            file,
+            reason: format!("more than {MAX_PART_FILE_BYTES} bytes, the limit for a part file"),
+        });
+    }
     let text = String::from_utf8(bytes).map_err(|e| PartFileError::Syntax {
         file: file.clone(),
         message: format!(

@@ -2,6 +2,12 @@
 //! with every local distance at Delta and no NaN anywhere, or give a typed
 //! error; random text never panics the part-file reader.
 
+#[path = "../common/mod.rs"]
+mod common;
+
+mod hostile_inputs;
+mod regressions;
+
 use proptest::prelude::*;
 use std::path::Path;
 use waam_slicer::io::part_file::parse_part;

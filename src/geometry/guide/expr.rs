@@ -13,6 +13,118 @@ use std::collections::BTreeMap;
 pub const MAX_EXPRESSION_LEN: usize = 4096;
 /// Most variables (the parameter plus named constants) one expression may use.
 const MAX_VARS: usize = 16;
+/// Deepest nesting of parentheses accepted: the symbolic derivatives recurse
+/// once per level (400 nested `sin(` overflowed the stack).
+pub const MAX_EXPRESSION_NESTING: usize = 32;
+/// Most tokens (numbers, names, operators) in one expression. Each operator
+/// on the way from the top of the expression to a use of the parameter can
+/// copy what lies below it when differentiated: 3000 unary minus signs took
+/// 15 s, a chain of 24 divisions by `t` 5 GB.
+pub const MAX_EXPRESSION_TOKENS: usize = 256;
+/// Most uses of the parameter in one expression: each use adds a term to the
+/// derivatives (a product of 60 factors of `t` took 3 GB to differentiate
+/// three times).
+pub const MAX_PARAMETER_USES: usize = 24;
+/// Work bound of one differentiation: the next derivative is computed only
+/// if the current one's characters × tokens stay below this (its size is at
+/// most about that product), else the expression is refused as too complex.
+const DERIVATIVE_WORK_LIMIT: usize = 1 << 20;
+/// Longest derivative text kept (characters).
+const MAX_DERIVATIVE_LEN: usize = 1 << 16;
+
+/// The shape of an expression's text: deepest parenthesis nesting, tokens,
+/// and uses of the parameter (identifiers: a letter or `_`, then letters,
+/// digits or `_`; numbers count as one token).
+#[derive(Debug, Clone, Copy)]
+struct Shape {
+    nesting: usize,
+    tokens: usize,
+    uses: usize,
+}
+
+fn shape(text: &str, param: &str) -> Shape {
+    let mut out = Shape {
+        nesting: 0,
+        tokens: 0,
+        uses: 0,
+    };
+    let mut depth = 0usize;
+    let mut chars = text.char_indices().peekable();
+    while let Some((i, c)) = chars.next() {
+        if c.is_whitespace() {
+            continue;
+        }
+        out.tokens += 1;
+        match c {
+            '(' => {
+                depth += 1;
+                out.nesting = out.nesting.max(depth);
+            }
+            ')' => depth = depth.saturating_sub(1),
+            c if c.is_alphanumeric() || c == '_' || c == '.' => {
+                let mut end = i + c.len_utf8();
+                while let Some(&(j, d)) = chars.peek() {
+                    if !(d.is_alphanumeric() || d == '_' || d == '.') {
+                        break;
+                    }
+                    end = j + d.len_utf8();
+                    chars.next();
+                }
+                if &text[i..end] == param {
+                    out.uses += 1;
+                }
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// Stack of the thread that differentiates: the derivatives are built by
+/// recursion as deep as the expression (within the limits above, several MiB
+/// in a debug build; more than a 2 MiB test or worker thread has).
+const DIFFERENTIATION_STACK_BYTES: usize = 64 << 20;
+
+/// `[f, f', f'', f''']` with respect to variable `k`, computed on a thread
+/// with a stack of [`DIFFERENTIATION_STACK_BYTES`]; refuses an expression whose
+/// next derivative would exceed the work bound.
+fn derivatives(f: FlatEx<f64>, k: usize, param: &str) -> Result<Vec<FlatEx<f64>>, String> {
+    let run = move || -> Result<Vec<FlatEx<f64>>, String> {
+        let mut chain = vec![f];
+        for order in 1..=3 {
+            let last = chain.last().cloned().expect("chain starts non-empty");
+            let size = last.unparse().len();
+            let work = size.saturating_mul(shape(last.unparse(), param).tokens);
+            if work > DERIVATIVE_WORK_LIMIT {
+                return Err(format!(
+                    "too complex to differentiate {order} times: derivative {} has {size} \
+                     characters (characters x tokens = {work}, the limit is {DERIVATIVE_WORK_LIMIT})",
+                    order - 1
+                ));
+            }
+            let d = last
+                .partial(k)
+                .map_err(|e| format!("cannot differentiate: {e}"))?;
+            chain.push(d);
+        }
+        let size = chain[3].unparse().len();
+        if size > MAX_DERIVATIVE_LEN {
+            return Err(format!(
+                "too complex: its third derivative has {size} characters; the limit is {MAX_DERIVATIVE_LEN}"
+            ));
+        }
+        Ok(chain)
+    };
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .name("waam-expression-derivatives".into())
+            .stack_size(DIFFERENTIATION_STACK_BYTES)
+            .spawn_scoped(scope, run)
+            .map_err(|e| format!("cannot start the differentiation thread: {e}"))?
+            .join()
+            .map_err(|_| "the expression library failed while differentiating".to_string())?
+    })
+}
 
 /// A scalar expression of one parameter (`t` by default) and named constants,
 /// with its first three derivatives computed symbolically once, at parse time.
@@ -42,8 +154,12 @@ impl Expression {
     /// `constants` substituted by value.
     ///
     /// # Errors
-    /// [`GeometryError::Expression`] when the text is too long, does not parse,
-    /// uses an unknown variable or function, or cannot be differentiated.
+    /// [`GeometryError::Expression`] when the text is too long, nests too deep,
+    /// has too many tokens or uses of the parameter (the limits are
+    /// [`MAX_EXPRESSION_LEN`], [`MAX_EXPRESSION_NESTING`],
+    /// [`MAX_EXPRESSION_TOKENS`], [`MAX_PARAMETER_USES`]), does not parse, uses
+    /// an unknown variable or function, or its derivatives would grow too large
+    /// to compute (each message says which, with the limit).
     pub fn parse(
         text: &str,
         param: &str,
@@ -61,6 +177,25 @@ impl Expression {
         }
         if text.trim().is_empty() {
             return Err(err("expression is empty".into()));
+        }
+        let sh = shape(text, param);
+        if sh.nesting > MAX_EXPRESSION_NESTING {
+            return Err(err(format!(
+                "parentheses nest {} deep; the limit is {MAX_EXPRESSION_NESTING}",
+                sh.nesting
+            )));
+        }
+        if sh.tokens > MAX_EXPRESSION_TOKENS {
+            return Err(err(format!(
+                "{} tokens (numbers, names, operators); the limit is {MAX_EXPRESSION_TOKENS}",
+                sh.tokens
+            )));
+        }
+        if sh.uses > MAX_PARAMETER_USES {
+            return Err(err(format!(
+                "uses `{param}` {} times; the limit is {MAX_PARAMETER_USES}",
+                sh.uses
+            )));
         }
         let f = exmex::parse::<f64>(text).map_err(|e| err(e.to_string()))?;
         let names: Vec<String> = f.var_names().to_vec();
@@ -85,16 +220,10 @@ impl Expression {
                 )));
             }
         }
-        let mut chain = vec![f];
-        if let Some(k) = slot {
-            for _ in 0..3 {
-                let last = chain.last().cloned().expect("chain starts non-empty");
-                let d = last
-                    .partial(k)
-                    .map_err(|e| err(format!("cannot differentiate: {e}")))?;
-                chain.push(d);
-            }
-        }
+        let chain = match slot {
+            Some(k) => derivatives(f, k, param).map_err(err)?,
+            None => vec![f],
+        };
         Ok(Self {
             text: text.to_string(),
             chain,

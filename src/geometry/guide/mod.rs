@@ -10,7 +10,10 @@ mod pipe;
 mod spline;
 
 pub use arc::CircleArc;
-pub use expr::{ExprCurve, Expression, MAX_EXPRESSION_LEN};
+pub use expr::{
+    ExprCurve, Expression, MAX_EXPRESSION_LEN, MAX_EXPRESSION_NESTING, MAX_EXPRESSION_TOKENS,
+    MAX_PARAMETER_USES,
+};
 pub use helix::Helix;
 pub use line::Line;
 pub use pipe::{PipeRun, PipeSegment};

@@ -1,0 +1,174 @@
+//! What each fuzz target checks, as plain functions so a crashing input can be
+//! replayed from a test or a debugger. Every function must return normally for
+//! any input: the library may refuse the input (an `Err`), but must not panic,
+//! hang, or let a NaN or infinity reach an output. Each accepted input is also
+//! pushed a few steps down the pipeline (tube, first layer, three layers of
+//! twelve points) so that semantic panics are found too, not only parser ones.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
+use waam_slicer::geometry::guide::{ExprCurve, Expression, GuideCurve, Line};
+use waam_slicer::geometry::{
+    FrameMethod, MeshSubstrate, ProfileLaw, ProfilePiece, Substrate, Tube, TubeRange,
+};
+use waam_slicer::io::part_file::parse_part;
+use waam_slicer::math::{Point3, UnitVector3, Vector3};
+use waam_slicer::path::{self, Discretisation, SliceOptions, Strategy};
+
+/// Folder the part-file target resolves relative STL paths against (the STL
+/// seeds: `file = "plate-binary.stl"` names a real mesh).
+pub fn stl_seed_dir() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/seeds/stl"))
+}
+
+fn finite(p: &Point3) -> bool {
+    p.coords.iter().all(|c| c.is_finite())
+}
+
+/// Slices at most three layers of twelve points and checks every number of
+/// the result is finite.
+fn slice_a_little(tube: &Tube, substrate: &Substrate, mut opts: SliceOptions) {
+    opts.max_layers = Some(3);
+    opts.discretisation = Discretisation::Points(12);
+    if let Ok(path) = path::slice(tube, substrate, &opts) {
+        for layer in &path.layers {
+            for p in &layer.points {
+                assert!(
+                    p.t.is_finite() && p.v.is_finite() && finite(&p.position),
+                    "non-finite path point {p:?} in slice {}",
+                    layer.slice
+                );
+                assert!(
+                    p.delta.is_none_or(f64::is_finite),
+                    "non-finite local distance {p:?}"
+                );
+            }
+        }
+    }
+}
+
+/// Part-file target: text → part; if it reads, slice a little.
+pub fn part_file(text: &str) {
+    match parse_part(text, "fuzz.toml", stl_seed_dir()) {
+        Ok(part) => slice_a_little(&part.tube, &part.substrate, part.slice_options()),
+        Err(e) => assert!(
+            e.to_string().starts_with("fuzz.toml"),
+            "error does not name the file: {e}"
+        ),
+    }
+}
+
+fn expr(text: &str) -> Expression {
+    Expression::parse(text, "t", &BTreeMap::new()).expect("fixed expression parses")
+}
+
+/// Expression target: `role` says where the text goes (0: the profile
+/// radius `A(t)` of a cylinder; 1: `x(t)` of the guide; 2: `z(t)` of the
+/// guide; 3: the second piece of a piecewise profile). The expression is
+/// evaluated at a few `t`; if the tube validates, it is sliced a little.
+pub fn expression(role: u8, text: &str) {
+    let constants = BTreeMap::from([("R".to_string(), 30.0), ("r".to_string(), 5.0)]);
+    let e = match Expression::parse(text, "t", &constants) {
+        Ok(e) => e,
+        Err(err) => {
+            assert!(!err.to_string().is_empty());
+            return;
+        }
+    };
+    for t in [0.0, 0.5, 1.0, -1.0, 16.0, 1e6, -1e300] {
+        for order in 0..=3 {
+            // NaN is allowed here (undefined there); the tube must catch it.
+            let _ = e.eval_derivative(order, t);
+        }
+    }
+    let line: Arc<dyn GuideCurve> = Arc::new(Line {
+        origin: Point3::origin(),
+        direction: UnitVector3::new_normalize(Vector3::z()),
+    });
+    let (guide, profile): (Arc<dyn GuideCurve>, ProfileLaw) = match role % 4 {
+        0 => (line, ProfileLaw::Expression(e)),
+        1 => (
+            Arc::new(ExprCurve {
+                x: e,
+                y: expr("0"),
+                z: expr("t"),
+            }),
+            ProfileLaw::Constant(2.0),
+        ),
+        2 => (
+            Arc::new(ExprCurve {
+                x: expr("0"),
+                y: expr("0"),
+                z: e,
+            }),
+            ProfileLaw::Constant(2.0),
+        ),
+        _ => (
+            line,
+            ProfileLaw::Piecewise(vec![
+                ProfilePiece {
+                    until: 8.0,
+                    radius: expr("5"),
+                },
+                ProfilePiece {
+                    until: f64::INFINITY,
+                    radius: e,
+                },
+            ]),
+        ),
+    };
+    let Ok(tube) = Tube::new(
+        guide,
+        FrameMethod::default(),
+        None,
+        profile,
+        TubeRange::new(0.0, 32.0),
+    ) else {
+        return;
+    };
+    let substrate = Substrate::Plane {
+        point: Point3::origin(),
+        normal: UnitVector3::new_normalize(Vector3::z()),
+    };
+    slice_a_little(
+        &tube,
+        &substrate,
+        SliceOptions::new(Strategy::Constant, 4.0),
+    );
+}
+
+/// STL target: bytes → mesh substrate; if it reads, find the first layer of
+/// a cylinder of radius 5 along Z (t from -20 to 20) on it.
+pub fn stl(bytes: &[u8]) {
+    let mesh = match MeshSubstrate::from_stl_bytes(bytes, "fuzz.stl") {
+        Ok(m) => m,
+        Err(e) => {
+            assert!(
+                e.to_string().contains("fuzz.stl"),
+                "error does not name the file: {e}"
+            );
+            return;
+        }
+    };
+    let tube = Tube::new(
+        Arc::new(Line {
+            origin: Point3::origin(),
+            direction: UnitVector3::new_normalize(Vector3::z()),
+        }),
+        FrameMethod::default(),
+        None,
+        ProfileLaw::Constant(5.0),
+        TubeRange::new(-20.0, 20.0),
+    )
+    .expect("fixed cylinder is valid");
+    let substrate = Substrate::Mesh(Box::new(mesh));
+    if let Ok(layer) = substrate.first_layer(&tube, 8) {
+        for p in &layer {
+            assert!(
+                p.t.is_finite() && finite(&p.position),
+                "non-finite first-layer point {p:?}"
+            );
+        }
+    }
+}

@@ -1,0 +1,119 @@
+//! Inputs that once crashed (panicked, hung or leaked a NaN), found by the
+//! fuzz targets in `fuzz/` or by review; each is fed as it was and must now be
+//! refused with an error naming the problem. Files too long to inline are in
+//! `tests/robustness/regressions/`.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
+use waam_slicer::geometry::guide::{Expression, Line};
+use waam_slicer::geometry::{FrameMethod, GeometryError, ProfileLaw, Tube, TubeRange};
+use waam_slicer::math::{Point3, Vector3};
+
+#[allow(dead_code)]
+fn regression_file(name: &str) -> Vec<u8> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/robustness/regressions")
+        .join(name);
+    std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+/// Review: a piecewise profile with no pieces panicked (index `0 - 1`) in
+/// `ProfileLaw::radius`; part files refuse it earlier, the API did not.
+#[test]
+fn piecewise_profile_without_pieces_is_refused_by_the_tube() {
+    let e = Tube::new(
+        Arc::new(Line {
+            origin: Point3::origin(),
+            direction: Vector3::z_axis(),
+        }),
+        FrameMethod::default(),
+        None,
+        ProfileLaw::Piecewise(Vec::new()),
+        TubeRange::new(0.0, 10.0),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, GeometryError::NonFinite { t, .. } if t == 0.0),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("profile radius"), "{e}");
+}
+
+fn expression_error(text: &str) -> String {
+    match Expression::parse(text, "t", &BTreeMap::new()) {
+        Ok(_) => panic!("accepted {} characters", text.len()),
+        Err(e) => {
+            assert!(matches!(e, GeometryError::Expression { .. }), "{e:?}");
+            e.to_string()
+        }
+    }
+}
+
+/// Review (probing the expression target): 400 nested `sin(` overflowed the
+/// stack while differentiating (SIGSEGV after 26 s).
+#[test]
+fn deeply_nested_expression_is_refused() {
+    let text = format!("{}t{}", "sin(".repeat(400), ")".repeat(400));
+    let msg = expression_error(&text);
+    assert!(msg.contains("nest 400 deep; the limit is 32"), "{msg}");
+}
+
+/// Review: `t^t^...^t` (300 uses) overflowed the stack; a product of 60
+/// factors `(1+t/k)` took 18 s and 3.3 GB before overflowing it.
+#[test]
+fn expression_with_too_many_uses_of_t_is_refused() {
+    let tower = vec!["t"; 300].join("^");
+    let msg = expression_error(&tower);
+    assert!(msg.contains("tokens") || msg.contains("uses `t`"), "{msg}");
+    let product: Vec<String> = (1..60).map(|k| format!("(1+t/{k})")).collect();
+    let msg = expression_error(&product.join("*"));
+    assert!(msg.contains("471 tokens"), "{msg}");
+    let msg = expression_error(&vec!["t"; 59].join("*"));
+    assert!(msg.contains("uses `t` 59 times; the limit is 24"), "{msg}");
+}
+
+/// Review: 3000 unary minus signs took 15 s to differentiate; 1000 `sin `
+/// without parentheses timed out (100 s).
+#[test]
+fn long_unary_chains_are_refused() {
+    let msg = expression_error(&format!("{}t", "-".repeat(3000)));
+    assert!(
+        msg.contains("3001 tokens") && msg.contains("limit is 256"),
+        "{msg}"
+    );
+    let msg = expression_error(&format!("{}t", "sin ".repeat(1000)));
+    assert!(msg.contains("tokens"), "{msg}");
+}
+
+/// Review: a chain of 24 divisions by `t` (within every text limit) took
+/// 26 s and 5 GB; `t/(t*(t/(t*...)))` 76 s and 2 GB. The work bound per
+/// differentiation refuses them at once.
+#[test]
+fn expression_whose_derivatives_explode_is_refused_quickly() {
+    let start = std::time::Instant::now();
+    let chain = vec!["t"; 24].join("/");
+    let msg = expression_error(&chain);
+    assert!(msg.contains("too complex"), "{msg}");
+    let nested = format!("{}t{}", "t/(t*(".repeat(7), "))".repeat(7));
+    let msg = expression_error(&nested);
+    assert!(msg.contains("too complex"), "{msg}");
+    assert!(start.elapsed().as_secs_f64() < 5.0, "{:?}", start.elapsed());
+}
+
+/// What the limits must not refuse: the sample parts' kind of expressions.
+#[test]
+fn ordinary_expressions_pass_the_limits() {
+    let c = BTreeMap::from([("R_s".to_string(), 45.0)]);
+    for text in [
+        "sqrt(R_s^2 - t^2)",
+        "(0.005 * t^3 - 0.22 * t^2) / 6",
+        "5 + cos(8 * PI * t / 40)",
+        "1 + 2*t + 3*t^2 + 4*t^3 + 5*t^4 + 6*t^5 + 7*t^6 + 8*t^7 + 9*t^8 + 10*t^9",
+        "exp(-t/20) * sin(t) / (1 + t^2) + atan(t) * cosh(t / 50)",
+    ] {
+        if let Err(e) = Expression::parse(text, "t", &c) {
+            panic!("{text}: {e}");
+        }
+    }
+}
