@@ -11,7 +11,9 @@ use crate::optimise::outcome::{Binding, Constraint};
 use crate::optimise::parameterisation::Basis;
 use crate::robot::cell::{Cell, CellPoint};
 use crate::robot::ik::Configuration;
-use crate::robot::indices::{dexterity, positioning_uncertainty, UncertaintyFormula};
+use crate::robot::indices::{
+    dexterity, dexterity_warm, positioning_uncertainty, SvdWarmStart, UncertaintyFormula,
+};
 use crate::robot::model::Joints;
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::RobotError;
@@ -50,6 +52,9 @@ pub(crate) struct LayerProblem<'a> {
     pub sigma: [f64; 6],
     /// Length scale of the dexterity (mm).
     pub dex_scale: f64,
+    /// Joints the first point is unwrapped towards (a spiral turn continuing
+    /// the one before); `None`: the representation inside the travel.
+    pub start_near: Option<Joints>,
 }
 
 /// Joints and derivatives at every point for given `R_Z`.
@@ -124,7 +129,8 @@ impl<'a> LayerProblem<'a> {
         let mut dex = Vec::with_capacity(p);
         let mut unc = Vec::new();
         let mut q8 = 0.0;
-        let mut prev: Option<Joints> = None;
+        let mut prev: Option<Joints> = self.start_near;
+        let mut warm = SvdWarmStart::default();
         for m in 0..p {
             let fail = |error| PointFailure { point: m, error };
             let (qm, pose) = self.joints_at(m, r[m], prev.as_ref(), q8).map_err(fail)?;
@@ -143,7 +149,7 @@ impl<'a> LayerProblem<'a> {
                 }));
             };
             g.push([sol[0], sol[1], sol[2], sol[3], sol[4], sol[5]]);
-            dex.push(dexterity(&jac, self.dex_scale));
+            dex.push(dexterity_warm(&jac, self.dex_scale, &mut warm));
             if self.objective == Objective::PositioningUncertainty {
                 unc.push(positioning_uncertainty(
                     &jac,
