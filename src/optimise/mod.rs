@@ -754,10 +754,12 @@ fn choice_reason(
 fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> BranchOutcome {
     let opts = setup.opts;
     let p = setup.points.len();
-    let psi = match opts.parameterisation {
-        Parameterisation::Fixed { .. } => setup.floors(cfg),
-        _ => setup.floors(cfg),
-    };
+    let mut psi = setup.floors(cfg);
+    if setup.anchor.is_some() {
+        // the shared point of a spiral turn was checked against the
+        // previous turn's floor, and cannot move
+        psi[0] = 0.0;
+    }
     let problem = setup.problem(cfg, psi.clone());
     let mut outcome = BranchOutcome {
         cfg,
@@ -916,6 +918,11 @@ fn scale_of(problem: &LayerProblem, r: &[f64], smoothness: f64) -> f64 {
     }
 }
 
+/// Point by point: every constraint is penalised from `PBP_MARGIN` inside
+/// its bound (rad, rad per step, or relative for the dexterity), so that the
+/// 1-D search's tolerance (1e-7 rad) cannot leave a point a hair outside.
+const PBP_MARGIN: f64 = 1e-6;
+
 /// The thesis's point-by-point baseline [§4.1.4]: point 0 minimises the
 /// centring term, each next point the weighted displacement from the
 /// previous point, each under that point's constraints (penalised), by a
@@ -949,13 +956,15 @@ fn point_by_point(
                 } else {
                     (problem.lower[j], problem.upper[j])
                 };
-                viol = viol.max(q[j] - hi).max(lo - q[j]);
+                viol = viol.max(q[j] - hi + PBP_MARGIN).max(lo - q[j] + PBP_MARGIN);
                 match prev {
                     Some(qp) => {
                         obj += problem.gamma[j] * (q[j] - qp[j]).powi(2);
                         if problem.dt[m] > 0.0 {
-                            viol = viol
-                                .max((q[j] - qp[j]).abs() - problem.max_speed[j] * problem.dt[m]);
+                            viol = viol.max(
+                                (q[j] - qp[j]).abs() - problem.max_speed[j] * problem.dt[m]
+                                    + PBP_MARGIN,
+                            );
                         }
                     }
                     None if problem.gamma[j] > 0.0 => {
@@ -966,11 +975,11 @@ fn point_by_point(
                 }
             }
             if let Some(h) = problem.hose {
-                viol = viol.max((q[3] + q[5]).abs() - h);
+                viol = viol.max((q[3] + q[5]).abs() - h + PBP_MARGIN);
             }
             if problem.psi[m] > 0.0 {
                 let d = crate::robot::indices::dexterity(&robot.jacobian(&q), problem.dex_scale);
-                viol = viol.max((problem.psi[m] - d) / problem.psi[m]);
+                viol = viol.max((problem.psi[m] - d) / problem.psi[m] + PBP_MARGIN);
             }
             obj + rho * viol
         };
