@@ -1072,6 +1072,8 @@ fn finish(
     let opts = setup.opts;
     let robot = setup.cell.robot();
     let p = e.q.len();
+    let mut e = e;
+    problem.exact_dexterity(&mut e);
     // the trajectory stage's own check, in the chosen branch
     let mut cell = setup.cell.clone();
     match &mut cell {
