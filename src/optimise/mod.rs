@@ -33,8 +33,11 @@
 //!    coefficient starts at 0) until the objective stops improving [§4.2.1].
 //! 3. **SQP**: the joints are linearised with the analytic `dq/dR_Z`
 //!    ([`Cell::pose`]'s flange twist through `J⁻¹`), chained through the
-//!    basis; each QP (clarabel) has an l∞ elastic variable, so an infeasible
-//!    layer ends at the least violation with the binding constraint named.
+//!    basis; each QP (closed form when no row binds, clarabel on a working
+//!    set otherwise) has an l∞ elastic variable, so an infeasible layer ends
+//!    at the least violation with the binding constraint named. The
+//!    dexterity's SVD runs only where a cheap bound cannot show the point
+//!    well above its floor, warm-started along the layer.
 //! 4. **Transitions**: every layer starts from the joint representation inside
 //!    the travel (J4/J6 rewound with the arc off), and the centring term of
 //!    [`OptimiseOptions::centring_weight`] keeps each layer well inside the

@@ -3,7 +3,11 @@
 //! basis, an l∞ elastic variable so that every QP is feasible (a layer that
 //! cannot be made feasible ends at the least violation instead of failing),
 //! and a trust region on the change of `R_Z` at any point. Each QP is solved
-//! with clarabel.
+//! in closed form when its unconstrained minimiser breaks no row (the usual
+//! case: few constraints bind among the hundreds linearised), otherwise with
+//! clarabel on a working set grown until no row is broken. With few
+//! coefficients the Gauss–Newton matrix gets a structured secant (PSB)
+//! correction, which the large centring residuals need.
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
