@@ -18,7 +18,7 @@
 //! | the per-layer problem (objective, constraints, `dq/dR_Z`) | `problem` | — |
 //! | sequential QP with clarabel, trust region, elastic mode | `sqp` | — |
 //! | outcomes as data | [`outcome`] | [`Plan`], [`LayerPlan`], [`LayerStatus`] |
-//! | the driver | here | [`optimise`], [`layer_points`] |
+//! | the driver | here | [`optimise`], [`optimise_spiral`], [`layer_points`] |
 //!
 //! How a layer is solved:
 //! 1. **Branch.** Every IK branch (FANUC `N/F U/D T/B`) is scored on a few
@@ -33,8 +33,11 @@
 //!    coefficient starts at 0) until the objective stops improving [§4.2.1].
 //! 3. **SQP**: the joints are linearised with the analytic `dq/dR_Z`
 //!    ([`Cell::pose`]'s flange twist through `J⁻¹`), chained through the
-//!    basis; each QP (clarabel) has an l∞ elastic variable, so an infeasible
-//!    layer ends at the least violation with the binding constraint named.
+//!    basis; each QP (closed form when no row binds, clarabel on a working
+//!    set otherwise) has an l∞ elastic variable, so an infeasible layer ends
+//!    at the least violation with the binding constraint named. The
+//!    dexterity's SVD runs only where a cheap bound cannot show the point
+//!    well above its floor, warm-started along the layer.
 //! 4. **Transitions**: every layer starts from the joint representation inside
 //!    the travel (J4/J6 rewound with the arc off), and the centring term of
 //!    [`OptimiseOptions::centring_weight`] keeps each layer well inside the
@@ -150,6 +153,117 @@ pub fn optimise(
     layers: &[LayerPoints],
     opts: &OptimiseOptions,
 ) -> Result<Plan, OptimiseError> {
+    validate_input(cell, layers, opts)?;
+    let t0 = Instant::now();
+    let plans: Vec<LayerPlan> = if opts.parallel {
+        layers
+            .par_iter()
+            .map(|l| optimise_layer(cell, l, opts, None))
+            .collect()
+    } else {
+        layers
+            .iter()
+            .map(|l| optimise_layer(cell, l, opts, None))
+            .collect()
+    };
+    let transitions = transitions(cell, &plans);
+    Ok(Plan {
+        layers: plans,
+        transitions,
+        time_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Optimises a spiral path (one continuous layer, `per_turn` points a turn,
+/// as [`Path::spiral`](crate::path::Path) gives it) turn by turn [SPEC §7]:
+/// the arc never stops, so every turn continues the one before — same IK
+/// branch, its first point's joints unwrapped from the previous turn's last
+/// joints, and `R_Z` held at the previous turn's last value on that joint
+/// point (the polynomial of [`Basis::anchored_polynomial`]: `R_Z` continuous,
+/// its slope free). Each turn is solved as a layer of its own, including that
+/// shared point, so the junction step counts in its objective and quality.
+/// The plan has one [`LayerPlan`] per turn (`layer` = turn number, points
+/// of that turn only); turns are solved in order, not in parallel. The
+/// smoothing spline and the point-by-point baseline hold the joints
+/// continuous but leave `R_Z` free on the shared point.
+///
+/// # Errors
+/// As [`optimise`]; [`OptimiseError::InvalidOption`] when `per_turn < 2`.
+pub fn optimise_spiral(
+    cell: &Cell,
+    spiral: &LayerPoints,
+    per_turn: usize,
+    opts: &OptimiseOptions,
+) -> Result<Plan, OptimiseError> {
+    validate_input(cell, std::slice::from_ref(spiral), opts)?;
+    if per_turn < 2 {
+        return Err(OptimiseError::InvalidOption {
+            field: "per_turn",
+            value: per_turn as f64,
+            reason: "must be at least 2",
+        });
+    }
+    let t0 = Instant::now();
+    let n = spiral.points.len();
+    let mut starts: Vec<usize> = (0..n).step_by(per_turn).collect();
+    // a last turn of fewer than 2 points joins the one before
+    if starts.len() > 1 && n - starts[starts.len() - 1] < 2 {
+        starts.pop();
+    }
+    let mut plans: Vec<LayerPlan> = Vec::with_capacity(starts.len());
+    for (k, &a) in starts.iter().enumerate() {
+        let b = starts.get(k + 1).copied().unwrap_or(n);
+        let anchor = plans.last().and_then(|prev: &LayerPlan| {
+            let last = prev.points.last()?;
+            Some(Anchor {
+                r_z: last.r_z,
+                joints: last.joints?,
+                configuration: prev.configuration.chosen,
+            })
+        });
+        let from = if anchor.is_some() { a - 1 } else { a };
+        let turn = LayerPoints {
+            layer: k,
+            points: spiral.points[from..b].to_vec(),
+        };
+        let mut plan = optimise_layer(cell, &turn, opts, anchor);
+        if anchor.is_some() {
+            strip_shared_point(&mut plan);
+        }
+        plans.push(plan);
+    }
+    let transitions = transitions(cell, &plans);
+    Ok(Plan {
+        layers: plans,
+        transitions,
+        time_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Drops point 0 (the previous turn's last point) from a turn's plan and
+/// renumbers the reported points.
+fn strip_shared_point(plan: &mut LayerPlan) {
+    if !plan.points.is_empty() {
+        plan.points.remove(0);
+    }
+    plan.violations.retain(|v| v.point > 0);
+    for v in &mut plan.violations {
+        v.point -= 1;
+    }
+    match &mut plan.status {
+        LayerStatus::Infeasible { binding } | LayerStatus::FixedViolates { binding } => {
+            binding.point = binding.point.saturating_sub(1);
+        }
+        LayerStatus::NoSolution { point, .. } => *point = point.saturating_sub(1),
+        _ => {}
+    }
+}
+
+fn validate_input(
+    cell: &Cell,
+    layers: &[LayerPoints],
+    opts: &OptimiseOptions,
+) -> Result<(), OptimiseError> {
     opts.validate()?;
     cell.validate()?;
     for l in layers {
@@ -173,24 +287,15 @@ pub fn optimise(
             }
         }
     }
-    let t0 = Instant::now();
-    let plans: Vec<LayerPlan> = if opts.parallel {
-        layers
-            .par_iter()
-            .map(|l| optimise_layer(cell, l, opts))
-            .collect()
-    } else {
-        layers
-            .iter()
-            .map(|l| optimise_layer(cell, l, opts))
-            .collect()
-    };
-    let transitions = transitions(cell, &plans);
-    Ok(Plan {
-        layers: plans,
-        transitions,
-        time_s: t0.elapsed().as_secs_f64(),
-    })
+    Ok(())
+}
+
+/// Where a spiral turn starts: the previous turn's last point.
+#[derive(Debug, Clone, Copy)]
+struct Anchor {
+    r_z: f64,
+    joints: Joints,
+    configuration: Configuration,
 }
 
 fn transitions(cell: &Cell, plans: &[LayerPlan]) -> Vec<Transition> {
@@ -244,6 +349,7 @@ struct LayerSetup<'a> {
     theta: Vec<f64>,
     turning: bool,
     cylindrical: bool,
+    anchor: Option<Anchor>,
 }
 
 impl<'a> LayerSetup<'a> {
@@ -281,12 +387,26 @@ impl<'a> LayerSetup<'a> {
             // I in micrometres·1e3 (thesis §4.2.2 scales sigma by 1e6 too)
             sigma: sigma_rad.map(|s| s * 1e6),
             dex_scale: self.opts.trajectory.dexterity_length_scale_mm,
+            start_near: self.anchor.map(|a| a.joints),
         }
     }
 
     /// The seed families on a layer.
     fn seed_laws(&self) -> Vec<(Vec<f64>, usize)> {
         let p = self.points.len();
+        if let Some(a) = self.anchor {
+            // continue the previous turn: R_Z held, then constant or `− theta`
+            let mut out = vec![(vec![a.r_z; p], 1)];
+            if self.turning {
+                let r = self
+                    .theta
+                    .iter()
+                    .map(|t| a.r_z - (t - self.theta[0]))
+                    .collect();
+                out.push((r, 1));
+            }
+            return out;
+        }
         let n = self.opts.seeds;
         let mut out = Vec::new();
         for i in 0..n {
@@ -313,7 +433,7 @@ impl<'a> LayerSetup<'a> {
             .seed_laws()
             .into_iter()
             .map(|(r, degree)| {
-                let mut prev: Option<Joints> = None;
+                let mut prev: Option<Joints> = prob.start_near;
                 let mut q8 = 0.0;
                 let (mut viol, mut est, mut cen) = (0.0f64, 0.0, 0.0);
                 for &m in &idx {
@@ -382,13 +502,18 @@ impl<'a> LayerSetup<'a> {
                 let prob = self.problem(cfg, vec![0.0; p]);
                 let robot = self.cell.robot();
                 let mut q8 = 0.0;
+                let mut warm = crate::robot::indices::SvdWarmStart::default();
                 let d: Vec<f64> = (0..p)
                     .map(|m| match prob.joints_at(m, 0.0, None, q8) {
                         Ok((q, pose)) => {
                             if let Some(qp) = pose.positioner {
                                 q8 = qp[1];
                             }
-                            crate::robot::indices::dexterity(&robot.jacobian(&q), prob.dex_scale)
+                            crate::robot::indices::dexterity_warm(
+                                &robot.jacobian(&q),
+                                prob.dex_scale,
+                                &mut warm,
+                            )
                         }
                         Err(_) => f64::NAN,
                     })
@@ -425,7 +550,12 @@ struct BranchOutcome {
     problem_psi: Vec<f64>,
 }
 
-fn optimise_layer(cell: &Cell, lp: &LayerPoints, opts: &OptimiseOptions) -> LayerPlan {
+fn optimise_layer(
+    cell: &Cell,
+    lp: &LayerPoints,
+    opts: &OptimiseOptions,
+    anchor: Option<Anchor>,
+) -> LayerPlan {
     let t0 = Instant::now();
     let points = &lp.points;
     let p = points.len();
@@ -451,12 +581,14 @@ fn optimise_layer(cell: &Cell, lp: &LayerPoints, opts: &OptimiseOptions) -> Laye
         theta,
         turning,
         cylindrical,
+        anchor,
     };
 
     // 1. branches
     let fixed = matches!(opts.parameterisation, Parameterisation::Fixed { .. });
-    let candidates: Vec<Configuration> = if fixed || opts.configuration == ConfigurationChoice::Cell
-    {
+    let candidates: Vec<Configuration> = if let Some(a) = anchor {
+        vec![a.configuration]
+    } else if fixed || opts.configuration == ConfigurationChoice::Cell {
         vec![cell.configuration()]
     } else {
         Configuration::ALL.to_vec()
@@ -525,7 +657,10 @@ fn optimise_layer(cell: &Cell, lp: &LayerPoints, opts: &OptimiseOptions) -> Laye
         .unwrap_or(0);
     let out = outcomes.swap_remove(pick);
     let chosen = out.cfg;
-    let reason = choice_reason(&ranking, chosen, own, branches_tried, fixed, opts);
+    let reason = match anchor {
+        Some(_) => format!("{chosen}: the previous spiral turn's branch (the arc does not stop)"),
+        None => choice_reason(&ranking, chosen, own, branches_tried, fixed, opts),
+    };
     let configuration = ConfigurationChoiceReport {
         chosen,
         ranking,
@@ -622,10 +757,12 @@ fn choice_reason(
 fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> BranchOutcome {
     let opts = setup.opts;
     let p = setup.points.len();
-    let psi = match opts.parameterisation {
-        Parameterisation::Fixed { .. } => setup.floors(cfg),
-        _ => setup.floors(cfg),
-    };
+    let mut psi = setup.floors(cfg);
+    if setup.anchor.is_some() {
+        // the shared point of a spiral turn was checked against the
+        // previous turn's floor, and cannot move
+        psi[0] = 0.0;
+    }
     let problem = setup.problem(cfg, psi.clone());
     let mut outcome = BranchOutcome {
         cfg,
@@ -648,7 +785,7 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
         }
         Parameterisation::PointByPoint => {
             outcome.law = RzLaw::PointByPoint;
-            outcome.eval = point_by_point(&problem, seed.r[0]);
+            outcome.eval = point_by_point(&problem, seed.r[0], setup.anchor.map(|a| a.r_z));
         }
         Parameterisation::SmoothingSpline { smoothness } => {
             outcome.law = RzLaw::SmoothingSpline;
@@ -658,6 +795,7 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
                 &problem,
                 &basis,
                 seed.r.clone(),
+                None,
                 smoothness,
                 scale,
                 &opts.sqp,
@@ -682,15 +820,38 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
             } else {
                 (0..p).map(|m| m as f64).collect()
             };
-            let start = seed.degree.min(max_degree);
-            let mut basis = Basis::polynomial(&x, start + 1);
+            let (start, mut basis) = match setup.anchor {
+                // continuity: R_Z held on the shared point, degree ≥ 1
+                Some(a) => {
+                    let d = seed.degree.min(max_degree).max(1);
+                    (d, Basis::anchored_polynomial(&x, d, a.r_z))
+                }
+                None => {
+                    let d = seed.degree.min(max_degree);
+                    (d, Basis::polynomial(&x, d + 1))
+                }
+            };
             let mut c = basis.fit(&seed.r);
-            let scale = scale_of(&problem, &basis.eval(&c), 0.0);
+            let e0 = problem.evaluate(&basis.eval(&c)).ok();
+            let scale = match &e0 {
+                Some(e) => problem.objective(e, 0.0).max(1e-6),
+                None => 1.0,
+            };
             let mut history = Vec::new();
             let mut best: Option<(usize, Vec<f64>, Basis, sqp::SqpResult)> = None;
-            for degree in start..=max_degree {
-                match sqp::solve(&problem, &basis, c.clone(), 0.0, scale, &opts.sqp) {
+            let mut at_c: Option<Evaluation> = e0;
+            for degree in start..=max_degree.max(start) {
+                match sqp::solve(
+                    &problem,
+                    &basis,
+                    c.clone(),
+                    at_c.take(),
+                    0.0,
+                    scale,
+                    &opts.sqp,
+                ) {
                     Ok(res) => {
+                        at_c = Some(res.eval.clone());
                         outcome.iterations += res.iterations;
                         outcome.qp_solves += res.qp_solves;
                         outcome.qp_failures += res.qp_failures;
@@ -760,16 +921,25 @@ fn scale_of(problem: &LayerProblem, r: &[f64], smoothness: f64) -> f64 {
     }
 }
 
+/// Point by point: every constraint is penalised from `PBP_MARGIN` inside
+/// its bound (rad, rad per step, or relative for the dexterity), so that the
+/// 1-D search's tolerance (1e-7 rad) cannot leave a point a hair outside.
+const PBP_MARGIN: f64 = 1e-6;
+
 /// The thesis's point-by-point baseline [§4.1.4]: point 0 minimises the
 /// centring term, each next point the weighted displacement from the
 /// previous point, each under that point's constraints (penalised), by a
 /// local 1-D search started from the previous point's `R_Z`.
-fn point_by_point(problem: &LayerProblem, r0: f64) -> Result<Evaluation, PointFailure> {
+fn point_by_point(
+    problem: &LayerProblem,
+    r0: f64,
+    held: Option<f64>,
+) -> Result<Evaluation, PointFailure> {
     let p = problem.points.len();
     let robot = problem.cell.robot();
     let rho = 1e3;
     let mut r = vec![0.0; p];
-    let mut prev: Option<Joints> = None;
+    let mut prev: Option<Joints> = problem.start_near;
     let mut q8 = 0.0;
     for m in 0..p {
         let f = |x: f64| -> f64 {
@@ -789,13 +959,15 @@ fn point_by_point(problem: &LayerProblem, r0: f64) -> Result<Evaluation, PointFa
                 } else {
                     (problem.lower[j], problem.upper[j])
                 };
-                viol = viol.max(q[j] - hi).max(lo - q[j]);
+                viol = viol.max(q[j] - hi + PBP_MARGIN).max(lo - q[j] + PBP_MARGIN);
                 match prev {
                     Some(qp) => {
                         obj += problem.gamma[j] * (q[j] - qp[j]).powi(2);
                         if problem.dt[m] > 0.0 {
-                            viol = viol
-                                .max((q[j] - qp[j]).abs() - problem.max_speed[j] * problem.dt[m]);
+                            viol = viol.max(
+                                (q[j] - qp[j]).abs() - problem.max_speed[j] * problem.dt[m]
+                                    + PBP_MARGIN,
+                            );
                         }
                     }
                     None if problem.gamma[j] > 0.0 => {
@@ -806,11 +978,11 @@ fn point_by_point(problem: &LayerProblem, r0: f64) -> Result<Evaluation, PointFa
                 }
             }
             if let Some(h) = problem.hose {
-                viol = viol.max((q[3] + q[5]).abs() - h);
+                viol = viol.max((q[3] + q[5]).abs() - h + PBP_MARGIN);
             }
             if problem.psi[m] > 0.0 {
                 let d = crate::robot::indices::dexterity(&robot.jacobian(&q), problem.dex_scale);
-                viol = viol.max((problem.psi[m] - d) / problem.psi[m]);
+                viol = viol.max((problem.psi[m] - d) / problem.psi[m] + PBP_MARGIN);
             }
             obj + rho * viol
         };
@@ -819,7 +991,10 @@ fn point_by_point(problem: &LayerProblem, r0: f64) -> Result<Evaluation, PointFa
             1 => r[0],
             _ => 2.0 * r[m - 1] - r[m - 2],
         };
-        let x = minimise_1d(&f, start, 0.02, 1e-7);
+        let x = match held {
+            Some(h) if m == 0 => h,
+            _ => minimise_1d(&f, start, 0.02, 1e-7),
+        };
         r[m] = x;
         let (q, pose) = problem
             .joints_at(m, x, prev.as_ref(), q8)
@@ -900,6 +1075,8 @@ fn finish(
     let opts = setup.opts;
     let robot = setup.cell.robot();
     let p = e.q.len();
+    let mut e = e;
+    problem.exact_dexterity(&mut e);
     // the trajectory stage's own check, in the chosen branch
     let mut cell = setup.cell.clone();
     match &mut cell {

@@ -46,8 +46,13 @@ pub enum Basis {
         x_min: f64,
         /// Abscissa at `s = +1`.
         x_max: f64,
-        /// Number of coefficients (degree + 1).
+        /// Number of coefficients (degree + 1; degree when anchored).
         coefficients: usize,
+        /// `Some(r0)`: `R` at point 0 is held at `r0` (rad): the abscissa is
+        /// scaled to `s = (x − x_0) / max|x − x_0|` and the constant term is
+        /// replaced by `r0`, so `R = r0 + Σ_{i≥1} c_i s^i` (the turns of a
+        /// spiral, each continuing the one before).
+        anchor: Option<f64>,
     },
     /// One coefficient per point.
     PerPoint {
@@ -71,6 +76,25 @@ impl Basis {
             x_min,
             x_max,
             coefficients,
+            anchor: None,
+        }
+    }
+
+    /// Polynomial of degree `degree` (≥ 1) on abscissa `x` with `R` held at
+    /// `r0` (rad) on point 0 (see [`Basis::Polynomial`]'s `anchor`).
+    pub fn anchored_polynomial(x: &[f64], degree: usize, r0: f64) -> Self {
+        let x0 = x.first().copied().unwrap_or(0.0);
+        let h = x.iter().map(|v| (v - x0).abs()).fold(0.0, f64::max);
+        let s = x
+            .iter()
+            .map(|v| if h > 0.0 { (v - x0) / h } else { 0.0 })
+            .collect();
+        Self::Polynomial {
+            s,
+            x_min: x0,
+            x_max: x0 + h,
+            coefficients: degree.max(1),
+            anchor: Some(r0),
         }
     }
 
@@ -100,9 +124,12 @@ impl Basis {
         out.clear();
         match self {
             Self::Polynomial {
-                s, coefficients, ..
+                s,
+                coefficients,
+                anchor,
+                ..
             } => {
-                let mut v = 1.0;
+                let mut v = if anchor.is_some() { s[m] } else { 1.0 };
                 for i in 0..*coefficients {
                     out.push((i, v));
                     v *= s[m];
@@ -123,9 +150,19 @@ impl Basis {
     /// `R = B c` (rad).
     pub fn eval(&self, c: &[f64]) -> Vec<f64> {
         match self {
-            Self::Polynomial { s, .. } => s
+            Self::Polynomial {
+                s, anchor: None, ..
+            } => s
                 .iter()
                 .map(|x| c.iter().rev().fold(0.0, |acc, ci| acc * x + ci))
+                .collect(),
+            Self::Polynomial {
+                s,
+                anchor: Some(r0),
+                ..
+            } => s
+                .iter()
+                .map(|x| r0 + x * c.iter().rev().fold(0.0, |acc, ci| acc * x + ci))
                 .collect(),
             Self::PerPoint { .. } => c.to_vec(),
         }
@@ -139,11 +176,13 @@ impl Basis {
                 x_min,
                 x_max,
                 coefficients,
+                anchor,
             } => Some(Self::Polynomial {
                 s: s.clone(),
                 x_min: *x_min,
                 x_max: *x_max,
                 coefficients: coefficients + 1,
+                anchor: *anchor,
             }),
             Self::PerPoint { .. } => None,
         }
@@ -154,12 +193,18 @@ impl Basis {
     pub fn fit(&self, r: &[f64]) -> Vec<f64> {
         match self {
             Self::PerPoint { .. } => r.to_vec(),
-            Self::Polynomial { coefficients, .. } => {
+            Self::Polynomial {
+                coefficients,
+                anchor,
+                ..
+            } => {
                 let k = *coefficients;
+                let r0 = anchor.unwrap_or(0.0);
                 let mut ata = nalgebra::DMatrix::<f64>::zeros(k, k);
                 let mut atb = nalgebra::DVector::<f64>::zeros(k);
                 let mut row = Vec::new();
                 for (m, rm) in r.iter().enumerate() {
+                    let rm = rm - r0;
                     self.row(m, &mut row);
                     for &(i, a) in &row {
                         atb[i] += a * rm;
@@ -172,7 +217,9 @@ impl Basis {
                     Some(ch) => ch.solve(&atb).iter().copied().collect(),
                     None => {
                         let mut c = vec![0.0; k];
-                        c[0] = r.iter().sum::<f64>() / r.len().max(1) as f64;
+                        if anchor.is_none() {
+                            c[0] = r.iter().sum::<f64>() / r.len().max(1) as f64;
+                        }
                         c
                     }
                 }
@@ -183,9 +230,15 @@ impl Basis {
     /// The polynomial in the thesis's form: coefficients of the unscaled
     /// abscissa (point index `m` counted from 1 as in eq. 4.1, or the angle in
     /// rad), highest power first, `R_Z` in degrees — `B_{C,n}` of eq. 4.1.
-    /// `None` for the per-point basis.
+    /// `None` for the per-point and the anchored bases.
     pub fn thesis_coefficients_deg(&self, c: &[f64], one_based_index: bool) -> Option<Vec<f64>> {
-        let Self::Polynomial { x_min, x_max, .. } = self else {
+        let Self::Polynomial {
+            x_min,
+            x_max,
+            anchor: None,
+            ..
+        } = self
+        else {
             return None;
         };
         let h = 0.5 * (x_max - x_min);

@@ -11,7 +11,9 @@ use crate::optimise::outcome::{Binding, Constraint};
 use crate::optimise::parameterisation::Basis;
 use crate::robot::cell::{Cell, CellPoint};
 use crate::robot::ik::Configuration;
-use crate::robot::indices::{dexterity, positioning_uncertainty, UncertaintyFormula};
+use crate::robot::indices::{
+    dexterity, dexterity_warm, positioning_uncertainty, SvdWarmStart, UncertaintyFormula,
+};
 use crate::robot::model::Joints;
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::RobotError;
@@ -20,6 +22,11 @@ use crate::robot::RobotError;
 /// robot model has none.
 pub(crate) const ARCMATE_SIGMA_DEG: [f64; 6] =
     [3.63e-8, 3.63e-8, 3.81e-8, 16.45e-8, 14.12e-8, 63.18e-8];
+
+/// Where the dexterity bound is at least this multiple of the floor, the
+/// SVD is skipped (the constraint is inactive and its slope is not needed:
+/// [`LayerProblem::constraints`] computes slopes below 1.5 floors).
+const DEX_BOUND_FACTOR: f64 = 1.5;
 
 /// Finite-difference step on `R_Z` for the dexterity and uncertainty slopes (rad).
 const FD_STEP_RAD: f64 = 1e-6;
@@ -50,6 +57,9 @@ pub(crate) struct LayerProblem<'a> {
     pub sigma: [f64; 6],
     /// Length scale of the dexterity (mm).
     pub dex_scale: f64,
+    /// Joints the first point is unwrapped towards (a spiral turn continuing
+    /// the one before); `None`: the representation inside the travel.
+    pub start_near: Option<Joints>,
 }
 
 /// Joints and derivatives at every point for given `R_Z`.
@@ -59,7 +69,10 @@ pub(crate) struct Evaluation {
     pub q: Vec<Joints>,
     pub g: Vec<Joints>,
     pub positioner: Vec<Option<PositionerJoints>>,
+    /// Dexterity per point, or a lower bound of it at least
+    /// `DEX_BOUND_FACTOR` times the floor where `dex_exact` is `false`.
     pub dex: Vec<f64>,
+    pub dex_exact: Vec<bool>,
     /// `I_m` (scaled units) when the objective needs it.
     pub unc: Vec<f64>,
 }
@@ -99,6 +112,48 @@ impl<'a> LayerProblem<'a> {
         Ok((q, pose))
     }
 
+    /// `1 / (‖J_s‖_F ‖J_s⁻¹‖_F) ≤ xi_min / xi_max` (`J_s`: linear rows
+    /// divided by the dexterity length scale), from the LU of `J`; 0 if singular.
+    fn dexterity_lower_bound(
+        &self,
+        jac: &Matrix6<f64>,
+        lu: &nalgebra::LU<f64, nalgebra::U6, nalgebra::U6>,
+    ) -> f64 {
+        let Some(inv) = lu.try_inverse() else {
+            return 0.0;
+        };
+        let s = self.dex_scale;
+        let mut nj = 0.0;
+        let mut ni = 0.0;
+        for r in 0..6 {
+            for c in 0..6 {
+                let (fj, fi) = if r < 3 { (1.0 / s, 1.0) } else { (1.0, 1.0) };
+                let fi = if c < 3 { fi * s } else { fi };
+                nj += (jac[(r, c)] * fj).powi(2);
+                ni += (inv[(r, c)] * fi).powi(2);
+            }
+        }
+        let b = 1.0 / (nj * ni).sqrt();
+        if b.is_finite() {
+            // shave rounding so that the bound stays below the true value
+            b * (1.0 - 1e-12)
+        } else {
+            0.0
+        }
+    }
+
+    /// Exact dexterity at every point of `e` (replacing the bounds).
+    pub fn exact_dexterity(&self, e: &mut Evaluation) {
+        let robot = self.cell.robot();
+        let mut warm = SvdWarmStart::default();
+        for m in 0..e.q.len() {
+            if !e.dex_exact[m] {
+                e.dex[m] = dexterity_warm(&robot.jacobian(&e.q[m]), self.dex_scale, &mut warm);
+                e.dex_exact[m] = true;
+            }
+        }
+    }
+
     fn dex_of(&self, q: &Joints) -> f64 {
         dexterity(&self.cell.robot().jacobian(q), self.dex_scale)
     }
@@ -122,9 +177,11 @@ impl<'a> LayerProblem<'a> {
         let mut g = Vec::with_capacity(p);
         let mut pos = Vec::with_capacity(p);
         let mut dex = Vec::with_capacity(p);
+        let mut dex_exact = Vec::with_capacity(p);
         let mut unc = Vec::new();
         let mut q8 = 0.0;
-        let mut prev: Option<Joints> = None;
+        let mut prev: Option<Joints> = self.start_near;
+        let mut warm = SvdWarmStart::default();
         for m in 0..p {
             let fail = |error| PointFailure { point: m, error };
             let (qm, pose) = self.joints_at(m, r[m], prev.as_ref(), q8).map_err(fail)?;
@@ -133,17 +190,26 @@ impl<'a> LayerProblem<'a> {
             }
             let jac: Matrix6<f64> = robot.jacobian(&qm);
             let tw: Vector6<f64> = pose.flange_twist_per_rz;
-            let sol = jac
-                .lu()
-                .solve(&tw)
-                .filter(|x| x.iter().all(|v| v.is_finite()));
+            let lu = jac.lu();
+            let sol = lu.solve(&tw).filter(|x| x.iter().all(|v| v.is_finite()));
             let Some(sol) = sol else {
                 return Err(fail(RobotError::SingularJacobian {
                     manipulability: crate::robot::indices::manipulability(&jac),
                 }));
             };
             g.push([sol[0], sol[1], sol[2], sol[3], sol[4], sol[5]]);
-            dex.push(dexterity(&jac, self.dex_scale));
+            // The SVD only where the floor could matter: elsewhere a cheap
+            // lower bound proves the point is well above it (it decides the
+            // constraint and its slope exactly as the value would; the
+            // reported dexterity is recomputed at the end).
+            let bound = self.dexterity_lower_bound(&jac, &lu);
+            let exact = !(bound >= DEX_BOUND_FACTOR * self.psi[m] && self.psi[m] > 0.0);
+            dex.push(if exact {
+                dexterity_warm(&jac, self.dex_scale, &mut warm)
+            } else {
+                bound
+            });
+            dex_exact.push(exact);
             if self.objective == Objective::PositioningUncertainty {
                 unc.push(positioning_uncertainty(
                     &jac,
@@ -161,6 +227,7 @@ impl<'a> LayerProblem<'a> {
             g,
             positioner: pos,
             dex,
+            dex_exact,
             unc,
         })
     }

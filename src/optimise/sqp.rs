@@ -3,7 +3,11 @@
 //! basis, an l∞ elastic variable so that every QP is feasible (a layer that
 //! cannot be made feasible ends at the least violation instead of failing),
 //! and a trust region on the change of `R_Z` at any point. Each QP is solved
-//! with clarabel.
+//! in closed form when its unconstrained minimiser breaks no row (the usual
+//! case: few constraints bind among the hundreds linearised), otherwise with
+//! clarabel on a working set grown until no row is broken. With few
+//! coefficients the Gauss–Newton matrix gets a structured secant (PSB)
+//! correction, which the large centring residuals need.
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -35,11 +39,78 @@ struct Qp {
 }
 
 /// Solves `min ½ δᵀPδ + gᵀδ + ρ t` s.t. `a·δ − t ≤ b`, `t ≥ 0`, `|δ_i| ≤ box`.
+///
+/// Most QPs of a layer have few binding rows among many: the unconstrained
+/// minimiser (a `k × k` Cholesky solve) is tried first and is the exact
+/// optimum when it satisfies every row and the box; otherwise clarabel
+/// solves the QP on a working set (the rows that minimiser violates, and
+/// the currently violated ones), grown with the rows its solution violates
+/// until none is (constraint generation: the same optimum as with all rows).
 fn solve_qp(
     k: usize,
     p_dense: &[f64],
     g: &[f64],
     rows: &[crate::optimise::problem::Row],
+    rho: f64,
+    bound: f64,
+) -> Option<Qp> {
+    let violated_by = |x: &[f64], t: f64, r: &crate::optimise::problem::Row| {
+        let ax: f64 = r.a.iter().map(|&(i, v)| v * x[i]).sum();
+        ax - t > r.b + 1e-10 * (1.0 + r.b.abs())
+    };
+    let mut work: Vec<usize> = Vec::new();
+    if let Some(x) = unconstrained(k, p_dense, g) {
+        if x.iter().all(|v| v.abs() < bound) {
+            work = (0..rows.len())
+                .filter(|&i| rows[i].b < 0.0 || violated_by(&x, 0.0, &rows[i]))
+                .collect();
+            if work.is_empty() {
+                return Some(Qp { x, t: 0.0 });
+            }
+        }
+    }
+    if work.is_empty() {
+        work = (0..rows.len()).filter(|&i| rows[i].b < 0.0).collect();
+    }
+    let mut in_work = vec![false; rows.len()];
+    for &i in &work {
+        in_work[i] = true;
+    }
+    for _ in 0..8 {
+        let sub: Vec<&crate::optimise::problem::Row> = work.iter().map(|&i| &rows[i]).collect();
+        let qp = solve_qp_clarabel(k, p_dense, g, &sub, rho, bound)?;
+        let mut added = false;
+        for (i, r) in rows.iter().enumerate() {
+            if !in_work[i] && violated_by(&qp.x, qp.t, r) {
+                in_work[i] = true;
+                work.push(i);
+                added = true;
+            }
+        }
+        if !added {
+            return Some(qp);
+        }
+    }
+    let all: Vec<&crate::optimise::problem::Row> = rows.iter().collect();
+    solve_qp_clarabel(k, p_dense, g, &all, rho, bound)
+}
+
+/// `−P⁻¹ g` when `P` (dense, `k × k`) is positive definite.
+fn unconstrained(k: usize, p_dense: &[f64], g: &[f64]) -> Option<Vec<f64>> {
+    let pm = nalgebra::DMatrix::from_row_slice(k, k, p_dense);
+    let ch = pm.cholesky()?;
+    let x = ch.solve(&(-nalgebra::DVector::from_column_slice(g)));
+    x.iter()
+        .all(|v| v.is_finite())
+        .then(|| x.iter().copied().collect())
+}
+
+/// The QP of [`solve_qp`] on the given rows, by clarabel.
+fn solve_qp_clarabel(
+    k: usize,
+    p_dense: &[f64],
+    g: &[f64],
+    rows: &[&crate::optimise::problem::Row],
     rho: f64,
     bound: f64,
 ) -> Option<Qp> {
@@ -114,13 +185,14 @@ fn solve_qp(
     }
 }
 
-/// Runs the SQP from coefficients `c0`. `scale` divides the objective (keep
+/// Runs the SQP from coefficients `c0` (`start`: the evaluation there, if known). `scale` divides the objective (keep
 /// it fixed for one layer so that merits compare). `Err` only when the start
 /// itself has no joint solution.
 pub(crate) fn solve(
     problem: &LayerProblem,
     basis: &Basis,
     c0: Vec<f64>,
+    start: Option<Evaluation>,
     smoothness: f64,
     scale: f64,
     opts: &SqpOptions,
@@ -128,7 +200,12 @@ pub(crate) fn solve(
     let k = basis.len();
     let rho = opts.penalty;
     let mut c = c0;
-    let mut e = problem.evaluate(&basis.eval(&c))?;
+    // `start` is the evaluation at `basis.eval(&c0)` when the caller has it
+    // (a degree raised with its new coefficient at 0 leaves `R_Z` unchanged)
+    let mut e = match start {
+        Some(e) => e,
+        None => problem.evaluate(&basis.eval(&c))?,
+    };
     let mut f = problem.objective(&e, smoothness);
     let mut v = problem.max_violation(&e);
     let mut merit = f / scale + rho * v;
@@ -138,22 +215,40 @@ pub(crate) fn solve(
     let mut converged = false;
     let mut p_dense = vec![0.0; k * k];
     let mut grad = vec![0.0; k];
+    gauss_newton(
+        problem,
+        &e,
+        smoothness,
+        basis,
+        scale,
+        &mut p_dense,
+        &mut grad,
+    );
+    // Structured secant correction of the Gauss–Newton matrix (PSB update on
+    // the gradient differences of every trial, accepted or not): the
+    // centring residuals are large, and Gauss–Newton alone overshoots and
+    // zig-zags on them. Only for few coefficients (dense k × k).
+    let secant = k <= 16;
+    let mut corr = vec![0.0; if secant { k * k } else { 0 }];
+    let mut p_model = vec![0.0; k * k];
+    let mut p_new = vec![0.0; k * k];
+    let mut grad_new = vec![0.0; k];
     while iterations < opts.max_iterations {
         iterations += 1;
-        // Gauss–Newton model: f(δ) ≈ Σ (r + a·δ)²
-        p_dense.iter_mut().for_each(|x| *x = 0.0);
-        grad.iter_mut().for_each(|x| *x = 0.0);
-        problem.residuals(&e, smoothness, Some(basis), &mut |r, a| {
-            for &(i, ai) in a {
-                grad[i] += 2.0 * r * ai / scale;
-                for &(j, aj) in a {
-                    p_dense[i * k + j] += 2.0 * ai * aj / scale;
-                }
+        p_model.copy_from_slice(&p_dense);
+        if secant {
+            for (m, s) in p_model.iter_mut().zip(&corr) {
+                *m += s;
             }
-        });
+            if corr.iter().any(|x| *x != 0.0) && !positive_definite(k, &p_model) {
+                corr.iter_mut().for_each(|x| *x = 0.0);
+                p_model.copy_from_slice(&p_dense);
+            }
+        }
         let rows = problem.constraint_rows(&e, basis, trust);
         qp_solves += 1;
-        let Some(qp) = solve_qp(k, &p_dense, &grad, &rows, rho, trust / l1) else {
+        let bound = trust / l1;
+        let Some(qp) = solve_qp(k, &p_model, &grad, &rows, rho, bound) else {
             qp_failures += 1;
             trust *= 0.25;
             if trust < opts.min_trust_rad {
@@ -166,7 +261,7 @@ pub(crate) fn solve(
         for i in 0..k {
             quad += grad[i] * dc[i];
             for j in 0..k {
-                quad += 0.5 * dc[i] * p_dense[i * k + j] * dc[j];
+                quad += 0.5 * dc[i] * p_model[i * k + j] * dc[j];
             }
         }
         let predicted = -quad + rho * (v - qp.t);
@@ -177,6 +272,7 @@ pub(crate) fn solve(
             .zip(&e.r)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
+        let box_bound = dc.iter().any(|x| x.abs() > 0.99 * bound);
         if !(predicted > 0.1 * opts.relative_tolerance * (1.0 + merit.abs()))
             || step < opts.step_tolerance_rad
         {
@@ -190,9 +286,23 @@ pub(crate) fn solve(
                 let v_new = problem.max_violation(&e_new);
                 let merit_new = f_new / scale + rho * v_new;
                 let ratio = (merit - merit_new) / predicted;
-                if ratio >= 1e-4 {
+                gauss_newton(
+                    problem,
+                    &e_new,
+                    smoothness,
+                    basis,
+                    scale,
+                    &mut p_new,
+                    &mut grad_new,
+                );
+                let ok = ratio >= 1e-4;
+                if secant {
+                    let p_ref = if ok { &p_new } else { &p_dense };
+                    psb_update(k, &mut corr, p_ref, dc, &grad, &grad_new);
+                }
+                if ok {
                     let gain = merit - merit_new;
-                    if ratio > 0.75 && step > 0.8 * trust {
+                    if ratio > 0.75 && (step > 0.8 * trust || box_bound) {
                         trust = (2.0 * trust).min(std::f64::consts::PI);
                     } else if ratio < 0.25 {
                         trust = 0.5 * step;
@@ -202,6 +312,8 @@ pub(crate) fn solve(
                     f = f_new;
                     v = v_new;
                     merit = merit_new;
+                    std::mem::swap(&mut p_dense, &mut p_new);
+                    std::mem::swap(&mut grad, &mut grad_new);
                     if gain <= opts.relative_tolerance * (1.0 + merit.abs()) {
                         converged = true;
                     }
@@ -279,4 +391,62 @@ pub(crate) fn solve(
         qp_failures,
         converged,
     })
+}
+
+/// Gauss–Newton model of `f / scale` at `e`: `P = 2 Σ aᵀa / scale` (dense,
+/// row-major `k × k`) and the gradient `2 Σ r a / scale`.
+fn gauss_newton(
+    problem: &LayerProblem,
+    e: &Evaluation,
+    smoothness: f64,
+    basis: &Basis,
+    scale: f64,
+    p_dense: &mut [f64],
+    grad: &mut [f64],
+) {
+    let k = grad.len();
+    p_dense.iter_mut().for_each(|x| *x = 0.0);
+    grad.iter_mut().for_each(|x| *x = 0.0);
+    problem.residuals(e, smoothness, Some(basis), &mut |r, a| {
+        for &(i, ai) in a {
+            grad[i] += 2.0 * r * ai / scale;
+            for &(j, aj) in a {
+                p_dense[i * k + j] += 2.0 * ai * aj / scale;
+            }
+        }
+    });
+}
+
+/// `true` when the dense symmetric `k × k` matrix has a Cholesky factor.
+fn positive_definite(k: usize, p: &[f64]) -> bool {
+    nalgebra::DMatrix::from_row_slice(k, k, p)
+        .cholesky()
+        .is_some()
+}
+
+/// Powell-symmetric-Broyden update of the correction `S` so that
+/// `(P_ref + S) s = y`, `y = g_new − g_old` (dense, row-major `k × k`).
+fn psb_update(k: usize, corr: &mut [f64], p_ref: &[f64], s: &[f64], g_old: &[f64], g_new: &[f64]) {
+    let ss: f64 = s.iter().map(|x| x * x).sum();
+    if !(ss > 0.0) {
+        return;
+    }
+    // w = y − P_ref s − S s
+    let w: Vec<f64> = (0..k)
+        .map(|i| {
+            let ps: f64 = (0..k)
+                .map(|j| (p_ref[i * k + j] + corr[i * k + j]) * s[j])
+                .sum();
+            g_new[i] - g_old[i] - ps
+        })
+        .collect();
+    if !w.iter().all(|x| x.is_finite()) {
+        return;
+    }
+    let ws: f64 = w.iter().zip(s).map(|(a, b)| a * b).sum();
+    for i in 0..k {
+        for j in 0..k {
+            corr[i * k + j] += (w[i] * s[j] + s[i] * w[j]) / ss - ws * s[i] * s[j] / (ss * ss);
+        }
+    }
 }

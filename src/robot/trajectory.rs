@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use crate::math::{Point3, UnitVector3};
 use crate::robot::cell::{Cell, CellPoint};
 use crate::robot::ik::Configuration;
-use crate::robot::indices::dexterity;
+use crate::robot::indices::{dexterity_warm, SvdWarmStart};
 use crate::robot::model::Joints;
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::RobotError;
@@ -357,6 +357,7 @@ pub fn joint_trajectory(
     let mut prev_q8 = 0.0;
     let sin_wrist = opts.wrist_singularity_margin_rad.sin();
     let sin_elbow = opts.elbow_singularity_margin_rad.sin();
+    let mut warm = SvdWarmStart::default();
 
     for (idx, p) in points.iter().enumerate() {
         let cp = CellPoint {
@@ -490,7 +491,7 @@ pub fn joint_trajectory(
             }
         }
         let jac = robot.jacobian(&q);
-        let dex = dexterity(&jac, opts.dexterity_length_scale_mm);
+        let dex = dexterity_warm(&jac, opts.dexterity_length_scale_mm, &mut warm);
         let dq_drz = if opts.with_derivatives {
             cell.dq_drz(&pose, &q).ok()
         } else {

@@ -5,5 +5,7 @@ mod common;
 
 mod circle;
 mod cli;
+mod objectives;
 mod parts;
+mod spiral;
 mod support;
