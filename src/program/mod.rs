@@ -235,7 +235,9 @@ pub fn build_program(
 pub struct ProgramOptions {
     /// Distance of the approach and retract points from the part along the
     /// tool axis (mm, ≥ 0; 0: no approach or retract points, each bead is
-    /// reached by a joint move to its first point). Default 20 mm.
+    /// reached by a joint move to its first point). Default 20 mm; where a
+    /// point at that distance leaves a joint's travel, a half, a quarter or
+    /// an eighth of it is used.
     pub clearance_mm: f64,
     /// Linear speed of the moves into and out of a bead (approach point →
     /// first point, last point → retract point), relative to the part
@@ -417,11 +419,23 @@ pub fn build_program_with(
         let mut all = Vec::with_capacity(out.len() + 2 * trajectory.points.len().min(out.len()));
         for (p, input) in out.iter().zip(points) {
             if p.arc == ArcFlag::Start {
-                all.push(clearance_point(cell, p, input, ArcFlag::Approach, opts)?);
+                all.push(clearance_point_within_travel(
+                    cell,
+                    p,
+                    input,
+                    ArcFlag::Approach,
+                    opts,
+                )?);
             }
             all.push(*p);
             if p.arc == ArcFlag::End {
-                all.push(clearance_point(cell, p, input, ArcFlag::Retract, opts)?);
+                all.push(clearance_point_within_travel(
+                    cell,
+                    p,
+                    input,
+                    ArcFlag::Retract,
+                    opts,
+                )?);
             }
         }
         out = all;
@@ -434,6 +448,29 @@ pub fn build_program_with(
     })
 }
 
+/// The approach or retract point of bead point `p` at `clearance_mm`, or,
+/// where that one leaves a joint's travel (a bead that ends with J5 a
+/// fraction of a degree inside its stop), at a half, a quarter or an eighth
+/// of it; refused with the full clearance's reason if none works.
+fn clearance_point_within_travel(
+    cell: &Cell,
+    p: &ProgramPoint,
+    input: &PathPointInput,
+    flag: ArcFlag,
+    opts: &ProgramOptions,
+) -> Result<ProgramPoint, ProgramError> {
+    let mut first_error = None;
+    for divisor in [1.0, 2.0, 4.0, 8.0] {
+        match clearance_point(cell, p, input, flag, opts, opts.clearance_mm / divisor) {
+            Ok(point) => return Ok(point),
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    Err(first_error.expect("at least one clearance tried"))
+}
+
 /// The approach or retract point of bead point `p`: `clearance_mm` along the
 /// tool axis, same orientation and positioner joints, joints unwrapped
 /// towards `p`'s; refused if a joint leaves its travel or the linear move
@@ -444,6 +481,7 @@ fn clearance_point(
     input: &PathPointInput,
     flag: ArcFlag,
     opts: &ProgramOptions,
+    clearance_mm: f64,
 ) -> Result<ProgramPoint, ProgramError> {
     let what = if flag == ArcFlag::Approach {
         "approach"
@@ -454,10 +492,10 @@ fn clearance_point(
         count: 1,
         first: format!(
             "layer {}, {what} point ({} mm from point {} along the tool axis): {msg}",
-            p.layer, opts.clearance_mm, p.point
+            p.layer, clearance_mm, p.point
         ),
     };
-    let position_mm = p.position_mm + p.tool_axis.into_inner() * opts.clearance_mm;
+    let position_mm = p.position_mm + p.tool_axis.into_inner() * clearance_mm;
     let cp = CellPoint {
         position_mm,
         tool_axis: p.tool_axis,
@@ -480,7 +518,7 @@ fn clearance_point(
             v.to_degrees()
         )));
     }
-    let dt = opts.clearance_mm / opts.approach_speed_mm_s;
+    let dt = clearance_mm / opts.approach_speed_mm_s;
     for (j, (qj, pj)) in q.iter().zip(p.joints).enumerate() {
         let s = (qj - pj).abs() / dt;
         if s > robot.max_speed_rad_s[j] {
