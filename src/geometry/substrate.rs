@@ -146,15 +146,13 @@ impl MeshSubstrate {
         }
         // Read at most one byte past the limit: a device or pipe reports a
         // length of 0 and would otherwise be read for ever.
+        use std::io::Read as _;
         let mut bytes = Vec::new();
-        std::io::Read::read_to_end(
-            &mut std::io::Read::take(
-                std::fs::File::open(path).map_err(|e| bad(format!("cannot open: {e}")))?,
-                MAX_STL_BYTES + 1,
-            ),
-            &mut bytes,
-        )
-        .map_err(|e| bad(format!("cannot read: {e}")))?;
+        std::fs::File::open(path)
+            .map_err(|e| bad(format!("cannot open: {e}")))?
+            .take(MAX_STL_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .map_err(|e| bad(format!("cannot read: {e}")))?;
         if bytes.len() as u64 > MAX_STL_BYTES {
             return Err(bad(format!(
                 "more than {MAX_STL_BYTES} bytes, the limit for an STL file"

@@ -436,15 +436,13 @@ pub fn read_part_file(path: &Path) -> Result<Part, PartFileError> {
         });
     }
     // At most one byte past the limit: a device or pipe reports length 0.
+    use std::io::Read as _;
     let mut bytes = Vec::new();
-    std::io::Read::read_to_end(
-        &mut std::io::Read::take(
-            std::fs::File::open(path).map_err(io)?,
-            MAX_PART_FILE_BYTES + 1,
-        ),
-        &mut bytes,
-    )
-    .map_err(io)?;
+    std::fs::File::open(path)
+        .map_err(io)?
+        .take(MAX_PART_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
     if bytes.len() as u64 > MAX_PART_FILE_BYTES {
         return Err(PartFileError::Io {
             file,
