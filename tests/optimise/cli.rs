@@ -71,3 +71,66 @@ fn plan_names_the_bad_file_and_field() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--rz"));
 }
+
+/// Issue 4's "every sample part that should be feasible is": all eight
+/// sample parts, sliced at Delta = 5 mm with their own `[tool_axis]` and
+/// `[process]` tables, plan in the ROBOWAM part-carried cell (the cell the
+/// thesis built its tubes in) and get a FANUC program that `check` accepts.
+/// Without the tool-axis rate bound (`--plain-axes`) the quarter torus is
+/// refused (exit 2): at the cusps of its upper layers the wrist would have
+/// to turn faster than J4/J6 can.
+#[test]
+fn every_sample_part_plans_in_the_part_carried_cell() {
+    let dir = tempfile::tempdir().unwrap();
+    let cell = part_path("cells/robowam_part_carried.toml");
+    for part in crate::common::SAMPLE_PARTS {
+        let out = dir.path().join(part);
+        let status = waam()
+            .args(["--quiet", "plan"])
+            .arg(part_path(part))
+            .arg("--cell")
+            .arg(&cell)
+            .args(["--delta", "5", "--out"])
+            .arg(&out)
+            .status()
+            .unwrap();
+        let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        assert_eq!(status.code(), Some(0), "{part}: {summary}");
+        // The main program: the shortest .ls name (NAME.ls before its
+        // NAME_001.ls, NAME_002.ls sub-programs when the plan was split).
+        let program = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "ls"))
+            .min_by_key(|p| p.as_os_str().len())
+            .unwrap_or_else(|| panic!("{part}: no program"));
+        let check = waam()
+            .args(["--quiet", "check"])
+            .arg(&program)
+            .arg("--cell")
+            .arg(&cell)
+            .output()
+            .unwrap();
+        assert_eq!(
+            check.status.code(),
+            Some(0),
+            "{part}: {}",
+            String::from_utf8_lossy(&check.stderr)
+        );
+    }
+    let out = dir.path().join("plain");
+    let status = waam()
+        .args(["--quiet", "plan"])
+        .arg(part_path("quarter-torus.toml"))
+        .arg("--cell")
+        .arg(&cell)
+        .args(["--plain-axes", "--out"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(2));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let v = summary["violations"].to_string();
+    assert!(v.contains("J4 needs") || v.contains("J6 needs"), "{v}");
+}
