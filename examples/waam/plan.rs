@@ -317,25 +317,8 @@ fn emit_program(
     dir: &std::path::Path,
 ) -> Result<Vec<String>, String> {
     use waam_slicer::program::{build_program, write_files, TravelSpeed};
-    use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
-    let inputs: Vec<PathPointInput> = layers
-        .iter()
-        .zip(&plan.layers)
-        .flat_map(|(lp, pl)| {
-            lp.points
-                .iter()
-                .zip(&pl.points)
-                .enumerate()
-                .map(move |(i, (cp, pp))| PathPointInput {
-                    layer: lp.layer,
-                    point: i,
-                    position_mm: cp.position_mm,
-                    tool_axis: cp.tool_axis,
-                    build_direction: cp.build_direction,
-                    r_z: pp.r_z,
-                })
-        })
-        .collect();
+    use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions};
+    let inputs = waam_slicer::optimise::trajectory_inputs(layers, plan);
     let traj = joint_trajectory(cell, &inputs, speed_mm_s, &TrajectoryOptions::default())
         .map_err(|e| e.to_string())?;
     let name: String = {

@@ -142,6 +142,35 @@ pub fn layer_points(path: &Path, frames: &[Vec<LocalFrame>]) -> Vec<LayerPoints>
         .collect()
 }
 
+/// The input of [`joint_trajectory`] and of the program stage: every point
+/// of `layers`, in order, with the `R_Z` that `plan` chose for it (`plan`
+/// made from the same `layers`).
+pub fn trajectory_inputs(layers: &[LayerPoints], plan: &Plan) -> Vec<PathPointInput> {
+    layers
+        .iter()
+        .zip(&plan.layers)
+        .flat_map(|(lp, pl)| {
+            lp.points
+                .iter()
+                .zip(&pl.points)
+                .enumerate()
+                .map(move |(m, (cp, pp))| path_point(lp.layer, m, cp, pp.r_z))
+        })
+        .collect()
+}
+
+/// One point of a layer as the trajectory stage takes it.
+fn path_point(layer: usize, point: usize, cp: &CellPoint, r_z: f64) -> PathPointInput {
+    PathPointInput {
+        layer,
+        point,
+        position_mm: cp.position_mm,
+        tool_axis: cp.tool_axis,
+        build_direction: cp.build_direction,
+        r_z,
+    }
+}
+
 /// Optimises `R_Z` layer by layer [SPEC §7].
 ///
 /// # Errors
@@ -1087,14 +1116,7 @@ fn finish(
         .points
         .iter()
         .enumerate()
-        .map(|(m, cp)| PathPointInput {
-            layer,
-            point: m,
-            position_mm: cp.position_mm,
-            tool_axis: cp.tool_axis,
-            build_direction: cp.build_direction,
-            r_z: e.r[m],
-        })
+        .map(|(m, cp)| path_point(layer, m, cp, e.r[m]))
         .collect();
     let mut topts = opts.trajectory;
     topts.with_derivatives = false;

@@ -17,7 +17,7 @@ use waam_slicer::program::readback::kuka::parse_krl;
 use waam_slicer::program::readback::parse_ls;
 use waam_slicer::program::validate::{validate_abb, validate_fanuc, validate_kuka};
 use waam_slicer::program::{build_program, Program, TravelSpeed};
-use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
+use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions};
 use waam_slicer::robot::Cell;
 use waam_slicer::toolaxis::local_frames;
 
@@ -53,24 +53,7 @@ fn plan_program(part: &str, cell: &Cell) -> Result<Program, String> {
             .expect("an infeasible layer");
         return Err(format!("layer {}: {}", l.layer, l.status));
     }
-    let inputs: Vec<PathPointInput> = layers
-        .iter()
-        .zip(&plan.layers)
-        .flat_map(|(lp, pl)| {
-            lp.points
-                .iter()
-                .zip(&pl.points)
-                .enumerate()
-                .map(move |(i, (cp, pp))| PathPointInput {
-                    layer: lp.layer,
-                    point: i,
-                    position_mm: cp.position_mm,
-                    tool_axis: cp.tool_axis,
-                    build_direction: cp.build_direction,
-                    r_z: pp.r_z,
-                })
-        })
-        .collect();
+    let inputs = waam_slicer::optimise::trajectory_inputs(&layers, &plan);
     let ts = opts.travel_speed_mm_s;
     let traj = joint_trajectory(cell, &inputs, ts, &TrajectoryOptions::default())
         .map_err(|e| e.to_string())?;
