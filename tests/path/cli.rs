@@ -156,7 +156,8 @@ fn plan_writes_a_program_that_check_accepts_and_a_corrupted_one_it_rejects() {
         String::from_utf8_lossy(&out.stderr)
     );
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("J5 = 17119") && err.contains("BAD:"), "{err}"); // file:line: what
+    // file:line: what (the first position, an approach point, had J5 = 120.6°)
+    assert!(err.contains("J5 = 17") && err.contains("BAD:"), "{err}");
 }
 
 /// The tool-axis and process flags reach the outputs: `--max-lean 50` keeps
