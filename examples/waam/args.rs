@@ -84,6 +84,36 @@ pub struct SliceExtras {
     pub max_layers: Option<usize>,
 }
 
+/// `Delta` and the discretisation, shared by `slice` and `plan`; each
+/// overrides the part file's `[slicing]` value.
+#[derive(Debug, Clone, clap::Args)]
+pub struct GridArgs {
+    /// Interlayer distance Delta in mm (default: the part file's).
+    #[arg(long)]
+    pub delta: Option<f64>,
+    /// Points per layer.
+    #[arg(long, conflicts_with = "chord")]
+    pub points: Option<usize>,
+    /// Max chord error in mm.
+    #[arg(long)]
+    pub chord: Option<f64>,
+}
+
+impl GridArgs {
+    /// Applies the overrides given to `opts`.
+    pub fn apply(&self, opts: &mut waam_slicer::path::SliceOptions) {
+        if let Some(d) = self.delta {
+            opts.delta_mm = d;
+        }
+        if let Some(n) = self.points {
+            opts.discretisation = waam_slicer::path::Discretisation::Points(n);
+        }
+        if let Some(e) = self.chord {
+            opts.discretisation = waam_slicer::path::Discretisation::ChordError(e);
+        }
+    }
+}
+
 /// Tool-axis and process settings shared by `slice` and `plan`; each
 /// overrides the part file's `[tool_axis]` / `[process]` value.
 #[derive(Debug, Clone, clap::Args)]
@@ -119,15 +149,9 @@ pub struct SliceArgs {
     /// Strategy (default: the part file's).
     #[arg(long, value_enum)]
     pub strategy: Option<StrategyArg>,
-    /// Interlayer distance Delta in mm (default: the part file's).
-    #[arg(long)]
-    pub delta: Option<f64>,
-    /// Points per layer.
-    #[arg(long, conflicts_with = "chord")]
-    pub points: Option<usize>,
-    /// Max chord error in mm.
-    #[arg(long)]
-    pub chord: Option<f64>,
+    /// Delta and the discretisation of each layer.
+    #[command(flatten)]
+    pub grid: GridArgs,
     /// Output folder (default out/<part name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -147,15 +171,9 @@ pub struct PlanArgs {
     /// The cell file (TOML, parts/cells/).
     #[arg(long)]
     pub cell: PathBuf,
-    /// Interlayer distance Delta in mm (default: the part file's).
-    #[arg(long)]
-    pub delta: Option<f64>,
-    /// Points per layer.
-    #[arg(long, conflicts_with = "chord")]
-    pub points: Option<usize>,
-    /// Max chord error in mm.
-    #[arg(long)]
-    pub chord: Option<f64>,
+    /// Delta and the discretisation of each layer.
+    #[command(flatten)]
+    pub grid: GridArgs,
     /// Robot program format written when the plan is feasible.
     #[arg(long, default_value = "fanuc", value_parser = ["fanuc", "kuka", "abb"])]
     pub format: String,

@@ -15,7 +15,7 @@ use waam_slicer::io::part_file::read_part_file;
 use waam_slicer::optimise::{
     layer_points, optimise, Abscissa, OptimiseOptions, Parameterisation, Plan,
 };
-use waam_slicer::path::{distance_map, slice, Discretisation};
+use waam_slicer::path::{distance_map, slice};
 use waam_slicer::robot::Cell;
 
 /// Header of `joints.csv` (degrees, part frame mm); `e1,e2` appended with a positioner.
@@ -84,15 +84,7 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
     };
     opts.validate().map_err(|e| e.to_string())?;
     let mut so = part.slice_options();
-    if let Some(d) = a.delta {
-        so.delta_mm = d;
-    }
-    if let Some(n) = a.points {
-        so.discretisation = Discretisation::Points(n);
-    }
-    if let Some(e) = a.chord {
-        so.discretisation = Discretisation::ChordError(e);
-    }
+    a.grid.apply(&mut so);
     let t_read = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let spinner = crate::progress::Stage::start(quiet, "slicing");

@@ -8,11 +8,11 @@ use waam_slicer::io::atomic::write_atomic;
 use waam_slicer::io::part_file::read_part_file;
 use waam_slicer::io::path_csv::write_path_csv;
 use waam_slicer::path::smooth::Smoothing;
-use waam_slicer::path::{distance_map, slice, Discretisation, Strategy};
+use waam_slicer::path::{distance_map, slice, Strategy};
 
 pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     let part_file = args.part.as_path();
-    let (strategy, delta, points, chord) = (args.strategy, args.delta, args.points, args.chord);
+    let strategy = args.strategy;
     let (out, more) = (args.out.as_deref(), &args.more);
     let t0 = Instant::now();
     let part = read_part_file(part_file).map_err(|e| e.to_string())?;
@@ -27,15 +27,7 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             StrategyArg::Spiral => Strategy::Spiral,
         };
     }
-    if let Some(d) = delta {
-        opts.delta_mm = d;
-    }
-    if let Some(n) = points {
-        opts.discretisation = Discretisation::Points(n);
-    }
-    if let Some(e) = chord {
-        opts.discretisation = Discretisation::ChordError(e);
-    }
+    args.grid.apply(&mut opts);
     if let Some(deg) = more.smooth {
         opts.smoothing = Some(Smoothing {
             max_turn_rad: deg.to_radians(),
