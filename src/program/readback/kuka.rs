@@ -138,6 +138,26 @@ fn code(raw: &str) -> &str {
 }
 
 fn parse_src(text: &str, file: &str) -> Result<(String, Vec<KrlStatement>), ProgramError> {
+    let name_of = |rest: &str| rest.split('(').next().unwrap_or("").trim().to_string();
+    parse_block(text, file, ("DEF", "name( )", "END"), name_of, |l, n| {
+        Ok(KrlStatement {
+            line: n,
+            op: parse_statement(l)?,
+        })
+    })
+}
+
+/// Reads a `DEF … END` or `DEFDAT … ENDDAT` file: the header's name (from
+/// the text after `open` by `name_of`), then each code line up to `close`
+/// through `body`; errors name the file and line (text after the end, a
+/// missing header or end).
+fn parse_block<T>(
+    text: &str,
+    file: &str,
+    (open, header, close): (&str, &str, &str),
+    name_of: impl Fn(&str) -> String,
+    body: impl Fn(&str, usize) -> Result<T, String>,
+) -> Result<(String, Vec<T>), ProgramError> {
     let mut name: Option<String> = None;
     let mut ended = false;
     let mut out = Vec::new();
@@ -150,31 +170,35 @@ fn parse_src(text: &str, file: &str) -> Result<(String, Vec<KrlStatement>), Prog
             continue;
         }
         if ended {
-            return Err(err(file, n, "text after END".into()));
+            return Err(err(file, n, format!("text after {close}")));
         }
-        let Some(_) = &name else {
+        if name.is_none() {
             let rest = l
-                .strip_prefix("DEF ")
-                .ok_or_else(|| err(file, n, format!("expected `DEF name( )`, got `{l}`")))?;
-            let nm = rest.split('(').next().unwrap_or("").trim();
+                .strip_prefix(open)
+                .and_then(|r| r.strip_prefix(' '))
+                .ok_or_else(|| err(file, n, format!("expected `{open} {header}`, got `{l}`")))?;
+            let nm = name_of(rest);
             if nm.is_empty() {
-                return Err(err(file, n, "DEF without a name".into()));
+                return Err(err(file, n, format!("{open} without a name")));
             }
-            name = Some(nm.to_string());
+            name = Some(nm);
             continue;
-        };
-        if l == "END" {
+        }
+        if l == close {
             ended = true;
             continue;
         }
-        let op = parse_statement(l).map_err(|r| err(file, n, r))?;
-        out.push(KrlStatement { line: n, op });
+        out.push(body(l, n).map_err(|r| err(file, n, r))?);
     }
     let Some(name) = name else {
-        return Err(err(file, last.max(1), "no DEF (empty file?)".into()));
+        return Err(err(file, last.max(1), format!("no {open} (empty file?)")));
     };
     if !ended {
-        return Err(err(file, last, "file ends without END (truncated?)".into()));
+        return Err(err(
+            file,
+            last,
+            format!("file ends without {close} (truncated?)"),
+        ));
     }
     Ok((name, out))
 }
@@ -266,46 +290,13 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
 }
 
 fn parse_dat(text: &str, file: &str) -> Result<(String, Vec<KrlPosition>), ProgramError> {
-    let mut name: Option<String> = None;
-    let mut ended = false;
-    let mut out = Vec::new();
-    let mut last = 0;
-    for (i, raw) in text.lines().enumerate() {
-        let n = i + 1;
-        last = n;
-        let l = code(raw);
-        if l.is_empty() {
-            continue;
-        }
-        if ended {
-            return Err(err(file, n, "text after ENDDAT".into()));
-        }
-        if name.is_none() {
-            let rest = l
-                .strip_prefix("DEFDAT ")
-                .ok_or_else(|| err(file, n, format!("expected `DEFDAT name`, got `{l}`")))?;
-            let nm = rest.split_whitespace().next().unwrap_or("");
-            name = Some(nm.to_string());
-            continue;
-        }
-        if l == "ENDDAT" {
-            ended = true;
-            continue;
-        }
-        let p = parse_decl(l).map_err(|r| err(file, n, r))?;
-        out.push(KrlPosition { line: n, ..p });
-    }
-    let Some(name) = name else {
-        return Err(err(file, last.max(1), "no DEFDAT (empty file?)".into()));
-    };
-    if !ended {
-        return Err(err(
-            file,
-            last,
-            "file ends without ENDDAT (truncated?)".into(),
-        ));
-    }
-    Ok((name, out))
+    let name_of = |rest: &str| rest.split_whitespace().next().unwrap_or("").to_string();
+    parse_block(text, file, ("DEFDAT", "name", "ENDDAT"), name_of, |l, n| {
+        Ok(KrlPosition {
+            line: n,
+            ..parse_decl(l)?
+        })
+    })
 }
 
 fn parse_decl(l: &str) -> Result<KrlPosition, String> {
