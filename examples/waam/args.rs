@@ -174,9 +174,11 @@ pub struct PlanArgs {
     /// Delta and the discretisation of each layer.
     #[command(flatten)]
     pub grid: GridArgs,
-    /// Robot program format written when the plan is feasible.
-    #[arg(long, default_value = "fanuc", value_parser = ["fanuc", "kuka", "abb"])]
-    pub format: String,
+    /// Robot program format written when the plan is feasible; default:
+    /// the cell robot's vendor. Another vendor's format is refused (exit 2):
+    /// the joints are in the cell robot's controller convention.
+    #[arg(long, value_parser = ["fanuc", "kuka", "abb"])]
+    pub format: Option<String>,
     /// R_Z law: fixed:DEG, poly:N (max degree), spline, point.
     #[arg(long, default_value = "poly:4")]
     pub rz: String,

@@ -50,20 +50,58 @@ fn parse_rz(s: &str) -> Result<Parameterisation, String> {
     }
 }
 
+/// Why `plan` stops before planning: bad input (exit 1) or a program format
+/// the cell's robot cannot run (exit 2).
+enum PlanError {
+    Input(String),
+    Format(String),
+}
+
+impl From<String> for PlanError {
+    fn from(message: String) -> Self {
+        PlanError::Input(message)
+    }
+}
+
+/// The emitter for `asked` (`None`: the cell robot's vendor's); another
+/// vendor's format is [`PlanError::Format`] with the library's message.
+fn program_format(asked: Option<&str>, cell: &Cell) -> Result<&'static str, PlanError> {
+    use waam_slicer::robot::Vendor;
+    let (vendor, name, emitter) = match asked {
+        Some("kuka") => (Vendor::Kuka, "kuka", waam_slicer::program::kuka::EMITTER),
+        Some("abb") => (Vendor::Abb, "abb", waam_slicer::program::abb::EMITTER),
+        Some(_) => (Vendor::Fanuc, "fanuc", waam_slicer::program::fanuc::EMITTER),
+        None => {
+            return Ok(match cell.robot().vendor {
+                Vendor::Fanuc => "fanuc",
+                Vendor::Kuka => "kuka",
+                Vendor::Abb => "abb",
+            })
+        }
+    };
+    waam_slicer::program::check_vendor(cell, vendor, emitter)
+        .map_err(|e| PlanError::Format(format!("--format {name}: {e}")))?;
+    Ok(name)
+}
+
 /// Runs the command; prints errors itself and returns the exit code.
 pub fn run(a: &PlanArgs, quiet: bool) -> ExitCode {
     match plan(a, quiet) {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(2),
-        Err(message) => {
+        Err(PlanError::Format(message)) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+        Err(PlanError::Input(message)) => {
             eprintln!("error: {message}");
             ExitCode::from(1)
         }
     }
 }
 
-/// `Ok(feasible)`, `Err` for bad input.
-fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
+/// `Ok(feasible)`, `Err` for bad input or a mismatching format.
+fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, PlanError> {
     let t0 = Instant::now();
     let part = read_part_file(&a.part).map_err(|e| e.to_string())?;
     let cell_file = read_cell_file(&a.cell).map_err(|e| e.to_string())?;
@@ -73,6 +111,9 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
             a.cell.display()
         )
     })?;
+    // The program format: the cell robot's vendor's unless asked; another
+    // vendor's is refused before any planning (exit 2, as the emitter would).
+    let format = program_format(a.format.as_deref(), &cell)?;
     // One IK branch for the whole part (the cell's): a program must not
     // reconfigure the arm between layers.
     let process = crate::stages::process_parameters(&part, &a.axes)?;
@@ -135,7 +176,7 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, String> {
     let feasible = if feasible {
         match emit_program(
             &part.name,
-            &a.format,
+            format,
             &cell,
             &layers,
             &result,

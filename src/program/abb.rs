@@ -39,10 +39,13 @@ use serde::{Deserialize, Serialize};
 use crate::math::Isometry3;
 use crate::program::fmt::{Deg, Mm, Unitless};
 use crate::program::{
-    check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::abb_quaternion;
-use crate::robot::{Cell, Joints, RobotModel};
+use crate::robot::{Cell, Joints, RobotModel, Vendor};
+
+/// The emitter's name in [`ProgramError::VendorMismatch`].
+pub const EMITTER: &str = "ABB RAPID";
 
 /// Options of the ABB emitter. Plain data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -221,8 +224,10 @@ fn extax(e: Option<[f64; 2]>) -> String {
 /// Writes the `.mod` of `program`.
 ///
 /// # Errors
-/// I/O errors of `w`.
+/// I/O errors of `w`; an error of kind `Other` wrapping
+/// [`ProgramError::VendorMismatch`] when the cell's robot is not an ABB arm.
 pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std::io::Result<()> {
+    check_vendor(&program.cell, Vendor::Abb, EMITTER).map_err(std::io::Error::other)?;
     let robot = program.cell.robot();
     let frames = opts.frames(&program.cell);
     writeln!(w, "MODULE {}", program.name)?;
@@ -363,8 +368,10 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
 /// The `.mod` file of `program`.
 ///
 /// # Errors
-/// [`ProgramError::InvalidOptions`] for bad options or name.
+/// [`ProgramError::InvalidOptions`] for bad options or name;
+/// [`ProgramError::VendorMismatch`] when the cell's robot is not an ABB arm.
 pub fn abb_files(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+    check_vendor(&program.cell, Vendor::Abb, EMITTER)?;
     opts.validate()?;
     check_name(&program.name)?;
     Ok(vec![EmittedFile {

@@ -56,10 +56,13 @@ use crate::math::Isometry3;
 use crate::program::fmt::{FanucDeg, FanucMm};
 use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
 use crate::program::{
-    check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::FanucPose;
-use crate::robot::Cell;
+use crate::robot::{Cell, Vendor};
+
+/// The emitter's name in [`ProgramError::VendorMismatch`].
+pub const EMITTER: &str = "FANUC TP";
 
 /// The remark opening a program with time-based linear moves (≤ 32 characters).
 pub const TIME_BASED_REMARK: &str = "TIMED: TORCH SPEED OVER PART";
@@ -407,8 +410,10 @@ pub struct TpProgram {
 ///
 /// # Errors
 /// [`ProgramError::InvalidOptions`] for bad options or a name too long
-/// for the sub-program suffix.
+/// for the sub-program suffix; [`ProgramError::VendorMismatch`] when the
+/// cell's robot is not a FANUC arm.
 pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgram>, ProgramError> {
+    check_vendor(&program.cell, Vendor::Fanuc, EMITTER)?;
     opts.validate()?;
     check_name(&program.name)?;
     let robot = program.cell.robot();

@@ -36,10 +36,13 @@ use crate::math::Isometry3;
 use crate::program::fanuc::PositionMode;
 use crate::program::fmt::{Deg, Mm};
 use crate::program::{
-    check_name, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::KukaAbc;
-use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel};
+use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel, Vendor};
+
+/// The emitter's name in [`ProgramError::VendorMismatch`].
+pub const EMITTER: &str = "KUKA KRL";
 
 /// Options of the KUKA emitter. Plain data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -196,8 +199,10 @@ pub(crate) fn switch_statements(opts: &KukaOptions) -> (String, String) {
 /// Writes the `.src` of `program`.
 ///
 /// # Errors
-/// I/O errors of `w`.
+/// I/O errors of `w`; an error of kind `Other` wrapping
+/// [`ProgramError::VendorMismatch`] when the cell's robot is not a KUKA arm.
 pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> std::io::Result<()> {
+    check_vendor(&program.cell, Vendor::Kuka, EMITTER).map_err(std::io::Error::other)?;
     let (on, off) = switch_statements(opts);
     writeln!(w, "&ACCESS RVP")?;
     writeln!(w, "&REL 1")?;
@@ -282,8 +287,10 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
 /// Writes the `.dat` of `program`.
 ///
 /// # Errors
-/// I/O errors of `w`.
+/// I/O errors of `w`; an error of kind `Other` wrapping
+/// [`ProgramError::VendorMismatch`] when the cell's robot is not a KUKA arm.
 pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> std::io::Result<()> {
+    check_vendor(&program.cell, Vendor::Kuka, EMITTER).map_err(std::io::Error::other)?;
     let robot = program.cell.robot();
     let (base, tool) = opts.frames(&program.cell);
     let user_from_base = base.inverse();
@@ -339,8 +346,10 @@ pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
 /// The `.src` and `.dat` files of `program`.
 ///
 /// # Errors
-/// [`ProgramError::InvalidOptions`] for bad options or name.
+/// [`ProgramError::InvalidOptions`] for bad options or name;
+/// [`ProgramError::VendorMismatch`] when the cell's robot is not a KUKA arm.
 pub fn kuka_files(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+    check_vendor(&program.cell, Vendor::Kuka, EMITTER)?;
     opts.validate()?;
     check_name(&program.name)?;
     Ok(vec![

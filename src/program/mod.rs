@@ -43,7 +43,7 @@ use crate::math::{Point3, UnitVector3};
 use crate::robot::cell::CellPoint;
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::trajectory::{JointTrajectory, PathPointInput};
-use crate::robot::{Cell, Configuration, Joints};
+use crate::robot::{Cell, Configuration, Joints, Vendor};
 
 /// Errors of the program stage; each names the point, field or file at fault.
 #[derive(Debug, thiserror::Error)]
@@ -84,6 +84,22 @@ pub enum ProgramError {
         path: String,
         /// The I/O error.
         source: std::io::Error,
+    },
+    /// The program's robot is another vendor's than the emitter's: its joints
+    /// are in that vendor's controller convention and its Cartesian poses
+    /// use that vendor's flange axes, meaningless on this controller.
+    #[error(
+        "the {emitter} emitter writes {emitter_vendor} programs, but the cell's robot `{robot}` has vendor {robot_vendor} (its joints are in the {robot_vendor} controller's convention): use the {robot_vendor} format"
+    )]
+    VendorMismatch {
+        /// The emitter or validator, e.g. `KUKA KRL`.
+        emitter: &'static str,
+        /// The emitter's vendor.
+        emitter_vendor: &'static str,
+        /// The cell's robot (its name).
+        robot: String,
+        /// The robot's vendor.
+        robot_vendor: &'static str,
     },
     /// A program file could not be read back.
     #[error("{file}:{line}: {reason}")]
@@ -559,6 +575,39 @@ pub fn check_name(name: &str) -> Result<(), ProgramError> {
             field: "name",
             value: name.to_string(),
             reason: "a letter, then letters, digits or `_`, at most 32 characters",
+        })
+    }
+}
+
+/// The vendor's name as written in messages (`FANUC`, `KUKA`, `ABB`).
+pub fn vendor_name(vendor: Vendor) -> &'static str {
+    match vendor {
+        Vendor::Fanuc => "FANUC",
+        Vendor::Kuka => "KUKA",
+        Vendor::Abb => "ABB",
+    }
+}
+
+/// Checks that `cell`'s robot is a `vendor` arm, the only one whose joints
+/// (controller convention, rad) and flange poses the `emitter` (e.g. `KUKA
+/// KRL`) may write or read.
+///
+/// # Errors
+/// [`ProgramError::VendorMismatch`] naming both vendors and the robot.
+pub fn check_vendor(
+    cell: &Cell,
+    vendor: Vendor,
+    emitter: &'static str,
+) -> Result<(), ProgramError> {
+    let robot = cell.robot();
+    if robot.vendor == vendor {
+        Ok(())
+    } else {
+        Err(ProgramError::VendorMismatch {
+            emitter,
+            emitter_vendor: vendor_name(vendor),
+            robot: robot.name.clone(),
+            robot_vendor: vendor_name(robot.vendor),
         })
     }
 }

@@ -25,7 +25,7 @@ use crate::program::fanuc::{ArmPosition, FanucOptions, MoveKind, Op, TpProgram};
 use crate::program::ProcessControl;
 use crate::robot::ik::wrap_pi;
 use crate::robot::orientation::FanucPose;
-use crate::robot::{ArmSide, Cell, Configuration, Elbow, Joints, RobotModel, Wrist};
+use crate::robot::{ArmSide, Cell, Configuration, Elbow, Joints, RobotModel, Vendor, Wrist};
 
 /// Largest accepted distance between a position and what it should reach (mm).
 pub const REACH_TOLERANCE_MM: f64 = 0.01;
@@ -455,6 +455,25 @@ pub(crate) fn decode_pose(
     Some(q)
 }
 
+/// `false`, with the problem pushed (line 1 of `file`), when `cell`'s robot
+/// is not a `vendor` arm: its joints are in another controller's convention
+/// and nothing else in the file can be checked against it.
+fn vendor_matches(
+    cell: &Cell,
+    vendor: Vendor,
+    emitter: &'static str,
+    file: &str,
+    report: &mut ValidationReport,
+) -> bool {
+    match crate::program::check_vendor(cell, vendor, emitter) {
+        Ok(()) => true,
+        Err(e) => {
+            push(report, file, 1, e.to_string());
+            false
+        }
+    }
+}
+
 /// The branch whose wrist has controller J5 of sign `j5_positive`.
 pub(crate) fn wrist_of_j5(robot: &RobotModel, j5_positive: bool) -> Wrist {
     // NoFlip when the canonical t5 = sign5·J5 is positive
@@ -480,6 +499,9 @@ pub(crate) fn arm_of(back: bool, positive_cos: bool) -> (ArmSide, Elbow) {
 /// the others by name) against `cell`, with the frames and process of
 /// `opts`. `planned`: the planned deposition points of the beads (part
 /// frame, mm), one per bead motion in execution order, when available.
+/// A cell whose robot is not a FANUC arm is refused: the report holds that
+/// one problem ([`ProgramError::VendorMismatch`](crate::program::ProgramError::VendorMismatch)'s
+/// message, line 1 of the main program).
 pub fn validate_fanuc(
     programs: &[TpProgram],
     cell: &Cell,
@@ -487,6 +509,16 @@ pub fn validate_fanuc(
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
     let mut report = ValidationReport::default();
+    let file = programs.first().map_or("", |p| p.name.as_str());
+    if !vendor_matches(
+        cell,
+        Vendor::Fanuc,
+        crate::program::fanuc::EMITTER,
+        file,
+        &mut report,
+    ) {
+        return report;
+    }
     let mut steps = Vec::new();
     if let Some(main) = programs.first() {
         fanuc_steps(programs, main, 0, cell, opts, &mut steps, &mut report);
@@ -681,7 +713,8 @@ fn abb_quadrant(q: f64, cf: i32) -> Option<f64> {
 /// Status bits (branch, checked against the cell's) and, for `PTP`, the
 /// Turn bits (each of A1, A4, A6 the value of that sign nearest zero inside
 /// its travel); a `LIN` ignores Turn as the controller does and takes the
-/// value nearest the previous position.
+/// value nearest the previous position. A cell whose robot is not a KUKA
+/// arm is refused: the report holds that one problem (line 1 of the `.src`).
 pub fn validate_kuka(
     program: &crate::program::readback::kuka::KrlProgram,
     cell: &Cell,
@@ -691,6 +724,15 @@ pub fn validate_kuka(
     use crate::program::readback::kuka::{KrlOp, KrlValue};
     use crate::robot::orientation::KukaAbc;
     let mut report = ValidationReport::default();
+    if !vendor_matches(
+        cell,
+        Vendor::Kuka,
+        crate::program::kuka::EMITTER,
+        &program.src_file,
+        &mut report,
+    ) {
+        return report;
+    }
     let robot = cell.robot();
     let (base, tool) = opts.frames(cell);
     let (on, off) = crate::program::kuka::switch_statements(opts);
@@ -888,7 +930,8 @@ pub fn validate_kuka(
 /// `wWaam` (held or stationary tool). `robtarget`s are decoded with their
 /// `confdata`: `cfx` gives the branch (checked against the cell's), `cf1`,
 /// `cf4`, `cf6` the quadrant of J1, J4, J6 (`ConfL \On` makes the controller
-/// keep them on linear moves).
+/// keep them on linear moves). A cell whose robot is not an ABB arm is
+/// refused: the report holds that one problem (line 1 of the module).
 pub fn validate_abb(
     module: &crate::program::readback::abb::RapidModule,
     cell: &Cell,
@@ -898,6 +941,15 @@ pub fn validate_abb(
     use crate::program::abb::AbbFrames;
     use crate::program::readback::abb::{RapidOp, RapidTargetValue};
     let mut report = ValidationReport::default();
+    if !vendor_matches(
+        cell,
+        Vendor::Abb,
+        crate::program::abb::EMITTER,
+        &module.file,
+        &mut report,
+    ) {
+        return report;
+    }
     let file = &module.file;
     let robot = cell.robot();
     let frames = match (&module.tool, &module.wobj) {

@@ -217,23 +217,59 @@ fn slice_applies_the_tool_axis_and_process_settings() {
 /// torch-carried cell (`--format kuka`) and the example ABB part-carried
 /// cell (`--format abb`) gives programs that `check` accepts; a joint pushed
 /// out of its travel in the KUKA `.dat` is named by file and line (exit 2).
+/// Without `--format` the cell robot's vendor's format is written; another
+/// vendor's format is refused before planning (exit 2, no program).
 #[test]
 fn kuka_and_abb_plans_pass_check() {
     let dir = tempfile::tempdir().unwrap();
+    for (format, cell, vendor) in [
+        ("fanuc", "cells/kuka_kr16_2_torch_carried.toml", "KUKA"),
+        ("abb", "cells/kuka_kr16_2_torch_carried.toml", "KUKA"),
+        ("kuka", "cells/robowam_part_carried.toml", "FANUC"),
+    ] {
+        let out = dir.path().join(format!("mismatch_{format}"));
+        let run = waam()
+            .args(["--quiet", "plan"])
+            .arg(part_path("nozzle.toml"))
+            .arg("--cell")
+            .arg(part_path(cell))
+            .args(["--delta", "5", "--points", "60", "--format", format])
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{format} in {cell}: {err}");
+        assert!(
+            err.contains(&format!("--format {format}"))
+                && err.contains(&format!("has vendor {vendor} ")),
+            "{err}"
+        );
+        assert!(
+            !out.exists(),
+            "{format} in {cell}: nothing planned or written"
+        );
+    }
     for (format, cell, program) in [
         ("kuka", "cells/kuka_kr16_2_torch_carried.toml", "NOZZLE.src"),
         ("abb", "cells/abb_irb2600_part_carried.toml", "NOZZLE.mod"),
     ] {
         let out = dir.path().join(format);
         let cell = part_path(cell);
+        // the KUKA cell without `--format`: the default follows the vendor
+        let format_args: &[&str] = if format == "kuka" {
+            &[]
+        } else {
+            &["--format", format]
+        };
         let status = waam()
             .args(["--quiet", "plan"])
             .arg(part_path("nozzle.toml"))
             .arg("--cell")
             .arg(&cell)
-            .args([
-                "--delta", "5", "--points", "60", "--format", format, "--out",
-            ])
+            .args(["--delta", "5", "--points", "60"])
+            .args(format_args)
+            .arg("--out")
             .arg(&out)
             .status()
             .unwrap();

@@ -1,13 +1,13 @@
 //! A few layers of the hemisphere (R_s = 45 mm, Delta = 5 mm, closed form
-//! of SPEC §2.1) in the ROBOWAM cells, with `R_Z = c − v` (J1–J5 still
-//! within a layer in the part-carried cell).
+//! of SPEC §2.1) in the ROBOWAM cells (FANUC) and the KUKA and ABB example
+//! cells, with a law `R_Z(v)` feasible in each ([`law`]).
 
 use waam_slicer::io::cell_file::read_cell_file;
 use waam_slicer::program::{build_program, Program, TravelSpeed};
 use waam_slicer::robot::trajectory::{
     joint_trajectory, JointTrajectory, PathPointInput, TrajectoryOptions,
 };
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::{Cell, Vendor};
 
 /// TS 36 cm/min = 6 mm/s [thesis table 3.1].
 pub const TS_MM_S: f64 = 6.0;
@@ -40,14 +40,41 @@ pub fn trajectory(cell: &Cell, path: &[PathPointInput]) -> JointTrajectory {
     joint_trajectory(cell, path, TS_MM_S, &TrajectoryOptions::default()).unwrap()
 }
 
-/// The law of each cell: `R_Z = −v` where the robot holds the part (J1–J5
-/// still), `R_Z = 0` where the positioner turns it (hose torsion bounded).
+/// The law of each cell. ROBOWAM (FANUC): `R_Z = −v` where the robot holds
+/// the part (J1–J5 still), `R_Z = 0` where the positioner turns it (hose
+/// torsion bounded). The KUKA and ABB example cells: `R_Z = 0` where the
+/// robot holds the part (with `−v`, J5 leaves its ±120°/±130° travel half
+/// way round), `R_Z = π` where it carries the torch (with 0 the hose
+/// torsion |J4 + J6| is 180°: their flange axes differ from FANUC's).
 pub fn law(cell: &Cell) -> fn(f64) -> f64 {
-    match cell {
-        Cell::PartCarried(_) => |v| -v,
-        Cell::TorchCarried(_) => |_| 0.0,
+    let fanuc = cell.robot().vendor == Vendor::Fanuc;
+    match (cell, fanuc) {
+        (Cell::PartCarried(_), true) => |v| -v,
+        (Cell::PartCarried(_), false) => |_| 0.0,
+        (Cell::TorchCarried(_), true) => |_| 0.0,
+        (Cell::TorchCarried(_), false) => |_| std::f64::consts::PI,
     }
 }
+
+/// The KUKA example cells: torch carried (positioner as `E1`, `E2`) and
+/// part carried (fixed-tool mode).
+pub const KUKA_CELLS: [&str; 2] = [
+    "kuka_kr16_2_torch_carried.toml",
+    "kuka_kr16_2_part_carried.toml",
+];
+
+/// The ABB example cells: part carried (stationary tool) and torch carried.
+pub const ABB_CELLS: [&str; 2] = [
+    "abb_irb2600_part_carried.toml",
+    "abb_irb2600_torch_carried.toml",
+];
+
+/// The ROBOWAM cells (FANUC ArcMate 120iC).
+pub const FANUC_CELLS: [&str; 3] = [
+    "robowam_part_carried.toml",
+    "robowam_part_carried_second_position.toml",
+    "robowam_torch_carried.toml",
+];
 
 /// The program of layers `layers` (`points` per layer) in `cell`.
 pub fn program(
@@ -64,11 +91,7 @@ pub fn program(
 
 #[test]
 fn the_test_layers_are_feasible_in_every_cell() {
-    for file in [
-        "robowam_part_carried.toml",
-        "robowam_part_carried_second_position.toml",
-        "robowam_torch_carried.toml",
-    ] {
+    for file in FANUC_CELLS.iter().chain(&KUKA_CELLS).chain(&ABB_CELLS) {
         let cell = cell(file);
         let path = hemisphere(0..4, 24, law(&cell));
         let tr = trajectory(&cell, &path);

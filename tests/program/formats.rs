@@ -4,21 +4,26 @@
 
 use waam_slicer::math::Point3;
 use waam_slicer::program::abb::{abb_files, AbbOptions};
-use waam_slicer::program::fanuc::PositionMode;
+use waam_slicer::program::fanuc::{fanuc_files, FanucOptions, PositionMode};
 use waam_slicer::program::kuka::{kuka_files, KukaOptions};
 use waam_slicer::program::readback::abb::parse_mod;
 use waam_slicer::program::readback::kuka::parse_krl;
-use waam_slicer::program::validate::{validate_abb, validate_kuka, ValidationReport};
-use waam_slicer::program::{EmittedFile, Program};
+use waam_slicer::program::readback::parse_ls;
+use waam_slicer::program::validate::{
+    validate_abb, validate_fanuc, validate_kuka, ValidationReport,
+};
+use waam_slicer::program::{EmittedFile, Program, ProgramError};
 use waam_slicer::robot::Cell;
 
-use crate::fixture::{cell, part_carried, program};
+use crate::fixture::{cell, part_carried, program, ABB_CELLS, KUKA_CELLS};
 
-const CELLS: [&str; 3] = [
-    "robowam_part_carried.toml",
-    "robowam_part_carried_second_position.toml",
-    "robowam_torch_carried.toml",
-];
+fn kuka_part_carried() -> Cell {
+    cell("kuka_kr16_2_part_carried.toml")
+}
+
+fn abb_part_carried() -> Cell {
+    cell("abb_irb2600_part_carried.toml")
+}
 
 fn hemi(cell: &Cell) -> (Program, Vec<Point3>) {
     let (prog, _) = program(cell, 0..4, 24);
@@ -62,8 +67,8 @@ fn abb_check(text: &str, cell: &Cell, planned: &[Point3]) -> ValidationReport {
 }
 
 #[test]
-fn kuka_and_abb_programs_read_back_and_validate_in_every_cell() {
-    for file in CELLS {
+fn kuka_and_abb_programs_read_back_and_validate_in_their_cells() {
+    for file in KUKA_CELLS {
         let c = cell(file);
         let (prog, planned) = hemi(&c);
         for positions in [PositionMode::Joint, PositionMode::Cartesian] {
@@ -76,6 +81,10 @@ fn kuka_and_abb_programs_read_back_and_validate_in_every_cell() {
             assert!(r.is_ok(), "{file} KUKA {positions:?}:\n{r}");
             assert_eq!((r.motions, r.beads), (96 + 8, 4));
         }
+    }
+    for file in ABB_CELLS {
+        let c = cell(file);
+        let (prog, planned) = hemi(&c);
         let f = abb_files(&prog, &AbbOptions::default()).unwrap();
         let r = abb_check(&f[0].text, &c, &planned);
         assert!(r.is_ok(), "{file} ABB:\n{r}");
@@ -83,27 +92,86 @@ fn kuka_and_abb_programs_read_back_and_validate_in_every_cell() {
     }
 }
 
+/// A program's joints are in its robot's controller convention: written by
+/// another vendor's emitter they would be meaningless (FANUC J2/J3 values as
+/// KUKA A2/A3). Every emitter and validator refuses another vendor's robot,
+/// naming both.
 #[test]
-fn part_carried_cell_uses_external_tcp_and_stationary_tool() {
-    let (prog, _) = hemi(&part_carried());
-    let k = kuka_files(&prog, &KukaOptions::default()).unwrap();
-    assert!(k[0].text.contains("$IPO_MODE = #TCP"));
-    let a = abb_files(&prog, &AbbOptions::default()).unwrap();
-    assert!(a[0].text.contains("PERS tooldata tWaam := [FALSE,"));
-    assert!(a[0].text.contains("PERS wobjdata wWaam := [TRUE,"));
-    let (prog, _) = hemi(&cell("robowam_torch_carried.toml"));
-    let k = kuka_files(&prog, &KukaOptions::default()).unwrap();
-    assert!(k[0].text.contains("$IPO_MODE = #BASE"));
+fn emitters_and_validators_refuse_another_vendors_robot() {
+    let (fanuc_prog, _) = program(&part_carried(), 0..1, 8);
+    let (kuka_prog, _) = program(&kuka_part_carried(), 0..1, 8);
+    let (abb_prog, _) = program(&abb_part_carried(), 0..1, 8);
+    let mismatch = |e: ProgramError, emitter: &str, robot_vendor: &str| {
+        let msg = e.to_string();
+        assert!(
+            matches!(e, ProgramError::VendorMismatch { .. })
+                && msg.contains(emitter)
+                && msg.contains(&format!("has vendor {robot_vendor} ")),
+            "{msg}"
+        );
+    };
+    mismatch(
+        kuka_files(&fanuc_prog, &KukaOptions::default()).unwrap_err(),
+        "KUKA KRL",
+        "FANUC",
+    );
+    mismatch(
+        abb_files(&fanuc_prog, &AbbOptions::default()).unwrap_err(),
+        "ABB RAPID",
+        "FANUC",
+    );
+    mismatch(
+        fanuc_files(&kuka_prog, &FanucOptions::default()).unwrap_err(),
+        "FANUC TP",
+        "KUKA",
+    );
+    mismatch(
+        abb_files(&kuka_prog, &AbbOptions::default()).unwrap_err(),
+        "ABB RAPID",
+        "KUKA",
+    );
+    mismatch(
+        kuka_files(&abb_prog, &KukaOptions::default()).unwrap_err(),
+        "KUKA KRL",
+        "ABB",
+    );
+    // the writers themselves refuse too
+    let mut sink = Vec::new();
+    assert!(
+        waam_slicer::program::kuka::write_dat(&mut sink, &fanuc_prog, &KukaOptions::default())
+            .is_err()
+    );
+    assert!(
+        waam_slicer::program::abb::write_mod(&mut sink, &kuka_prog, &AbbOptions::default())
+            .is_err()
+    );
+    // validators: a right program checked against another vendor's cell
+    let k = kuka_files(&kuka_prog, &KukaOptions::default()).unwrap();
+    let krl = parse_krl(&k[0].text, &k[0].name, &k[1].text, &k[1].name).unwrap();
+    let r = validate_kuka(&krl, &part_carried(), &KukaOptions::default(), None);
+    assert_eq!(r.problems.len(), 1, "{r}");
+    assert!(
+        r.problems[0].line == 1 && r.problems[0].message.contains("has vendor FANUC "),
+        "{r}"
+    );
+    let a = abb_files(&abb_prog, &AbbOptions::default()).unwrap();
+    let m = parse_mod(&a[0].text, &a[0].name).unwrap();
+    let r = validate_abb(&m, &kuka_part_carried(), &AbbOptions::default(), None);
+    assert!(r.problems[0].message.contains("has vendor KUKA "), "{r}");
+    let f = fanuc_files(&fanuc_prog, &FanucOptions::default()).unwrap();
+    let tp = parse_ls(&f[0].text, &f[0].name).unwrap();
+    let r = validate_fanuc(&[tp], &abb_part_carried(), &FanucOptions::default(), None);
+    assert!(r.problems[0].message.contains("has vendor ABB "), "{r}");
 }
 
 #[test]
 fn kuka_corruptions_are_named_by_their_line() {
-    let c = part_carried();
+    let c = kuka_part_carried();
     let (prog, planned) = hemi(&c);
     let opts = KukaOptions::default();
     let f = kuka_files(&prog, &opts).unwrap();
     let (src, dat) = (&f[0].text, &f[1].text);
-    // a joint pushed out of range (J5 travel ±135°)
+    // a joint pushed out of range (J5 travel ±130°)
     let l = line_of(dat, "DECL E6AXIS P3=", 0);
     let bad = edit(dat, l, |s| {
         let a = s.find("A5 ").unwrap();
@@ -175,7 +243,7 @@ fn kuka_corruptions_are_named_by_their_line() {
 
 #[test]
 fn abb_corruptions_are_named_by_their_line() {
-    let c = part_carried();
+    let c = abb_part_carried();
     let (prog, planned) = hemi(&c);
     let text = &abb_files(&prog, &AbbOptions::default()).unwrap()[0].text;
     // a joint pushed out of range in the approach jointtarget

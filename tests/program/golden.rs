@@ -119,25 +119,48 @@ fn fanuc_torch_carried_golden_has_group_2() {
     check_all("fanuc_torch_", &files);
 }
 
+/// Two layers in a KUKA or ABB example cell.
+fn small_in(file: &str) -> Program {
+    program(&cell(file), 0..2, 8).0
+}
+
 #[test]
 fn kuka_golden() {
+    // torch carried: E6AXIS with the positioner as E1, E2
     check_all(
         "kuka_joint_",
-        &kuka_files(&small(), &KukaOptions::default()).unwrap(),
+        &kuka_files(
+            &small_in("kuka_kr16_2_torch_carried.toml"),
+            &KukaOptions::default(),
+        )
+        .unwrap(),
     );
+    // part carried: fixed-tool mode, E6POS of the part in the torch frame
     let opts = KukaOptions {
         positions: PositionMode::Cartesian,
         ..Default::default()
     };
-    let files = kuka_files(&small(), &opts).unwrap();
-    check_golden("kuka_cartesian_HEMI.dat", &files[1].text);
+    let files = kuka_files(&small_in("kuka_kr16_2_part_carried.toml"), &opts).unwrap();
+    check_all("kuka_cartesian_", &files);
 }
 
 #[test]
 fn abb_golden() {
     check_all(
         "abb_",
-        &abb_files(&small(), &AbbOptions::default()).unwrap(),
+        &abb_files(
+            &small_in("abb_irb2600_part_carried.toml"),
+            &AbbOptions::default(),
+        )
+        .unwrap(),
+    );
+    check_all(
+        "abb_torch_",
+        &abb_files(
+            &small_in("abb_irb2600_torch_carried.toml"),
+            &AbbOptions::default(),
+        )
+        .unwrap(),
     );
 }
 
