@@ -3,8 +3,9 @@
 //! * Positions as `robtarget`s (`[[x,y,z],[q1,q2,q3,q4],[cf1,cf4,cf6,cfx],
 //!   [e1..e6]]`: the tool in the work object, mm, quaternion `[w,x,y,z]`)
 //!   with `confdata` derived from the chosen joints (`cf1 cf4 cf6` the
-//!   quarter turn of J1, J4, J6, `floor(q / 90°)`; `cfx` 0–7 = front/back ×
-//!   elbow × sign of J5, ABB's table), and a `jointtarget` for the joint move
+//!   quarter turn of J1, J4, J6, `floor(q / 90°)`; `cfx` 0–7 = wrist
+//!   centre in front of/behind axis 1 × in front of/behind the lower arm ×
+//!   sign of J5, ABB's table, [`confdata`]), and a `jointtarget` for the joint move
 //!   to every bead start; the torch-carried cell's positioner as external
 //!   axes `eax_a`, `eax_b` (deg), the others `9E+09`.
 //! * `ConfL \On` so that the controller keeps our branch on linear moves.
@@ -180,12 +181,19 @@ impl AbbOptions {
     }
 }
 
-/// ABB `confdata` `[cf1, cf4, cf6, cfx]` of joints `q` (module doc).
+/// ABB `confdata` `[cf1, cf4, cf6, cfx]` of joints `q` (ABB convention,
+/// rad) (module doc). `cfx` = 4 · (wrist centre behind axis 1) + 2 · (wrist
+/// centre behind the lower arm) + (J5 < 0), ABB's table (RAPID reference,
+/// `confdata`, as quoted by CEAD-group/py-opw-kinematics
+/// `AXIS_CONFIGURATION.md`). "Behind the lower arm" is a joint test of the
+/// elbow (J3 past the stretched-elbow angle), not the geometric elbow-down:
+/// with the wrist centre behind axis 1 the usual posture is `cfx` 4 or 5,
+/// not 6 or 7.
 pub fn confdata(robot: &RobotModel, q: &Joints) -> [i32; 4] {
     let quarter = |v: f64| (v / std::f64::consts::FRAC_PI_2).floor() as i32;
     let c = robot.configuration_of(q);
     let side = matches!(c.side, crate::robot::ArmSide::Back) as i32;
-    let elbow = matches!(c.elbow, crate::robot::Elbow::Down) as i32;
+    let elbow = !crate::program::kuka::elbow_positive_cos(&c) as i32;
     let wrist = (q[4] < 0.0) as i32;
     [
         quarter(q[0]),
@@ -378,4 +386,68 @@ pub fn abb_files(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile
         name: format!("{}.mod", program.name),
         text: render(|w| write_mod(w, program, opts))?,
     }])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::robot::ArmGeometry;
+
+    /// An ABB IRB 1660-like arm (the OPW parameters of CEAD-group's
+    /// py-opw-kinematics `axis_configuration.rs` test: a1 150, a2 −110,
+    /// c1 486.5, c2 700, c3 678, c4 135 mm) on the IRB 2600's travel.
+    fn irb1660() -> RobotModel {
+        let mut r = RobotModel::abb_irb2600_12_185();
+        r.geometry = ArmGeometry {
+            shoulder_offset_mm: 150.0,
+            lateral_offset_mm: 0.0,
+            shoulder_height_mm: 486.5,
+            upper_arm_mm: 700.0,
+            elbow_offset_mm: 110.0,
+            forearm_mm: 678.0,
+            wrist_to_flange_mm: 135.0,
+        };
+        r
+    }
+
+    fn rad(d: [f64; 6]) -> Joints {
+        d.map(f64::to_radians)
+    }
+
+    /// Wrist centre behind axis 1 (J2 ≈ −85°: the upper arm leans back),
+    /// elbow in its usual range: `cfx` 5 with J5 < 0 and 4 with J5 > 0
+    /// (the reference's cases), where the geometric elbow (down, seen from
+    /// behind) would give 7 and 6.
+    #[test]
+    fn cfx_behind_axis_1_follows_the_elbow_joint_test() {
+        let r = irb1660();
+        for (q, cfx) in [
+            ([-103.1, -85.03, 19.06, -70.19, -35.87, 185.01], 5),
+            ([-116.97, -85.69, 16.82, -63.5, -39.63, 192.76], 5),
+            ([-124.68, -61.16, -20.4, 56.41, -38.79, -24.56], 5),
+            ([-103.1, -85.03, 19.06, 109.81, 35.87, 5.01], 4),
+            ([-127.36, -62.29, -16.83, -120.65, 35.14, 156.58], 4),
+        ] {
+            let q = rad(q);
+            assert_eq!(
+                r.configuration_of(&q).side,
+                crate::robot::ArmSide::Back,
+                "{q:?}"
+            );
+            assert_eq!(confdata(&r, &q)[3], cfx, "{q:?}");
+            // the validator decodes cfx back to the same branch
+            let c = r.configuration_of(&q);
+            assert_eq!(
+                crate::program::validate::arm_of(cfx & 4 != 0, cfx & 2 == 0),
+                (c.side, c.elbow)
+            );
+        }
+        // in front: the usual posture is 0/1, the elbow past stretched 2/3
+        assert_eq!(confdata(&r, &rad([0.0, 0.0, 0.0, 0.0, 30.0, 0.0]))[3], 0);
+        assert_eq!(confdata(&r, &rad([0.0, 0.0, 0.0, 0.0, -30.0, 0.0]))[3], 1);
+        assert_eq!(
+            confdata(&r, &rad([0.0, 30.0, -150.0, 0.0, 30.0, 0.0]))[3],
+            2
+        );
+    }
 }

@@ -24,9 +24,14 @@
 //!   fixed torch travels over it at `$VEL.CP`, and `E6POS` positions are the
 //!   part frame in the torch frame ([`KukaOptions::external_tcp`]).
 //!
-//! Status bits (KUKA): bit 0 wrist centre behind the A1 axis (overhead
-//! area), bit 1 `A3 >= phi` (the branch with `cos gamma > 0` here: elbow up
-//! in front), bit 2 `A5 <= 0`. Turn bit `i` set when `A(i+1) < 0`.
+//! Status bits (KUKA): bit 0 wrist centre behind the A1 axis (x < 0 in the
+//! A1 frame: overhead area), bit 1 `A3 >= phi`, `phi` the A3 angle of the
+//! stretched elbow (a joint test: the same for the wrist centre in front of
+//! or behind A1; set in the usual elbow-up posture, `S 2`), bit 2 A5 in
+//! `[-180°, 0°)` (strictly negative; clear at `A5 = 0`). Turn bit `i` set
+//! when `A(i+1) < 0`. Source of these definitions: the KUKA expert
+//! programming manual's Status table as quoted on robot-forum.com (not
+//! checked against the manual itself).
 
 use std::io::Write;
 
@@ -151,12 +156,22 @@ impl KukaOptions {
     }
 }
 
-/// KUKA Status bits of joints `q` (module doc).
+/// KUKA Status bits of joints `q` (A1..A6, KUKA convention, rad) (module
+/// doc).
 pub fn status(robot: &RobotModel, q: &Joints) -> u8 {
     let c = robot.configuration_of(q);
     let back = c.side == ArmSide::Back;
-    let positive_cos = (c.side == ArmSide::Front) == (c.elbow == Elbow::Up);
-    (back as u8) | ((positive_cos as u8) << 1) | (((q[4] <= 0.0) as u8) << 2)
+    (back as u8) | ((elbow_positive_cos(&c) as u8) << 1) | (((q[4] < 0.0) as u8) << 2)
+}
+
+/// The elbow joint test of a configuration: `true` on the side of the
+/// stretched elbow where the arm is in the usual elbow-up posture with the
+/// wrist centre in front of J1 (KUKA `A3 >= phi`, ABB wrist centre in front
+/// of the lower arm). [`Configuration`](crate::robot::Configuration)'s elbow
+/// is geometric (above or below the shoulder-wrist line), which swaps when
+/// the wrist centre goes behind J1; this test does not.
+pub fn elbow_positive_cos(c: &crate::robot::Configuration) -> bool {
+    (c.side == ArmSide::Front) == (c.elbow == Elbow::Up)
 }
 
 /// KUKA Turn bits of joints `q`: bit `i` set when `A(i+1) < 0`.
@@ -362,4 +377,50 @@ pub fn kuka_files(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFi
             text: render(|w| write_dat(w, program, opts))?,
         },
     ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rad(d: [f64; 6]) -> Joints {
+        d.map(f64::to_radians)
+    }
+
+    /// Bit 2 is set for A5 strictly negative: clear at A5 = 0.
+    #[test]
+    fn status_bit_2_is_a5_strictly_negative() {
+        let r = RobotModel::kuka_kr16_2();
+        let s = |a5: f64| status(&r, &rad([0.0, -90.0, 90.0, 0.0, a5, 0.0])) & 4;
+        assert_eq!(s(30.0), 0);
+        assert_eq!(s(0.0), 0);
+        assert_eq!(s(-1e-3), 4);
+        assert_eq!(s(-30.0), 4);
+    }
+
+    /// Bit 1 (`A3 >= phi`) is a joint test: an elbow-up A3 (60°..120°)
+    /// sets it whether the wrist centre is in front of A1 (bit 0 clear) or
+    /// behind it (bit 0 set, the upper arm leaning back), and an A3 past the
+    /// stretched elbow (−60°) clears it on both sides.
+    #[test]
+    fn status_bit_1_is_the_a3_joint_test_on_both_sides() {
+        let r = RobotModel::kuka_kr16_2();
+        assert_eq!(status(&r, &rad([0.0, -90.0, 90.0, 0.0, 30.0, 0.0])), 2);
+        let mut sides = [0usize; 2];
+        for a3 in [60.0, 90.0, 120.0, -60.0] {
+            for k in 0..=38 {
+                let a2 = -155.0 + 5.0 * k as f64;
+                let s = status(&r, &rad([0.0, a2, a3, 0.0, 30.0, 0.0]));
+                sides[(s & 1) as usize] += 1;
+                let want = if a3 > 0.0 { 2 } else { 0 };
+                assert_eq!(s & 2, want, "A2 {a2}, A3 {a3}: S {s}");
+            }
+        }
+        assert!(sides[0] > 0 && sides[1] > 0, "{sides:?}");
+    }
+
+    #[test]
+    fn turn_bits() {
+        assert_eq!(turn(&rad([91.0, -45.0, 37.0, 1.0, -1.0, 0.0])), 0b010010);
+    }
 }

@@ -484,7 +484,8 @@ pub(crate) fn wrist_of_j5(robot: &RobotModel, j5_positive: bool) -> Wrist {
     }
 }
 
-/// The arm side and elbow of `front`/`positive_cos` (KUKA Status bits 0, 1).
+/// The arm side and elbow of `back`/`positive_cos` (KUKA Status bits 0
+/// and 1; ABB `cfx` bit 2 and the negation of bit 1).
 pub(crate) fn arm_of(back: bool, positive_cos: bool) -> (ArmSide, Elbow) {
     let side = if back { ArmSide::Back } else { ArmSide::Front };
     let elbow = if positive_cos != back {
@@ -1063,18 +1064,9 @@ pub fn validate_abb(
         let (joints, from_cartesian) = match (&t.value, kind) {
             (RapidTargetValue::Joint(a), MoveKind::Joint) => (Some(a.map(f64::to_radians)), false),
             (RapidTargetValue::Rob { pose, conf }, MoveKind::Linear) => {
-                let (side, elbow) = (
-                    if conf[3] & 4 != 0 {
-                        ArmSide::Back
-                    } else {
-                        ArmSide::Front
-                    },
-                    if conf[3] & 2 != 0 {
-                        Elbow::Down
-                    } else {
-                        Elbow::Up
-                    },
-                );
+                // cfx bit 2: wrist centre behind axis 1; bit 1: behind the
+                // lower arm, the elbow joint test (abb::confdata)
+                let (side, elbow) = arm_of(conf[3] & 4 != 0, conf[3] & 2 == 0);
                 let cfg = Configuration {
                     wrist: wrist_of_j5(robot, conf[3] & 1 == 0),
                     elbow,
