@@ -4,6 +4,11 @@
 //!   robot model) or `E6POS` (`X Y Z A B C`, mm and deg, `$TOOL` in `$BASE`)
 //!   with the Status `S` and Turn `T` bits derived from the chosen joints;
 //!   the torch-carried cell's positioner as external axes `E1 E2` (deg).
+//!   With joint positions ([`PositionMode::Joint`]) only the `PTP` targets
+//!   are `E6AXIS`: `LIN` targets (bead points, the move into a bead, the
+//!   retract point) are always `E6POS` with S and T, the Cartesian target
+//!   form of a `LIN` (an axis-specific `LIN` target is not the form KUKA's
+//!   inline forms write, and may be refused).
 //! * Each bead: `PTP` to its first point (exact stop), then `LIN` moves at
 //!   `$VEL.CP` (m/s) blended with `C_DIS` inside the bead, the last one
 //!   exact. The arc is switched by `TRIGGER WHEN DISTANCE=0` before the
@@ -211,6 +216,17 @@ pub(crate) fn switch_statements(opts: &KukaOptions) -> (String, String) {
     }
 }
 
+/// `true` when point `i` of `program` is reached by a `PTP` (an approach
+/// point, or a bead's first point without one); every other point is a
+/// `LIN` target.
+pub fn is_ptp_target(program: &Program, i: usize) -> bool {
+    match program.points[i].arc {
+        ArcFlag::Approach => true,
+        ArcFlag::Start => i == 0 || program.points[i - 1].arc != ArcFlag::Approach,
+        _ => false,
+    }
+}
+
 /// Writes the `.src` of `program`.
 ///
 /// # Errors
@@ -319,8 +335,8 @@ pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
             Deg(e[0]),
             Deg(e[1])
         );
-        match opts.positions {
-            PositionMode::Joint => {
+        match (opts.positions, is_ptp_target(program, i)) {
+            (PositionMode::Joint, true) => {
                 let a = p.joints.map(f64::to_degrees);
                 writeln!(
                     w,
@@ -334,7 +350,7 @@ pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                     Deg(a[5])
                 )?;
             }
-            PositionMode::Cartesian => {
+            (PositionMode::Cartesian, _) | (PositionMode::Joint, false) => {
                 let pose = user_from_base * robot.flange_pose(&p.joints) * tool;
                 let t = pose.translation.vector;
                 let abc = KukaAbc::from_rotation(&pose.rotation.to_rotation_matrix()).to_degrees();

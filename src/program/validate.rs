@@ -835,6 +835,17 @@ pub fn validate_kuka(
         } else {
             MotionSpeed::Joint
         };
+        if linear && matches!(pos.value, KrlValue::Axis(_)) {
+            push(
+                &mut report,
+                src,
+                line,
+                format!(
+                    "LIN to {}, an E6AXIS ({dat}:{}): a LIN target must be an E6POS",
+                    pos.name, pos.line
+                ),
+            );
+        }
         let (joints, from_cartesian) = match &pos.value {
             KrlValue::Axis(a) => (Some(a.map(f64::to_radians)), false),
             KrlValue::Pos {

@@ -164,6 +164,59 @@ fn emitters_and_validators_refuse_another_vendors_robot() {
     assert!(r.problems[0].message.contains("has vendor ABB "), "{r}");
 }
 
+/// With joint positions only PTP targets are E6AXIS: every LIN target is an
+/// E6POS with S and T; a LIN to an E6AXIS is named by the validator.
+#[test]
+fn kuka_lin_targets_are_e6pos_even_with_joint_positions() {
+    for file in KUKA_CELLS {
+        let c = cell(file);
+        let (prog, planned) = hemi(&c);
+        let opts = KukaOptions::default();
+        let f = kuka_files(&prog, &opts).unwrap();
+        let (src, dat) = (&f[0].text, &f[1].text);
+        let mut lin = 0;
+        for l in src.lines().map(str::trim) {
+            let (lin_move, target) = match l.split_whitespace().collect::<Vec<_>>()[..] {
+                ["LIN", t, ..] => (true, t),
+                ["PTP", t] => (false, t),
+                _ => continue,
+            };
+            lin += lin_move as usize;
+            let decl = dat
+                .lines()
+                .find(|d| d.contains(&format!(" {target}=")))
+                .unwrap();
+            let want = if lin_move {
+                "DECL E6POS "
+            } else {
+                "DECL E6AXIS "
+            };
+            assert!(decl.trim_start().starts_with(want), "{file}: {l}: {decl}");
+        }
+        assert_eq!(
+            lin,
+            96 + 4,
+            "{file}: 92 bead LINs, 4 into and 4 out of beads"
+        );
+        // P3 (a bead point, LIN) replaced by the E6AXIS of P2's joints
+        let p2 = prog.points[1].joints.map(f64::to_degrees);
+        let l = line_of(dat, "DECL E6POS P3=", 0);
+        let bad = edit(dat, l, |_| {
+            format!(
+                "  DECL E6AXIS P3={{A1 {},A2 {},A3 {},A4 {},A5 {},A6 {},E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}}",
+                p2[0], p2[1], p2[2], p2[3], p2[4], p2[5]
+            )
+        });
+        let r = kuka_check(&f, src, &bad, &c, &opts, &planned);
+        assert!(
+            r.problems
+                .iter()
+                .any(|p| p.message.contains("LIN to P3, an E6AXIS")),
+            "{file}: {r}"
+        );
+    }
+}
+
 #[test]
 fn kuka_corruptions_are_named_by_their_line() {
     let c = kuka_part_carried();
@@ -171,8 +224,9 @@ fn kuka_corruptions_are_named_by_their_line() {
     let opts = KukaOptions::default();
     let f = kuka_files(&prog, &opts).unwrap();
     let (src, dat) = (&f[0].text, &f[1].text);
-    // a joint pushed out of range (J5 travel ±130°)
-    let l = line_of(dat, "DECL E6AXIS P3=", 0);
+    // a joint pushed out of range (J5 travel ±130°) in the approach point
+    // (a PTP target: E6AXIS)
+    let l = line_of(dat, "DECL E6AXIS P1=", 0);
     let bad = edit(dat, l, |s| {
         let a = s.find("A5 ").unwrap();
         let b = a + s[a..].find(',').unwrap();
@@ -182,7 +236,7 @@ fn kuka_corruptions_are_named_by_their_line() {
     assert!(
         r.problems.iter().any(|p| p.file == "HEMI.dat"
             && p.line == l
-            && p.message.contains("P3: J5 = 170.0000°")),
+            && p.message.contains("P1: J5 = 170.0000°")),
         "{r}"
     );
     // a dropped arc end: the next bead's start names it
