@@ -15,7 +15,10 @@
 //!   first `LIN` (fires at the exact first point) and `TRIGGER WHEN
 //!   DISTANCE=1` before the last `LIN` (fires at its exact end point), so
 //!   blending never moves an arc switching point.
-//! * Arc process: output `$OUT[schedule]`; custom: the user's statements.
+//! * Arc process: output `$OUT[schedule]`; custom: the user's statements,
+//!   which a `TRIGGER ... DO` accepts only as an assignment or a subprogram
+//!   call ([`is_trigger_action`]; others are refused by
+//!   [`KukaOptions::validate`]).
 //! * With approach and retract points: `PTP` to the approach point, `LIN`
 //!   into the bead's first point (exact), the bead, `LIN` out to the retract
 //!   point, all at `$VEL.CP` = the program's approach speed.
@@ -157,7 +160,74 @@ impl KukaOptions {
         if !(1..=16).contains(&self.tool) {
             return Err(bad("tool", self.tool.to_string(), "must be in 1..=16"));
         }
-        self.process.validate()
+        self.process.validate()?;
+        if let ProcessControl::Custom { start, end } = &self.process {
+            for (field, line) in [("process.start", start), ("process.end", end)] {
+                if !is_trigger_action(line) {
+                    return Err(bad(
+                        field,
+                        line.clone(),
+                        "a KRL `TRIGGER ... DO` takes only an assignment `NAME=value` or a subprogram call `NAME(...)` (e.g. `$OUT[3]=TRUE`, `ARC_ON()`); put other statements in a subprogram",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `true` when `s` is a statement a KRL `TRIGGER WHEN ... DO` accepts: an
+/// assignment `NAME=value` (`NAME` a variable, optionally indexed `[...]`
+/// or with `.FIELD`s: `$OUT[1]=TRUE`, `$ANOUT[2]=0.5`, `FLAG.ON=TRUE`) or a
+/// subprogram call `NAME(...)`. Anything else (`WAIT FOR ...`, `IF ...`,
+/// `PULSE(...)` is a call and accepted) would not compile after `DO`.
+pub fn is_trigger_action(s: &str) -> bool {
+    let s = s.trim();
+    let ident_len = |t: &str| {
+        let mut n = 0;
+        for (i, c) in t.char_indices() {
+            let ok = if i == 0 {
+                c.is_ascii_alphabetic() || c == '$' || c == '_'
+            } else {
+                c.is_ascii_alphanumeric() || c == '$' || c == '_'
+            };
+            if !ok {
+                break;
+            }
+            n = i + c.len_utf8();
+        }
+        n
+    };
+    let n = ident_len(s);
+    if n == 0 {
+        return false;
+    }
+    let rest = s[n..].trim_start();
+    // a call: NAME ( ... )
+    if rest.starts_with('(') {
+        return rest.ends_with(')');
+    }
+    // an assignment: a variable path, then `=` (not `==`), then a value
+    let mut t = &s[n..];
+    loop {
+        if let Some(r) = t.strip_prefix('[') {
+            match r.find(']') {
+                Some(k) if k > 0 => t = &r[k + 1..],
+                _ => return false,
+            }
+        } else if let Some(r) = t.strip_prefix('.') {
+            let m = ident_len(r);
+            if m == 0 {
+                return false;
+            }
+            t = &r[m..];
+        } else {
+            break;
+        }
+    }
+    match t.trim_start().strip_prefix('=') {
+        Some(v) => !v.starts_with('=') && !v.trim().is_empty(),
+        None => false,
     }
 }
 
@@ -433,6 +503,42 @@ mod tests {
             }
         }
         assert!(sides[0] > 0 && sides[1] > 0, "{sides:?}");
+    }
+
+    #[test]
+    fn trigger_actions_are_assignments_or_calls() {
+        for ok in [
+            "$OUT[3]=TRUE",
+            "$OUT[3] = FALSE",
+            "$ANOUT[2]=0.5",
+            "FLAG.ON=TRUE",
+            "ARC_ON()",
+            "PULSE($OUT[2],TRUE,0.1)",
+            "EXTRUDER_ON ( 3 )",
+        ] {
+            assert!(is_trigger_action(ok), "{ok}");
+        }
+        for bad in [
+            "WAIT FOR $IN[1]==TRUE",
+            "WAIT SEC 0.5",
+            "$OUT[3]==TRUE",
+            "IF A THEN",
+            "=TRUE",
+            "$OUT[]=TRUE",
+            "$OUT[1]=",
+            "HALT",
+        ] {
+            assert!(!is_trigger_action(bad), "{bad}");
+        }
+        let opts = KukaOptions {
+            process: ProcessControl::Custom {
+                start: "$OUT[2]=TRUE".into(),
+                end: "WAIT FOR $IN[1]".into(),
+            },
+            ..Default::default()
+        };
+        let e = opts.validate().unwrap_err().to_string();
+        assert!(e.contains("`process.end`") && e.contains("TRIGGER"), "{e}");
     }
 
     #[test]
