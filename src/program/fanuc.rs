@@ -392,7 +392,9 @@ pub struct Position {
 pub struct TpProgram {
     /// `/PROG` name.
     pub name: String,
-    /// `/ATTR COMMENT`.
+    /// `/ATTR COMMENT` (at most [`COMMENT_MAX`] characters: `waam-slicer`,
+    /// `waam: 3 parts` for a main program, `waam: 1 of 3` for a
+    /// sub-program).
     pub comment: String,
     /// Motion groups in use (1 or 2).
     pub groups: usize,
@@ -456,7 +458,7 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
         check_name(names.last().expect("at least two chunks"))?;
         out.push(TpProgram {
             name: program.name.clone(),
-            comment: format!("waam-slicer: {} sub-programs", ranges.len()),
+            comment: attr_comment(&format!("waam: {} parts", ranges.len())),
             groups,
             arc_welding,
             instructions: names
@@ -571,11 +573,11 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             } else {
                 program.name.clone()
             },
-            comment: if split {
-                format!("waam-slicer: part {} of {}", k + 1, ranges.len())
+            comment: attr_comment(&if split {
+                format!("waam: {} of {}", k + 1, ranges.len())
             } else {
                 "waam-slicer".into()
-            },
+            }),
             groups,
             arc_welding,
             instructions: ins,
@@ -583,6 +585,14 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
         });
     }
     Ok(out)
+}
+
+/// Longest `/ATTR COMMENT` a TP program takes (characters).
+pub const COMMENT_MAX: usize = 16;
+
+/// `s` cut to [`COMMENT_MAX`] characters.
+fn attr_comment(s: &str) -> String {
+    s.chars().take(COMMENT_MAX).collect()
 }
 
 /// Writes one TP program as ASCII `.ls`.

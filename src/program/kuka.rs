@@ -57,6 +57,9 @@ use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel, Vendor};
 /// The emitter's name in [`ProgramError::VendorMismatch`].
 pub const EMITTER: &str = "KUKA KRL";
 
+/// Longest KRL name (`DEF`, `DEFDAT`, characters).
+pub const KRL_NAME_MAX: usize = 24;
+
 /// Options of the KUKA emitter. Plain data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -447,12 +450,20 @@ pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
 /// The `.src` and `.dat` files of `program`.
 ///
 /// # Errors
-/// [`ProgramError::InvalidOptions`] for bad options or name;
-/// [`ProgramError::VendorMismatch`] when the cell's robot is not a KUKA arm.
+/// [`ProgramError::InvalidOptions`] for bad options or a bad name (or one
+/// longer than [`KRL_NAME_MAX`]); [`ProgramError::VendorMismatch`] when the
+/// cell's robot is not a KUKA arm.
 pub fn kuka_files(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFile>, ProgramError> {
     check_vendor(&program.cell, Vendor::Kuka, EMITTER)?;
     opts.validate()?;
     check_name(&program.name)?;
+    if program.name.len() > KRL_NAME_MAX {
+        return Err(ProgramError::InvalidOptions {
+            field: "name",
+            value: program.name.clone(),
+            reason: "KRL names (DEF, DEFDAT, file name) have at most 24 characters",
+        });
+    }
     Ok(vec![
         EmittedFile {
             name: format!("{}.src", program.name),

@@ -558,8 +558,10 @@ fn clearance_point(
 }
 
 /// Checks a controller program name: an ASCII letter first, then letters,
-/// digits or `_`, at most 32 characters (FANUC's `/PROG`, KRL's `DEF`,
-/// RAPID's `MODULE` all accept these).
+/// digits or `_`, at most 32 characters (RAPID identifiers take 32; FANUC
+/// TP program names take up to 36 characters on recent controllers, 8 on
+/// old ones, where shorter names are the user's choice; KRL names take 24,
+/// which [`kuka::kuka_files`] checks on top of this).
 ///
 /// # Errors
 /// [`ProgramError::InvalidOptions`] naming `name`.

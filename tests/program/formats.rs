@@ -217,6 +217,20 @@ fn kuka_lin_targets_are_e6pos_even_with_joint_positions() {
     }
 }
 
+/// KRL names have at most 24 characters: a 25-character name (which FANUC
+/// and ABB accept) is refused by the KUKA emitter, naming the field.
+#[test]
+fn kuka_refuses_names_over_24_characters() {
+    let (mut prog, _) = program(&kuka_part_carried(), 0..1, 8);
+    prog.name = "A".repeat(24);
+    assert!(kuka_files(&prog, &KukaOptions::default()).is_ok());
+    prog.name = "A".repeat(25);
+    let e = kuka_files(&prog, &KukaOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`name`") && e.contains("24 characters"), "{e}");
+}
+
 #[test]
 fn kuka_corruptions_are_named_by_their_line() {
     let c = kuka_part_carried();

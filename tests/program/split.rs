@@ -74,6 +74,10 @@ fn split_at_n_points_concatenates_to_the_unsplit_program() {
             }
         }
         assert_eq!(flatten(&parts), flatten(&whole), "N = {n}");
+        // `/ATTR COMMENT` takes at most 16 characters
+        for tp in &parts {
+            assert!(tp.comment.chars().count() <= 16, "{:?}", tp.comment);
+        }
         let report = validate_fanuc(&parts, &cell, &opts, Some(&planned));
         assert!(report.is_ok(), "N = {n}: {report}");
         assert_eq!(report.beads, 3);
