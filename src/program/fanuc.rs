@@ -14,7 +14,8 @@
 //!   `q7 q8` in degrees), `DEFAULT_GROUP = 1,1,*,*,*`.
 //! * Over [`FanucOptions::point_limit`] positions the program is split into
 //!   numbered sub-programs and a main program calling them in order
-//!   ([`split`](crate::program::split)).
+//!   ([`split`](crate::program::split)); cuts fall between beads only, so
+//!   every sub-program holds whole beads (arc start and end together).
 //!
 //! * With approach and retract points ([`ArcFlag::Approach`],
 //!   [`ArcFlag::Retract`]) a bead is `J P[a] 10% FINE` (approach point, arc
@@ -134,8 +135,9 @@ pub struct FanucOptions {
     /// `None`: the cell's torch (`flange_from_tcp`) in the torch-carried
     /// cell, the flange itself in the part-carried cell.
     pub flange_from_tool: Option<Isometry3>,
-    /// Most positions in one program; more are split into sub-programs.
-    /// Default 15 000 (R-30iB Plus).
+    /// Most positions in one program; more are split into sub-programs of
+    /// whole beads, so it must be at least the longest bead's point count
+    /// (approach and retract included). Default 15 000 (R-30iB Plus).
     pub point_limit: usize,
 }
 
@@ -408,11 +410,13 @@ pub struct TpProgram {
 
 /// The FANUC programs of `program`: one program when it has at most
 /// `opts.point_limit` points, else the main program (first, named
-/// `program.name`) and its sub-programs `NAME_001`, `NAME_002`, ...
+/// `program.name`) and its sub-programs `NAME_001`, `NAME_002`, ... of
+/// whole beads ([`split::chunks`](crate::program::split::chunks)).
 ///
 /// # Errors
-/// [`ProgramError::InvalidOptions`] for bad options or a name too long
-/// for the sub-program suffix; [`ProgramError::VendorMismatch`] when the
+/// [`ProgramError::InvalidOptions`] for bad options, a name too long for
+/// the sub-program suffix, or a bead longer than the point limit (field
+/// `point_limit`, naming the layer); [`ProgramError::VendorMismatch`] when the
 /// cell's robot is not a FANUC arm.
 pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgram>, ProgramError> {
     check_vendor(&program.cell, Vendor::Fanuc, EMITTER)?;
@@ -448,7 +452,15 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             }
         }
     };
-    let ranges = chunks(program.points.len(), opts.point_limit);
+    let arcs: Vec<ArcFlag> = program.points.iter().map(|p| p.arc).collect();
+    let ranges = chunks(&arcs, opts.point_limit).map_err(|b| ProgramError::InvalidOptions {
+        field: "point_limit",
+        value: format!(
+            "{} (the bead of layer {} has {} points with its approach and retract)",
+            opts.point_limit, program.points[b.first].layer, b.len
+        ),
+        reason: "a sub-program holds whole beads: the limit must be at least the longest bead's point count",
+    })?;
     let split = ranges.len() > 1;
     let mut out = Vec::new();
     if split {

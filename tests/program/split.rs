@@ -1,7 +1,12 @@
-//! Splitting at N points: ceil(points / N) sub-programs, called in order by
-//! a main program, whose concatenated motions are the unsplit program's.
+//! Splitting at N points: sub-programs of whole beads (at most N points
+//! each, filled greedily, so ceil(points / N) of them only when N is a
+//! multiple of the bead size), called in order by a main program, whose
+//! concatenated motions are the unsplit program's; a bead longer than N is
+//! refused.
 
-use waam_slicer::program::fanuc::{fanuc_files, ArmPosition, FanucOptions, Op, TpProgram};
+use waam_slicer::program::fanuc::{
+    fanuc_files, ArmPosition, FanucOptions, MoveKind, Op, TpProgram,
+};
 use waam_slicer::program::readback::parse_ls;
 use waam_slicer::program::validate::validate_fanuc;
 
@@ -50,15 +55,25 @@ fn split_at_n_points_concatenates_to_the_unsplit_program() {
     };
     let whole = read(&FanucOptions::default());
     assert_eq!(whole.len(), 1);
-    for n in [1usize, 7, 10, 35, 36, 37] {
+    // 30 bead points and an approach and a retract point per bead: three
+    // beads of 12 points
+    assert_eq!(prog.points.len(), 36);
+    // Sub-programs hold whole beads, filled greedily: ceil(points / N) only
+    // when N is a multiple of the bead size; a bead is never cut
+    for (n, subs) in [
+        (12usize, 3usize),
+        (13, 3),
+        (23, 3),
+        (24, 2),
+        (35, 2),
+        (36, 1),
+        (37, 1),
+    ] {
         let opts = FanucOptions {
             point_limit: n,
             ..Default::default()
         };
         let parts = read(&opts);
-        // 30 bead points and an approach and a retract point per bead
-        assert_eq!(prog.points.len(), 36);
-        let subs = 36usize.div_ceil(n);
         if subs == 1 {
             assert_eq!(parts.len(), 1);
         } else {
@@ -71,6 +86,24 @@ fn split_at_n_points_concatenates_to_the_unsplit_program() {
             for (k, sub) in parts[1..].iter().enumerate() {
                 assert_eq!(sub.name, format!("HEMI_{:03}", k + 1));
                 assert!(sub.positions.len() <= n);
+                // whole beads: as many arc starts as ends, the first motion
+                // a joint move to an approach point
+                let count =
+                    |f: fn(&Op) -> bool| sub.instructions.iter().filter(|i| f(&i.op)).count();
+                let starts = count(|o| matches!(o, Op::ArcStart(_)));
+                assert!(
+                    starts >= 1 && starts == count(|o| matches!(o, Op::ArcEnd(_))),
+                    "N = {n}"
+                );
+                let first_move = sub
+                    .instructions
+                    .iter()
+                    .find_map(|i| match &i.op {
+                        Op::Move { kind, .. } => Some(*kind),
+                        _ => None,
+                    })
+                    .unwrap();
+                assert_eq!(first_move, MoveKind::Joint, "N = {n}");
             }
         }
         assert_eq!(flatten(&parts), flatten(&whole), "N = {n}");
@@ -82,4 +115,20 @@ fn split_at_n_points_concatenates_to_the_unsplit_program() {
         assert!(report.is_ok(), "N = {n}: {report}");
         assert_eq!(report.beads, 3);
     }
+}
+
+/// A bead longer than the limit is refused, naming `point_limit` and the
+/// layer, rather than split with the arc on across two programs.
+#[test]
+fn a_bead_longer_than_the_limit_is_refused() {
+    let (prog, _) = program(&part_carried(), 0..3, 10);
+    let opts = FanucOptions {
+        point_limit: 11,
+        ..Default::default()
+    };
+    let e = fanuc_files(&prog, &opts).unwrap_err().to_string();
+    assert!(
+        e.contains("`point_limit`") && e.contains("layer 0 has 12 points"),
+        "{e}"
+    );
 }
