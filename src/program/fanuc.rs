@@ -720,3 +720,34 @@ pub fn fanuc_files(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::robot::ik::turn_number;
+    use crate::robot::RobotModel;
+
+    /// FANUC turn 0 is `-180° < J <= 180°`: +180° is turn 0, −180° turn −1.
+    #[test]
+    fn turn_numbers_at_half_a_turn() {
+        let t = |deg: f64| turn_number(deg.to_radians());
+        assert_eq!(t(180.0), 0);
+        assert_eq!(turn_number(std::f64::consts::PI), 0);
+        assert_eq!(t(180.0001), 1);
+        assert_eq!(t(181.0), 1);
+        assert_eq!(t(540.0), 1);
+        assert_eq!(t(540.0001), 2);
+        assert_eq!(t(-179.9999), 0);
+        assert_eq!(t(-180.0), -1);
+        assert_eq!(t(-540.0), -2);
+        assert_eq!(t(0.0), 0);
+    }
+
+    /// The CONFIG string of a posture with J4 = +180° and J6 = −180°.
+    #[test]
+    fn config_turns_at_half_a_turn() {
+        let r = RobotModel::arcmate_120ic_nominal();
+        let q = [0.0, 0.0, 0.0, 180.0, -30.0, -180.0].map(f64::to_radians);
+        let c = r.fanuc_config(&q);
+        assert_eq!((c.turn_j1, c.turn_j4, c.turn_j6), (0, 0, -1));
+    }
+}
