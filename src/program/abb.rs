@@ -38,7 +38,7 @@ use std::io::Write;
 use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
-use crate::program::fmt::{Deg, Mm, Unitless};
+use crate::program::fmt::{ascii_comment, Deg, Mm, Unitless};
 use crate::program::{
     check_name, check_vendor, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
@@ -242,7 +242,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     writeln!(
         w,
         "  ! waam-slicer: {}, {} points, {} beads",
-        program.cell.name(),
+        ascii_comment(program.cell.name()),
         program.points.len(),
         program.num_beads()
     )?;

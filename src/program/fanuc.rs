@@ -54,7 +54,7 @@ use std::io::Write;
 use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
-use crate::program::fmt::{FanucDeg, FanucMm};
+use crate::program::fmt::{ascii_comment, FanucDeg, FanucMm};
 use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
 use crate::program::{
     check_name, check_vendor, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
@@ -339,7 +339,7 @@ impl std::fmt::Display for Op {
             Op::ArcStart(n) => write!(f, "  Arc Start[{n}] ;"),
             Op::ArcEnd(n) => write!(f, "  Arc End[{n}] ;"),
             Op::Call(n) => write!(f, "  CALL {n}    ;"),
-            Op::Remark(s) => write!(f, "  ! {s} ;"),
+            Op::Remark(s) => write!(f, "  ! {} ;", ascii_comment(s)),
             Op::Other(s) => write!(f, "  {s} ;"),
         }
     }
@@ -615,7 +615,7 @@ pub fn write_ls(w: &mut dyn Write, tp: &TpProgram) -> std::io::Result<()> {
     writeln!(w, "/PROG  {}", tp.name)?;
     writeln!(w, "/ATTR")?;
     writeln!(w, "OWNER\t\t= MNEDITOR;")?;
-    writeln!(w, "COMMENT\t\t= \"{}\";", tp.comment)?;
+    writeln!(w, "COMMENT\t\t= \"{}\";", ascii_comment(&tp.comment))?;
     writeln!(w, "PROG_SIZE\t= 0;")?;
     writeln!(w, "CREATE\t\t= DATE 00-01-01  TIME 00:00:00;")?;
     writeln!(w, "MODIFIED\t= DATE 00-01-01  TIME 00:00:00;")?;

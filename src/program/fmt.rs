@@ -98,9 +98,58 @@ impl fmt::Display for Unitless {
     }
 }
 
+/// Comment text for a controller file: ASCII only (KRL, RAPID and TP
+/// editors choke on other bytes). Common symbols are spelled out (`§` →
+/// `sec.`, `°` → ` deg`, `·` → `*`, dashes → `-`, `×` → `x`), accented
+/// Latin letters lose their accent, control characters become spaces and
+/// anything else `?`.
+pub fn ascii_comment(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            ' '..='~' => out.push(c),
+            '§' => out.push_str("sec."),
+            '°' => out.push_str(" deg"),
+            '·' | '×' => out.push(if c == '×' { 'x' } else { '*' }),
+            '–' | '—' | '−' => out.push('-'),
+            '‘' | '’' => out.push('\''),
+            '“' | '”' => out.push('"'),
+            'à' | 'á' | 'â' | 'ä' | 'ã' => out.push('a'),
+            'é' | 'è' | 'ê' | 'ë' => out.push('e'),
+            'î' | 'ï' | 'í' => out.push('i'),
+            'ô' | 'ö' | 'ó' => out.push('o'),
+            'ù' | 'û' | 'ü' | 'ú' => out.push('u'),
+            'ç' => out.push('c'),
+            'ñ' => out.push('n'),
+            'ß' => out.push_str("ss"),
+            'À' | 'Â' | 'Ä' => out.push('A'),
+            'É' | 'È' | 'Ê' => out.push('E'),
+            'Ô' | 'Ö' => out.push('O'),
+            'Ü' => out.push('U'),
+            'Ç' => out.push('C'),
+            c if c.is_control() => out.push(' '),
+            _ => out.push('?'),
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn comments_are_ascii() {
+        assert_eq!(
+            ascii_comment("ROBOWAM part carried, D_R of §3.3"),
+            "ROBOWAM part carried, D_R of sec.3.3"
+        );
+        assert_eq!(
+            ascii_comment("45° · 2 – Stäubli\tπ"),
+            "45 deg * 2 - Staubli ?"
+        );
+        assert!(ascii_comment("dépôt porté ✓").is_ascii());
+    }
 
     #[test]
     fn no_negative_zero_and_padding() {

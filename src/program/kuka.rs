@@ -47,7 +47,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
 use crate::program::fanuc::PositionMode;
-use crate::program::fmt::{Deg, Mm};
+use crate::program::fmt::{ascii_comment, Deg, Mm};
 use crate::program::{
     check_name, check_vendor, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
@@ -314,7 +314,7 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     writeln!(
         w,
         "  ; waam-slicer: {}, {} points, {} beads",
-        program.cell.name(),
+        ascii_comment(program.cell.name()),
         program.points.len(),
         program.num_beads()
     )?;

@@ -641,7 +641,8 @@ impl Default for ProcessControl {
 }
 
 impl ProcessControl {
-    /// Checks the schedule number and that custom lines are single, non-empty lines.
+    /// Checks the schedule number and that custom lines are single, non-empty
+    /// ASCII lines (controllers reject other bytes).
     ///
     /// # Errors
     /// [`ProgramError::InvalidOptions`] naming the field.
@@ -656,11 +657,11 @@ impl ProcessControl {
             }
             ProcessControl::Custom { start, end } => {
                 for (field, s) in [("process.start", start), ("process.end", end)] {
-                    if s.trim().is_empty() || s.contains(['\n', '\r', ';']) {
+                    if s.trim().is_empty() || s.contains(['\n', '\r', ';']) || !s.is_ascii() {
                         return Err(ProgramError::InvalidOptions {
                             field,
                             value: s.clone(),
-                            reason: "must be one non-empty line without `;`",
+                            reason: "must be one non-empty ASCII line without `;`",
                         });
                     }
                 }

@@ -54,6 +54,10 @@ fn golden_dir() -> PathBuf {
 }
 
 pub fn check_golden(name: &str, text: &str) {
+    // controllers choke on non-ASCII bytes, comments included
+    if let Some((line, l)) = text.lines().enumerate().find(|(_, l)| !l.is_ascii()) {
+        panic!("{name}:{}: non-ASCII: {l}", line + 1);
+    }
     let path = golden_dir().join(name);
     if std::env::var_os("UPDATE_GOLDEN").is_some() || !path.exists() {
         std::fs::write(&path, text).unwrap();
@@ -162,6 +166,59 @@ fn abb_golden() {
         )
         .unwrap(),
     );
+}
+
+/// A cell named with `§`, `°` and `·` (like the ROBOWAM cells' names)
+/// gives pure ASCII files in every format.
+#[test]
+fn every_emitted_file_is_ascii_whatever_the_cell_name() {
+    use waam_slicer::robot::Cell;
+    let rename = |file: &str| {
+        let mut c = cell(file);
+        match &mut c {
+            Cell::PartCarried(p) => p.name = "cell §3.3 · 45° – test".into(),
+            Cell::TorchCarried(t) => t.name = "cell §3.3 · 45° – test".into(),
+        }
+        program(&c, 0..1, 8).0
+    };
+    let mut files = fanuc_files(
+        &rename("robowam_torch_carried.toml"),
+        &FanucOptions::default(),
+    )
+    .unwrap();
+    files.extend(
+        fanuc_files(
+            &small(),
+            &FanucOptions {
+                timing: waam_slicer::program::fanuc::MotionTiming::Time,
+                ..Default::default()
+            },
+        )
+        .unwrap(),
+    );
+    files.extend(
+        kuka_files(
+            &rename("kuka_kr16_2_part_carried.toml"),
+            &KukaOptions::default(),
+        )
+        .unwrap(),
+    );
+    files.extend(
+        abb_files(
+            &rename("abb_irb2600_torch_carried.toml"),
+            &AbbOptions::default(),
+        )
+        .unwrap(),
+    );
+    for f in &files {
+        assert!(f.text.is_ascii(), "{}:\n{}", f.name, f.text);
+    }
+    // every golden file on disk too
+    for e in std::fs::read_dir(golden_dir()).unwrap() {
+        let p = e.unwrap().path();
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.is_ascii(), "{}", p.display());
+    }
 }
 
 #[test]
