@@ -28,6 +28,14 @@
 //!   `uframe` = the cell's `flange_from_part`): the speeds are then the
 //!   torch's over the part, as planned, and `robtarget`s are the torch in
 //!   the part frame.
+//! * **Torch-carried cell, positioner turning.** Where the positioner moves
+//!   within a bead ([`positioner_moves`](crate::program::positioner_moves))
+//!   the TCP's speed in the world frame is not the torch's over the part
+//!   (the work object is not coordinated with the positioner here): such
+//!   moves carry the optional argument `\T` (`ArcL p13, [6,500,5000,1000]
+//!   \T:=5.705, ...`), the segment time in seconds = the segment's length
+//!   in the part frame / the planned speed, which RAPID uses instead of the
+//!   `speeddata`.
 //! * Weld speed: ArcWare takes the speed of the arc-on moves (`ArcL`,
 //!   `ArcLEnd`) from `weld<n>.weld_speed`; the inline `speeddata` (the planned
 //!   speed) applies when welding is blocked. The weld data must give the
@@ -40,7 +48,8 @@ use serde::{Deserialize, Serialize};
 use crate::math::Isometry3;
 use crate::program::fmt::{ascii_comment, Deg, Mm, Unitless};
 use crate::program::{
-    check_name, check_vendor, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, positioner_moves, render, segment_length_mm, ArcFlag, EmittedFile,
+    ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::abb_quaternion;
 use crate::robot::{Cell, Joints, RobotModel, Vendor};
@@ -320,7 +329,12 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     for (i, p) in program.points.iter().enumerate() {
         let k = i + 1;
         let prev = i.checked_sub(1).map(|k| &program.points[k]);
-        let v = format!("[{},500,5000,1000]", Mm(p.speed_mm_s));
+        let mut v = format!("[{},500,5000,1000]", Mm(p.speed_mm_s));
+        if positioner_moves(program, i) {
+            // the part turns under the torch: time the move (s)
+            let t = segment_length_mm(program, i) / p.speed_mm_s;
+            v += &format!("\\T:={}", crate::program::fmt::Fixed::new(t.max(0.001), 3));
+        }
         match (&opts.process, p.arc) {
             (_, ArcFlag::Approach) => {
                 writeln!(w, "    ! bead {} (layer {}): approach", p.layer, p.layer)?;

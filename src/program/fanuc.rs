@@ -48,6 +48,14 @@
 //! segment (exactly at the points; between them the controller interpolates
 //! the flange pose, which for the short segments of a bead keeps the
 //! deposition point within a fraction of a millimetre of the chord).
+//!
+//! The same holds in the torch-carried cell on a segment where the
+//! positioner turns: the part moves under the torch, the TCP's travel in
+//! the robot frame is not the deposition point's travel over the part (the
+//! TCP may be nearly still while the part turns 45°), and a TCP speed would
+//! be wrong. [`MotionTiming::Auto`] writes every such segment time-based
+//! (segment length in the part frame / planned speed) and keeps `mm/sec`
+//! or `cm/min` where the positioner is still.
 
 use std::io::Write;
 
@@ -57,7 +65,8 @@ use crate::math::Isometry3;
 use crate::program::fmt::{ascii_comment, FanucDeg, FanucMm};
 use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
 use crate::program::{
-    check_name, check_vendor, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
+    ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::FanucPose;
 use crate::robot::{Cell, Vendor};
@@ -94,8 +103,10 @@ pub enum SpeedUnit {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MotionTiming {
-    /// Time-based (`msec`) in the part-carried cell, TCP speed in the
-    /// torch-carried cell.
+    /// Time-based (`msec`) in the part-carried cell; in the torch-carried
+    /// cell time-based on every segment where the positioner moves
+    /// ([`positioner_moves`](crate::program::positioner_moves)), TCP speed
+    /// elsewhere.
     #[default]
     Auto,
     /// TCP speed (`mm/sec` or `cm/min`) everywhere: only right in the
@@ -200,13 +211,23 @@ impl FanucOptions {
         self.process.validate()
     }
 
-    /// `true` when linear moves are written as segment times in `cell`.
+    /// `true` when every linear move is written as a segment time in
+    /// `cell` (see [`FanucOptions::segment_time_based`] for single
+    /// segments).
     pub fn time_based(&self, cell: &Cell) -> bool {
         match self.timing {
             MotionTiming::Auto => matches!(cell, Cell::PartCarried(_)),
             MotionTiming::TcpSpeed => false,
             MotionTiming::Time => true,
         }
+    }
+
+    /// `true` when the linear move into point `i` of `program` is written
+    /// as a segment time: [`FanucOptions::time_based`], or with
+    /// [`MotionTiming::Auto`] a segment where the positioner moves.
+    pub fn segment_time_based(&self, program: &Program, i: usize) -> bool {
+        self.time_based(&program.cell)
+            || (self.timing == MotionTiming::Auto && positioner_moves(program, i))
     }
 
     /// The tool frame used for Cartesian positions in `cell` (mm).
@@ -435,15 +456,10 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
         ProcessControl::Arc { schedule } => (Op::ArcStart(*schedule), Op::ArcEnd(*schedule)),
         ProcessControl::Custom { start, end } => (Op::Other(start.clone()), Op::Other(end.clone())),
     };
-    let time_based = opts.time_based(&program.cell);
     // the speed of the linear move into point `i` at `v` mm/s
     let linear_speed = |i: usize, v: f64| {
-        if time_based {
-            let d = if i == 0 {
-                0.0
-            } else {
-                (program.points[i].position_mm - program.points[i - 1].position_mm).norm()
-            };
+        if opts.segment_time_based(program, i) {
+            let d = segment_length_mm(program, i);
             Speed::Msec(((1000.0 * d / v).round() as u32).max(1))
         } else {
             match opts.speed_unit {
@@ -494,7 +510,10 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
                 op: Op::UTool(opts.tool_frame),
             },
         ];
-        if time_based {
+        if range
+            .clone()
+            .any(|i| !joint_move_target(program, i) && opts.segment_time_based(program, i))
+        {
             ins.push(Instruction {
                 line: 0,
                 op: Op::Remark(TIME_BASED_REMARK.into()),

@@ -32,6 +32,21 @@
 //!   fixed torch travels over it at `$VEL.CP`, and `E6POS` positions are the
 //!   part frame in the torch frame ([`KukaOptions::external_tcp`]).
 //!
+//! * **Torch-carried cell, positioner turning.** `$VEL.CP` is the TCP's
+//!   speed in the robot frame; where the positioner turns within a bead the
+//!   part moves under a nearly still torch, and the planned speed (over the
+//!   part) is not the TCP's. KRL's `LIN` has no time argument: such a `LIN`
+//!   gets `$VEL.CP` = the TCP's travel / the planned segment time and
+//!   `$VEL_EXTAX[n]` = the positioner axis's turn / that time, in % of its
+//!   maximum speed ([`timed_segment`]), so that the TCP and each external
+//!   axis take the planned time; the next `PTP` re-issues `BAS
+//!   (#VEL_PTP,n)`. **Assumptions, not checked on a controller:** the
+//!   positioner's axes are non-integrated external axes moved with the path
+//!   (the `LIN` taking the longest of the TCP's and the axes' times),
+//!   `BAS (#VEL_PTP,n)` also sets `$VEL_EXTAX`, and the orientation speed
+//!   (`$VEL.ORI1/2`) does not bind; a `$VEL.CP` under 0.001 mm/s (a still
+//!   TCP) is written as 0.001 mm/s. The validator uses the same model.
+//!
 //! Status bits (KUKA): bit 0 wrist centre behind the A1 axis (x < 0 in the
 //! A1 frame: overhead area), bit 1 `A3 >= phi`, `phi` the A3 angle of the
 //! stretched elbow (a joint test: the same for the wrist centre in front of
@@ -47,9 +62,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
 use crate::program::fanuc::PositionMode;
-use crate::program::fmt::{ascii_comment, Deg, Mm};
+use crate::program::fmt::{ascii_comment, Deg, Fixed, Mm};
 use crate::program::{
-    check_name, check_vendor, render, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
+    ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::KukaAbc;
 use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel, Vendor};
@@ -289,15 +305,50 @@ pub(crate) fn switch_statements(opts: &KukaOptions) -> (String, String) {
     }
 }
 
-/// `true` when point `i` of `program` is reached by a `PTP` (an approach
-/// point, or a bead's first point without one); every other point is a
-/// `LIN` target.
-pub fn is_ptp_target(program: &Program, i: usize) -> bool {
-    match program.points[i].arc {
-        ArcFlag::Approach => true,
-        ArcFlag::Start => i == 0 || program.points[i - 1].arc != ArcFlag::Approach,
-        _ => false,
+/// The speeds of a timed `LIN` (module doc, "Torch-carried cell,
+/// positioner turning").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimedSegment {
+    /// The segment's planned time (s): its length over the part (part frame)
+    /// / the planned speed.
+    pub time_s: f64,
+    /// `$VEL.CP` (mm/s; written in m/s) making the TCP's travel in the robot
+    /// base frame take `time_s` (at least 0.001 mm/s).
+    pub vel_cp_mm_s: f64,
+    /// `$VEL_EXTAX[1]`, `$VEL_EXTAX[2]` (% of the positioner axes' maximum
+    /// speeds, at most 100) making each axis's turn take `time_s`; `None`
+    /// for an axis that does not move or has no finite maximum speed.
+    pub vel_extax_percent: [Option<f64>; 2],
+}
+
+/// The speeds of the `LIN` into point `i` when it must be timed: in a
+/// torch-carried cell outside the fixed-tool mode, where the positioner
+/// moves ([`positioner_moves`]); `None` elsewhere (the planned speed is the
+/// TCP's: `$VEL.CP` = the planned speed).
+pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<TimedSegment> {
+    let Cell::TorchCarried(c) = &program.cell else {
+        return None;
+    };
+    if opts.uses_external_tcp(&program.cell) || !positioner_moves(program, i) {
+        return None;
     }
+    let (p, a) = (&program.points[i], &program.points[i - 1]);
+    let time_s = segment_length_mm(program, i) / p.speed_mm_s;
+    let robot = &c.robot;
+    let tool = tool_of(opts, &program.cell);
+    let tcp = |q: &Joints| (robot.flange_pose(q) * tool).translation.vector;
+    let tcp_mm = (tcp(&p.joints) - tcp(&a.joints)).norm();
+    let (qp, qa) = (p.positioner?, a.positioner?);
+    let vel_extax_percent = std::array::from_fn(|n| {
+        let max = c.positioner.max_speed_rad_s[n];
+        let turn = (qp[n] - qa[n]).abs();
+        (max.is_finite() && turn > 0.0).then(|| (100.0 * turn / time_s / max).clamp(1e-4, 100.0))
+    });
+    Some(TimedSegment {
+        time_s,
+        vel_cp_mm_s: (tcp_mm / time_s).max(1e-3),
+        vel_extax_percent,
+    })
 }
 
 /// Writes the `.src` of `program`.
@@ -335,6 +386,17 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     writeln!(w, "  $BASE = BASE_DATA[{}]", opts.base)?;
     writeln!(w, "  $APO.CDIS = {}", Mm(opts.cdis_mm))?;
     writeln!(w, "  BAS (#VEL_PTP,{} )", opts.ptp_percent)?;
+    // external-axis speeds (%) written since the last PTP speed setting
+    let mut extax: [Option<f64>; 2] = [None; 2];
+    // before a PTP after timed moves: the PTP speeds again (BAS sets the
+    // external axes' speeds too)
+    let restore_ptp = |w: &mut dyn Write, extax: &mut [Option<f64>; 2]| -> std::io::Result<()> {
+        if extax.iter().any(Option::is_some) {
+            writeln!(w, "  BAS (#VEL_PTP,{} )", opts.ptp_percent)?;
+            *extax = [None; 2];
+        }
+        Ok(())
+    };
     let mut vel: Option<f64> = None;
     let mut set_vel = |w: &mut dyn Write, mm_s: f64| -> std::io::Result<()> {
         let v = mm_s / 1000.0;
@@ -354,6 +416,7 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                     "  ; bead {} (layer {}): approach, arc off",
                     p.layer, p.layer
                 )?;
+                restore_ptp(w, &mut extax)?;
                 writeln!(w, "  PTP {name}")?;
             }
             ArcFlag::Start => match prev {
@@ -363,11 +426,29 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                 }
                 _ => {
                     writeln!(w, "  ; bead {} (layer {}), arc off", p.layer, p.layer)?;
+                    restore_ptp(w, &mut extax)?;
                     writeln!(w, "  PTP {name}")?;
                 }
             },
+            ArcFlag::On | ArcFlag::End => match timed_segment(program, opts, i) {
+                Some(t) => {
+                    set_vel(w, t.vel_cp_mm_s)?;
+                    for (n, pct) in t.vel_extax_percent.iter().enumerate() {
+                        if let Some(pct) = pct {
+                            if extax[n] != Some(*pct) {
+                                writeln!(w, "  $VEL_EXTAX[{}] = {}", n + 1, Fixed::new(*pct, 4))?;
+                                extax[n] = Some(*pct);
+                            }
+                        }
+                    }
+                }
+                None => set_vel(w, p.speed_mm_s)?,
+            },
+            ArcFlag::Retract => {}
+        }
+        match p.arc {
+            ArcFlag::Approach | ArcFlag::Start => {}
             ArcFlag::On | ArcFlag::End => {
-                set_vel(w, p.speed_mm_s)?;
                 if prev.is_some_and(|q| q.arc == ArcFlag::Start) {
                     writeln!(w, "  TRIGGER WHEN DISTANCE=0 DELAY=0 DO {on}")?;
                 }
@@ -408,7 +489,7 @@ pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
             Deg(e[0]),
             Deg(e[1])
         );
-        match (opts.positions, is_ptp_target(program, i)) {
+        match (opts.positions, joint_move_target(program, i)) {
             (PositionMode::Joint, true) => {
                 let a = p.joints.map(f64::to_degrees);
                 writeln!(

@@ -557,6 +557,49 @@ fn clearance_point(
     })
 }
 
+/// `true` when point `i` of `program` is reached by a joint move (FANUC
+/// `J`, KUKA `PTP`, ABB `MoveAbsJ`): an approach point, or a bead's first
+/// point without one; every other point is reached by a linear move.
+pub fn joint_move_target(program: &Program, i: usize) -> bool {
+    match program.points[i].arc {
+        ArcFlag::Approach => true,
+        ArcFlag::Start => i == 0 || program.points[i - 1].arc != ArcFlag::Approach,
+        _ => false,
+    }
+}
+
+/// Largest positioner motion over a segment still counted as a positioner
+/// at rest (deg): above it, a torch-carried cell's segment is
+/// [`positioner_moves`] and emitters time it instead of giving a TCP speed.
+pub const POSITIONER_STILL_DEG: f64 = 0.01;
+
+/// `true` when the positioner turns by more than [`POSITIONER_STILL_DEG`]
+/// on either axis between point `i - 1` and point `i` of `program` (never
+/// for `i = 0` or without a positioner). On such a segment the TCP's
+/// travel in the robot frame is not the deposition point's travel over the
+/// part (the part turns under a nearly still torch), so a TCP speed would
+/// not give the planned travel speed.
+pub fn positioner_moves(program: &Program, i: usize) -> bool {
+    let Some(prev) = i.checked_sub(1).map(|k| &program.points[k]) else {
+        return false;
+    };
+    match (program.points[i].positioner, prev.positioner) {
+        (Some(a), Some(b)) => {
+            (a[0] - b[0]).abs().max((a[1] - b[1]).abs()) > POSITIONER_STILL_DEG.to_radians()
+        }
+        _ => false,
+    }
+}
+
+/// Length of the segment into point `i` of `program`, the deposition point's
+/// travel over the part (part frame, mm); 0 for `i = 0`.
+pub fn segment_length_mm(program: &Program, i: usize) -> f64 {
+    match i.checked_sub(1) {
+        Some(k) => (program.points[i].position_mm - program.points[k].position_mm).norm(),
+        None => 0.0,
+    }
+}
+
 /// Checks a controller program name: an ASCII letter first, then letters,
 /// digits or `_`, at most 32 characters (RAPID identifiers take 32; FANUC
 /// TP program names take up to 36 characters on recent controllers, 8 on

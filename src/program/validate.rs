@@ -743,6 +743,11 @@ pub fn validate_kuka(
     let mut vel: Option<f64> = None;
     let mut pending: Vec<(u8, String, usize)> = Vec::new();
     let mut prev_q: Option<Joints> = None;
+    let mut prev_ext: Option<[f64; 2]> = None;
+    // external axes' path speeds (%), as the last `BAS (#VEL_PTP,n)` or
+    // `$VEL_EXTAX[n]` left them (assumed 100 before either)
+    let mut vel_extax = [100.0; 6];
+    let external_tcp = opts.uses_external_tcp(cell);
     for st in &program.statements {
         let line = st.line;
         let (target, linear) = match &st.op {
@@ -750,6 +755,14 @@ pub fn validate_kuka(
             KrlOp::Lin { target, .. } => (target, true),
             KrlOp::VelCp(v) => {
                 vel = Some(v * 1000.0);
+                continue;
+            }
+            KrlOp::VelExtax { axis, percent } => {
+                vel_extax[(*axis - 1) as usize] = *percent;
+                continue;
+            }
+            KrlOp::VelPtp(p) => {
+                vel_extax = [*p; 6];
                 continue;
             }
             KrlOp::Trigger { distance, action } => {
@@ -903,6 +916,29 @@ pub fn validate_kuka(
                 (q, true)
             }
         };
+        // Outside the fixed-tool mode $VEL.CP is the TCP's speed in the
+        // robot frame, and external axes move with the path at
+        // $VEL_EXTAX: the move takes the longest of the TCP's travel and
+        // each positioner axis's turn at its speed. (In the fixed-tool mode
+        // $VEL.CP is the torch's speed over the part, the planned meaning.)
+        let speed = match (speed, &joints, &prev_q, cell) {
+            (MotionSpeed::Linear(v), Some(q), Some(pq), Cell::TorchCarried(c)) if !external_tcp => {
+                let tcp = |q: &Joints| (robot.flange_pose(q) * tool).translation.vector;
+                let mut t = (tcp(q) - tcp(pq)).norm() / v;
+                if let Some(pe) = prev_ext {
+                    for n in 0..2 {
+                        let max = c.positioner.max_speed_rad_s[n] * vel_extax[n] / 100.0;
+                        let turn = (pos.external[n] - pe[n]).to_radians().abs();
+                        if max.is_finite() && turn > 0.0 {
+                            t = t.max(turn / max);
+                        }
+                    }
+                }
+                MotionSpeed::Time(t)
+            }
+            (speed, ..) => speed,
+        };
+        prev_ext = Some(pos.external);
         prev_q = joints.or(prev_q);
         steps.push(Step::Motion(Box::new(Motion {
             file: src.clone(),
@@ -1032,6 +1068,7 @@ pub fn validate_abb(
                 target,
                 speed_mm_s,
                 weld,
+                time_s,
             } => {
                 let arc = instruction != "MoveL";
                 if arc && (start.is_some() || weld.as_ref() != end.as_ref()) {
@@ -1053,7 +1090,10 @@ pub fn validate_abb(
                 };
                 (
                     target,
-                    MotionSpeed::Linear(*speed_mm_s),
+                    match time_s {
+                        Some(t) => MotionSpeed::Time(*t),
+                        None => MotionSpeed::Linear(*speed_mm_s),
+                    },
                     MoveKind::Linear,
                     event,
                 )

@@ -120,6 +120,10 @@ fn fanuc_torch_carried_golden_has_group_2() {
     let files = fanuc_files(&prog, &FanucOptions::default()).unwrap();
     assert!(files[0].text.contains("DEFAULT_GROUP\t= 1,1,*,*,*;"));
     assert!(files[0].text.contains("   GP2:"));
+    // layer 0: the positioner is still, TCP speed; layer 1: it turns 45° per
+    // segment under a nearly still torch, time-based moves (34.2 mm / 6 mm/s)
+    assert!(files[0].text.contains("L P[3] 36cm/min CNT100"));
+    assert!(files[0].text.contains("L P[13] 5705msec CNT100"));
     check_all("fanuc_torch_", &files);
 }
 
@@ -139,6 +143,15 @@ fn kuka_golden() {
         )
         .unwrap(),
     );
+    // layer 1: the positioner turns 45° per segment under a still torch:
+    // $VEL.CP and $VEL_EXTAX[2] make each LIN take the planned 5.705 s
+    let src = &kuka_files(
+        &small_in("kuka_kr16_2_torch_carried.toml"),
+        &KukaOptions::default(),
+    )
+    .unwrap()[0]
+        .text;
+    assert!(src.contains("  $VEL_EXTAX[2] = 4.3822\n"), "{src}");
     // part carried: fixed-tool mode, E6POS of the part in the torch frame
     let opts = KukaOptions {
         positions: PositionMode::Cartesian,
@@ -158,6 +171,18 @@ fn abb_golden() {
         )
         .unwrap(),
     );
+    let torch = abb_files(
+        &small_in("abb_irb2600_torch_carried.toml"),
+        &AbbOptions::default(),
+    )
+    .unwrap();
+    // layer 1: timed moves where the positioner turns, not in layer 0
+    assert!(torch[0]
+        .text
+        .contains("ArcL p13, [6.0000,500,5000,1000]\\T:=5.705, seam1"));
+    assert!(torch[0]
+        .text
+        .contains("ArcL p3, [6.0000,500,5000,1000], seam1"));
     check_all(
         "abb_torch_",
         &abb_files(

@@ -205,6 +205,8 @@ pub enum RapidOp {
         speed_mm_s: f64,
         /// Weld data name for arc instructions (`weld1`).
         weld: Option<String>,
+        /// The move's time (s) when the speed argument carries `\T:=t`.
+        time_s: Option<f64>,
     },
     /// `ConfL \On` (`true`) or `\Off`.
     ConfL(bool),
@@ -414,7 +416,19 @@ fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
                     args.len()
                 ));
             }
-            let speed = parse_aggregate(&args[1])
+            let (speed_arg, time_s) = match args[1].split_once("\\T:=") {
+                Some((v, t)) => {
+                    let t: f64 = t
+                        .trim()
+                        .parse()
+                        .ok()
+                        .filter(|t: &f64| t.is_finite() && *t > 0.0)
+                        .ok_or_else(|| format!("{name}: bad \\T `{}`", t.trim()))?;
+                    (v.trim().to_string(), Some(t))
+                }
+                None => (args[1].clone(), None),
+            };
+            let speed = parse_aggregate(&speed_arg)
                 .and_then(|n| n.nums::<4>())
                 .map_err(|e| format!("{name}: speeddata: {e}"))?;
             if !(speed[0] > 0.0) {
@@ -425,6 +439,7 @@ fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
                 target: args[0].clone(),
                 speed_mm_s: speed[0],
                 weld: arc.then(|| args[3].clone()),
+                time_s,
             })
         }
         _ => Ok(RapidOp::Other(stmt.to_string())),

@@ -29,11 +29,21 @@ pub enum KrlOp {
     },
     /// `$IPO_MODE = #TCP` (`true`) or `#BASE` (`false`).
     IpoTcp(bool),
-    /// `$TOOL = TOOL_DATA[n]`.
+    /// `$VEL_EXTAX[n] = p`: external axis `n` (1-based) at `p` % of its
+    /// maximum speed in path motions.
+    VelExtax {
+        /// Axis `n`, 1-based.
+        axis: u8,
+        /// Percent.
+        percent: f64,
+    },
+    /// `BAS (#VEL_PTP,n )`: PTP speeds (robot and external axes) at `n` %.
+    VelPtp(f64),
+    /// `BAS (#TOOL,n)` or `$TOOL = TOOL_DATA[n]`.
     Tool(u8),
-    /// `$BASE = BASE_DATA[n]`.
+    /// `BAS (#BASE,n)` or `$BASE = BASE_DATA[n]`.
     Base(u8),
-    /// Anything else (`BAS (...)`, `$APO.CDIS = ...`), as written.
+    /// Anything else (other `BAS (...)`, `$APO.CDIS = ...`), as written.
     Other(String),
 }
 
@@ -246,6 +256,35 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
                 action: action.trim().to_string(),
             });
         }
+        Some(b) if b.starts_with("BAS") => {
+            if let Some(args) = l
+                .strip_prefix("BAS")
+                .map(str::trim)
+                .and_then(|r| r.strip_prefix('('))
+                .and_then(|r| r.strip_suffix(')'))
+            {
+                if let Some((what, n)) = args.split_once(',') {
+                    let n = n.trim();
+                    let int = || {
+                        n.parse::<u8>()
+                            .map_err(|_| format!("bad number `{n}` in `{l}`"))
+                    };
+                    match what.trim() {
+                        "#TOOL" => return Ok(KrlOp::Tool(int()?)),
+                        "#BASE" => return Ok(KrlOp::Base(int()?)),
+                        "#VEL_PTP" => {
+                            let v: f64 = n
+                                .parse()
+                                .ok()
+                                .filter(|v: &f64| *v > 0.0 && *v <= 100.0)
+                                .ok_or_else(|| format!("bad #VEL_PTP `{n}`"))?;
+                            return Ok(KrlOp::VelPtp(v));
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
         _ => {}
     }
     if let Some((k, v)) = l.split_once('=') {
@@ -258,6 +297,20 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
                     .filter(|x: &f64| x.is_finite() && *x > 0.0)
                     .ok_or_else(|| format!("bad $VEL.CP `{v}`"))?;
                 return Ok(KrlOp::VelCp(x));
+            }
+            _ if k.starts_with("$VEL_EXTAX[") => {
+                let axis = k
+                    .strip_prefix("$VEL_EXTAX[")
+                    .and_then(|r| r.strip_suffix(']'))
+                    .and_then(|n| n.parse::<u8>().ok())
+                    .filter(|n| (1..=6).contains(n))
+                    .ok_or_else(|| format!("bad `{k}`"))?;
+                let percent: f64 = v
+                    .parse()
+                    .ok()
+                    .filter(|x: &f64| x.is_finite() && *x > 0.0 && *x <= 100.0)
+                    .ok_or_else(|| format!("bad {k} `{v}` (0 < % <= 100)"))?;
+                return Ok(KrlOp::VelExtax { axis, percent });
             }
             "$IPO_MODE" => {
                 return match v {
