@@ -7,7 +7,8 @@
 //!   centre in front of/behind axis 1 × in front of/behind the lower arm ×
 //!   sign of J5, ABB's table, [`confdata`]), and a `jointtarget` for the joint move
 //!   to every bead start; the torch-carried cell's positioner as external
-//!   axes `eax_a`, `eax_b` (deg), the others `9E+09`.
+//!   axes `eax_a`, `eax_b` (deg; [`AbbOptions::positioner_axes`]), the
+//!   others `9E+09`.
 //! * `ConfL \On` so that the controller keeps our branch on linear moves.
 //! * Arc process: `ArcLStart` (`fine`) / `ArcL` (`z1`) / `ArcLEnd` (`fine`)
 //!   with `seam1` and `weld<schedule>`, which must exist in the system;
@@ -78,6 +79,10 @@ pub struct AbbOptions {
     /// With a stationary tool, the torch in the world (= robot base) frame
     /// (mm); `None`: at the cell's `D_R`, z down.
     pub fixed_tool: Option<Isometry3>,
+    /// The external axes (`extjoint` fields `eax_a` .. `eax_f`, by their
+    /// letter) holding the positioner's tilt `q7` and turn `q8` (deg), as
+    /// the system's mechanical units are configured. Default `['a', 'b']`.
+    pub positioner_axes: [char; 2],
 }
 
 impl Default for AbbOptions {
@@ -90,6 +95,7 @@ impl Default for AbbOptions {
             flange_from_tool: None,
             stationary_tool: None,
             fixed_tool: None,
+            positioner_axes: ['a', 'b'],
         }
     }
 }
@@ -186,7 +192,28 @@ impl AbbOptions {
                 reason: "must be finite and > 0",
             });
         }
+        self.positioner_slots()?;
         self.process.validate()
+    }
+
+    /// Indices (0 = `eax_a` .. 5 = `eax_f`) of [`AbbOptions::positioner_axes`].
+    ///
+    /// # Errors
+    /// [`ProgramError::InvalidOptions`] unless two different letters `a`–`f`.
+    pub fn positioner_slots(&self) -> Result<[usize; 2], ProgramError> {
+        let slot = |c: char| {
+            ('a'..='f')
+                .position(|l| l == c.to_ascii_lowercase())
+                .ok_or(())
+        };
+        match (slot(self.positioner_axes[0]), slot(self.positioner_axes[1])) {
+            (Ok(a), Ok(b)) if a != b => Ok([a, b]),
+            _ => Err(ProgramError::InvalidOptions {
+                field: "positioner_axes",
+                value: format!("{:?}", self.positioner_axes),
+                reason: "two different external axes among a..f (eax_a..eax_f)",
+            }),
+        }
     }
 }
 
@@ -227,15 +254,15 @@ fn pose_line(pose: &Isometry3) -> String {
     )
 }
 
-fn extax(e: Option<[f64; 2]>) -> String {
-    match e {
-        Some(e) => format!(
-            "[{},{},9E+09,9E+09,9E+09,9E+09]",
-            Deg(e[0].to_degrees()),
-            Deg(e[1].to_degrees())
-        ),
-        None => "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]".into(),
+/// `extjoint` with the positioner's joints (rad) in `slots`, `9E+09` elsewhere.
+fn extax(e: Option<[f64; 2]>, slots: [usize; 2]) -> String {
+    let mut v: [String; 6] = std::array::from_fn(|_| "9E+09".to_string());
+    if let Some(e) = e {
+        for (k, slot) in slots.iter().enumerate() {
+            v[*slot] = Deg(e[k].to_degrees()).to_string();
+        }
     }
+    format!("[{}]", v.join(","))
 }
 
 /// Writes the `.mod` of `program`.
@@ -247,6 +274,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     check_vendor(&program.cell, Vendor::Abb, EMITTER).map_err(std::io::Error::other)?;
     let robot = program.cell.robot();
     let frames = opts.frames(&program.cell);
+    let slots = opts.positioner_slots().map_err(std::io::Error::other)?;
     writeln!(w, "MODULE {}", program.name)?;
     writeln!(
         w,
@@ -294,7 +322,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             c[1],
             c[2],
             c[3],
-            extax(p.positioner)
+            extax(p.positioner, slots)
         )?;
         let prev = i.checked_sub(1).map(|k| program.points[k].arc);
         if p.arc == ArcFlag::Approach
@@ -311,7 +339,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
                 Deg(a[3]),
                 Deg(a[4]),
                 Deg(a[5]),
-                extax(p.positioner)
+                extax(p.positioner, slots)
             )?;
         }
     }

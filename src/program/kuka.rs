@@ -19,6 +19,11 @@
 //!   which a `TRIGGER ... DO` accepts only as an assignment or a subprogram
 //!   call ([`is_trigger_action`]; others are refused by
 //!   [`KukaOptions::validate`]).
+//! * The `INI` fold declares the usual stop-message interrupt (`GLOBAL
+//!   INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )`, `INTERRUPT ON
+//!   3`) before `BAS (#INITMOV,0 )`; tool and base are selected with `BAS
+//!   (#TOOL,n)` and `BAS (#BASE,n)` (which also set the tool's load
+//!   `$LOAD`), then `$IPO_MODE`.
 //! * With approach and retract points: `PTP` to the approach point, `LIN`
 //!   into the bead's first point (exact), the bead, `LIN` out to the retract
 //!   point, all at `$VEL.CP` = the program's approach speed.
@@ -370,20 +375,26 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
         program.num_beads()
     )?;
     writeln!(w, "  ;FOLD INI")?;
+    writeln!(
+        w,
+        "  GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )"
+    )?;
+    writeln!(w, "  INTERRUPT ON 3")?;
     writeln!(w, "  BAS (#INITMOV,0 )")?;
     writeln!(w, "  ;ENDFOLD")?;
     writeln!(w, "  $BWDSTART = FALSE")?;
+    // BAS sets $TOOL and $LOAD (TOOL_DATA[n], LOAD_DATA[n]), and $BASE
+    writeln!(w, "  BAS (#TOOL,{})", opts.tool)?;
+    writeln!(w, "  BAS (#BASE,{})", opts.base)?;
     if opts.uses_external_tcp(&program.cell) {
         writeln!(
             w,
-            "  ; external TCP: $TOOL = the part on the flange, $BASE = the fixed torch"
+            "  ; external TCP: the tool is the part on the flange, the base the fixed torch"
         )?;
         writeln!(w, "  $IPO_MODE = #TCP")?;
     } else {
         writeln!(w, "  $IPO_MODE = #BASE")?;
     }
-    writeln!(w, "  $TOOL = TOOL_DATA[{}]", opts.tool)?;
-    writeln!(w, "  $BASE = BASE_DATA[{}]", opts.base)?;
     writeln!(w, "  $APO.CDIS = {}", Mm(opts.cdis_mm))?;
     writeln!(w, "  BAS (#VEL_PTP,{} )", opts.ptp_percent)?;
     // external-axis speeds (%) written since the last PTP speed setting

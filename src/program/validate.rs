@@ -999,6 +999,13 @@ pub fn validate_abb(
         return report;
     }
     let file = &module.file;
+    let slots = match opts.positioner_slots() {
+        Ok(s) => s,
+        Err(e) => {
+            push(&mut report, file, 1, e.to_string());
+            return report;
+        }
+    };
     let robot = cell.robot();
     let frames = match (&module.tool, &module.wobj) {
         (Some(t), Some(w)) => match (t.robhold, w.robhold) {
@@ -1176,7 +1183,10 @@ pub fn validate_abb(
             value_lines: [t.line; 6],
             joints,
             from_cartesian,
-            positioner: t.external.map(|e| e.map(f64::to_radians)),
+            positioner: match (t.external[slots[0]], t.external[slots[1]]) {
+                (Some(a), Some(b)) => Some([a.to_radians(), b.to_radians()]),
+                _ => None,
+            },
             kind,
             speed,
         })));

@@ -231,6 +231,85 @@ fn kuka_refuses_names_over_24_characters() {
     assert!(e.contains("`name`") && e.contains("24 characters"), "{e}");
 }
 
+/// KUKA: the INI fold declares the stop-message interrupt, and tool and base
+/// are selected with BAS (which sets the load too); the validator reads BAS
+/// and compares the numbers with the options.
+#[test]
+fn kuka_ini_fold_interrupt_and_bas_tool_base() {
+    let c = kuka_part_carried();
+    let (prog, planned) = hemi(&c);
+    let opts = KukaOptions {
+        tool: 3,
+        base: 2,
+        ..Default::default()
+    };
+    let f = kuka_files(&prog, &opts).unwrap();
+    let src = &f[0].text;
+    let ini: Vec<&str> = src
+        .lines()
+        .skip_while(|l| !l.contains(";FOLD INI"))
+        .take_while(|l| !l.contains(";ENDFOLD"))
+        .map(str::trim)
+        .collect();
+    assert_eq!(
+        ini[1..],
+        [
+            "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
+            "INTERRUPT ON 3",
+            "BAS (#INITMOV,0 )"
+        ]
+    );
+    assert!(
+        src.contains("\n  BAS (#TOOL,3)\n  BAS (#BASE,2)\n"),
+        "{src}"
+    );
+    assert!(!src.contains("$TOOL =") && !src.contains("$BASE ="));
+    let r = kuka_check(&f, src, &f[1].text, &c, &opts, &planned);
+    assert!(r.is_ok(), "{r}");
+    let other = KukaOptions {
+        tool: 1,
+        ..opts.clone()
+    };
+    let r = kuka_check(&f, src, &f[1].text, &c, &other, &planned);
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.message.contains("TOOL_DATA[3], the options give 1")),
+        "{r}"
+    );
+}
+
+/// ABB: the positioner's external axes are configurable (`eax_c`, `eax_d`
+/// here); the validator reads them from the same slots.
+#[test]
+fn abb_positioner_axes_are_configurable() {
+    let c = cell("abb_irb2600_torch_carried.toml");
+    let (prog, planned) = hemi(&c);
+    let opts = AbbOptions {
+        positioner_axes: ['c', 'd'],
+        ..Default::default()
+    };
+    let text = &abb_files(&prog, &opts).unwrap()[0].text;
+    let p13 = text
+        .lines()
+        .find(|l| l.contains("CONST robtarget p13 :="))
+        .unwrap();
+    let ext = &p13[p13.rfind(",[").unwrap() + 1..];
+    assert!(
+        ext.starts_with("[9E+09,9E+09,") && ext.matches("9E+09").count() == 4,
+        "{p13}"
+    );
+    let m = parse_mod(text, "HEMI.mod").unwrap();
+    let r = validate_abb(&m, &c, &opts, Some(&planned));
+    assert!(r.is_ok(), "{r}");
+    let bad = AbbOptions {
+        positioner_axes: ['a', 'a'],
+        ..Default::default()
+    };
+    let e = abb_files(&prog, &bad).unwrap_err().to_string();
+    assert!(e.contains("`positioner_axes`"), "{e}");
+}
+
 #[test]
 fn kuka_corruptions_are_named_by_their_line() {
     let c = kuka_part_carried();

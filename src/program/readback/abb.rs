@@ -182,8 +182,8 @@ pub struct RapidTarget {
     pub line: usize,
     /// Value.
     pub value: RapidTargetValue,
-    /// External axes `eax_a`, `eax_b` (deg), `None` when `9E+09`.
-    pub external: Option<[f64; 2]>,
+    /// External axes `eax_a` .. `eax_f` (deg), `None` where `9E+09`.
+    pub external: [Option<f64>; 6],
 }
 
 /// One instruction of `main`.
@@ -327,9 +327,8 @@ fn parse_declaration(stmt: &str, line: usize, m: &mut RapidModule) -> Result<(),
     };
     let v = parse_aggregate(value)?;
     let items = v.list()?;
-    let ext = |n: &Node| -> Result<Option<[f64; 2]>, String> {
-        let e = n.nums::<6>()?;
-        Ok((e[0] < 8.9e9).then_some([e[0], e[1]]))
+    let ext = |n: &Node| -> Result<[Option<f64>; 6], String> {
+        Ok(n.nums::<6>()?.map(|e| (e < 8.9e9).then_some(e)))
     };
     match *ty {
         "tooldata" => {
