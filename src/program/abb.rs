@@ -361,7 +361,9 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         if positioner_moves(program, i) {
             // the part turns under the torch: time the move (s)
             let t = segment_length_mm(program, i) / p.speed_mm_s;
-            v += &format!("\\T:={}", crate::program::fmt::Fixed::new(t.max(0.001), 3));
+            // rounded up to the ms: never faster than planned
+            let t = ((t * 1000.0 - 1e-9).ceil() / 1000.0).max(0.001);
+            v += &format!("\\T:={}", crate::program::fmt::Fixed::new(t, 3));
         }
         match (&opts.process, p.arc) {
             (_, ArcFlag::Approach) => {

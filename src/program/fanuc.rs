@@ -25,8 +25,9 @@
 //!   transition.
 //!
 //! Speeds are integers (mm/sec, cm/min or msec), the only form a TP motion
-//! line takes without a register; modulated travel speeds are rounded to the
-//! nearest unit (prefer cm/min for a finer step).
+//! line takes without a register; speeds are rounded down and times up to
+//! the unit, so that no move runs faster than planned (a joint planned at
+//! its maximum speed stays within it); prefer cm/min for a finer step.
 //!
 //! **What the speed means.** The planned speed is the travel speed of the
 //! deposition point relative to the part (what the plan and the validator
@@ -460,11 +461,14 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
     let linear_speed = |i: usize, v: f64| {
         if opts.segment_time_based(program, i) {
             let d = segment_length_mm(program, i);
-            Speed::Msec(((1000.0 * d / v).round() as u32).max(1))
+            // rounded up: never faster than planned (a joint at its
+            // maximum speed stays within it)
+            Speed::Msec(((1000.0 * d / v - 1e-9).ceil() as u32).max(1))
         } else {
             match opts.speed_unit {
-                SpeedUnit::MmPerSec => Speed::MmPerSec((v.round() as u32).max(1)),
-                SpeedUnit::CmPerMin => Speed::CmPerMin(((v * 6.0).round() as u32).max(1)),
+                // rounded down: never faster than planned
+                SpeedUnit::MmPerSec => Speed::MmPerSec(((v + 1e-9).floor() as u32).max(1)),
+                SpeedUnit::CmPerMin => Speed::CmPerMin(((v * 6.0 + 1e-9).floor() as u32).max(1)),
             }
         }
     };

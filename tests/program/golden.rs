@@ -36,6 +36,19 @@
 //!   mm/s: from memory of the RAPID reference manual, not against a source
 //!   found here. Units: FANUC mm/sec (or cm/min, msec), KUKA m/s, ABB mm/s.
 //!
+//! * Second review (issue 8): KUKA and ABB goldens are now made in the
+//!   KUKA and ABB example cells (a program's joints are its robot's). KUKA:
+//!   `LIN` targets are `E6POS` with S/T even with joint positions;
+//!   `BAS (#TOOL,n)`/`BAS (#BASE,n)`; the `INI` fold's `GLOBAL INTERRUPT
+//!   DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )`/`INTERRUPT ON 3`;
+//!   `$VEL_EXTAX[n]` on moves where the positioner turns: from memory of
+//!   KUKA-written programs and forum threads (robot-forum.com Status/Turn
+//!   threads for S and T), not a manual. ABB: `\T:=s` after the speed
+//!   argument of `ArcL`/`MoveL` (RAPID's optional time argument): from
+//!   memory of the RAPID reference. FANUC: `msec` on the torch-carried
+//!   cell's moves where the positioner turns; `/ATTR COMMENT` of at most 16
+//!   characters. Every file is pure ASCII.
+//!
 //! Not verified: that a controller loads these files (no controller or
 //! simulator was available).
 
