@@ -310,6 +310,11 @@ pub(crate) fn switch_statements(opts: &KukaOptions) -> (String, String) {
     }
 }
 
+/// `x` rounded down to 4 decimals (at least 0.0001).
+fn floor4(x: f64) -> f64 {
+    ((x * 1e4 + 1e-6).floor() / 1e4).max(1e-4)
+}
+
 /// The speeds of a timed `LIN` (module doc, "Torch-carried cell,
 /// positioner turning").
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -410,7 +415,9 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     };
     let mut vel: Option<f64> = None;
     let mut set_vel = |w: &mut dyn Write, mm_s: f64| -> std::io::Result<()> {
-        let v = mm_s / 1000.0;
+        // m/s, rounded down to the written 6 decimals: never faster than
+        // planned
+        let v = ((mm_s * 1000.0 + 1e-6).floor() / 1e6).max(1e-6);
         if vel != Some(v) {
             writeln!(w, "  $VEL.CP = {}", crate::program::fmt::Fixed::new(v, 6))?;
             vel = Some(v);
@@ -447,7 +454,12 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                     for (n, pct) in t.vel_extax_percent.iter().enumerate() {
                         if let Some(pct) = pct {
                             if extax[n] != Some(*pct) {
-                                writeln!(w, "  $VEL_EXTAX[{}] = {}", n + 1, Fixed::new(*pct, 4))?;
+                                writeln!(
+                                    w,
+                                    "  $VEL_EXTAX[{}] = {}",
+                                    n + 1,
+                                    Fixed::new(floor4(*pct), 4)
+                                )?;
                                 extax[n] = Some(*pct);
                             }
                         }
