@@ -36,7 +36,11 @@
 //!   moves carry the optional argument `\T` (`ArcL p13, [6,500,5000,1000]
 //!   \T:=5.705, ...`), the segment time in seconds = the segment's length
 //!   in the part frame / the planned speed, which RAPID uses instead of the
-//!   `speeddata`.
+//!   `speeddata` (`Speed [\V] | [\T]` of `MoveL`/`MoveC`/`MoveAbsJ`;
+//!   uncoordinated external axes reach their targets with the robot). Not
+//!   verified: that ArcWare honours `\T` on `ArcL` while welding, when it
+//!   takes the arc-on speed from `weld<n>.weld_speed` (see below); if it
+//!   does not, the turning segments run at the weld speed as a TCP speed.
 //! * Weld speed: ArcWare takes the speed of the arc-on moves (`ArcL`,
 //!   `ArcLEnd`) from `weld<n>.weld_speed`; the inline `speeddata` (the planned
 //!   speed) applies when welding is blocked. The weld data must give the
