@@ -30,7 +30,7 @@
 //!   torch's over the part, as planned, and `robtarget`s are the torch in
 //!   the part frame.
 //! * **Torch-carried cell, positioner turning.** Where the positioner moves
-//!   within a bead ([`positioner_moves`](crate::program::positioner_moves))
+//!   within a bead ([`positioner_moves`])
 //!   the TCP's speed in the world frame is not the torch's over the part
 //!   (the work object is not coordinated with the positioner here): such
 //!   moves carry the optional argument `\T` (`ArcL p13, [6,500,5000,1000]

@@ -106,7 +106,7 @@ pub enum SpeedUnit {
 pub enum MotionTiming {
     /// Time-based (`msec`) in the part-carried cell; in the torch-carried
     /// cell time-based on every segment where the positioner moves
-    /// ([`positioner_moves`](crate::program::positioner_moves)), TCP speed
+    /// ([`positioner_moves`]), TCP speed
     /// elsewhere.
     #[default]
     Auto,
