@@ -230,11 +230,12 @@ impl AbbOptions {
 /// with the wrist centre behind axis 1 the usual posture is `cfx` 4 or 5,
 /// not 6 or 7.
 pub fn confdata(robot: &RobotModel, q: &Joints) -> [i32; 4] {
-    let quarter = |v: f64| (v / std::f64::consts::FRAC_PI_2).floor() as i32;
+    let printed = crate::program::fmt::as_printed_rad;
+    let quarter = |v: f64| (printed(v) / std::f64::consts::FRAC_PI_2).floor() as i32;
     let c = robot.configuration_of(q);
     let side = matches!(c.side, crate::robot::ArmSide::Back) as i32;
     let elbow = !crate::program::kuka::elbow_positive_cos(&c) as i32;
-    let wrist = (q[4] < 0.0) as i32;
+    let wrist = (printed(q[4]) < 0.0) as i32;
     [
         quarter(q[0]),
         quarter(q[3]),
@@ -460,6 +461,25 @@ mod tests {
 
     fn rad(d: [f64; 6]) -> Joints {
         d.map(f64::to_radians)
+    }
+
+    /// Joints written as `0.00000` (within 1e-12 rad of a quadrant edge or
+    /// of J5 = 0) take the quadrant of the printed value, not the one of a
+    /// rounding residue a quarter turn away.
+    #[test]
+    fn quadrants_follow_the_printed_value() {
+        let r = RobotModel::abb_irb2600_12_185();
+        let q = [
+            -1e-12,
+            0.3,
+            0.2,
+            -1e-13,
+            -1e-12,
+            std::f64::consts::FRAC_PI_2 - 1e-13,
+        ];
+        let c = confdata(&r, &q);
+        assert_eq!([c[0], c[1], c[2]], [0, 0, 1]);
+        assert_eq!(c[3] & 1, 0, "J5 printed 0 is not negative: cfx {}", c[3]);
     }
 
     /// Wrist centre behind axis 1 (J2 ≈ −85°: the upper arm leans back),

@@ -88,6 +88,21 @@ impl fmt::Display for Deg {
     }
 }
 
+/// An angle (rad) as [`Deg`] prints it, back in rad: configuration bits
+/// (KUKA Status/Turn, ABB `confdata`) are taken from this value, so that a
+/// joint at `-1e-12` rad, written `0.00000`, does not set a "negative" bit
+/// that would send the controller to the other side of zero (a full turn
+/// away for KUKA A4/A6).
+pub fn as_printed_rad(v: f64) -> f64 {
+    let scale = 1e5;
+    let d = (v.to_degrees() * scale).round() / scale;
+    if d == 0.0 {
+        0.0
+    } else {
+        d.to_radians()
+    }
+}
+
 /// Unitless components (direction cosines, quaternions): 7 decimals.
 #[derive(Debug, Clone, Copy)]
 pub struct Unitless(pub f64);

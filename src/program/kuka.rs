@@ -260,7 +260,8 @@ pub fn is_trigger_action(s: &str) -> bool {
 pub fn status(robot: &RobotModel, q: &Joints) -> u8 {
     let c = robot.configuration_of(q);
     let back = c.side == ArmSide::Back;
-    (back as u8) | ((elbow_positive_cos(&c) as u8) << 1) | (((q[4] < 0.0) as u8) << 2)
+    let a5_negative = crate::program::fmt::as_printed_rad(q[4]) < 0.0;
+    (back as u8) | ((elbow_positive_cos(&c) as u8) << 1) | ((a5_negative as u8) << 2)
 }
 
 /// The elbow joint test of a configuration: `true` on the side of the
@@ -275,9 +276,9 @@ pub fn elbow_positive_cos(c: &crate::robot::Configuration) -> bool {
 
 /// KUKA Turn bits of joints `q`: bit `i` set when `A(i+1) < 0`.
 pub fn turn(q: &Joints) -> u8 {
-    q.iter()
-        .enumerate()
-        .fold(0, |t, (i, v)| t | (((*v < 0.0) as u8) << i))
+    q.iter().enumerate().fold(0, |t, (i, v)| {
+        t | (((crate::program::fmt::as_printed_rad(*v) < 0.0) as u8) << i)
+    })
 }
 
 /// A fixed torch at `d` (robot base frame, mm): z down (its approach
@@ -659,5 +660,7 @@ mod tests {
     #[test]
     fn turn_bits() {
         assert_eq!(turn(&rad([91.0, -45.0, 37.0, 1.0, -1.0, 0.0])), 0b010010);
+        // a joint printed as 0.00000 is not negative (A4 = -1e-12 rad)
+        assert_eq!(turn(&[0.1, -0.5, 0.3, -1e-12, 0.2, -1e-9]), 0b000010);
     }
 }
