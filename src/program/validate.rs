@@ -88,6 +88,23 @@ pub enum MotionSpeed {
     Linear(f64),
     /// Linear move taking this long (s).
     Time(f64),
+    /// Linear move at the controller's TCP speed: the TCP (`flange ·
+    /// flange_from_tcp`) travels at `mm_s` in the robot base frame, and the
+    /// positioner's axes, moving with the path, arrive with it, each at most
+    /// at `extax_fraction` of its maximum speed: the move takes the longest
+    /// of these. This is what FANUC `mm/sec`/`cm/min`, ABB `v_tcp` with the
+    /// tool held by the robot and KUKA `$VEL.CP` outside the fixed-tool mode
+    /// mean; it equals [`MotionSpeed::Linear`] only where the part is still.
+    Tcp {
+        /// TCP speed in the robot base frame (mm/s).
+        mm_s: f64,
+        /// The TCP on the flange (mm).
+        flange_from_tcp: Isometry3,
+        /// Fraction (0–1] of each positioner axis's maximum speed allowed
+        /// for external axes moving with the path (KUKA `$VEL_EXTAX[n]/100`;
+        /// 1 elsewhere).
+        extax_fraction: [f64; 2],
+    },
 }
 
 /// One motion of a program, decoded.
@@ -335,6 +352,29 @@ pub fn check_steps(
                 (MotionSpeed::Linear(v), Some(a), Some(b)) => {
                     let d = (a - b).norm();
                     (d > 0.0).then(|| (d / v, format!("at {v:.3} mm/s")))
+                }
+                (
+                    MotionSpeed::Tcp {
+                        mm_s,
+                        flange_from_tcp,
+                        extax_fraction,
+                    },
+                    _,
+                    _,
+                ) => {
+                    let tcp =
+                        |q: &Joints| (robot.flange_pose(q) * flange_from_tcp).translation.vector;
+                    let mut t = (tcp(&q) - tcp(pq)).norm() / mm_s;
+                    if let (Cell::TorchCarried(c), Some(a), Some(b)) = (cell, qp, pqp) {
+                        for n in 0..2 {
+                            let max = c.positioner.max_speed_rad_s[n] * extax_fraction[n];
+                            let turn = (a[n] - b[n]).abs();
+                            if max.is_finite() && max > 0.0 && turn > 0.0 {
+                                t = t.max(turn / max);
+                            }
+                        }
+                    }
+                    (t > 0.0).then(|| (t, format!("at {mm_s:.3} mm/s TCP speed")))
                 }
                 (MotionSpeed::Time(t), _, _) => {
                     if t > 0.0 {
@@ -672,7 +712,11 @@ fn fanuc_steps(
                     positioner: pos.group2.map(|g| g.map(f64::to_radians)),
                     kind: *kind,
                     speed: match (speed.mm_s(), speed.time_s()) {
-                        (Some(v), _) => MotionSpeed::Linear(v),
+                        (Some(v), _) => MotionSpeed::Tcp {
+                            mm_s: v,
+                            flange_from_tcp: tool,
+                            extax_fraction: [1.0; 2],
+                        },
                         (None, Some(t)) => MotionSpeed::Time(t),
                         _ => MotionSpeed::Joint,
                     },
@@ -743,7 +787,6 @@ pub fn validate_kuka(
     let mut vel: Option<f64> = None;
     let mut pending: Vec<(u8, String, usize)> = Vec::new();
     let mut prev_q: Option<Joints> = None;
-    let mut prev_ext: Option<[f64; 2]> = None;
     // external axes' path speeds (%), as the last `BAS (#VEL_PTP,n)` or
     // `$VEL_EXTAX[n]` left them (assumed 100 before either)
     let mut vel_extax = [100.0; 6];
@@ -918,27 +961,16 @@ pub fn validate_kuka(
         };
         // Outside the fixed-tool mode $VEL.CP is the TCP's speed in the
         // robot frame, and external axes move with the path at
-        // $VEL_EXTAX: the move takes the longest of the TCP's travel and
-        // each positioner axis's turn at its speed. (In the fixed-tool mode
-        // $VEL.CP is the torch's speed over the part, the planned meaning.)
-        let speed = match (speed, &joints, &prev_q, cell) {
-            (MotionSpeed::Linear(v), Some(q), Some(pq), Cell::TorchCarried(c)) if !external_tcp => {
-                let tcp = |q: &Joints| (robot.flange_pose(q) * tool).translation.vector;
-                let mut t = (tcp(q) - tcp(pq)).norm() / v;
-                if let Some(pe) = prev_ext {
-                    for n in 0..2 {
-                        let max = c.positioner.max_speed_rad_s[n] * vel_extax[n] / 100.0;
-                        let turn = (pos.external[n] - pe[n]).to_radians().abs();
-                        if max.is_finite() && turn > 0.0 {
-                            t = t.max(turn / max);
-                        }
-                    }
-                }
-                MotionSpeed::Time(t)
-            }
-            (speed, ..) => speed,
+        // $VEL_EXTAX. (In the fixed-tool mode $VEL.CP is the torch's speed
+        // over the part, the planned meaning.)
+        let speed = match speed {
+            MotionSpeed::Linear(v) if !external_tcp => MotionSpeed::Tcp {
+                mm_s: v,
+                flange_from_tcp: tool,
+                extax_fraction: [vel_extax[0] / 100.0, vel_extax[1] / 100.0],
+            },
+            speed => speed,
         };
-        prev_ext = Some(pos.external);
         prev_q = joints.or(prev_q);
         steps.push(Step::Motion(Box::new(Motion {
             file: src.clone(),
@@ -1097,9 +1129,21 @@ pub fn validate_abb(
                 };
                 (
                     target,
-                    match time_s {
-                        Some(t) => MotionSpeed::Time(*t),
-                        None => MotionSpeed::Linear(*speed_mm_s),
+                    match (time_s, &frames) {
+                        (Some(t), _) => MotionSpeed::Time(*t),
+                        // v_tcp is the speed of the robot-held tool
+                        (
+                            None,
+                            Some(AbbFrames::Held {
+                                flange_from_tool, ..
+                            }),
+                        ) => MotionSpeed::Tcp {
+                            mm_s: *speed_mm_s,
+                            flange_from_tcp: *flange_from_tool,
+                            extax_fraction: [1.0; 2],
+                        },
+                        // a stationary tool: v_tcp is its speed over the work object
+                        (None, _) => MotionSpeed::Linear(*speed_mm_s),
                     },
                     MoveKind::Linear,
                     event,
