@@ -102,7 +102,7 @@ use rayon::prelude::*;
 use crate::math::UnitVector3;
 use crate::path::Path;
 use crate::robot::cell::{Cell, CellPoint};
-use crate::robot::ik::Configuration;
+use crate::robot::ik::{unwrap_near, Configuration};
 use crate::robot::model::Joints;
 use crate::robot::trajectory::{joint_trajectory, PathPointInput, ViolationKind};
 use crate::toolaxis::LocalFrame;
@@ -449,76 +449,109 @@ impl<'a> LayerSetup<'a> {
         out
     }
 
-    /// Scores every seed in branch `cfg` on the sample points; best first.
-    fn score_seeds(&self, cfg: Configuration) -> Vec<Seed> {
+    /// Scores every seed in each branch of `cfgs` on the sample points; per
+    /// branch, its best seed. The cell poses of a seed's sample points do not
+    /// depend on the branch: they are computed once and every branch's IK is
+    /// solved from them ([`RobotModel::inverse_all`](crate::robot::RobotModel::inverse_all)).
+    fn best_seeds(&self, cfgs: &[Configuration]) -> Vec<Seed> {
         let p = self.points.len();
         let ns = self.opts.seed_points.min(p);
         let idx: Vec<usize> = (0..ns)
             .map(|i| ((i as f64) * (p - 1) as f64 / (ns - 1).max(1) as f64).round() as usize)
             .collect();
-        let prob = self.problem(cfg, vec![0.0; p]);
+        let prob = self.problem(cfgs[0], vec![0.0; p]);
         let robot = self.cell.robot();
-        let mut seeds: Vec<Seed> = self
-            .seed_laws()
-            .into_iter()
-            .map(|(r, degree)| {
-                let mut prev: Option<Joints> = prob.start_near;
-                let mut q8 = 0.0;
-                let (mut viol, mut est, mut cen) = (0.0f64, 0.0, 0.0);
-                for &m in &idx {
-                    match prob.joints_at(m, r[m], prev.as_ref(), q8) {
-                        Ok((q, pose)) => {
-                            if let Some(qp) = pose.positioner {
-                                q8 = qp[1];
-                            }
-                            for j in 0..6 {
-                                let (lo, hi) = if j == 4 {
-                                    if q[4] >= 0.0 {
-                                        (prob.lower[4].max(prob.wrist_margin), prob.upper[4])
-                                    } else {
-                                        (prob.lower[4], prob.upper[4].min(-prob.wrist_margin))
-                                    }
-                                } else {
-                                    (prob.lower[j], prob.upper[j])
-                                };
-                                viol = viol.max(q[j] - hi).max(lo - q[j]);
-                                if prob.gamma[j] > 0.0 {
-                                    let l = &robot.limits[j];
-                                    cen += ((q[j] - l.mid_rad()) / l.range_rad()).powi(2);
-                                    if let Some(qq) = prev {
-                                        est += prob.gamma[j] * (q[j] - qq[j]).powi(2);
-                                    }
-                                }
-                            }
-                            if let Some(h) = prob.hose {
-                                viol = viol.max((q[3] + q[5]).abs() - h);
-                            }
-                            prev = Some(q);
+        let mut best: Vec<Option<Seed>> = vec![None; cfgs.len()];
+        for (r, degree) in self.seed_laws() {
+            // per branch: (violation, displacement estimate, centring, previous joints)
+            let mut acc: Vec<(f64, f64, f64, Option<Joints>)> =
+                vec![(0.0, 0.0, 0.0, prob.start_near); cfgs.len()];
+            let mut q8 = 0.0;
+            for &m in &idx {
+                let pose = match self.cell.pose(&self.points[m], r[m], q8) {
+                    Ok(pose) => pose,
+                    Err(_) => {
+                        for a in &mut acc {
+                            a.0 = f64::INFINITY;
                         }
+                        break;
+                    }
+                };
+                let all = robot.inverse_all(&pose.base_from_flange);
+                let mut any = false;
+                for (a, cfg) in acc.iter_mut().zip(cfgs) {
+                    if a.0 == f64::INFINITY {
+                        continue;
+                    }
+                    let q = match &all[cfg.index()] {
+                        Ok(q) => match a.3 {
+                            Some(n) => std::array::from_fn(|j| unwrap_near(q[j], n[j])),
+                            None => *q,
+                        },
                         Err(_) => {
-                            viol = f64::INFINITY;
-                            break;
+                            a.0 = f64::INFINITY;
+                            continue;
+                        }
+                    };
+                    any = true;
+                    let (viol, est, cen, prev) = a;
+                    for j in 0..6 {
+                        let (lo, hi) = if j == 4 {
+                            if q[4] >= 0.0 {
+                                (prob.lower[4].max(prob.wrist_margin), prob.upper[4])
+                            } else {
+                                (prob.lower[4], prob.upper[4].min(-prob.wrist_margin))
+                            }
+                        } else {
+                            (prob.lower[j], prob.upper[j])
+                        };
+                        *viol = viol.max(q[j] - hi).max(lo - q[j]);
+                        if prob.gamma[j] > 0.0 {
+                            let l = &robot.limits[j];
+                            *cen += ((q[j] - l.mid_rad()) / l.range_rad()).powi(2);
+                            if let Some(qq) = prev {
+                                *est += prob.gamma[j] * (q[j] - qq[j]).powi(2);
+                            }
                         }
                     }
+                    if let Some(h) = prob.hose {
+                        *viol = viol.max((q[3] + q[5]).abs() - h);
+                    }
+                    *prev = Some(q);
                 }
-                cen /= ns as f64;
+                if !any {
+                    break;
+                }
+                if let Some(qp) = pose.positioner {
+                    q8 = qp[1];
+                }
+            }
+            for (b, (viol, est, cen, _)) in best.iter_mut().zip(acc) {
+                let cen = cen / ns as f64;
                 // displacement between samples ≈ (ns−1)/(p−1) of the full sum
-                est *= (ns - 1) as f64 / (p - 1) as f64;
-                Seed {
-                    r,
+                let est = est * (ns - 1) as f64 / (p - 1) as f64;
+                let seed = Seed {
+                    r: r.clone(),
                     degree,
                     violation: viol.max(0.0),
                     estimate: est + self.opts.centring_weight * cen,
                     centring: cen,
+                };
+                // the first of equal seeds wins (a stable sort's order)
+                let better = b.as_ref().is_none_or(|s| {
+                    seed.violation
+                        .total_cmp(&s.violation)
+                        .then(seed.estimate.total_cmp(&s.estimate))
+                        .is_lt()
+                });
+                if better {
+                    *b = Some(seed);
                 }
-            })
-            .collect();
-        seeds.sort_by(|a, b| {
-            a.violation
-                .total_cmp(&b.violation)
-                .then(a.estimate.total_cmp(&b.estimate))
-        });
-        seeds
+            }
+        }
+        best.into_iter()
+            .map(|b| b.expect("at least one seed law"))
+            .collect()
     }
 
     /// Dexterity floor per point from the unoptimised path (`R_Z = 0`).
@@ -624,10 +657,8 @@ fn optimise_layer(
     };
     let mut ranked: Vec<(Configuration, Seed)> = candidates
         .iter()
-        .map(|&cfg| {
-            let best = setup.score_seeds(cfg).swap_remove(0);
-            (cfg, best)
-        })
+        .copied()
+        .zip(setup.best_seeds(&candidates))
         .collect();
     let own = cell.configuration();
     ranked.sort_by(|a, b| {

@@ -233,16 +233,18 @@ impl<'a> LayerProblem<'a> {
     }
 
     /// Slope of a scalar function of the joints at point `m` along `R_Z`
-    /// (central difference through the IK).
-    fn slope(&self, e: &Evaluation, m: usize, f: impl Fn(&Self, &Joints) -> f64) -> f64 {
-        let q8 = e.positioner[m].map(|p| p[1]).unwrap_or(0.0);
-        let at = |d: f64| {
-            self.joints_at(m, e.r[m] + d, Some(&e.q[m]), q8)
-                .map(|(q, _)| f(self, &q))
-        };
-        match (at(FD_STEP_RAD), at(-FD_STEP_RAD)) {
-            (Ok(a), Ok(b)) => (a - b) / (2.0 * FD_STEP_RAD),
-            _ => 0.0,
+    /// (per rad), `f0` its value at `e.q[m]`: a forward difference along
+    /// the analytic tangent `dq/dR_Z` (`q + h·g`; no IK: the second-order
+    /// term of the joints changes the slope by `O(h)`, as the difference does).
+    fn slope(&self, e: &Evaluation, m: usize, f0: f64, f: impl Fn(&Self, &Joints) -> f64) -> f64 {
+        let q = &e.q[m];
+        let g = &e.g[m];
+        let q1: Joints = std::array::from_fn(|j| q[j] + FD_STEP_RAD * g[j]);
+        let d = (f(self, &q1) - f0) / FD_STEP_RAD;
+        if d.is_finite() {
+            d
+        } else {
+            0.0
         }
     }
 
@@ -323,7 +325,7 @@ impl<'a> LayerProblem<'a> {
                 for m in 0..p {
                     rows(m, &mut row_m);
                     let d = if basis.is_some() {
-                        self.slope(e, m, Self::unc_of)
+                        self.slope(e, m, e.unc[m], Self::unc_of)
                     } else {
                         0.0
                     };
@@ -406,7 +408,7 @@ impl<'a> LayerProblem<'a> {
             let psi = self.psi[m];
             if psi > 0.0 {
                 let d = if with_dex_slope && e.dex[m] < 1.5 * psi {
-                    self.slope(e, m, Self::dex_of)
+                    self.slope(e, m, e.dex[m], Self::dex_of)
                 } else {
                     0.0
                 };
