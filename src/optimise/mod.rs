@@ -30,7 +30,10 @@
 //!    [`ConfigurationChoiceReport`]. If its optimisation ends infeasible the
 //!    next branches are tried.
 //! 2. **Polynomial degree** raised from the seed's with warm starts (the new
-//!    coefficient starts at 0) until the objective stops improving [§4.2.1].
+//!    coefficient starts at 0) until the objective stops improving [§4.2.1]
+//!    — or, with no constraint in reach, until the Gauss–Newton model at the
+//!    current optimum bounds the next degree's gain far below that criterion
+//!    (the next degree is then not solved).
 //! 3. **SQP**: the joints are linearised with the analytic `dq/dR_Z`
 //!    ([`Cell::pose`]'s flange twist through `J⁻¹`), chained through the
 //!    basis; each QP (closed form when no row binds, clarabel on a working
@@ -947,6 +950,17 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
                 }
                 match basis.raised() {
                     Some(b) => {
+                        // The Gauss–Newton model at this optimum bounds what
+                        // the next degree can gain while no constraint is in
+                        // reach of its step: far below the stop criterion,
+                        // solving it is not worth its evaluations.
+                        if let (Some(e), Some((_, _, _, bst))) = (&at_c, &best) {
+                            if bst.violation <= 0.0
+                                && skip_raise(&problem, e, &b, stop_relative_gain * bst.objective)
+                            {
+                                break;
+                            }
+                        }
                         basis = b;
                         c.push(0.0);
                     }
@@ -971,6 +985,25 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
         outcome.violation = problem.max_violation(e);
     }
     outcome
+}
+
+/// Fraction of the stop criterion (relative gain) below which the
+/// Gauss–Newton model's gain from one more degree skips that degree.
+const RAISE_MODEL_FRACTION: f64 = 1e-2;
+
+/// `true` when raising to `raised` cannot pay: at the current optimum `e`
+/// the unconstrained Gauss–Newton model of the raised problem predicts a
+/// decrease below `RAISE_MODEL_FRACTION × threshold` (objective units), and
+/// no constraint is within reach of that model step (with one, the model
+/// would not bound the gain).
+fn skip_raise(problem: &LayerProblem, e: &Evaluation, raised: &Basis, threshold: f64) -> bool {
+    let Some((gain, step)) = sqp::predicted_gain(problem, e, 0.0, raised) else {
+        return false;
+    };
+    gain < RAISE_MODEL_FRACTION * threshold
+        && problem
+            .constraint_rows(e, raised, step.max(1e-6))
+            .is_empty()
 }
 
 /// Objective scale of a layer: its value at the seed (bounded below).
@@ -1136,7 +1169,6 @@ fn finish(
     let robot = setup.cell.robot();
     let p = e.q.len();
     let mut e = e;
-    problem.exact_dexterity(&mut e);
     // the trajectory stage's own check, in the chosen branch
     let mut cell = setup.cell.clone();
     match &mut cell {
@@ -1151,9 +1183,22 @@ fn finish(
         .collect();
     let mut topts = opts.trajectory;
     topts.with_derivatives = false;
-    let violations = joint_trajectory(&cell, &inputs, opts.travel_speed_mm_s, &topts)
-        .map(|t| t.report.violations)
-        .unwrap_or_default();
+    let violations = match joint_trajectory(&cell, &inputs, opts.travel_speed_mm_s, &topts) {
+        Ok(t) => {
+            // its dexterity is the exact value the plan reports, wherever
+            // it solved the same joints (it does everywhere: same IK, same
+            // unwrapping); the SVD is not repeated there
+            for (m, jp) in t.points.iter().enumerate().take(p) {
+                if !e.dex_exact[m] && jp.joints == Some(e.q[m]) {
+                    e.dex[m] = jp.dexterity;
+                    e.dex_exact[m] = true;
+                }
+            }
+            t.report.violations
+        }
+        Err(_) => Vec::new(),
+    };
+    problem.exact_dexterity(&mut e);
     let binding = problem.binding(&e, 1e-9).or_else(|| {
         violations.first().map(|v| Binding {
             point: v.point,

@@ -393,6 +393,32 @@ pub(crate) fn solve(
     })
 }
 
+/// Largest decrease of the objective (unscaled) that the Gauss–Newton
+/// model at `e` predicts over `basis` without constraints, `½ gᵀP⁻¹g`, and
+/// the largest change of `R_Z` (rad) of that model step; `None` when `P` is
+/// not positive definite. With constraints the model's decrease can only be
+/// smaller.
+pub(crate) fn predicted_gain(
+    problem: &LayerProblem,
+    e: &Evaluation,
+    smoothness: f64,
+    basis: &Basis,
+) -> Option<(f64, f64)> {
+    let k = basis.len();
+    let mut p_dense = vec![0.0; k * k];
+    let mut grad = vec![0.0; k];
+    gauss_newton(problem, e, smoothness, basis, 1.0, &mut p_dense, &mut grad);
+    let x = unconstrained(k, &p_dense, &grad)?;
+    let gain = -0.5 * grad.iter().zip(&x).map(|(g, x)| g * x).sum::<f64>();
+    // δR = B δc (the anchored basis's constant `r0` cancels)
+    let step = basis
+        .eval(&x)
+        .iter()
+        .zip(basis.eval(&vec![0.0; k]))
+        .fold(0.0f64, |a, (v, v0)| a.max((v - v0).abs()));
+    (gain.is_finite() && step.is_finite()).then_some((gain.max(0.0), step))
+}
+
 /// Gauss–Newton model of `f / scale` at `e`: `P = 2 Σ aᵀa / scale` (dense,
 /// row-major `k × k`) and the gradient `2 Σ r a / scale`.
 fn gauss_newton(
