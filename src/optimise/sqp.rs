@@ -362,7 +362,8 @@ pub(crate) fn solve(
                 .zip(&e.r)
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
-            if step > 1e-3 {
+            // a step below the convergence tolerance is not worth an evaluation
+            if step > 1e-3 || step < opts.step_tolerance_rad {
                 break;
             }
             let Ok(e_new) = problem.evaluate(&r_new) else {
