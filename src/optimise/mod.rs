@@ -982,7 +982,7 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
         }
     }
     if let Ok(e) = &outcome.eval {
-        outcome.violation = problem.max_violation(e);
+        outcome.violation = problem.max_violation_of_bounds(e);
     }
     outcome
 }
