@@ -190,12 +190,12 @@ pub fn optimise(
     let plans: Vec<LayerPlan> = if opts.parallel {
         layers
             .par_iter()
-            .map(|l| optimise_layer(cell, l, opts, None))
+            .map(|l| optimise_layer(cell, l, opts, None).0)
             .collect()
     } else {
         layers
             .iter()
-            .map(|l| optimise_layer(cell, l, opts, None))
+            .map(|l| optimise_layer(cell, l, opts, None).0)
             .collect()
     };
     let transitions = transitions(cell, &plans);
@@ -214,6 +214,8 @@ pub fn optimise(
 /// point (the polynomial of [`Basis::anchored_polynomial`]: `R_Z` continuous,
 /// its slope free). Each turn is solved as a layer of its own, including that
 /// shared point, so the junction step counts in its objective and quality.
+/// The dexterity floor is continuous along the spiral: over each turn it
+/// goes linearly from the previous turn's floor to the turn's own.
 /// The plan has one [`LayerPlan`] per turn (`layer` = turn number, points
 /// of that turn only); turns are solved in order, not in parallel. The
 /// smoothing spline and the point-by-point baseline hold the joints
@@ -243,6 +245,7 @@ pub fn optimise_spiral(
         starts.pop();
     }
     let mut plans: Vec<LayerPlan> = Vec::with_capacity(starts.len());
+    let mut floor = 0.0;
     for (k, &a) in starts.iter().enumerate() {
         let b = starts.get(k + 1).copied().unwrap_or(n);
         let anchor = plans.last().and_then(|prev: &LayerPlan| {
@@ -251,6 +254,7 @@ pub fn optimise_spiral(
                 r_z: last.r_z,
                 joints: last.joints?,
                 configuration: prev.configuration.chosen,
+                floor,
             })
         });
         let from = if anchor.is_some() { a - 1 } else { a };
@@ -258,7 +262,8 @@ pub fn optimise_spiral(
             layer: k,
             points: spiral.points[from..b].to_vec(),
         };
-        let mut plan = optimise_layer(cell, &turn, opts, anchor);
+        let (mut plan, end_floor) = optimise_layer(cell, &turn, opts, anchor);
+        floor = end_floor;
         if anchor.is_some() {
             strip_shared_point(&mut plan);
         }
@@ -328,6 +333,8 @@ struct Anchor {
     r_z: f64,
     joints: Joints,
     configuration: Configuration,
+    /// The previous turn's dexterity floor at its last point.
+    floor: f64,
 }
 
 fn transitions(cell: &Cell, plans: &[LayerPlan]) -> Vec<Transition> {
@@ -615,12 +622,14 @@ struct BranchOutcome {
     problem_psi: Vec<f64>,
 }
 
+/// One layer (or spiral turn, `anchor` given); also returns the dexterity
+/// floor at its last point (the next spiral turn starts from it).
 fn optimise_layer(
     cell: &Cell,
     lp: &LayerPoints,
     opts: &OptimiseOptions,
     anchor: Option<Anchor>,
-) -> LayerPlan {
+) -> (LayerPlan, f64) {
     let t0 = Instant::now();
     let points = &lp.points;
     let p = points.len();
@@ -736,10 +745,11 @@ fn optimise_layer(
         branches_tried,
         time_s,
     };
+    let end_floor = out.problem_psi.last().copied().unwrap_or(0.0);
     let eval = match out.eval {
         Ok(e) => e,
         Err(f) => {
-            return LayerPlan {
+            let plan = LayerPlan {
                 layer: lp.layer,
                 status: LayerStatus::NoSolution {
                     point: f.point,
@@ -752,11 +762,12 @@ fn optimise_layer(
                 quality: LayerQuality::default(),
                 solver: solver(t0.elapsed().as_secs_f64()),
                 violations: Vec::new(),
-            }
+            };
+            return (plan, end_floor);
         }
     };
     let problem = setup.problem(chosen, out.problem_psi);
-    finish(
+    let plan = finish(
         &setup,
         lp.layer,
         &problem,
@@ -768,7 +779,8 @@ fn optimise_layer(
         configuration,
         solver,
         t0,
-    )
+    );
+    (plan, end_floor)
 }
 
 fn choice_reason(
@@ -821,6 +833,18 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
     let opts = setup.opts;
     let p = setup.points.len();
     let mut psi = setup.floors(cfg);
+    if let Some(a) = setup.anchor {
+        // A continuous floor along the spiral: from the previous turn's at
+        // the shared point to this turn's own at its last point. A step at
+        // the junction would leave the shared point, held where the
+        // previous turn put it (on its floor, when that was active), below
+        // the new floor, and the turn would have to bend R_Z steeply away
+        // from it.
+        let n = (p - 1).max(1) as f64;
+        for (m, x) in psi.iter_mut().enumerate() {
+            *x = a.floor + (*x - a.floor) * m as f64 / n;
+        }
+    }
     if setup.anchor.is_some() {
         // the shared point of a spiral turn was checked against the
         // previous turn's floor, and cannot move
