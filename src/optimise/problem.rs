@@ -302,6 +302,15 @@ impl<'a> LayerProblem<'a> {
             rp: &[(usize, f64)],
         ) {
             a.clear();
+            // the polynomial bases: both rows over the same coefficients
+            if rm.len() == rp.len() && rm.iter().zip(rp).all(|(u, v)| u.0 == v.0) {
+                a.extend(
+                    rm.iter()
+                        .zip(rp)
+                        .map(|(&(i, u), &(_, v))| (i, x * u + y * v)),
+                );
+                return;
+            }
             for &(i, v) in rm {
                 a.push((i, x * v));
             }
@@ -315,9 +324,10 @@ impl<'a> LayerProblem<'a> {
         }
         match self.objective {
             Objective::JointDisplacement => {
+                rows(0, &mut row_m);
                 for m in 1..p {
+                    std::mem::swap(&mut row_m, &mut row_p);
                     rows(m, &mut row_m);
-                    rows(m - 1, &mut row_p);
                     for j in 0..6 {
                         if self.gamma[j] == 0.0 {
                             continue;
@@ -390,7 +400,7 @@ impl<'a> LayerProblem<'a> {
         e: &Evaluation,
         with_dex_slope: bool,
         solver: bool,
-        sink: &mut dyn FnMut(usize, Constraint, f64, f64, f64),
+        sink: &mut impl FnMut(usize, Constraint, f64, f64, f64),
     ) {
         let p = e.q.len();
         let hose = self
