@@ -35,6 +35,12 @@ const DEX_BOUND_FACTOR: f64 = 1.5;
 /// hair inside it makes an optimiser-feasible layer pass the re-check.
 pub(crate) const HOSE_MARGIN_RAD: f64 = 1e-5;
 
+/// The joint-speed bounds the SQP works to are this fraction tighter than
+/// the robot's (relative): as for the hose, its last steps can leave an
+/// active bound a hair outside, and the trajectory re-check tests
+/// `|Δq| / Δt` against the speed itself.
+pub(crate) const SPEED_MARGIN_REL: f64 = 1e-6;
+
 /// Finite-difference step on `R_Z` for the dexterity and uncertainty slopes (rad).
 const FD_STEP_RAD: f64 = 1e-6;
 
@@ -394,7 +400,8 @@ impl<'a> LayerProblem<'a> {
     /// at point m and at m−1)`. Gradients of the dexterity are computed only
     /// when `with_dex_slope` and the point is within a factor 1.5 of its floor.
     /// `solver`: the bounds the SQP works to (the hose bound
-    /// [`HOSE_MARGIN_RAD`] tighter); otherwise the bounds themselves.
+    /// [`HOSE_MARGIN_RAD`] and the joint speeds [`SPEED_MARGIN_REL`]
+    /// tighter); otherwise the bounds themselves.
     pub fn constraints(
         &self,
         e: &Evaluation,
@@ -448,7 +455,10 @@ impl<'a> LayerProblem<'a> {
                 let qp = &e.q[m - 1];
                 let gp = &e.g[m - 1];
                 for j in 0..6 {
-                    let lim = self.max_speed[j] * self.dt[m];
+                    let mut lim = self.max_speed[j] * self.dt[m];
+                    if solver {
+                        lim *= 1.0 - SPEED_MARGIN_REL;
+                    }
                     let c = Constraint::JointSpeed { joint: j + 1 };
                     let dq = q[j] - qp[j];
                     sink(m, c, dq - lim, g[j], -gp[j]);
