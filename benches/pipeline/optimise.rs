@@ -2,11 +2,13 @@
 //! part-carried cell: the hemisphere at Delta = 5 and 1 mm and the nozzle at
 //! Delta = 1 mm (500 points per layer). Target: under 0.5 s for the
 //! hemisphere at Delta = 1 on 2 cores (the thesis needed 92 s in Matlab for
-//! Delta = 5 at degree 1). Measured on the shared 2-core box (other builds
-//! running): 0.29 s, 1.30 s and 3.18 s (before the closed-form QPs, secant
-//! model and dexterity bound: 2.67 s, 10.7 s, 29.3 s); the target is not
-//! met yet (the time goes to the IK, Jacobian and dexterity of some eight
-//! evaluations of every point per layer).
+//! Delta = 5 at degree 1). Measured on the shared 2-core box with nothing
+//! else running: 67 ms, 0.33 s and 0.74 s (before the shared seed poses,
+//! tangent slopes, model-bounded degree raising and polish: 111 ms, 0.59 s,
+//! 1.32 s); with another build on the box, about twice that. The time goes
+//! to the IK, Jacobian and dexterity of some five evaluations of every
+//! point per layer, plus the layer's unoptimised dexterity (its floor) and
+//! the trajectory re-check, each one SVD per point.
 
 use std::hint::black_box;
 use std::path::PathBuf;

@@ -30,7 +30,10 @@
 //!    [`ConfigurationChoiceReport`]. If its optimisation ends infeasible the
 //!    next branches are tried.
 //! 2. **Polynomial degree** raised from the seed's with warm starts (the new
-//!    coefficient starts at 0) until the objective stops improving [§4.2.1].
+//!    coefficient starts at 0) until the objective stops improving [§4.2.1]
+//!    — or, with no constraint in reach, until the Gauss–Newton model at the
+//!    current optimum bounds the next degree's gain far below that criterion
+//!    (the next degree is then not solved).
 //! 3. **SQP**: the joints are linearised with the analytic `dq/dR_Z`
 //!    ([`Cell::pose`]'s flange twist through `J⁻¹`), chained through the
 //!    basis; each QP (closed form when no row binds, clarabel on a working
@@ -102,7 +105,7 @@ use rayon::prelude::*;
 use crate::math::UnitVector3;
 use crate::path::Path;
 use crate::robot::cell::{Cell, CellPoint};
-use crate::robot::ik::Configuration;
+use crate::robot::ik::{unwrap_near, Configuration};
 use crate::robot::model::Joints;
 use crate::robot::trajectory::{joint_trajectory, PathPointInput, ViolationKind};
 use crate::toolaxis::LocalFrame;
@@ -187,12 +190,12 @@ pub fn optimise(
     let plans: Vec<LayerPlan> = if opts.parallel {
         layers
             .par_iter()
-            .map(|l| optimise_layer(cell, l, opts, None))
+            .map(|l| optimise_layer(cell, l, opts, None).0)
             .collect()
     } else {
         layers
             .iter()
-            .map(|l| optimise_layer(cell, l, opts, None))
+            .map(|l| optimise_layer(cell, l, opts, None).0)
             .collect()
     };
     let transitions = transitions(cell, &plans);
@@ -211,6 +214,8 @@ pub fn optimise(
 /// point (the polynomial of [`Basis::anchored_polynomial`]: `R_Z` continuous,
 /// its slope free). Each turn is solved as a layer of its own, including that
 /// shared point, so the junction step counts in its objective and quality.
+/// The dexterity floor is continuous along the spiral: over each turn it
+/// goes linearly from the previous turn's floor to the turn's own.
 /// The plan has one [`LayerPlan`] per turn (`layer` = turn number, points
 /// of that turn only); turns are solved in order, not in parallel. The
 /// smoothing spline and the point-by-point baseline hold the joints
@@ -240,6 +245,7 @@ pub fn optimise_spiral(
         starts.pop();
     }
     let mut plans: Vec<LayerPlan> = Vec::with_capacity(starts.len());
+    let mut floor = 0.0;
     for (k, &a) in starts.iter().enumerate() {
         let b = starts.get(k + 1).copied().unwrap_or(n);
         let anchor = plans.last().and_then(|prev: &LayerPlan| {
@@ -248,6 +254,7 @@ pub fn optimise_spiral(
                 r_z: last.r_z,
                 joints: last.joints?,
                 configuration: prev.configuration.chosen,
+                floor,
             })
         });
         let from = if anchor.is_some() { a - 1 } else { a };
@@ -255,7 +262,8 @@ pub fn optimise_spiral(
             layer: k,
             points: spiral.points[from..b].to_vec(),
         };
-        let mut plan = optimise_layer(cell, &turn, opts, anchor);
+        let (mut plan, end_floor) = optimise_layer(cell, &turn, opts, anchor);
+        floor = end_floor;
         if anchor.is_some() {
             strip_shared_point(&mut plan);
         }
@@ -325,6 +333,8 @@ struct Anchor {
     r_z: f64,
     joints: Joints,
     configuration: Configuration,
+    /// The previous turn's dexterity floor at its last point.
+    floor: f64,
 }
 
 fn transitions(cell: &Cell, plans: &[LayerPlan]) -> Vec<Transition> {
@@ -449,76 +459,109 @@ impl<'a> LayerSetup<'a> {
         out
     }
 
-    /// Scores every seed in branch `cfg` on the sample points; best first.
-    fn score_seeds(&self, cfg: Configuration) -> Vec<Seed> {
+    /// Scores every seed in each branch of `cfgs` on the sample points; per
+    /// branch, its best seed. The cell poses of a seed's sample points do not
+    /// depend on the branch: they are computed once and every branch's IK is
+    /// solved from them ([`RobotModel::inverse_all`](crate::robot::RobotModel::inverse_all)).
+    fn best_seeds(&self, cfgs: &[Configuration]) -> Vec<Seed> {
         let p = self.points.len();
         let ns = self.opts.seed_points.min(p);
         let idx: Vec<usize> = (0..ns)
             .map(|i| ((i as f64) * (p - 1) as f64 / (ns - 1).max(1) as f64).round() as usize)
             .collect();
-        let prob = self.problem(cfg, vec![0.0; p]);
+        let prob = self.problem(cfgs[0], vec![0.0; p]);
         let robot = self.cell.robot();
-        let mut seeds: Vec<Seed> = self
-            .seed_laws()
-            .into_iter()
-            .map(|(r, degree)| {
-                let mut prev: Option<Joints> = prob.start_near;
-                let mut q8 = 0.0;
-                let (mut viol, mut est, mut cen) = (0.0f64, 0.0, 0.0);
-                for &m in &idx {
-                    match prob.joints_at(m, r[m], prev.as_ref(), q8) {
-                        Ok((q, pose)) => {
-                            if let Some(qp) = pose.positioner {
-                                q8 = qp[1];
-                            }
-                            for j in 0..6 {
-                                let (lo, hi) = if j == 4 {
-                                    if q[4] >= 0.0 {
-                                        (prob.lower[4].max(prob.wrist_margin), prob.upper[4])
-                                    } else {
-                                        (prob.lower[4], prob.upper[4].min(-prob.wrist_margin))
-                                    }
-                                } else {
-                                    (prob.lower[j], prob.upper[j])
-                                };
-                                viol = viol.max(q[j] - hi).max(lo - q[j]);
-                                if prob.gamma[j] > 0.0 {
-                                    let l = &robot.limits[j];
-                                    cen += ((q[j] - l.mid_rad()) / l.range_rad()).powi(2);
-                                    if let Some(qq) = prev {
-                                        est += prob.gamma[j] * (q[j] - qq[j]).powi(2);
-                                    }
-                                }
-                            }
-                            if let Some(h) = prob.hose {
-                                viol = viol.max((q[3] + q[5]).abs() - h);
-                            }
-                            prev = Some(q);
+        let mut best: Vec<Option<Seed>> = vec![None; cfgs.len()];
+        for (r, degree) in self.seed_laws() {
+            // per branch: (violation, displacement estimate, centring, previous joints)
+            let mut acc: Vec<(f64, f64, f64, Option<Joints>)> =
+                vec![(0.0, 0.0, 0.0, prob.start_near); cfgs.len()];
+            let mut q8 = 0.0;
+            for &m in &idx {
+                let pose = match self.cell.pose(&self.points[m], r[m], q8) {
+                    Ok(pose) => pose,
+                    Err(_) => {
+                        for a in &mut acc {
+                            a.0 = f64::INFINITY;
                         }
+                        break;
+                    }
+                };
+                let all = robot.inverse_all(&pose.base_from_flange);
+                let mut any = false;
+                for (a, cfg) in acc.iter_mut().zip(cfgs) {
+                    if a.0 == f64::INFINITY {
+                        continue;
+                    }
+                    let q = match &all[cfg.index()] {
+                        Ok(q) => match a.3 {
+                            Some(n) => std::array::from_fn(|j| unwrap_near(q[j], n[j])),
+                            None => *q,
+                        },
                         Err(_) => {
-                            viol = f64::INFINITY;
-                            break;
+                            a.0 = f64::INFINITY;
+                            continue;
+                        }
+                    };
+                    any = true;
+                    let (viol, est, cen, prev) = a;
+                    for j in 0..6 {
+                        let (lo, hi) = if j == 4 {
+                            if q[4] >= 0.0 {
+                                (prob.lower[4].max(prob.wrist_margin), prob.upper[4])
+                            } else {
+                                (prob.lower[4], prob.upper[4].min(-prob.wrist_margin))
+                            }
+                        } else {
+                            (prob.lower[j], prob.upper[j])
+                        };
+                        *viol = viol.max(q[j] - hi).max(lo - q[j]);
+                        if prob.gamma[j] > 0.0 {
+                            let l = &robot.limits[j];
+                            *cen += ((q[j] - l.mid_rad()) / l.range_rad()).powi(2);
+                            if let Some(qq) = prev {
+                                *est += prob.gamma[j] * (q[j] - qq[j]).powi(2);
+                            }
                         }
                     }
+                    if let Some(h) = prob.hose {
+                        *viol = viol.max((q[3] + q[5]).abs() - h);
+                    }
+                    *prev = Some(q);
                 }
-                cen /= ns as f64;
+                if !any {
+                    break;
+                }
+                if let Some(qp) = pose.positioner {
+                    q8 = qp[1];
+                }
+            }
+            for (b, (viol, est, cen, _)) in best.iter_mut().zip(acc) {
+                let cen = cen / ns as f64;
                 // displacement between samples ≈ (ns−1)/(p−1) of the full sum
-                est *= (ns - 1) as f64 / (p - 1) as f64;
-                Seed {
-                    r,
+                let est = est * (ns - 1) as f64 / (p - 1) as f64;
+                let seed = Seed {
+                    r: r.clone(),
                     degree,
                     violation: viol.max(0.0),
                     estimate: est + self.opts.centring_weight * cen,
                     centring: cen,
+                };
+                // the first of equal seeds wins (a stable sort's order)
+                let better = b.as_ref().is_none_or(|s| {
+                    seed.violation
+                        .total_cmp(&s.violation)
+                        .then(seed.estimate.total_cmp(&s.estimate))
+                        .is_lt()
+                });
+                if better {
+                    *b = Some(seed);
                 }
-            })
-            .collect();
-        seeds.sort_by(|a, b| {
-            a.violation
-                .total_cmp(&b.violation)
-                .then(a.estimate.total_cmp(&b.estimate))
-        });
-        seeds
+            }
+        }
+        best.into_iter()
+            .map(|b| b.expect("at least one seed law"))
+            .collect()
     }
 
     /// Dexterity floor per point from the unoptimised path (`R_Z = 0`).
@@ -579,12 +622,14 @@ struct BranchOutcome {
     problem_psi: Vec<f64>,
 }
 
+/// One layer (or spiral turn, `anchor` given); also returns the dexterity
+/// floor at its last point (the next spiral turn starts from it).
 fn optimise_layer(
     cell: &Cell,
     lp: &LayerPoints,
     opts: &OptimiseOptions,
     anchor: Option<Anchor>,
-) -> LayerPlan {
+) -> (LayerPlan, f64) {
     let t0 = Instant::now();
     let points = &lp.points;
     let p = points.len();
@@ -624,10 +669,8 @@ fn optimise_layer(
     };
     let mut ranked: Vec<(Configuration, Seed)> = candidates
         .iter()
-        .map(|&cfg| {
-            let best = setup.score_seeds(cfg).swap_remove(0);
-            (cfg, best)
-        })
+        .copied()
+        .zip(setup.best_seeds(&candidates))
         .collect();
     let own = cell.configuration();
     ranked.sort_by(|a, b| {
@@ -702,10 +745,11 @@ fn optimise_layer(
         branches_tried,
         time_s,
     };
+    let end_floor = out.problem_psi.last().copied().unwrap_or(0.0);
     let eval = match out.eval {
         Ok(e) => e,
         Err(f) => {
-            return LayerPlan {
+            let plan = LayerPlan {
                 layer: lp.layer,
                 status: LayerStatus::NoSolution {
                     point: f.point,
@@ -718,11 +762,12 @@ fn optimise_layer(
                 quality: LayerQuality::default(),
                 solver: solver(t0.elapsed().as_secs_f64()),
                 violations: Vec::new(),
-            }
+            };
+            return (plan, end_floor);
         }
     };
     let problem = setup.problem(chosen, out.problem_psi);
-    finish(
+    let plan = finish(
         &setup,
         lp.layer,
         &problem,
@@ -734,7 +779,8 @@ fn optimise_layer(
         configuration,
         solver,
         t0,
-    )
+    );
+    (plan, end_floor)
 }
 
 fn choice_reason(
@@ -787,6 +833,18 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
     let opts = setup.opts;
     let p = setup.points.len();
     let mut psi = setup.floors(cfg);
+    if let Some(a) = setup.anchor {
+        // A continuous floor along the spiral: from the previous turn's at
+        // the shared point to this turn's own at its last point. A step at
+        // the junction would leave the shared point, held where the
+        // previous turn put it (on its floor, when that was active), below
+        // the new floor, and the turn would have to bend R_Z steeply away
+        // from it.
+        let n = (p - 1).max(1) as f64;
+        for (m, x) in psi.iter_mut().enumerate() {
+            *x = a.floor + (*x - a.floor) * m as f64 / n;
+        }
+    }
     if setup.anchor.is_some() {
         // the shared point of a spiral turn was checked against the
         // previous turn's floor, and cannot move
@@ -916,6 +974,17 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
                 }
                 match basis.raised() {
                     Some(b) => {
+                        // The Gauss–Newton model at this optimum bounds what
+                        // the next degree can gain while no constraint is in
+                        // reach of its step: far below the stop criterion,
+                        // solving it is not worth its evaluations.
+                        if let (Some(e), Some((_, _, _, bst))) = (&at_c, &best) {
+                            if bst.violation <= 0.0
+                                && skip_raise(&problem, e, &b, stop_relative_gain * bst.objective)
+                            {
+                                break;
+                            }
+                        }
                         basis = b;
                         c.push(0.0);
                     }
@@ -937,9 +1006,28 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
         }
     }
     if let Ok(e) = &outcome.eval {
-        outcome.violation = problem.max_violation(e);
+        outcome.violation = problem.max_violation_of_bounds(e);
     }
     outcome
+}
+
+/// Fraction of the stop criterion (relative gain) below which the
+/// Gauss–Newton model's gain from one more degree skips that degree.
+const RAISE_MODEL_FRACTION: f64 = 1e-2;
+
+/// `true` when raising to `raised` cannot pay: at the current optimum `e`
+/// the unconstrained Gauss–Newton model of the raised problem predicts a
+/// decrease below `RAISE_MODEL_FRACTION × threshold` (objective units), and
+/// no constraint is within reach of that model step (with one, the model
+/// would not bound the gain).
+fn skip_raise(problem: &LayerProblem, e: &Evaluation, raised: &Basis, threshold: f64) -> bool {
+    let Some((gain, step)) = sqp::predicted_gain(problem, e, 0.0, raised) else {
+        return false;
+    };
+    gain < RAISE_MODEL_FRACTION * threshold
+        && problem
+            .constraint_rows(e, raised, step.max(1e-6))
+            .is_empty()
 }
 
 /// Objective scale of a layer: its value at the seed (bounded below).
@@ -1105,7 +1193,6 @@ fn finish(
     let robot = setup.cell.robot();
     let p = e.q.len();
     let mut e = e;
-    problem.exact_dexterity(&mut e);
     // the trajectory stage's own check, in the chosen branch
     let mut cell = setup.cell.clone();
     match &mut cell {
@@ -1120,9 +1207,22 @@ fn finish(
         .collect();
     let mut topts = opts.trajectory;
     topts.with_derivatives = false;
-    let violations = joint_trajectory(&cell, &inputs, opts.travel_speed_mm_s, &topts)
-        .map(|t| t.report.violations)
-        .unwrap_or_default();
+    let violations = match joint_trajectory(&cell, &inputs, opts.travel_speed_mm_s, &topts) {
+        Ok(t) => {
+            // its dexterity is the exact value the plan reports, wherever
+            // it solved the same joints (it does everywhere: same IK, same
+            // unwrapping); the SVD is not repeated there
+            for (m, jp) in t.points.iter().enumerate().take(p) {
+                if !e.dex_exact[m] && jp.joints == Some(e.q[m]) {
+                    e.dex[m] = jp.dexterity;
+                    e.dex_exact[m] = true;
+                }
+            }
+            t.report.violations
+        }
+        Err(_) => Vec::new(),
+    };
+    problem.exact_dexterity(&mut e);
     let binding = problem.binding(&e, 1e-9).or_else(|| {
         violations.first().map(|v| Binding {
             point: v.point,

@@ -34,7 +34,10 @@ pub enum Parameterisation {
     /// `R_Z` a polynomial of degree `n` in the abscissa [eq. 4.1–4.2]. The
     /// degree is raised from the seed's (0 or 1) with warm starts up to
     /// `max_degree`, stopping early when the objective stops improving
-    /// (relative gain below `stop_relative_gain`) [§4.2.1].
+    /// (relative gain below `stop_relative_gain`) [§4.2.1], or before
+    /// solving the next degree when, with no constraint in reach, the
+    /// Gauss–Newton model at the optimum predicts a relative gain below a
+    /// hundredth of `stop_relative_gain`.
     Polynomial {
         /// Highest degree tried (0..=8).
         max_degree: usize,

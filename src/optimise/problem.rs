@@ -28,6 +28,19 @@ pub(crate) const ARCMATE_SIGMA_DEG: [f64; 6] =
 /// [`LayerProblem::constraints`] computes slopes below 1.5 floors).
 const DEX_BOUND_FACTOR: f64 = 1.5;
 
+/// How far inside the cell's hose-torsion bound the SQP holds `|J4 + J6|`
+/// (rad). Its last steps stop below the step tolerance (1e-7 rad of `R_Z`),
+/// which can leave an active bound a few 1e-8 rad outside; the layer's
+/// status and the trajectory re-check test the bound itself, so aiming this
+/// hair inside it makes an optimiser-feasible layer pass the re-check.
+pub(crate) const HOSE_MARGIN_RAD: f64 = 1e-5;
+
+/// The joint-speed bounds the SQP works to are this fraction tighter than
+/// the robot's (relative): as for the hose, its last steps can leave an
+/// active bound a hair outside, and the trajectory re-check tests
+/// `|Δq| / Δt` against the speed itself.
+pub(crate) const SPEED_MARGIN_REL: f64 = 1e-6;
+
 /// Finite-difference step on `R_Z` for the dexterity and uncertainty slopes (rad).
 const FD_STEP_RAD: f64 = 1e-6;
 
@@ -48,6 +61,7 @@ pub(crate) struct LayerProblem<'a> {
     pub upper: [f64; 6],
     /// `|J5|` must stay above this on its branch's side (rad).
     pub wrist_margin: f64,
+    /// The cell's hose-torsion bound on `|q4 + q6|` (rad; torch-carried cell).
     pub hose: Option<f64>,
     pub max_speed: [f64; 6],
     /// Centring weight per point (already divided by the number of points).
@@ -233,16 +247,18 @@ impl<'a> LayerProblem<'a> {
     }
 
     /// Slope of a scalar function of the joints at point `m` along `R_Z`
-    /// (central difference through the IK).
-    fn slope(&self, e: &Evaluation, m: usize, f: impl Fn(&Self, &Joints) -> f64) -> f64 {
-        let q8 = e.positioner[m].map(|p| p[1]).unwrap_or(0.0);
-        let at = |d: f64| {
-            self.joints_at(m, e.r[m] + d, Some(&e.q[m]), q8)
-                .map(|(q, _)| f(self, &q))
-        };
-        match (at(FD_STEP_RAD), at(-FD_STEP_RAD)) {
-            (Ok(a), Ok(b)) => (a - b) / (2.0 * FD_STEP_RAD),
-            _ => 0.0,
+    /// (per rad), `f0` its value at `e.q[m]`: a forward difference along
+    /// the analytic tangent `dq/dR_Z` (`q + h·g`; no IK: the second-order
+    /// term of the joints changes the slope by `O(h)`, as the difference does).
+    fn slope(&self, e: &Evaluation, m: usize, f0: f64, f: impl Fn(&Self, &Joints) -> f64) -> f64 {
+        let q = &e.q[m];
+        let g = &e.g[m];
+        let q1: Joints = std::array::from_fn(|j| q[j] + FD_STEP_RAD * g[j]);
+        let d = (f(self, &q1) - f0) / FD_STEP_RAD;
+        if d.is_finite() {
+            d
+        } else {
+            0.0
         }
     }
 
@@ -292,6 +308,15 @@ impl<'a> LayerProblem<'a> {
             rp: &[(usize, f64)],
         ) {
             a.clear();
+            // the polynomial bases: both rows over the same coefficients
+            if rm.len() == rp.len() && rm.iter().zip(rp).all(|(u, v)| u.0 == v.0) {
+                a.extend(
+                    rm.iter()
+                        .zip(rp)
+                        .map(|(&(i, u), &(_, v))| (i, x * u + y * v)),
+                );
+                return;
+            }
             for &(i, v) in rm {
                 a.push((i, x * v));
             }
@@ -305,9 +330,10 @@ impl<'a> LayerProblem<'a> {
         }
         match self.objective {
             Objective::JointDisplacement => {
+                rows(0, &mut row_m);
                 for m in 1..p {
+                    std::mem::swap(&mut row_m, &mut row_p);
                     rows(m, &mut row_m);
-                    rows(m - 1, &mut row_p);
                     for j in 0..6 {
                         if self.gamma[j] == 0.0 {
                             continue;
@@ -323,7 +349,7 @@ impl<'a> LayerProblem<'a> {
                 for m in 0..p {
                     rows(m, &mut row_m);
                     let d = if basis.is_some() {
-                        self.slope(e, m, Self::unc_of)
+                        self.slope(e, m, e.unc[m], Self::unc_of)
                     } else {
                         0.0
                     };
@@ -373,13 +399,20 @@ impl<'a> LayerProblem<'a> {
     /// dexterity), calling `sink(point, constraint, value, gradient along R_Z
     /// at point m and at m−1)`. Gradients of the dexterity are computed only
     /// when `with_dex_slope` and the point is within a factor 1.5 of its floor.
+    /// `solver`: the bounds the SQP works to (the hose bound
+    /// [`HOSE_MARGIN_RAD`] and the joint speeds [`SPEED_MARGIN_REL`]
+    /// tighter); otherwise the bounds themselves.
     pub fn constraints(
         &self,
         e: &Evaluation,
         with_dex_slope: bool,
-        sink: &mut dyn FnMut(usize, Constraint, f64, f64, f64),
+        solver: bool,
+        sink: &mut impl FnMut(usize, Constraint, f64, f64, f64),
     ) {
         let p = e.q.len();
+        let hose = self
+            .hose
+            .map(|h| if solver { h - HOSE_MARGIN_RAD } else { h });
         for m in 0..p {
             let q = &e.q[m];
             let g = &e.g[m];
@@ -397,7 +430,7 @@ impl<'a> LayerProblem<'a> {
                     sink(m, c, lo - q[j], -g[j], 0.0);
                 }
             }
-            if let Some(h) = self.hose {
+            if let Some(h) = hose {
                 let t = q[3] + q[5];
                 let d = g[3] + g[5];
                 sink(m, Constraint::HoseTorsion, t - h, d, 0.0);
@@ -406,7 +439,7 @@ impl<'a> LayerProblem<'a> {
             let psi = self.psi[m];
             if psi > 0.0 {
                 let d = if with_dex_slope && e.dex[m] < 1.5 * psi {
-                    self.slope(e, m, Self::dex_of)
+                    self.slope(e, m, e.dex[m], Self::dex_of)
                 } else {
                     0.0
                 };
@@ -422,7 +455,10 @@ impl<'a> LayerProblem<'a> {
                 let qp = &e.q[m - 1];
                 let gp = &e.g[m - 1];
                 for j in 0..6 {
-                    let lim = self.max_speed[j] * self.dt[m];
+                    let mut lim = self.max_speed[j] * self.dt[m];
+                    if solver {
+                        lim *= 1.0 - SPEED_MARGIN_REL;
+                    }
                     let c = Constraint::JointSpeed { joint: j + 1 };
                     let dq = q[j] - qp[j];
                     sink(m, c, dq - lim, g[j], -gp[j]);
@@ -432,10 +468,11 @@ impl<'a> LayerProblem<'a> {
         }
     }
 
-    /// The most violated constraint at `e`, if any is violated by more than `tol`.
+    /// The most violated constraint at `e` (the bounds themselves), if any
+    /// is violated by more than `tol`.
     pub fn binding(&self, e: &Evaluation, tol: f64) -> Option<Binding> {
         let mut worst: Option<Binding> = None;
-        self.constraints(e, false, &mut |m, c, v, _, _| {
+        self.constraints(e, false, false, &mut |m, c, v, _, _| {
             if v > tol && worst.is_none_or(|w| v > w.violation) {
                 worst = Some(Binding {
                     point: m,
@@ -447,10 +484,17 @@ impl<'a> LayerProblem<'a> {
         worst
     }
 
-    /// Largest violation (0 when feasible).
+    /// Largest violation of the SQP's bounds (0 when feasible).
     pub fn max_violation(&self, e: &Evaluation) -> f64 {
         let mut worst: f64 = 0.0;
-        self.constraints(e, false, &mut |_, _, v, _, _| worst = worst.max(v));
+        self.constraints(e, false, true, &mut |_, _, v, _, _| worst = worst.max(v));
+        worst
+    }
+
+    /// Largest violation of the bounds themselves (0 when feasible).
+    pub fn max_violation_of_bounds(&self, e: &Evaluation) -> f64 {
+        let mut worst: f64 = 0.0;
+        self.constraints(e, false, false, &mut |_, _, v, _, _| worst = worst.max(v));
         worst
     }
 
@@ -460,7 +504,7 @@ impl<'a> LayerProblem<'a> {
         let mut out = Vec::new();
         let mut rm = Vec::new();
         let mut rp = Vec::new();
-        self.constraints(e, true, &mut |m, _, v, d, dp| {
+        self.constraints(e, true, true, &mut |m, _, v, d, dp| {
             let reach = (d.abs() + dp.abs()) * trust;
             if v + reach <= 0.0 || (d == 0.0 && dp == 0.0) {
                 return;
