@@ -374,6 +374,15 @@ pub fn check_steps(
                             }
                         }
                     }
+                    let turns = q.iter().zip(pq).any(|(a, b)| (a - b).abs() > 1e-9);
+                    if t == 0.0 && turns {
+                        // the controller then runs the move at its
+                        // orientation speed, not at any planned speed
+                        msgs.push(format!(
+                            "linear move at {mm_s:.3} mm/s TCP speed with the TCP still while the joints turn: \
+                             the controller would turn at its orientation speed limit (write it time-based)"
+                        ));
+                    }
                     (t > 0.0).then(|| (t, format!("at {mm_s:.3} mm/s TCP speed")))
                 }
                 (MotionSpeed::Time(t), _, _) => {

@@ -2,7 +2,7 @@
 //! the line; the program stage refuses infeasible plans.
 
 use waam_slicer::program::fanuc::{
-    fanuc_files, write_ls, FanucOptions, Op, PositionMode, TpProgram,
+    fanuc_files, write_ls, FanucOptions, MotionTiming, Op, PositionMode, TpProgram,
 };
 use waam_slicer::program::readback::parse_ls;
 use waam_slicer::program::validate::{validate_fanuc, ValidationReport};
@@ -170,6 +170,31 @@ fn a_truncated_file_is_named_by_its_last_line() {
         );
     }
     let _ = cell;
+}
+
+/// In the part-carried cell the flange is the controller's TCP: with the
+/// fixture's law (J1–J5 still, J6 turning the part under the torch) it does
+/// not move, so a TCP speed (`cm/min`) would let the controller turn the
+/// part at its orientation speed limit. Our default writes segment times;
+/// the same program with TCP speeds is refused, naming the first such move.
+#[test]
+fn tcp_speeds_with_a_still_tcp_are_refused() {
+    let cell = part_carried();
+    let opts = FanucOptions {
+        timing: MotionTiming::TcpSpeed,
+        ..Default::default()
+    };
+    let (text, planned) = emitted(&cell, &opts);
+    let r = check(&text, &cell, &opts, &planned);
+    let p = r
+        .problems
+        .iter()
+        .find(|p| p.message.contains("TCP still"))
+        .unwrap_or_else(|| panic!("{r}"));
+    let first_bead_move = line_of(&text, ":L P[", line_of(&text, "Arc Start[1]", 0));
+    assert_eq!(p.line, first_bead_move, "{r}");
+    let timed = emitted(&cell, &FanucOptions::default());
+    assert!(check(&timed.0, &cell, &FanucOptions::default(), &timed.1).is_ok());
 }
 
 #[test]
