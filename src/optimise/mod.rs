@@ -1224,15 +1224,43 @@ fn finish(
     };
     problem.exact_dexterity(&mut e);
     let binding = problem.binding(&e, 1e-9).or_else(|| {
-        violations.first().map(|v| Binding {
-            point: v.point,
-            constraint: match v.kind {
-                ViolationKind::JointLimit { joint, .. } => Constraint::JointLimit { joint },
-                ViolationKind::JointSpeed { joint, .. } => Constraint::JointSpeed { joint },
-                ViolationKind::HoseTorsion { .. } => Constraint::HoseTorsion,
-                _ => Constraint::Dexterity,
-            },
-            violation: 0.0,
+        violations.first().map(|v| {
+            // the amount in the units of `Binding::violation`: rad past a
+            // bound, rad over one step for a speed, relative for dexterity
+            let (constraint, violation) = match v.kind {
+                ViolationKind::JointLimit {
+                    joint,
+                    value_rad,
+                    lower_rad,
+                    upper_rad,
+                } => (
+                    Constraint::JointLimit { joint },
+                    (lower_rad - value_rad).max(value_rad - upper_rad),
+                ),
+                ViolationKind::JointSpeed {
+                    joint,
+                    speed_rad_s,
+                    max_rad_s,
+                } => {
+                    let step_mm = v.point.checked_sub(1).map_or(0.0, |k| {
+                        (inputs[v.point].position_mm - inputs[k].position_mm).norm()
+                    });
+                    (
+                        Constraint::JointSpeed { joint },
+                        (speed_rad_s - max_rad_s) * step_mm / opts.travel_speed_mm_s,
+                    )
+                }
+                ViolationKind::HoseTorsion {
+                    torsion_rad,
+                    max_rad,
+                } => (Constraint::HoseTorsion, torsion_rad - max_rad),
+                _ => (Constraint::Dexterity, 0.0),
+            };
+            Binding {
+                point: v.point,
+                constraint,
+                violation,
+            }
         })
     });
     let status = match binding {

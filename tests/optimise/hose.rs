@@ -1,6 +1,7 @@
 //! The hose torsion `|J4 + J6| ≤ 120°` of the torch-carried cells (eq. 4.8;
 //! SPEC §7): a layer the optimiser holds on that bound must pass the
-//! trajectory stage's re-check of the same bound.
+//! trajectory stage's re-check of the same bound; what only the re-check
+//! finds (the positioner's speed) is named with its amount.
 
 use crate::common::load_part;
 use crate::support::cell;
@@ -77,4 +78,42 @@ fn a_layer_held_on_the_hose_bound_passes_the_trajectory_recheck() {
         .filter(|v| matches!(v.kind, ViolationKind::HoseTorsion { .. }))
         .collect();
     assert!(hose.is_empty(), "{:?}", hose.first());
+}
+
+/// The positioner's turn `q8` does not depend on `R_Z`: a layer of the torus
+/// on a cylinder in the KUKA torch-carried example cell asks it to turn
+/// faster than its 180°/s at the part's travel speed, which no `R_Z` law
+/// can fix. The optimiser does not model the positioner's speed; the
+/// trajectory re-check finds it, and the layer's binding constraint says so
+/// with the amount (rad over one step), not "over by 0°".
+#[test]
+fn a_positioner_speed_found_by_the_recheck_is_named_with_its_amount() {
+    let part = load_part("torus-on-cylinder.toml");
+    let path = slice(&part.tube, &part.substrate, &part.slice_options()).unwrap();
+    let axes = tool_axes(
+        &path,
+        Some(&part.tube),
+        Some(&part.substrate),
+        &part.tool_axis,
+    )
+    .unwrap();
+    let all = layer_points(&path, &axes.frames);
+    let layers = vec![all[0].clone()];
+    let cell = cell("kuka_kr16_2_torch_carried.toml");
+    let opts = OptimiseOptions {
+        travel_speed_mm_s: part.process.travel_speed_mm_s,
+        configuration: ConfigurationChoice::Cell,
+        ..OptimiseOptions::default()
+    };
+    let plan = optimise(&cell, &layers, &opts).unwrap();
+    let LayerStatus::Infeasible { binding } = &plan.layers[0].status else {
+        panic!("{}", plan.layers[0].status);
+    };
+    assert_eq!(
+        binding.constraint,
+        waam_slicer::optimise::Constraint::JointSpeed { joint: 8 },
+        "{binding}"
+    );
+    assert!(binding.violation > 1e-3, "{binding}");
+    assert!(!binding.to_string().contains("over by 0.0000"), "{binding}");
 }
