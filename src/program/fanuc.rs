@@ -5,7 +5,12 @@
 //!   which is the controller convention of [`RobotModel`](crate::robot::RobotModel))
 //!   or Cartesian `X Y Z W P R` (mm, deg, tool frame in the user frame) with
 //!   `CONFIG : 'F U T, t1, t4, t6'` derived from the chosen joints, so that
-//!   the controller reproduces our branch and turns.
+//!   the controller reproduces our branch and turns. A position whose J1,
+//!   J4 or J6 lies within [`TURN_EDGE_DEG`] of a turn-number edge (an odd
+//!   multiple of 180°) is written in joint representation even then: the
+//!   controller recomputes the joints from the rounded `W P R`, and on the
+//!   edge the turn number alone cannot say on which side (a full turn
+//!   apart) it should land.
 //! * Each bead: a joint move (`J P[n] 10% FINE`) to its first point with the
 //!   arc off, `Arc Start[s]` (or the user's start line), linear moves at the
 //!   travel speed blended with `CNT`, the last one `FINE` so that the arc
@@ -70,10 +75,25 @@ use crate::program::{
     ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::FanucPose;
-use crate::robot::{Cell, Vendor};
+use crate::robot::{Cell, Joints, Vendor};
 
 /// The emitter's name in [`ProgramError::VendorMismatch`].
 pub const EMITTER: &str = "FANUC TP";
+
+/// Distance (deg) from a turn-number edge (an odd multiple of 180°) of J1,
+/// J4 or J6 within which a Cartesian position is written in joint
+/// representation (module doc). Far above the joint error of re-solving a
+/// pose printed to 0.001 mm and 0.0001° (about 1e-4°).
+pub const TURN_EDGE_DEG: f64 = 0.01;
+
+/// `true` when J1, J4 or J6 of `q` (rad) is within [`TURN_EDGE_DEG`] of an
+/// odd multiple of 180°.
+pub fn near_turn_edge(q: &Joints) -> bool {
+    [0, 3, 5].iter().any(|&j| {
+        let r = (q[j].to_degrees() - 180.0).rem_euclid(360.0);
+        r.min(360.0 - r) < TURN_EDGE_DEG
+    })
+}
 
 /// The remark opening a program with time-based linear moves (≤ 32 characters).
 pub const TIME_BASED_REMARK: &str = "TIMED: TORCH SPEED OVER PART";
@@ -529,14 +549,14 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             let global = range.start + local;
             let prev = global.checked_sub(1).map(|g| &program.points[g]);
             let arm = match opts.positions {
-                PositionMode::Joint => ArmPosition::Joint(p.joints.map(f64::to_degrees)),
-                PositionMode::Cartesian => {
+                PositionMode::Cartesian if !near_turn_edge(&p.joints) => {
                     let pose = user_from_base * robot.flange_pose(&p.joints) * tool;
                     ArmPosition::Cartesian {
                         xyzwpr: FanucPose::from_isometry(&pose).to_xyzwpr_deg(),
                         config: robot.fanuc_config(&p.joints).to_string(),
                     }
                 }
+                _ => ArmPosition::Joint(p.joints.map(f64::to_degrees)),
             };
             positions.push(Position {
                 index,

@@ -288,3 +288,70 @@ fn no_program_for_an_infeasible_plan() {
     let e = build_program("9LIVES", &cell, &path, &tr, &TravelSpeed::Constant(6.0)).unwrap_err();
     assert!(e.to_string().contains("`name`"), "{e}");
 }
+
+/// A Cartesian position whose J6 sits on a turn-number edge (180°) is
+/// written in joint representation: from the rounded `W P R` the
+/// controller could land on either side, a full turn apart. The rest stay
+/// Cartesian, and the mixed file validates.
+#[test]
+fn a_cartesian_position_on_a_turn_edge_is_written_in_joints() {
+    use std::f64::consts::{PI, TAU};
+    let cell = part_carried();
+    let opts = FanucOptions {
+        positions: PositionMode::Cartesian,
+        ..Default::default()
+    };
+    // the fixture's law R_Z = c - v with c turning J6 of the first layer's
+    // fourth point onto the nearest odd multiple of 180° (J6 follows R_Z
+    // one for one, in one sense or the other)
+    let plan = |c: f64| {
+        let path = hemisphere(0..4, 24, move |v| c - v);
+        let tr = trajectory(&cell, &path);
+        let prog = build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(TS_MM_S))
+            .unwrap_or_else(|e| panic!("{e}"));
+        (prog, path)
+    };
+    let j6_at = |prog: &waam_slicer::program::Program| {
+        let p = prog
+            .points
+            .iter()
+            .find(|p| p.layer == 0 && p.point == 3 && p.arc.is_bead())
+            .unwrap();
+        p.joints
+    };
+    let j6 = j6_at(&plan(0.0).0)[5];
+    let edge = PI * (2.0 * ((j6 - PI) / TAU).round() + 1.0) + 1e-7;
+    // secant iterations on c: J6 - edge = 0
+    let f = |c: f64| j6_at(&plan(c).0)[5] - edge;
+    let (mut c0, mut c1) = (0.0, 0.01);
+    let (mut f0, mut f1) = (f(c0), f(c1));
+    for _ in 0..20 {
+        if f1.abs() < 1e-9 {
+            break;
+        }
+        let c2 = c1 - f1 * (c1 - c0) / (f1 - f0);
+        (c0, f0) = (c1, f1);
+        c1 = c2;
+        f1 = f(c1);
+    }
+    assert!(f1.abs() < 1e-9, "J6 off its edge by {f1} rad");
+    let (prog, path) = plan(c1);
+    assert!(waam_slicer::program::fanuc::near_turn_edge(&j6_at(&prog)));
+    let text = fanuc_files(&prog, &opts).unwrap()[0].text.clone();
+    let tp = parse_ls(&text, "HEMI.ls").unwrap();
+    let joint_records: Vec<usize> = tp
+        .positions
+        .iter()
+        .filter(|p| matches!(p.arm, waam_slicer::program::fanuc::ArmPosition::Joint(_)))
+        .map(|p| p.index)
+        .collect();
+    let k = prog
+        .points
+        .iter()
+        .position(|p| p.layer == 0 && p.point == 3 && p.arc.is_bead())
+        .unwrap();
+    assert_eq!(joint_records, vec![k + 1], "{text}");
+    let planned: Vec<_> = path.iter().map(|p| p.position_mm).collect();
+    let r = validate_fanuc(&[tp], &cell, &opts, Some(&planned));
+    assert!(r.is_ok(), "{r}");
+}
