@@ -51,7 +51,7 @@ use std::io::Write;
 use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
-use crate::program::fmt::{ascii_comment, Deg, Mm, Unitless};
+use crate::program::fmt::{ascii_comment, floor_to, Deg, Mm, Unitless};
 use crate::program::{
     check_name, check_vendor, positioner_moves, render, segment_length_mm, ArcFlag, EmittedFile,
     ProcessControl, Program, ProgramError,
@@ -356,13 +356,15 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         writeln!(
             w,
             "    MoveAbsJ j{k}, [{},500,5000,1000], fine, {tw};",
-            Mm(opts.approach_speed_mm_s)
+            Mm(floor_to(opts.approach_speed_mm_s, 4))
         )
     };
+    // v_tcp rounded down to its 4 written decimals: never faster than planned
+    let speeddata = |mm_s: f64| format!("[{},500,5000,1000]", Mm(floor_to(mm_s, 4)));
     for (i, p) in program.points.iter().enumerate() {
         let k = i + 1;
         let prev = i.checked_sub(1).map(|k| &program.points[k]);
-        let mut v = format!("[{},500,5000,1000]", Mm(p.speed_mm_s));
+        let mut v = speeddata(p.speed_mm_s);
         if positioner_moves(program, i) {
             // the part turns under the torch: time the move (s)
             let t = segment_length_mm(program, i) / p.speed_mm_s;
@@ -380,13 +382,13 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
                 // into the bead: from the approach point at its speed, else
                 // a joint move to the first point
                 let v = match prev {
-                    Some(a) if a.arc == ArcFlag::Approach => {
-                        format!("[{},500,5000,1000]", Mm(a.speed_mm_s))
-                    }
+                    Some(a) if a.arc == ArcFlag::Approach => speeddata(a.speed_mm_s),
                     _ => {
                         writeln!(w, "    ! bead {} (layer {})", p.layer, p.layer)?;
                         abs_j(w, k)?;
-                        v
+                        // MoveAbsJ has reached the point: the arc start is a
+                        // zero-length move, never timed
+                        speeddata(p.speed_mm_s)
                     }
                 };
                 match &opts.process {
@@ -429,6 +431,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
 /// [`ProgramError::VendorMismatch`] when the cell's robot is not an ABB arm.
 pub fn abb_files(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile>, ProgramError> {
     check_vendor(&program.cell, Vendor::Abb, EMITTER)?;
+    program.check_finite()?;
     opts.validate()?;
     check_name(&program.name)?;
     Ok(vec![EmittedFile {

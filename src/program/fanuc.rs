@@ -462,6 +462,7 @@ pub struct TpProgram {
 /// cell's robot is not a FANUC arm.
 pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgram>, ProgramError> {
     check_vendor(&program.cell, Vendor::Fanuc, EMITTER)?;
+    program.check_finite()?;
     opts.validate()?;
     check_name(&program.name)?;
     let robot = program.cell.robot();
@@ -477,19 +478,28 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
         ProcessControl::Arc { schedule } => (Op::ArcStart(*schedule), Op::ArcEnd(*schedule)),
         ProcessControl::Custom { start, end } => (Op::Other(start.clone()), Op::Other(end.clone())),
     };
-    // the speed of the linear move into point `i` at `v` mm/s
+    // the segment time of the linear move into point `i` at `v` mm/s,
+    // rounded up: never faster than planned (a joint at its maximum speed
+    // stays within it)
+    let timed = |i: usize, v: f64| {
+        let d = segment_length_mm(program, i);
+        Speed::Msec(((1000.0 * d / v - 1e-9).ceil() as u32).max(1))
+    };
+    // the speed of the linear move into point `i` at `v` mm/s: rounded down
+    // (never faster than planned); a speed below the unit's step is written
+    // as the segment time rather than raised to 1
     let linear_speed = |i: usize, v: f64| {
         if opts.segment_time_based(program, i) {
-            let d = segment_length_mm(program, i);
-            // rounded up: never faster than planned (a joint at its
-            // maximum speed stays within it)
-            Speed::Msec(((1000.0 * d / v - 1e-9).ceil() as u32).max(1))
+            return timed(i, v);
+        }
+        let (n, speed): (f64, fn(u32) -> Speed) = match opts.speed_unit {
+            SpeedUnit::MmPerSec => ((v + 1e-9).floor(), Speed::MmPerSec),
+            SpeedUnit::CmPerMin => ((v * 6.0 + 1e-9).floor(), Speed::CmPerMin),
+        };
+        if n >= 1.0 {
+            speed(n as u32)
         } else {
-            match opts.speed_unit {
-                // rounded down: never faster than planned
-                SpeedUnit::MmPerSec => Speed::MmPerSec(((v + 1e-9).floor() as u32).max(1)),
-                SpeedUnit::CmPerMin => Speed::CmPerMin(((v * 6.0 + 1e-9).floor() as u32).max(1)),
-            }
+            timed(i, v)
         }
     };
     let arcs: Vec<ArcFlag> = program.points.iter().map(|p| p.arc).collect();

@@ -103,6 +103,13 @@ pub fn as_printed_rad(v: f64) -> f64 {
     }
 }
 
+/// `v` rounded down to `decimals` decimals (a speed written this way is
+/// never faster than `v`; `1e-9` of slack keeps an exact value exact).
+pub fn floor_to(v: f64, decimals: i32) -> f64 {
+    let scale = 10f64.powi(decimals);
+    (v * scale + 1e-9).floor() / scale
+}
+
 /// Unitless components (direction cosines, quaternions): 7 decimals.
 #[derive(Debug, Clone, Copy)]
 pub struct Unitless(pub f64);

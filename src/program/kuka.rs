@@ -560,6 +560,7 @@ pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
 /// cell's robot is not a KUKA arm.
 pub fn kuka_files(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFile>, ProgramError> {
     check_vendor(&program.cell, Vendor::Kuka, EMITTER)?;
+    program.check_finite()?;
     opts.validate()?;
     check_name(&program.name)?;
     if program.name.len() > KRL_NAME_MAX {

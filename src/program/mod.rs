@@ -190,6 +190,45 @@ pub struct Program {
 }
 
 impl Program {
+    /// Checks that every number an emitter writes is finite (positions,
+    /// tool axes, `R_Z`, joints, positioner joints, speeds > 0): a
+    /// hand-built program must not put `NaN` or `inf` into a controller file.
+    ///
+    /// # Errors
+    /// [`ProgramError::Mismatch`] naming the first bad point and field.
+    pub fn check_finite(&self) -> Result<(), ProgramError> {
+        for (index, p) in self.points.iter().enumerate() {
+            let bad = |field: &str| ProgramError::Mismatch {
+                index,
+                reason: format!(
+                    "layer {}, point {}: `{field}` is not finite",
+                    p.layer, p.point
+                ),
+            };
+            if !p.position_mm.iter().all(|v| v.is_finite()) {
+                return Err(bad("position_mm"));
+            }
+            if !p.tool_axis.iter().all(|v| v.is_finite()) {
+                return Err(bad("tool_axis"));
+            }
+            if !p.r_z.is_finite() {
+                return Err(bad("r_z"));
+            }
+            if !p.joints.iter().all(|v| v.is_finite()) {
+                return Err(bad("joints"));
+            }
+            if p.positioner
+                .is_some_and(|q| !q.iter().all(|v| v.is_finite()))
+            {
+                return Err(bad("positioner"));
+            }
+            if !(p.speed_mm_s.is_finite() && p.speed_mm_s > 0.0) {
+                return Err(bad("speed_mm_s (must be finite and > 0)"));
+            }
+        }
+        Ok(())
+    }
+
     /// The bead points (approach and retract points left out), in order.
     pub fn bead_points(&self) -> impl Iterator<Item = &ProgramPoint> {
         self.points.iter().filter(|p| p.arc.is_bead())
@@ -388,6 +427,23 @@ pub fn build_program_with(
         if !first {
             let prev = &out[i - 1];
             let d = (p.position_mm - prev.position_mm).norm();
+            let turns = q.iter().zip(prev.joints).any(|(a, b)| (a - b).abs() > 1e-9)
+                || match (jp.positioner, prev.positioner) {
+                    (Some(a), Some(b)) => a.iter().zip(b).any(|(x, y)| (x - y).abs() > 1e-9),
+                    _ => false,
+                };
+            if d == 0.0 && turns {
+                return Err(ProgramError::Infeasible {
+                    count: 1,
+                    first: format!(
+                        "layer {}, point {}: same position as point {} while the joints turn: \
+                         a zero-length segment has no travel time at any speed",
+                        p.layer,
+                        p.point,
+                        points[i - 1].point
+                    ),
+                });
+            }
             if d > 0.0 {
                 let dt = d / speeds[i];
                 for (j, (qj, pj)) in q.iter().zip(prev.joints).enumerate() {

@@ -810,7 +810,12 @@ pub fn validate_kuka(
                 continue;
             }
             KrlOp::VelExtax { axis, percent } => {
-                vel_extax[(*axis - 1) as usize] = *percent;
+                if let Some(slot) = (*axis as usize)
+                    .checked_sub(1)
+                    .and_then(|i| vel_extax.get_mut(i))
+                {
+                    *slot = *percent;
+                }
                 continue;
             }
             KrlOp::VelPtp(p) => {

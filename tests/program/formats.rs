@@ -448,3 +448,43 @@ fn abb_corruptions_are_named_by_their_line() {
         "{r}"
     );
 }
+
+/// Without approach points a bead is reached by `MoveAbsJ` to its first
+/// point; the `ArcLStart` that follows is a zero-length move and carries
+/// no `\T` even where the positioner turned since the previous bead.
+#[test]
+fn abb_arc_start_after_moveabsj_is_not_timed() {
+    use waam_slicer::program::{build_program_with, ProgramOptions, TravelSpeed};
+    let c = cell("abb_irb2600_torch_carried.toml");
+    let path = crate::fixture::hemisphere(0..3, 24, crate::fixture::law(&c));
+    let tr = crate::fixture::trajectory(&c, &path);
+    let prog = build_program_with(
+        "HEMI",
+        &c,
+        &path,
+        &tr,
+        &TravelSpeed::Constant(crate::fixture::TS_MM_S),
+        &ProgramOptions {
+            clearance_mm: 0.0,
+            ..Default::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    // the positioner tilts between the layers
+    let e: Vec<f64> = prog
+        .points
+        .iter()
+        .filter(|p| p.arc == waam_slicer::program::ArcFlag::Start)
+        .map(|p| p.positioner.unwrap()[0])
+        .collect();
+    assert!((e[1] - e[0]).abs() > 1e-3, "{e:?}");
+    let text = &abb_files(&prog, &AbbOptions::default()).unwrap()[0].text;
+    let starts: Vec<&str> = text.lines().filter(|l| l.contains("ArcLStart")).collect();
+    assert_eq!(starts.len(), 3, "{text}");
+    for l in starts {
+        assert!(!l.contains("\\T"), "{l}");
+    }
+    let planned: Vec<Point3> = prog.bead_points().map(|p| p.position_mm).collect();
+    let r = abb_check(text, &c, &planned);
+    assert!(r.is_ok(), "{r}");
+}

@@ -355,3 +355,71 @@ fn a_cartesian_position_on_a_turn_edge_is_written_in_joints() {
     let r = validate_fanuc(&[tp], &cell, &opts, Some(&planned));
     assert!(r.is_ok(), "{r}");
 }
+
+/// Two consecutive points at the same place while the joints turn (here a
+/// repeated point with another `R_Z`): no travel speed times such a
+/// segment, and an emitter would have to write an infinite speed or a 1 ms
+/// move. `build_program` refuses it, naming the layer and point.
+#[test]
+fn a_zero_length_segment_that_turns_the_joints_is_refused() {
+    let cell = part_carried();
+    let mut path = hemisphere(0..2, 24, |v| -v);
+    path[5].position_mm = path[4].position_mm;
+    path[5].tool_axis = path[4].tool_axis;
+    path[5].build_direction = path[4].build_direction;
+    let tr = trajectory(&cell, &path);
+    match build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(TS_MM_S)) {
+        Err(ProgramError::Infeasible { first, .. }) => {
+            assert!(first.contains("layer 0, point 5"), "{first}");
+            assert!(first.contains("zero-length"), "{first}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A hand-built program with a NaN joint or a non-finite speed gets no
+/// file: every emitter refuses it, naming the point and the field.
+#[test]
+fn emitters_refuse_non_finite_values() {
+    let cell = part_carried();
+    let (mut prog, _) = program(&cell, 0..2, 24);
+    prog.points[7].joints[2] = f64::NAN;
+    match fanuc_files(&prog, &FanucOptions::default()) {
+        Err(ProgramError::Mismatch { index, reason }) => {
+            assert_eq!(index, 7);
+            assert!(reason.contains("`joints`"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let (mut prog, _) = program(&cell, 0..2, 24);
+    prog.points[3].speed_mm_s = f64::INFINITY;
+    let e = fanuc_files(&prog, &FanucOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("speed_mm_s"), "{e}");
+}
+
+/// A travel speed below the unit's step (0.1 mm/s < 1 cm/min) is written
+/// as the segment's time, not raised to `1cm/min` (never faster than
+/// planned).
+#[test]
+fn a_speed_below_the_units_step_is_written_as_a_time() {
+    let cell = cell("robowam_torch_carried.toml");
+    let path = hemisphere(0..1, 24, |_| 0.0);
+    let tr = trajectory(&cell, &path);
+    let prog = build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(0.1))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let opts = FanucOptions {
+        timing: MotionTiming::TcpSpeed,
+        ..Default::default()
+    };
+    let text = fanuc_files(&prog, &opts).unwrap()[0].text.clone();
+    let bead: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.contains("Arc Start"))
+        .take_while(|l| !l.contains("Arc End"))
+        .filter(|l| l.contains(":L P["))
+        .collect();
+    assert!(!bead.is_empty(), "{text}");
+    for l in bead {
+        assert!(l.contains("msec"), "{l}");
+    }
+}
