@@ -41,6 +41,12 @@ pub(crate) const HOSE_MARGIN_RAD: f64 = 1e-5;
 /// `|Δq| / Δt` against the speed itself.
 pub(crate) const SPEED_MARGIN_REL: f64 = 1e-6;
 
+/// How far inside the joint travels (rad) and the dexterity floors
+/// (relative) the SQP works, for the reason of [`HOSE_MARGIN_RAD`]: an
+/// active bound left a few 1e-8 outside by the last steps would make the
+/// layer's status, which tests the bounds themselves, call it infeasible.
+pub(crate) const BOUND_MARGIN: f64 = 1e-6;
+
 /// Finite-difference step on `R_Z` for the dexterity and uncertainty slopes (rad).
 const FD_STEP_RAD: f64 = 1e-6;
 
@@ -400,8 +406,9 @@ impl<'a> LayerProblem<'a> {
     /// at point m and at m−1)`. Gradients of the dexterity are computed only
     /// when `with_dex_slope` and the point is within a factor 1.5 of its floor.
     /// `solver`: the bounds the SQP works to (the hose bound
-    /// [`HOSE_MARGIN_RAD`] and the joint speeds [`SPEED_MARGIN_REL`]
-    /// tighter); otherwise the bounds themselves.
+    /// [`HOSE_MARGIN_RAD`], the joint speeds [`SPEED_MARGIN_REL`], the
+    /// travels and dexterity floors [`BOUND_MARGIN`] tighter); otherwise the
+    /// bounds themselves.
     pub fn constraints(
         &self,
         e: &Evaluation,
@@ -423,11 +430,12 @@ impl<'a> LayerProblem<'a> {
                     (self.lower[j], self.upper[j])
                 };
                 let c = Constraint::JointLimit { joint: j + 1 };
+                let margin = if solver { BOUND_MARGIN } else { 0.0 };
                 if hi.is_finite() {
-                    sink(m, c, q[j] - hi, g[j], 0.0);
+                    sink(m, c, q[j] - hi + margin, g[j], 0.0);
                 }
                 if lo.is_finite() {
-                    sink(m, c, lo - q[j], -g[j], 0.0);
+                    sink(m, c, lo - q[j] + margin, -g[j], 0.0);
                 }
             }
             if let Some(h) = hose {
@@ -443,10 +451,11 @@ impl<'a> LayerProblem<'a> {
                 } else {
                     0.0
                 };
+                let margin = if solver { BOUND_MARGIN } else { 0.0 };
                 sink(
                     m,
                     Constraint::Dexterity,
-                    (psi - e.dex[m]) / psi,
+                    (psi - e.dex[m]) / psi + margin,
                     -d / psi,
                     0.0,
                 );
