@@ -6,11 +6,47 @@
 use crate::common::load_part;
 use crate::support::cell;
 use waam_slicer::optimise::{
-    layer_points, optimise, trajectory_inputs, ConfigurationChoice, LayerStatus, OptimiseOptions,
+    layer_points, optimise, trajectory_inputs, ConfigurationChoice, LayerPoints, LayerStatus,
+    OptimiseOptions,
 };
 use waam_slicer::path::slice;
 use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions, ViolationKind};
+use waam_slicer::robot::Cell;
 use waam_slicer::toolaxis::tool_axes;
+
+/// Layer `layer` of `part` (its own settings, `delta_mm` if given) with its
+/// tool axes, and the options `plan` uses in the KUKA torch-carried cell
+/// (the part's travel speed, the cell's branch).
+fn kuka_torch_layer(
+    part: &str,
+    delta_mm: Option<f64>,
+    layer: usize,
+) -> (Vec<LayerPoints>, Cell, OptimiseOptions) {
+    let part = load_part(part);
+    let mut so = part.slice_options();
+    if let Some(d) = delta_mm {
+        so.delta_mm = d;
+    }
+    let path = slice(&part.tube, &part.substrate, &so).unwrap();
+    let axes = tool_axes(
+        &path,
+        Some(&part.tube),
+        Some(&part.substrate),
+        &part.tool_axis,
+    )
+    .unwrap();
+    let all = layer_points(&path, &axes.frames);
+    let opts = OptimiseOptions {
+        travel_speed_mm_s: part.process.travel_speed_mm_s,
+        configuration: ConfigurationChoice::Cell,
+        ..OptimiseOptions::default()
+    };
+    (
+        vec![all[layer].clone()],
+        cell("kuka_kr16_2_torch_carried.toml"),
+        opts,
+    )
+}
 
 /// The nozzle at Delta = 1 mm, its own tool-axis and process settings, in
 /// the KUKA KR16-2 torch-carried cell with the cell's branch (as `plan`
@@ -23,29 +59,11 @@ use waam_slicer::toolaxis::tool_axes;
 /// hose violation.
 #[test]
 fn a_layer_held_on_the_hose_bound_passes_the_trajectory_recheck() {
-    let part = load_part("nozzle.toml");
-    let mut so = part.slice_options();
-    so.delta_mm = 1.0;
-    let path = slice(&part.tube, &part.substrate, &so).unwrap();
-    let axes = tool_axes(
-        &path,
-        Some(&part.tube),
-        Some(&part.substrate),
-        &part.tool_axis,
-    )
-    .unwrap();
-    let all = layer_points(&path, &axes.frames);
-    let layers = vec![all[99].clone()];
-    let cell = cell("kuka_kr16_2_torch_carried.toml");
-    let opts = OptimiseOptions {
-        travel_speed_mm_s: part.process.travel_speed_mm_s,
-        configuration: ConfigurationChoice::Cell,
-        ..OptimiseOptions::default()
-    };
+    let (layers, cell, opts) = kuka_torch_layer("nozzle.toml", Some(1.0), 99);
     let plan = optimise(&cell, &layers, &opts).unwrap();
     let l = &plan.layers[0];
     let max = match &cell {
-        waam_slicer::robot::Cell::TorchCarried(c) => c.max_hose_torsion_rad,
+        Cell::TorchCarried(c) => c.max_hose_torsion_rad,
         _ => unreachable!(),
     };
     // the bound is active on this layer
@@ -88,23 +106,7 @@ fn a_layer_held_on_the_hose_bound_passes_the_trajectory_recheck() {
 /// with the amount (rad over one step), not "over by 0°".
 #[test]
 fn a_positioner_speed_found_by_the_recheck_is_named_with_its_amount() {
-    let part = load_part("torus-on-cylinder.toml");
-    let path = slice(&part.tube, &part.substrate, &part.slice_options()).unwrap();
-    let axes = tool_axes(
-        &path,
-        Some(&part.tube),
-        Some(&part.substrate),
-        &part.tool_axis,
-    )
-    .unwrap();
-    let all = layer_points(&path, &axes.frames);
-    let layers = vec![all[0].clone()];
-    let cell = cell("kuka_kr16_2_torch_carried.toml");
-    let opts = OptimiseOptions {
-        travel_speed_mm_s: part.process.travel_speed_mm_s,
-        configuration: ConfigurationChoice::Cell,
-        ..OptimiseOptions::default()
-    };
+    let (layers, cell, opts) = kuka_torch_layer("torus-on-cylinder.toml", None, 0);
     let plan = optimise(&cell, &layers, &opts).unwrap();
     let LayerStatus::Infeasible { binding } = &plan.layers[0].status else {
         panic!("{}", plan.layers[0].status);
