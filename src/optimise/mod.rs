@@ -507,11 +507,7 @@ impl<'a> LayerSetup<'a> {
                     let (viol, est, cen, prev) = a;
                     for j in 0..6 {
                         let (lo, hi) = if j == 4 {
-                            if q[4] >= 0.0 {
-                                (prob.lower[4].max(prob.wrist_margin), prob.upper[4])
-                            } else {
-                                (prob.lower[4], prob.upper[4].min(-prob.wrist_margin))
-                            }
+                            prob.j5_bounds(q[4])
                         } else {
                             (prob.lower[j], prob.upper[j])
                         };

@@ -28,24 +28,14 @@ pub(crate) const ARCMATE_SIGMA_DEG: [f64; 6] =
 /// [`LayerProblem::constraints`] computes slopes below 1.5 floors).
 const DEX_BOUND_FACTOR: f64 = 1.5;
 
-/// How far inside the cell's hose-torsion bound the SQP holds `|J4 + J6|`
-/// (rad). Its last steps stop below the step tolerance (1e-7 rad of `R_Z`),
-/// which can leave an active bound a few 1e-8 rad outside; the layer's
-/// status and the trajectory re-check test the bound itself, so aiming this
-/// hair inside it makes an optimiser-feasible layer pass the re-check.
-pub(crate) const HOSE_MARGIN_RAD: f64 = 1e-5;
-
-/// The joint-speed bounds the SQP works to are this fraction tighter than
-/// the robot's (relative): as for the hose, its last steps can leave an
-/// active bound a hair outside, and the trajectory re-check tests
-/// `|Δq| / Δt` against the speed itself.
-pub(crate) const SPEED_MARGIN_REL: f64 = 1e-6;
-
-/// How far inside the joint travels (rad) and the dexterity floors
-/// (relative) the SQP works, for the reason of [`HOSE_MARGIN_RAD`]: an
-/// active bound left a few 1e-8 outside by the last steps would make the
-/// layer's status, which tests the bounds themselves, call it infeasible.
-pub(crate) const BOUND_MARGIN: f64 = 1e-6;
+/// How far inside every bound the SQP works (rad for joint travels, hose
+/// torsion and a step's joint motion; relative for the dexterity floors).
+/// Its last steps stop below the step tolerance (1e-7 rad of `R_Z`), which
+/// can leave an active bound a few 1e-8 outside (the KUKA torch-carried
+/// nozzle's top layer: hose torsion 1.8e-8 rad over); the layer's status
+/// and the trajectory re-check test the bounds themselves, so aiming this
+/// hair inside them makes an optimiser-feasible layer pass the re-check.
+pub(crate) const SOLVER_MARGIN: f64 = 1e-6;
 
 /// Finite-difference step on `R_Z` for the dexterity and uncertainty slopes (rad).
 const FD_STEP_RAD: f64 = 1e-6;
@@ -393,7 +383,7 @@ impl<'a> LayerProblem<'a> {
     }
 
     /// Wrist bounds of J5 on the current side (rad): `[lo, hi]`.
-    fn j5_bounds(&self, q5: f64) -> (f64, f64) {
+    pub(crate) fn j5_bounds(&self, q5: f64) -> (f64, f64) {
         if q5 >= 0.0 {
             (self.lower[4].max(self.wrist_margin), self.upper[4])
         } else {
@@ -405,10 +395,8 @@ impl<'a> LayerProblem<'a> {
     /// dexterity), calling `sink(point, constraint, value, gradient along R_Z
     /// at point m and at m−1)`. Gradients of the dexterity are computed only
     /// when `with_dex_slope` and the point is within a factor 1.5 of its floor.
-    /// `solver`: the bounds the SQP works to (the hose bound
-    /// [`HOSE_MARGIN_RAD`], the joint speeds [`SPEED_MARGIN_REL`], the
-    /// travels and dexterity floors [`BOUND_MARGIN`] tighter); otherwise the
-    /// bounds themselves.
+    /// `solver`: the bounds the SQP works to, every one [`SOLVER_MARGIN`]
+    /// tighter; otherwise the bounds themselves.
     pub fn constraints(
         &self,
         e: &Evaluation,
@@ -416,10 +404,9 @@ impl<'a> LayerProblem<'a> {
         solver: bool,
         sink: &mut impl FnMut(usize, Constraint, f64, f64, f64),
     ) {
+        let margin = if solver { SOLVER_MARGIN } else { 0.0 };
+        let mut sink = |m, c, v: f64, d, dp| sink(m, c, v + margin, d, dp);
         let p = e.q.len();
-        let hose = self
-            .hose
-            .map(|h| if solver { h - HOSE_MARGIN_RAD } else { h });
         for m in 0..p {
             let q = &e.q[m];
             let g = &e.g[m];
@@ -430,15 +417,14 @@ impl<'a> LayerProblem<'a> {
                     (self.lower[j], self.upper[j])
                 };
                 let c = Constraint::JointLimit { joint: j + 1 };
-                let margin = if solver { BOUND_MARGIN } else { 0.0 };
                 if hi.is_finite() {
-                    sink(m, c, q[j] - hi + margin, g[j], 0.0);
+                    sink(m, c, q[j] - hi, g[j], 0.0);
                 }
                 if lo.is_finite() {
-                    sink(m, c, lo - q[j] + margin, -g[j], 0.0);
+                    sink(m, c, lo - q[j], -g[j], 0.0);
                 }
             }
-            if let Some(h) = hose {
+            if let Some(h) = self.hose {
                 let t = q[3] + q[5];
                 let d = g[3] + g[5];
                 sink(m, Constraint::HoseTorsion, t - h, d, 0.0);
@@ -451,11 +437,10 @@ impl<'a> LayerProblem<'a> {
                 } else {
                     0.0
                 };
-                let margin = if solver { BOUND_MARGIN } else { 0.0 };
                 sink(
                     m,
                     Constraint::Dexterity,
-                    (psi - e.dex[m]) / psi + margin,
+                    (psi - e.dex[m]) / psi,
                     -d / psi,
                     0.0,
                 );
@@ -464,10 +449,7 @@ impl<'a> LayerProblem<'a> {
                 let qp = &e.q[m - 1];
                 let gp = &e.g[m - 1];
                 for j in 0..6 {
-                    let mut lim = self.max_speed[j] * self.dt[m];
-                    if solver {
-                        lim *= 1.0 - SPEED_MARGIN_REL;
-                    }
+                    let lim = self.max_speed[j] * self.dt[m];
                     let c = Constraint::JointSpeed { joint: j + 1 };
                     let dq = q[j] - qp[j];
                     sink(m, c, dq - lim, g[j], -gp[j]);
