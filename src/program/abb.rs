@@ -51,7 +51,7 @@ use std::io::Write;
 use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
-use crate::program::fmt::{ascii_comment, floor_to, Deg, Mm, Unitless};
+use crate::program::fmt::{ascii_comment, ceil_to, floor_to, Deg, Mm, Unitless};
 use crate::program::{
     check_name, check_vendor, positioner_moves, render, segment_length_mm, ArcFlag, EmittedFile,
     ProcessControl, Program, ProgramError,
@@ -369,7 +369,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             // the part turns under the torch: time the move (s)
             let t = segment_length_mm(program, i) / p.speed_mm_s;
             // rounded up to the ms: never faster than planned
-            let t = ((t * 1000.0 - 1e-9).ceil() / 1000.0).max(0.001);
+            let t = ceil_to(t, 3).max(0.001);
             v += &format!("\\T:={}", crate::program::fmt::Fixed::new(t, 3));
         }
         match (&opts.process, p.arc) {

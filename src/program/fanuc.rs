@@ -68,7 +68,7 @@ use std::io::Write;
 use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
-use crate::program::fmt::{ascii_comment, FanucDeg, FanucMm};
+use crate::program::fmt::{ascii_comment, ceil_to, floor_to, FanucDeg, FanucMm};
 use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
 use crate::program::{
     check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
@@ -482,8 +482,8 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
     // rounded up: never faster than planned (a joint at its maximum speed
     // stays within it)
     let timed = |i: usize, v: f64| {
-        let d = segment_length_mm(program, i);
-        Speed::Msec(((1000.0 * d / v - 1e-9).ceil() as u32).max(1))
+        let ms = 1000.0 * segment_length_mm(program, i) / v;
+        Speed::Msec((ceil_to(ms, 0) as u32).max(1))
     };
     // the speed of the linear move into point `i` at `v` mm/s: rounded down
     // (never faster than planned); a speed below the unit's step is written
@@ -493,8 +493,8 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             return timed(i, v);
         }
         let (n, speed): (f64, fn(u32) -> Speed) = match opts.speed_unit {
-            SpeedUnit::MmPerSec => ((v + 1e-9).floor(), Speed::MmPerSec),
-            SpeedUnit::CmPerMin => ((v * 6.0 + 1e-9).floor(), Speed::CmPerMin),
+            SpeedUnit::MmPerSec => (floor_to(v, 0), Speed::MmPerSec),
+            SpeedUnit::CmPerMin => (floor_to(v * 6.0, 0), Speed::CmPerMin),
         };
         if n >= 1.0 {
             speed(n as u32)

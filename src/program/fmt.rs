@@ -110,6 +110,13 @@ pub fn floor_to(v: f64, decimals: i32) -> f64 {
     (v * scale + 1e-9).floor() / scale
 }
 
+/// `v` rounded up to `decimals` decimals (a segment time written this way
+/// is never shorter than `v`; `1e-9` of slack keeps an exact value exact).
+pub fn ceil_to(v: f64, decimals: i32) -> f64 {
+    let scale = 10f64.powi(decimals);
+    (v * scale - 1e-9).ceil() / scale
+}
+
 /// Unitless components (direction cosines, quaternions): 7 decimals.
 #[derive(Debug, Clone, Copy)]
 pub struct Unitless(pub f64);

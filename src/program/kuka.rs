@@ -67,7 +67,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
 use crate::program::fanuc::PositionMode;
-use crate::program::fmt::{ascii_comment, Deg, Fixed, Mm};
+use crate::program::fmt::{ascii_comment, floor_to, Deg, Fixed, Mm};
 use crate::program::{
     check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
     ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
@@ -311,11 +311,6 @@ pub(crate) fn switch_statements(opts: &KukaOptions) -> (String, String) {
     }
 }
 
-/// `x` rounded down to 4 decimals (at least 0.0001).
-fn floor4(x: f64) -> f64 {
-    ((x * 1e4 + 1e-6).floor() / 1e4).max(1e-4)
-}
-
 /// The speeds of a timed `LIN` (module doc, "Torch-carried cell,
 /// positioner turning").
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -418,7 +413,7 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     let mut set_vel = |w: &mut dyn Write, mm_s: f64| -> std::io::Result<()> {
         // m/s, rounded down to the written 6 decimals: never faster than
         // planned
-        let v = ((mm_s * 1000.0 + 1e-6).floor() / 1e6).max(1e-6);
+        let v = floor_to(mm_s / 1000.0, 6).max(1e-6);
         if vel != Some(v) {
             writeln!(w, "  $VEL.CP = {}", crate::program::fmt::Fixed::new(v, 6))?;
             vel = Some(v);
@@ -459,7 +454,7 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                                     w,
                                     "  $VEL_EXTAX[{}] = {}",
                                     n + 1,
-                                    Fixed::new(floor4(*pct), 4)
+                                    Fixed::new(floor_to(*pct, 4).max(1e-4), 4)
                                 )?;
                                 extax[n] = Some(*pct);
                             }

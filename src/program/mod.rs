@@ -427,9 +427,9 @@ pub fn build_program_with(
         if !first {
             let prev = &out[i - 1];
             let d = (p.position_mm - prev.position_mm).norm();
-            let turns = q.iter().zip(prev.joints).any(|(a, b)| (a - b).abs() > 1e-9)
+            let turns = joints_move(&q, &prev.joints)
                 || match (jp.positioner, prev.positioner) {
-                    (Some(a), Some(b)) => a.iter().zip(b).any(|(x, y)| (x - y).abs() > 1e-9),
+                    (Some(a), Some(b)) => joints_move(&a, &b),
                     _ => false,
                 };
             if d == 0.0 && turns {
@@ -617,11 +617,35 @@ fn clearance_point(
 /// `J`, KUKA `PTP`, ABB `MoveAbsJ`): an approach point, or a bead's first
 /// point without one; every other point is reached by a linear move.
 pub fn joint_move_target(program: &Program, i: usize) -> bool {
-    match program.points[i].arc {
+    opens_bead(
+        i.checked_sub(1).map(|k| program.points[k].arc),
+        program.points[i].arc,
+    )
+}
+
+/// `true` when a point with flag `arc`, after one with flag `prev` (`None`
+/// for the first point), opens a bead's block of points: an approach point,
+/// or a bead's first point without one. Such a point is reached by a joint
+/// move ([`joint_move_target`]) and a program is split only before one
+/// ([`split::beads`]).
+pub fn opens_bead(prev: Option<ArcFlag>, arc: ArcFlag) -> bool {
+    match arc {
         ArcFlag::Approach => true,
-        ArcFlag::Start => i == 0 || program.points[i - 1].arc != ArcFlag::Approach,
+        ArcFlag::Start => prev != Some(ArcFlag::Approach),
         _ => false,
     }
+}
+
+/// Smallest joint change (rad) counted as motion between two consecutive
+/// points.
+pub const JOINT_STILL_RAD: f64 = 1e-9;
+
+/// `true` when any of `a` differs from `b` by more than [`JOINT_STILL_RAD`]
+/// (joints or positioner joints, rad).
+pub fn joints_move(a: &[f64], b: &[f64]) -> bool {
+    a.iter()
+        .zip(b)
+        .any(|(x, y)| (x - y).abs() > JOINT_STILL_RAD)
 }
 
 /// Largest positioner motion over a segment still counted as a positioner

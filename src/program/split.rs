@@ -16,7 +16,7 @@
 
 use std::ops::Range;
 
-use crate::program::ArcFlag;
+use crate::program::{opens_bead, ArcFlag};
 
 /// Default point limit of one program (FANUC R-30iB Plus).
 pub const DEFAULT_POINT_LIMIT: usize = 15_000;
@@ -35,11 +35,7 @@ pub struct BeadTooLong {
 /// approach point (or a bead start without one) to just before the next.
 pub fn beads(arcs: &[ArcFlag]) -> Vec<Range<usize>> {
     let mut starts: Vec<usize> = (0..arcs.len())
-        .filter(|&i| match arcs[i] {
-            ArcFlag::Approach => true,
-            ArcFlag::Start => i == 0 || arcs[i - 1] != ArcFlag::Approach,
-            _ => false,
-        })
+        .filter(|&i| opens_bead(i.checked_sub(1).map(|k| arcs[k]), arcs[i]))
         .collect();
     if starts.first() != Some(&0) {
         starts.insert(0, 0);

@@ -374,8 +374,7 @@ pub fn check_steps(
                             }
                         }
                     }
-                    let turns = q.iter().zip(pq).any(|(a, b)| (a - b).abs() > 1e-9);
-                    if t == 0.0 && turns {
+                    if t == 0.0 && crate::program::joints_move(&q, pq) {
                         // the controller then runs the move at its
                         // orientation speed, not at any planned speed
                         msgs.push(format!(
