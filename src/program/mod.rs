@@ -427,12 +427,14 @@ pub fn build_program_with(
         if !first {
             let prev = &out[i - 1];
             let d = (p.position_mm - prev.position_mm).norm();
-            let turns = joints_move(&q, &prev.joints)
-                || match (jp.positioner, prev.positioner) {
-                    (Some(a), Some(b)) => joints_move(&a, &b),
-                    _ => false,
-                };
-            if d == 0.0 && turns {
+            let turns = || {
+                joints_move(&q, &prev.joints)
+                    || match (jp.positioner, prev.positioner) {
+                        (Some(a), Some(b)) => joints_move(&a, &b),
+                        _ => false,
+                    }
+            };
+            if d == 0.0 && turns() {
                 return Err(ProgramError::Infeasible {
                     count: 1,
                     first: format!(

@@ -110,31 +110,35 @@ fn emitters_and_validators_refuse_another_vendors_robot() {
             "{msg}"
         );
     };
-    mismatch(
-        kuka_files(&fanuc_prog, &KukaOptions::default()).unwrap_err(),
-        "KUKA KRL",
-        "FANUC",
-    );
-    mismatch(
-        abb_files(&fanuc_prog, &AbbOptions::default()).unwrap_err(),
-        "ABB RAPID",
-        "FANUC",
-    );
-    mismatch(
-        fanuc_files(&kuka_prog, &FanucOptions::default()).unwrap_err(),
-        "FANUC TP",
-        "KUKA",
-    );
-    mismatch(
-        abb_files(&kuka_prog, &AbbOptions::default()).unwrap_err(),
-        "ABB RAPID",
-        "KUKA",
-    );
-    mismatch(
-        kuka_files(&abb_prog, &KukaOptions::default()).unwrap_err(),
-        "KUKA KRL",
-        "ABB",
-    );
+    for (result, emitter, robot_vendor) in [
+        (
+            kuka_files(&fanuc_prog, &KukaOptions::default()),
+            "KUKA KRL",
+            "FANUC",
+        ),
+        (
+            abb_files(&fanuc_prog, &AbbOptions::default()),
+            "ABB RAPID",
+            "FANUC",
+        ),
+        (
+            fanuc_files(&kuka_prog, &FanucOptions::default()),
+            "FANUC TP",
+            "KUKA",
+        ),
+        (
+            abb_files(&kuka_prog, &AbbOptions::default()),
+            "ABB RAPID",
+            "KUKA",
+        ),
+        (
+            kuka_files(&abb_prog, &KukaOptions::default()),
+            "KUKA KRL",
+            "ABB",
+        ),
+    ] {
+        mismatch(result.unwrap_err(), emitter, robot_vendor);
+    }
     // the writers themselves refuse too
     let mut sink = Vec::new();
     assert!(
