@@ -3,8 +3,11 @@
 
 use crate::geometry::GeometryError;
 use crate::io::cell_file::CellFileError;
+use crate::io::joints_csv::JointsCsvError;
 use crate::io::part_file::PartFileError;
+use crate::io::path_csv::PathCsvError;
 use crate::optimise::OptimiseError;
+use crate::path::PathError;
 use crate::process::ProcessError;
 use crate::program::ProgramError;
 use crate::robot::RobotError;
@@ -38,4 +41,28 @@ pub enum Error {
     /// Writing, reading back or checking a robot program failed.
     #[error(transparent)]
     Program(#[from] ProgramError),
+    /// Slicing failed (bad option, no root, too many points).
+    #[error(transparent)]
+    Path(#[from] PathError),
+    /// A path CSV could not be read.
+    #[error(transparent)]
+    PathCsv(#[from] PathCsvError),
+    /// A joints CSV could not be read.
+    #[error(transparent)]
+    JointsCsv(#[from] JointsCsvError),
+    /// A stage failed on a part read from a file: the file, then the stage's
+    /// error (which names the field, layer or point).
+    #[error("{file}: {source}")]
+    InPart {
+        /// The part file.
+        file: String,
+        /// The stage's error.
+        source: Box<Error>,
+    },
+    /// The host program asked to stop (see [`Control`](crate::pipeline::Control)).
+    #[error("cancelled during {stage}")]
+    Cancelled {
+        /// The stage running when the request was seen.
+        stage: &'static str,
+    },
 }

@@ -42,9 +42,28 @@
 //! * Scalars are concrete `f64`; vector types are the aliases of [`math`], and
 //!   [`nalgebra`] is re-exported so that users get the same version.
 //!
+//! ## The front door
+//!
+//! Most callers need only the crate root ([`pipeline`]): [`Part::read`],
+//! [`Cell::read`], [`slice_part`], [`plan_part`] →
+//! [`PlannedPart::write_programs`], [`check_program`].
+//!
+//! ```no_run
+//! use waam_slicer::{Cell, Part, PlanOptions, ProgramFormat};
+//! # fn main() -> Result<(), waam_slicer::Error> {
+//! let part = Part::read("parts/hemisphere.toml")?;
+//! let cell = Cell::read("parts/cells/robowam_part_carried.toml")?;
+//! let planned = waam_slicer::plan_part(&part, &cell, &PlanOptions::default())?;
+//! if planned.is_feasible() {
+//!     planned.write_programs("out/hemisphere", ProgramFormat::Fanuc)?;
+//! }
+//! # Ok(()) }
+//! ```
+//!
 //! ## Examples
 //!
 //! * `examples/waam` — the command-line tool (`cargo run --release --example waam -- --help`).
+//! * `examples/embed.rs` — a host program planning a part through the front door.
 #![warn(missing_docs, missing_debug_implementations)]
 #![forbid(unsafe_code)]
 // `!(x > 0.0)` is how we reject NaN together with the bad range; keep it readable.
@@ -58,9 +77,19 @@ pub mod io;
 pub mod math;
 pub mod optimise;
 pub mod path;
+pub mod pipeline;
 pub mod process;
 pub mod program;
 pub mod robot;
 pub mod toolaxis;
 
 pub use error::Error;
+
+// The README's "Use as a library" block runs as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+pub use pipeline::{
+    check_program, plan_part, slice_part, slice_part_with, Cell, Control, Part, PlanOptions,
+    PlannedPart, ProgramFormat, RzLaw, SliceOverrides, SlicedPart,
+};

@@ -100,16 +100,15 @@ pub struct GridArgs {
 }
 
 impl GridArgs {
-    /// Applies the overrides given to `opts`.
-    pub fn apply(&self, opts: &mut waam_slicer::path::SliceOptions) {
-        if let Some(d) = self.delta {
-            opts.delta_mm = d;
-        }
+    /// Applies the overrides given to `o`.
+    pub fn apply(&self, o: &mut waam_slicer::SliceOverrides) {
+        use waam_slicer::path::Discretisation;
+        o.delta_mm = self.delta.or(o.delta_mm);
         if let Some(n) = self.points {
-            opts.discretisation = waam_slicer::path::Discretisation::Points(n);
+            o.discretisation = Some(Discretisation::Points(n));
         }
         if let Some(e) = self.chord {
-            opts.discretisation = waam_slicer::path::Discretisation::ChordError(e);
+            o.discretisation = Some(Discretisation::ChordError(e));
         }
     }
 }
@@ -139,6 +138,21 @@ pub struct AxisArgs {
     /// Travel speed (mm/s): the programmed torch speed over the part.
     #[arg(long, value_name = "MM_S")]
     pub travel_speed: Option<f64>,
+}
+
+impl AxisArgs {
+    /// Applies the tool-axis and process overrides given to `o`.
+    pub fn apply(&self, o: &mut waam_slicer::SliceOverrides) {
+        o.tool_axis = waam_slicer::pipeline::AxisOverrides {
+            plain: self.plain_axes,
+            lead_rad: self.lead.map(f64::to_radians),
+            tilt_rad: self.tilt.map(f64::to_radians),
+            max_lean_rad: self.max_lean.map(f64::to_radians),
+            max_axis_rate_rad_per_mm: self.max_axis_rate.map(f64::to_radians),
+        };
+        o.process = self.process.map(|p| p.parameters());
+        o.travel_speed_mm_s = self.travel_speed;
+    }
 }
 
 /// Arguments of `waam slice`.

@@ -12,7 +12,6 @@ mod plan;
 mod plots;
 mod progress;
 mod slice;
-mod stages;
 
 use args::{Args, Command};
 use clap::Parser;

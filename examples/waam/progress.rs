@@ -23,6 +23,19 @@ impl Stage {
     }
 }
 
+impl Stage {
+    /// A library [`Control`](waam_slicer::Control) whose progress reports
+    /// show the stage's name and percentage on this spinner.
+    pub fn control(&self) -> waam_slicer::Control {
+        let pb = self.0.clone();
+        waam_slicer::Control::default().with_progress(move |stage, fraction| {
+            if let Some(pb) = &pb {
+                pb.set_message(format!("{stage} ({:.0} %)", 100.0 * fraction));
+            }
+        })
+    }
+}
+
 impl Drop for Stage {
     fn drop(&mut self) {
         if let Some(pb) = &self.0 {

@@ -1,78 +1,57 @@
-//! `waam slice`: part file → path.csv + summary.json.
+//! `waam slice`: part file → the library's `slice_part_with` → path.csv,
+//! wall.stl, path.svg, distance.svg and summary.json.
 
 use crate::args::{SliceArgs, StrategyArg};
-use serde_json::json;
 use std::path::{Path as FsPath, PathBuf};
 use std::time::Instant;
 use waam_slicer::io::atomic::write_atomic;
-use waam_slicer::io::part_file::read_part_file;
-use waam_slicer::io::path_csv::write_path_csv;
 use waam_slicer::path::smooth::Smoothing;
-use waam_slicer::path::{distance_map, slice, Strategy};
+use waam_slicer::path::Strategy;
+use waam_slicer::{slice_part_with, Part, SliceOverrides};
 
 pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     let part_file = args.part.as_path();
-    let strategy = args.strategy;
-    let (out, more) = (args.out.as_deref(), &args.more);
+    let more = &args.more;
     let t0 = Instant::now();
-    let part = read_part_file(part_file).map_err(|e| e.to_string())?;
+    let part = Part::read(part_file).map_err(|e| e.to_string())?;
     let t_read = t0.elapsed().as_secs_f64();
-    let mut opts = part.slice_options();
-    if let Some(s) = strategy {
-        opts.strategy = match s {
+    let mut o = SliceOverrides {
+        strategy: args.strategy.map(|s| match s {
             StrategyArg::Constant => Strategy::Constant,
             StrategyArg::Iso => Strategy::Iso,
             StrategyArg::Perpendicular => Strategy::Perpendicular,
             StrategyArg::Planar => Strategy::Planar,
             StrategyArg::Spiral => Strategy::Spiral,
-        };
-    }
-    args.grid.apply(&mut opts);
-    if let Some(deg) = more.smooth {
-        opts.smoothing = Some(Smoothing {
+        }),
+        smoothing: more.smooth.map(|deg| Smoothing {
             max_turn_rad: deg.to_radians(),
             tolerance: more.smooth_tol,
-        });
-    }
-    if let Some(deg) = more.stagger {
-        opts.stagger_rad = deg.to_radians();
-        opts.align_seams = false;
-    }
-    if let Some(deg) = more.spiral_start {
-        opts.spiral_start_rad = deg.to_radians();
-    }
-    opts.spiral_reverse = more.reverse;
-    opts.max_layers = more.max_layers.or(opts.max_layers);
-    let t1 = Instant::now();
+        }),
+        stagger_rad: more.stagger.map(f64::to_radians),
+        spiral_start_rad: more.spiral_start.map(f64::to_radians),
+        spiral_reverse: more.reverse,
+        max_layers: more.max_layers,
+        ..SliceOverrides::default()
+    };
+    args.grid.apply(&mut o);
+    args.axes.apply(&mut o);
     let spinner = crate::progress::Stage::start(quiet, "slicing");
-    let path = slice(&part.tube, &part.substrate, &opts)
-        .map_err(|e| format!("{}: {e}", part_file.display()))?;
+    let sliced = slice_part_with(&part, &o, &spinner.control()).map_err(|e| e.to_string())?;
     drop(spinner);
-    let t_slice = t1.elapsed().as_secs_f64();
-    let t2 = Instant::now();
-    let map = distance_map(&path);
-    let t_map = t2.elapsed().as_secs_f64();
-    let t3 = Instant::now();
-    let axes = crate::stages::axes_of(&part, &path, &args.axes, part_file)?;
-    let frames = &axes.frames;
-    let t_axes = t3.elapsed().as_secs_f64();
+    let (path, map) = (&sliced.path, &sliced.map);
 
-    let dir: PathBuf = out
-        .map(FsPath::to_path_buf)
+    let dir: PathBuf = args
+        .out
+        .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&part.name));
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let csv = dir.join("path.csv");
-    write_atomic(&csv, |w| write_path_csv(w, &path.layers, frames))
+    write_atomic(&csv, |w| sliced.write_path_csv(w))
         .map_err(|e| format!("{}: {e}", csv.display()))?;
-    let params = crate::stages::process_parameters(&part, &args.axes)?;
-    let shared = crate::stages::path_summary(&path, &map, &params, &axes)?;
     let stl = dir.join("wall.stl");
     let width = more.bead_width.unwrap_or(path.delta_mm);
-    let triangles = waam_slicer::io::wall_stl::wall_triangles(&path, frames, width);
-    write_atomic(&stl, |w| {
-        waam_slicer::io::wall_stl::write_stl(w, &triangles)
-    })
-    .map_err(|e| format!("{}: {e}", stl.display()))?;
+    write_atomic(&stl, |w| sliced.write_wall_stl(w, width))
+        .map_err(|e| format!("{}: {e}", stl.display()))?;
     // Pictures: written to temporary names, then renamed (no half-written file).
     let t4 = Instant::now();
     for (name, draw) in [
@@ -80,7 +59,7 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             "path.svg",
             Box::new(|f: &FsPath| {
                 crate::plots::path_view(
-                    &path,
+                    path,
                     &format!(
                         "{}: {} path, Delta = {} mm",
                         part.name,
@@ -95,8 +74,8 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             "distance.svg",
             Box::new(|f: &FsPath| {
                 crate::plots::distance_plot(
-                    &path,
-                    &map,
+                    path,
+                    map,
                     &format!("{}: local interlayer distance per layer", part.name),
                     f,
                 )
@@ -109,22 +88,9 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             .map_err(|e| format!("{}: {e}", dir.join(name).display()))?;
     }
     let t_plots = t4.elapsed().as_secs_f64();
-    let mut summary = json!({
-        "part": part.name,
-        "part_file": part_file.display().to_string(),
-        "slicer": {
-            "grid_points": path.report.grid_points,
-            "root_finds": path.report.root_finds,
-            "evaluations": path.report.evaluations,
-            "max_residual_mm": path.report.max_residual_mm,
-            "truncated_points": path.report.truncated_points,
-            "stop": format!("{:?}", path.report.stop),
-            "max_turn_before_deg": path.report.max_turn_before_rad.to_degrees(),
-            "max_turn_after_deg": path.report.max_turn_after_rad.to_degrees(),
-        },
-        "run_time_s": { "read": t_read, "slice": t_slice, "distance_map": t_map, "tool_axes": t_axes, "pictures": t_plots },
-    });
-    crate::stages::merge(&mut summary, shared);
+    let mut summary = sliced.summary();
+    summary["run_time_s"]["read"] = t_read.into();
+    summary["run_time_s"]["pictures"] = t_plots.into();
     let summary_file = dir.join("summary.json");
     write_atomic(&summary_file, |w| {
         serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
@@ -141,7 +107,7 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             path.layers.len(),
             path.num_points(),
             path.length_mm(),
-            t_slice
+            sliced.times.slice
         );
         if let Some(o) = o {
             println!(

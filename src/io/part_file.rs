@@ -380,6 +380,9 @@ pub struct Slicing {
 pub struct Part {
     /// Short name.
     pub name: String,
+    /// The file it was read from, as given (or the origin passed to
+    /// [`parse_part`]); errors and reports name it.
+    pub file: String,
     /// One-line description.
     pub description: String,
     /// Source of the numbers.
@@ -532,6 +535,7 @@ pub fn build_part(spec: PartSpec, file: &str, base_dir: &Path) -> Result<Part, P
     let process = cx.process(&spec.process.clone().unwrap_or_default())?;
     Ok(Part {
         name: spec.name.clone(),
+        file: file.to_string(),
         description: spec.description.clone(),
         source: spec.source.clone(),
         tube,

@@ -59,6 +59,17 @@ pub enum ProgramError {
         /// The first one, with its layer, point and joint.
         first: String,
     },
+    /// A layer of the plan is infeasible or has lost points: no program is
+    /// written, so that no layer can silently vanish from it.
+    #[error("refusing to write a program: layer {layer} cannot be built ({status}); {count} layer(s) in all")]
+    InfeasibleLayer {
+        /// The first such layer.
+        layer: usize,
+        /// How many layers are in that state.
+        count: usize,
+        /// Its status (binding constraint, missing solution).
+        status: String,
+    },
     /// Path points, trajectory and speeds do not describe the same path.
     #[error("input mismatch at index {index}: {reason}")]
     Mismatch {

@@ -2,6 +2,7 @@
 //! emitter, read-back and validation of our FANUC output, corrupted files,
 //! splitting at a point limit, refusal of infeasible plans.
 
+mod api;
 mod fixture;
 mod formats;
 mod golden;

@@ -1,0 +1,215 @@
+//! **The front door: the whole pipeline in one call per job.** Reads a part
+//! file ([`Part::read`]) and a cell file ([`Cell::read`]), slices a part with
+//! its tool axes and process ([`slice_part`] → [`SlicedPart`]), plans it in a
+//! cell (slice → tool axes → `R_Z` optimisation → joint trajectory → program
+//! model: [`plan_part`] → [`PlannedPart`]), writes its robot program
+//! ([`PlannedPart::write_programs`]) and checks a program file against a
+//! cell ([`check_program`]). Every function returns the crate's [`Error`],
+//! whose messages name the file, field, layer or point. Lengths in mm,
+//! angles in rad, speeds in mm/s; part-frame geometry; joints in the robot's
+//! controller convention. The stage modules stay public for callers that
+//! need one step.
+//!
+//! ```no_run
+//! use waam_slicer::{Cell, Part, PlanOptions, ProgramFormat};
+//! # fn main() -> Result<(), waam_slicer::Error> {
+//! let part = Part::read("parts/hemisphere.toml")?;
+//! let cell = Cell::read("parts/cells/robowam_part_carried.toml")?;
+//! let planned = waam_slicer::plan_part(&part, &cell, &PlanOptions::default())?;
+//! assert!(planned.is_feasible());
+//! let files = planned.write_programs("out/hemisphere", ProgramFormat::Fanuc)?;
+//! let report = waam_slicer::check_program(&files[0], &cell)?;
+//! assert!(report.problems.is_empty());
+//! # Ok(()) }
+//! ```
+
+mod check;
+mod options;
+mod planned;
+mod sliced;
+
+use std::path::Path as FsPath;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+pub use check::{check_program, read_fanuc_with_calls};
+pub use options::{
+    AxisOverrides, ParseOptionError, PlanOptions, ProgramFormat, RzLaw, SliceOverrides,
+};
+pub use planned::{plan_part, program_name, PlanTimes, PlannedPart};
+pub use sliced::{slice_part, slice_part_with, SliceTimes, SlicedPart};
+
+use crate::io::cell_file::{parse_cell_file, read_cell_file, CellFile, CellFileError};
+use crate::io::part_file::{parse_part, read_part_file, PartFileError};
+use crate::robot::RobotModel;
+
+pub use crate::io::part_file::Part;
+
+impl Part {
+    /// Reads and validates a part file (TOML, see `parts/README.md`).
+    ///
+    /// # Errors
+    /// [`PartFileError`] naming the file and the field.
+    pub fn read(path: impl AsRef<FsPath>) -> Result<Part, PartFileError> {
+        read_part_file(path.as_ref())
+    }
+
+    /// Parses and validates part-file text; `origin` names it in errors, and
+    /// relative paths in it (an STL substrate) are resolved from the folder
+    /// of `origin`.
+    ///
+    /// # Errors
+    /// [`PartFileError`] naming `origin` and the field.
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Part, PartFileError> {
+        let base = FsPath::new(origin)
+            .parent()
+            .map(FsPath::to_path_buf)
+            .unwrap_or_default();
+        parse_part(text, origin, &base)
+    }
+}
+
+/// A robot cell as a cell file describes it: the robot and its layout (part
+/// carried under a fixed torch, or torch carried over a positioner), with the
+/// file's name and source. Robot base frame, mm.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    /// Name of the cell (the file's `name`).
+    pub name: String,
+    /// Where its numbers come from (the file's `source`).
+    pub source: String,
+    /// The file it was read from, as given (or the origin passed to
+    /// [`Cell::from_toml_str`]).
+    pub file: String,
+    /// The robot, the deposition point or positioner, the torch: what the
+    /// optimiser, the trajectory and the program stages take.
+    pub layout: crate::robot::Cell,
+}
+
+impl Cell {
+    /// Reads and validates a cell file (TOML, `parts/cells/`).
+    ///
+    /// # Errors
+    /// [`CellFileError`] naming the file and the key; a file describing a
+    /// robot only (no `[part_carried]` or `[torch_carried]` table) is refused.
+    pub fn read(path: impl AsRef<FsPath>) -> Result<Cell, CellFileError> {
+        let shown = path.as_ref().display().to_string();
+        Self::from_file(read_cell_file(path)?, &shown)
+    }
+
+    /// Parses and validates cell-file text; `origin` names it in errors.
+    ///
+    /// # Errors
+    /// As [`Cell::read`].
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Cell, CellFileError> {
+        Self::from_file(parse_cell_file(text, origin)?, origin)
+    }
+
+    /// The cell of a read cell file.
+    ///
+    /// # Errors
+    /// [`CellFileError::Invalid`] when the file describes no cell.
+    pub fn from_file(file: CellFile, origin: &str) -> Result<Cell, CellFileError> {
+        let layout = file.cell.ok_or_else(|| CellFileError::Invalid {
+            path: origin.to_string(),
+            key: "part_carried".into(),
+            reason: "no [part_carried] or [torch_carried] section: a robot, not a cell".into(),
+        })?;
+        Ok(Cell {
+            name: file.name,
+            source: file.source,
+            file: origin.to_string(),
+            layout,
+        })
+    }
+
+    /// The robot arm.
+    pub fn robot(&self) -> &RobotModel {
+        self.layout.robot()
+    }
+
+    /// The program format of the robot's controller.
+    pub fn native_format(&self) -> ProgramFormat {
+        ProgramFormat::of_vendor(self.robot().vendor)
+    }
+}
+
+/// A progress callback: `(stage, fraction of the run done)`.
+type ProgressFn = dyn Fn(&str, f64) + Send + Sync;
+
+/// How a long run reports progress and is cancelled by a host program.
+/// Cloning shares the same callback and flag.
+#[derive(Clone, Default)]
+pub struct Control {
+    progress: Option<Arc<ProgressFn>>,
+    cancel: Option<Arc<AtomicBool>>,
+}
+
+impl std::fmt::Debug for Control {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Control")
+            .field("progress", &self.progress.is_some())
+            .field("cancel", &self.cancel.is_some())
+            .finish()
+    }
+}
+
+impl PartialEq for Control {
+    /// Two controls are equal when they share the same callback and flag.
+    fn eq(&self, other: &Self) -> bool {
+        let same_progress = match (&self.progress, &other.progress) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            (None, None) => true,
+            _ => false,
+        };
+        let same_cancel = match (&self.cancel, &other.cancel) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            (None, None) => true,
+            _ => false,
+        };
+        same_progress && same_cancel
+    }
+}
+
+impl Control {
+    /// Reports progress to `f(stage, fraction)`: the stage's name
+    /// (`slicing`, `tool axes`, `optimising`, `program`) and the fraction of
+    /// the whole run done (0..=1).
+    pub fn with_progress(mut self, f: impl Fn(&str, f64) + Send + Sync + 'static) -> Self {
+        self.progress = Some(Arc::new(f));
+        self
+    }
+
+    /// Stops the run at the next stage or layer once `flag` is set; the run
+    /// then returns [`Error::Cancelled`].
+    pub fn with_cancel(mut self, flag: Arc<AtomicBool>) -> Self {
+        self.cancel = Some(flag);
+        self
+    }
+
+    /// Reports `fraction` of the run done in `stage`.
+    pub fn report(&self, stage: &str, fraction: f64) {
+        if let Some(f) = &self.progress {
+            f(stage, fraction.clamp(0.0, 1.0));
+        }
+    }
+
+    /// `true` once the host asked to stop.
+    pub fn is_cancelled(&self) -> bool {
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+
+    /// [`Error::Cancelled`] naming `stage` once the host asked to stop.
+    ///
+    /// # Errors
+    /// [`Error::Cancelled`].
+    pub fn check(&self, stage: &'static str) -> Result<(), crate::Error> {
+        if self.is_cancelled() {
+            Err(crate::Error::Cancelled { stage })
+        } else {
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,290 @@
+//! What a caller may change of a part file's settings, each given once: the
+//! slicing, tool-axis and process overrides of [`SliceOverrides`], and for a
+//! plan the `R_Z` law and the program format of [`PlanOptions`].
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::optimise::{Abscissa, Parameterisation};
+use crate::path::smooth::Smoothing;
+use crate::path::{Discretisation, SliceOptions, Strategy};
+use crate::process::ProcessParameters;
+use crate::robot::Vendor;
+use crate::toolaxis::{AxisRule, ToolAxisOptions};
+
+/// Overrides of a part file's `[slicing]`, `[tool_axis]` and `[process]`
+/// tables. `None` / `false` keeps the part file's value. Plain data.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SliceOverrides {
+    /// Slicing strategy.
+    pub strategy: Option<Strategy>,
+    /// Target interlayer distance `Delta` (mm, > 0).
+    pub delta_mm: Option<f64>,
+    /// Discretisation of each layer (points, chord error or spacing in mm).
+    pub discretisation: Option<Discretisation>,
+    /// Bound on the turning angle of constant-distance layers (SPEC §3.4).
+    pub smoothing: Option<Smoothing>,
+    /// Rotate the start of layer `k` by `k × stagger` (rad of `v`); setting it
+    /// turns seam alignment off.
+    pub stagger_rad: Option<f64>,
+    /// Spiral only: profile angle where the spiral starts (rad).
+    pub spiral_start_rad: Option<f64>,
+    /// Spiral only: travel toward decreasing profile angle.
+    pub spiral_reverse: bool,
+    /// Stop after this many layers (or spiral turns).
+    pub max_layers: Option<usize>,
+    /// Tool-axis overrides.
+    pub tool_axis: AxisOverrides,
+    /// Process parameters replacing the part's whole `[process]` table (e.g.
+    /// a [`ProcessPreset`](crate::process::ProcessPreset)'s).
+    pub process: Option<ProcessParameters>,
+    /// Programmed travel speed of the torch over the part (mm/s): the process
+    /// estimates, the joint-speed constraints and the program all use it.
+    pub travel_speed_mm_s: Option<f64>,
+}
+
+/// Overrides of a part file's `[tool_axis]` table. Plain data.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct AxisOverrides {
+    /// Tool axis along the build direction: no lead, tilt, lean rule or rate
+    /// bound (applied before the other overrides).
+    pub plain: bool,
+    /// Constant lead angle (rad, feed plane).
+    pub lead_rad: Option<f64>,
+    /// Constant tilt angle (rad, normal plane).
+    pub tilt_rad: Option<f64>,
+    /// The torch never leans more than this from the part's Z (rad; the
+    /// thesis's 50° rule, eq. 3.20–3.21).
+    pub max_lean_rad: Option<f64>,
+    /// Bound on the turning rate of the torch axis along a layer (rad/mm).
+    pub max_axis_rate_rad_per_mm: Option<f64>,
+}
+
+impl AxisOverrides {
+    /// `base` (a part's `[tool_axis]` settings) with these overrides applied.
+    pub fn apply(&self, base: &ToolAxisOptions) -> ToolAxisOptions {
+        let mut o = base.clone();
+        if self.plain {
+            o.lead_rad = 0.0;
+            o.tilt_rad = 0.0;
+            o.rule = AxisRule::None;
+            o.max_rate_rad_per_mm = None;
+            o.max_axis_rate_rad_per_mm = None;
+        }
+        if let Some(r) = self.max_axis_rate_rad_per_mm {
+            o.max_axis_rate_rad_per_mm = Some(r);
+        }
+        if let Some(a) = self.lead_rad {
+            o.lead_rad = a;
+        }
+        if let Some(a) = self.tilt_rad {
+            o.tilt_rad = a;
+        }
+        if let Some(a) = self.max_lean_rad {
+            o.rule = AxisRule::MaxAngleFromAxis {
+                axis: [0.0, 0.0, 1.0],
+                max_angle_rad: a,
+            };
+        }
+        o
+    }
+}
+
+impl SliceOverrides {
+    /// `base` (a part's slicing options) with these overrides applied.
+    pub fn apply(&self, base: &SliceOptions) -> SliceOptions {
+        let mut o = *base;
+        if let Some(s) = self.strategy {
+            o.strategy = s;
+        }
+        if let Some(d) = self.delta_mm {
+            o.delta_mm = d;
+        }
+        if let Some(d) = self.discretisation {
+            o.discretisation = d;
+        }
+        if self.smoothing.is_some() {
+            o.smoothing = self.smoothing;
+        }
+        if let Some(s) = self.stagger_rad {
+            o.stagger_rad = s;
+            o.align_seams = false;
+        }
+        if let Some(s) = self.spiral_start_rad {
+            o.spiral_start_rad = s;
+        }
+        o.spiral_reverse |= self.spiral_reverse;
+        o.max_layers = self.max_layers.or(o.max_layers);
+        o
+    }
+
+    /// `base` (a part's process parameters) with the process and travel-speed
+    /// overrides applied (not yet validated).
+    pub fn apply_process(&self, base: &ProcessParameters) -> ProcessParameters {
+        let mut p = self.process.clone().unwrap_or_else(|| base.clone());
+        if let Some(v) = self.travel_speed_mm_s {
+            p.travel_speed_mm_s = v;
+        }
+        p
+    }
+}
+
+/// A robot program format: the vendor whose controller runs it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ProgramFormat {
+    /// FANUC TP ASCII `.ls` (split into sub-programs of whole beads).
+    Fanuc,
+    /// KUKA KRL `.src` + `.dat`.
+    Kuka,
+    /// ABB RAPID `.mod`.
+    Abb,
+}
+
+impl ProgramFormat {
+    /// The format of `vendor`'s controllers.
+    pub fn of_vendor(vendor: Vendor) -> Self {
+        match vendor {
+            Vendor::Fanuc => Self::Fanuc,
+            Vendor::Kuka => Self::Kuka,
+            Vendor::Abb => Self::Abb,
+        }
+    }
+
+    /// The vendor whose controller runs this format.
+    pub fn vendor(self) -> Vendor {
+        match self {
+            Self::Fanuc => Vendor::Fanuc,
+            Self::Kuka => Vendor::Kuka,
+            Self::Abb => Vendor::Abb,
+        }
+    }
+
+    /// The name on the command line and in files: `fanuc`, `kuka`, `abb`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Fanuc => "fanuc",
+            Self::Kuka => "kuka",
+            Self::Abb => "abb",
+        }
+    }
+
+    /// The emitter's name in messages, e.g. `FANUC TP`.
+    pub fn emitter(self) -> &'static str {
+        match self {
+            Self::Fanuc => crate::program::fanuc::EMITTER,
+            Self::Kuka => crate::program::kuka::EMITTER,
+            Self::Abb => crate::program::abb::EMITTER,
+        }
+    }
+}
+
+impl fmt::Display for ProgramFormat {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A word that names no [`ProgramFormat`] or `R_Z` law.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("`{given}`: expected {expected}")]
+pub struct ParseOptionError {
+    /// What was given.
+    pub given: String,
+    /// What is accepted.
+    pub expected: &'static str,
+}
+
+impl FromStr for ProgramFormat {
+    type Err = ParseOptionError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "fanuc" => Ok(Self::Fanuc),
+            "kuka" => Ok(Self::Kuka),
+            "abb" => Ok(Self::Abb),
+            _ => Err(ParseOptionError {
+                given: s.to_string(),
+                expected: "fanuc, kuka or abb",
+            }),
+        }
+    }
+}
+
+/// The `R_Z` law of a plan in its written form: `fixed:DEG`, `poly:N` (most
+/// degree 0..=8, raised while it pays, SPEC §7), `spline` or `point` (the
+/// point-by-point baseline).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RzLaw(pub Parameterisation);
+
+impl Default for RzLaw {
+    /// `poly:4`.
+    fn default() -> Self {
+        Self(Parameterisation::Polynomial {
+            max_degree: 4,
+            abscissa: Abscissa::Auto,
+            stop_relative_gain: 1e-3,
+        })
+    }
+}
+
+impl FromStr for RzLaw {
+    type Err = ParseOptionError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let bad = || ParseOptionError {
+            given: s.to_string(),
+            expected: "fixed:DEG, poly:N (0..=8), spline or point",
+        };
+        let law = match s.split_once(':') {
+            Some(("fixed", d)) => {
+                let deg: f64 = d.parse().map_err(|_| bad())?;
+                if !deg.is_finite() {
+                    return Err(bad());
+                }
+                Parameterisation::Fixed {
+                    r_z_rad: deg.to_radians(),
+                }
+            }
+            Some(("poly", n)) => {
+                let n: usize = n.parse().map_err(|_| bad())?;
+                if n > 8 {
+                    return Err(bad());
+                }
+                Parameterisation::Polynomial {
+                    max_degree: n,
+                    abscissa: Abscissa::Auto,
+                    stop_relative_gain: 1e-3,
+                }
+            }
+            None if s == "spline" => Parameterisation::SmoothingSpline { smoothness: 1.0 },
+            None if s == "point" => Parameterisation::PointByPoint,
+            _ => return Err(bad()),
+        };
+        Ok(Self(law))
+    }
+}
+
+impl fmt::Display for RzLaw {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            Parameterisation::Fixed { r_z_rad } => write!(f, "fixed:{}", r_z_rad.to_degrees()),
+            Parameterisation::Polynomial { max_degree, .. } => write!(f, "poly:{max_degree}"),
+            Parameterisation::SmoothingSpline { .. } => f.write_str("spline"),
+            Parameterisation::PointByPoint => f.write_str("point"),
+        }
+    }
+}
+
+/// Options of [`plan_part`](crate::plan_part): the slicing overrides, the
+/// `R_Z` law and the program format. Plain data; `Default` plans with the
+/// part file's settings, `poly:4` and the cell robot's vendor's format.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlanOptions {
+    /// Overrides of the part file's slicing, tool-axis and process settings
+    /// (the travel speed among them, given once).
+    pub slice: SliceOverrides,
+    /// How `R_Z` varies along a layer.
+    pub rz: RzLaw,
+    /// Program format; `None`: the cell robot's vendor's.
+    pub format: Option<ProgramFormat>,
+    /// Progress reports and cancellation for a host program.
+    pub control: super::Control,
+}

@@ -1,0 +1,412 @@
+//! Planning a part in a cell in one call: slice → tool axes → `R_Z`
+//! optimisation layer by layer (SPEC §7) → joint trajectory → program model
+//! (SPEC §8), and writing the plan's files.
+
+use std::path::{Path as FsPath, PathBuf};
+use std::time::Instant;
+
+use serde::ser::SerializeMap;
+use serde::Serialize;
+use serde_json::{json, Value};
+
+use super::sliced::merge;
+use super::{slice_part_with, Cell, Part, PlanOptions, ProgramFormat, RzLaw, SlicedPart};
+use crate::optimise::{
+    layer_points, optimise, trajectory_inputs, ConfigurationChoice, LayerPoints, OptimiseOptions,
+    Plan,
+};
+use crate::program::{
+    build_program, check_vendor, write_files, Program, ProgramError, TravelSpeed,
+};
+use crate::robot::trajectory::{joint_trajectory, TrajectoryOptions};
+use crate::Error;
+
+/// Wall-clock time of each planning stage (s).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct PlanTimes {
+    /// Slicing, distance map and tool axes (s).
+    pub slice: f64,
+    /// Tool axes and the layer points (s).
+    pub tool_axes: f64,
+    /// `R_Z` optimisation (s).
+    pub optimise: f64,
+    /// Joint trajectory and program model (s).
+    pub program: f64,
+}
+
+/// A part planned in a cell: the sliced part, the optimised plan (one
+/// [`LayerPlan`](crate::optimise::LayerPlan) per layer: status, `R_Z`, joints)
+/// and, when every layer is feasible, the program model the emitters write.
+///
+/// Serialises (serde) as `{ "summary": …, "points": [...] }`: the summary
+/// is [`PlannedPart::summary`]; each point gives its layer, index, position
+/// (mm, part frame), `R_Z` (deg), joints (deg, controller convention; `null`
+/// without solution) and positioner joints (deg).
+#[derive(Debug, Clone)]
+pub struct PlannedPart {
+    /// The part as sliced for the plan.
+    pub sliced: SlicedPart,
+    /// The cell (robot base frame).
+    pub cell: Cell,
+    /// The layers as the cell sees them (part frame).
+    pub layers: Vec<LayerPoints>,
+    /// The optimiser's options (travel speed in mm/s among them).
+    pub optimise: OptimiseOptions,
+    /// The `R_Z` law asked for.
+    pub rz: RzLaw,
+    /// The program format the plan writes by default.
+    pub format: ProgramFormat,
+    /// The optimised plan, one entry per layer.
+    pub plan: Plan,
+    /// The program model, `Some` when every layer is feasible and the
+    /// trajectory rebuilt from the plan passes the program stage's checks.
+    pub program: Option<Program>,
+    /// Why there is no program (`None` when there is one).
+    pub refusal: Option<String>,
+    /// Run times.
+    pub times: PlanTimes,
+}
+
+/// The program name for a part: its name in upper case, letters, digits and
+/// `_` only, starting with a letter (`P` prepended otherwise), at most 24
+/// characters (the shortest limit of the three controllers, KUKA's).
+pub fn program_name(part_name: &str) -> String {
+    let mut n: String = part_name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_uppercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if !n.starts_with(|c: char| c.is_ascii_alphabetic()) {
+        n.insert(0, 'P');
+    }
+    n.truncate(24);
+    n
+}
+
+/// Plans `part` in `cell`: slices it with its file's settings and the
+/// overrides of `opts`, attaches tool axes, optimises `R_Z` layer by layer
+/// with the cell's IK branch on every layer (a program must not reconfigure
+/// the arm between layers), rebuilds the joint trajectory at the travel
+/// speed and builds the program model. An infeasible layer is data, not an
+/// error: see [`PlannedPart::is_feasible`].
+///
+/// # Errors
+/// Bad input: the part's or the overrides' ([`Error::InPart`]), the
+/// optimiser's options or the cell ([`Error::Optimise`]), a program format
+/// the cell's robot cannot run ([`ProgramError::VendorMismatch`], checked
+/// before any work); [`Error::Cancelled`].
+pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<PlannedPart, Error> {
+    let format = opts.format.unwrap_or_else(|| cell.native_format());
+    check_vendor(&cell.layout, format.vendor(), format.emitter())?;
+    let control = &opts.control;
+    let t = Instant::now();
+    let sliced = slice_part_with(part, &opts.slice, control)?;
+    let t_slice = t.elapsed().as_secs_f64() - sliced.times.tool_axes;
+    let t = Instant::now();
+    let layers = layer_points(&sliced.path, &sliced.axes.frames);
+    let t_axes = sliced.times.tool_axes + t.elapsed().as_secs_f64();
+    let optimise_opts = OptimiseOptions {
+        parameterisation: opts.rz.0,
+        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
+        configuration: ConfigurationChoice::Cell,
+        ..OptimiseOptions::default()
+    };
+    optimise_opts.validate()?;
+    control.check("optimising")?;
+    control.report("optimising", 0.1);
+    let plan = optimise(&cell.layout, &layers, &optimise_opts)?;
+    control.check("optimising")?;
+    control.report("program", 0.95);
+    let t = Instant::now();
+    let name = program_name(&part.name);
+    let (program, refusal) = match build(&name, cell, &layers, &plan, &optimise_opts) {
+        Ok(p) => (Some(p), None),
+        Err(e) => (None, Some(e.to_string())),
+    };
+    let t_program = t.elapsed().as_secs_f64();
+    control.report("program", 1.0);
+    Ok(PlannedPart {
+        times: PlanTimes {
+            slice: t_slice,
+            tool_axes: t_axes,
+            optimise: plan.time_s,
+            program: t_program,
+        },
+        sliced,
+        cell: cell.clone(),
+        layers,
+        optimise: optimise_opts,
+        rz: opts.rz,
+        format,
+        plan,
+        program,
+        refusal,
+    })
+}
+
+/// The program model of a plan, refused when a layer is infeasible or lost.
+fn build(
+    name: &str,
+    cell: &Cell,
+    layers: &[LayerPoints],
+    plan: &Plan,
+    opts: &OptimiseOptions,
+) -> Result<Program, ProgramError> {
+    check_every_layer(layers, plan)?;
+    let inputs = trajectory_inputs(layers, plan);
+    let speed = opts.travel_speed_mm_s;
+    let traj = joint_trajectory(&cell.layout, &inputs, speed, &TrajectoryOptions::default())
+        .map_err(|e| ProgramError::Mismatch {
+            index: 0,
+            reason: format!("joint trajectory: {e}"),
+        })?;
+    build_program(
+        name,
+        &cell.layout,
+        &inputs,
+        &traj,
+        &TravelSpeed::Constant(speed),
+    )
+}
+
+/// No layer may vanish between the plan and the program: each layer of the
+/// path has its plan, with a joint solution at each of its points, and is
+/// feasible.
+fn check_every_layer(layers: &[LayerPoints], plan: &Plan) -> Result<(), ProgramError> {
+    let infeasible: Vec<_> = plan.infeasible_layers().collect();
+    if let Some(first) = infeasible.first() {
+        return Err(ProgramError::InfeasibleLayer {
+            layer: first.layer,
+            count: infeasible.len(),
+            status: first.status.to_string(),
+        });
+    }
+    for (i, lp) in layers.iter().enumerate() {
+        let Some(pl) = plan.layers.get(i) else {
+            return Err(ProgramError::InfeasibleLayer {
+                layer: lp.layer,
+                count: layers.len() - i,
+                status: "no plan for this layer".into(),
+            });
+        };
+        if pl.layer != lp.layer || pl.points.len() != lp.points.len() {
+            return Err(ProgramError::InfeasibleLayer {
+                layer: lp.layer,
+                count: 1,
+                status: format!(
+                    "the plan has {} point(s) for its {} (layer {})",
+                    pl.points.len(),
+                    lp.points.len(),
+                    pl.layer
+                ),
+            });
+        }
+        if let Some(m) = pl.points.iter().position(|p| p.joints.is_none()) {
+            return Err(ProgramError::InfeasibleLayer {
+                layer: lp.layer,
+                count: 1,
+                status: format!("point {m} has no joint solution"),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn deg6(q: &[f64; 6]) -> Vec<f64> {
+    q.iter().map(|v| v.to_degrees()).collect()
+}
+
+impl PlannedPart {
+    /// `true` when every layer is feasible and the program model was built:
+    /// [`PlannedPart::write_programs`] will write it.
+    pub fn is_feasible(&self) -> bool {
+        self.plan.is_feasible() && self.program.is_some()
+    }
+
+    /// The travel speed planned (mm/s).
+    pub fn travel_speed_mm_s(&self) -> f64 {
+        self.optimise.travel_speed_mm_s
+    }
+
+    /// `true` when the cell has a positioner (torch carried): the joints
+    /// have two more values.
+    pub fn has_positioner(&self) -> bool {
+        matches!(self.cell.layout, crate::robot::Cell::TorchCarried(_))
+    }
+
+    /// Writes `joints.csv` (see [`crate::io::joints_csv`]).
+    ///
+    /// # Errors
+    /// I/O errors of `w`.
+    pub fn write_joints_csv(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+        crate::io::joints_csv::write_joints_csv(w, &self.layers, &self.plan, self.has_positioner())
+    }
+
+    /// The emitted program files in `format`, not written.
+    ///
+    /// # Errors
+    /// [`ProgramError::InfeasibleLayer`] naming the first infeasible layer,
+    /// [`ProgramError::Infeasible`] when the program stage refused the
+    /// trajectory, [`ProgramError::VendorMismatch`] for another vendor's format.
+    pub fn program_files(
+        &self,
+        format: ProgramFormat,
+    ) -> Result<Vec<crate::program::EmittedFile>, Error> {
+        check_vendor(&self.cell.layout, format.vendor(), format.emitter())?;
+        check_every_layer(&self.layers, &self.plan)?;
+        let program = self
+            .program
+            .as_ref()
+            .ok_or_else(|| ProgramError::Infeasible {
+                count: 1,
+                first: self.refusal.clone().unwrap_or_default(),
+            })?;
+        Ok(match format {
+            ProgramFormat::Fanuc => {
+                crate::program::fanuc::fanuc_files(program, &Default::default())?
+            }
+            ProgramFormat::Kuka => crate::program::kuka::kuka_files(program, &Default::default())?,
+            ProgramFormat::Abb => crate::program::abb::abb_files(program, &Default::default())?,
+        })
+    }
+
+    /// Writes the robot program in `format` into `dir` (created if missing),
+    /// each file atomically; returns the written paths, the main program first.
+    ///
+    /// # Errors
+    /// As [`PlannedPart::program_files`]; [`ProgramError::Io`] naming the file.
+    pub fn write_programs(
+        &self,
+        dir: impl AsRef<FsPath>,
+        format: ProgramFormat,
+    ) -> Result<Vec<PathBuf>, Error> {
+        let files = self.program_files(format)?;
+        let dir = dir.as_ref();
+        std::fs::create_dir_all(dir).map_err(|source| ProgramError::Io {
+            path: dir.display().to_string(),
+            source,
+        })?;
+        write_files(dir, &files)?;
+        Ok(files.iter().map(|f| dir.join(&f.name)).collect())
+    }
+
+    /// The content of `plan`'s `summary.json`: the part and cell files, the
+    /// `R_Z` law, travel speed, feasibility, every violation, per layer the
+    /// status, IK branch, law, objective, quality figures and solver counts,
+    /// the layer transitions, run times (s) and the path summary
+    /// ([`SlicedPart::path_summary`]).
+    pub fn summary(&self) -> Value {
+        let plan = &self.plan;
+        let layers: Vec<_> = plan
+            .layers
+            .iter()
+            .map(|l| {
+                let q = &l.quality;
+                json!({
+                    "layer": l.layer,
+                    "status": l.status.to_string(),
+                    "feasible": l.status.is_feasible(),
+                    "configuration": l.configuration.chosen.to_string(),
+                    "configuration_reason": l.configuration.reason,
+                    "law": format!("{:?}", l.law),
+                    "points": l.points.len(),
+                    "objective": {
+                        "joint_displacement": l.objective.joint_displacement,
+                        "uncertainty_sum_sq_mm2": l.objective.uncertainty_sum_sq_mm2,
+                        "mean_uncertainty_mm": l.objective.mean_uncertainty_mm,
+                        "centring": l.objective.centring,
+                    },
+                    "quality": {
+                        "joint_travel_deg": deg6(&q.joint_travel_rad),
+                        "peak_speed_deg_s": deg6(&q.peak_speed_rad_s),
+                        "peak_acceleration_deg_s2": deg6(&q.peak_acceleration_rad_s2),
+                        "summed_acceleration_j1_j5_deg_s": q.summed_acceleration_rad_s.to_degrees(),
+                        "direction_reversals": q.direction_reversals,
+                        "min_dexterity": q.min_dexterity,
+                        "min_limit_distance_deg": q.min_limit_distance_rad.to_degrees(),
+                        "min_limit_distance_joint": q.min_limit_distance_joint,
+                        "max_hose_torsion_deg": q.max_hose_torsion_rad.to_degrees(),
+                    },
+                    "solver": {
+                        "iterations": l.solver.iterations,
+                        "qp_solves": l.solver.qp_solves,
+                        "qp_failures": l.solver.qp_failures,
+                        "branches_tried": l.solver.branches_tried,
+                        "time_s": l.solver.time_s,
+                    },
+                })
+            })
+            .collect();
+        let violations: Vec<String> = plan.violations().map(|v| v.to_string()).collect();
+        let mut s = json!({
+            "part": self.sliced.part_name,
+            "part_file": self.sliced.part_file,
+            "cell_file": self.cell.file,
+            "rz": self.rz.to_string(),
+            "travel_speed_mm_s": self.optimise.travel_speed_mm_s,
+            "feasible": plan.is_feasible(),
+            "infeasible_layers": plan.infeasible_layers().map(|l| l.layer).collect::<Vec<_>>(),
+            "violations": violations,
+            "layer_plans": layers,
+            "transitions": plan.transitions.iter().map(|t| json!({
+                "from_layer": t.from_layer,
+                "to_layer": t.to_layer,
+                "joint_change_deg": deg6(&t.joint_change_rad),
+                "branch_change": t.branch_change,
+                "start_limit_distance_deg": t.start_limit_distance_rad.to_degrees(),
+            })).collect::<Vec<_>>(),
+            "program": Value::Null,
+            "run_time_s": {
+                "slice": self.times.slice,
+                "tool_axes": self.times.tool_axes,
+                "optimise": self.times.optimise,
+            },
+        });
+        merge(&mut s, self.sliced.path_summary());
+        s
+    }
+}
+
+/// One planned point as serialised.
+#[derive(Serialize)]
+struct PointView {
+    layer: usize,
+    point: usize,
+    position_mm: [f64; 3],
+    rz_deg: f64,
+    joints_deg: Option<[f64; 6]>,
+    positioner_deg: Option<[f64; 2]>,
+}
+
+impl Serialize for PlannedPart {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let points: Vec<PointView> = self
+            .layers
+            .iter()
+            .zip(&self.plan.layers)
+            .flat_map(|(lp, pl)| {
+                lp.points
+                    .iter()
+                    .zip(&pl.points)
+                    .enumerate()
+                    .map(move |(m, (cp, pp))| PointView {
+                        layer: lp.layer,
+                        point: m,
+                        position_mm: cp.position_mm.coords.into(),
+                        rz_deg: pp.r_z.to_degrees(),
+                        joints_deg: pp.joints.map(|q| q.map(f64::to_degrees)),
+                        positioner_deg: pp.positioner.map(|e| e.map(f64::to_degrees)),
+                    })
+            })
+            .collect();
+        let mut m = s.serialize_map(Some(2))?;
+        m.serialize_entry("summary", &self.summary())?;
+        m.serialize_entry("points", &points)?;
+        m.end()
+    }
+}

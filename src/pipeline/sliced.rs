@@ -1,0 +1,256 @@
+//! Slicing a part in one call: path (SPEC §3), distance map (§3.2), tool axes
+//! (§4) and process plan (§5) with the part file's settings and the caller's
+//! overrides.
+
+use std::time::Instant;
+
+use serde::ser::{SerializeMap, SerializeStruct};
+use serde::Serialize;
+use serde_json::{json, Value};
+
+use super::{Control, Part, SliceOverrides};
+use crate::path::{distance_map, slice, DistanceMap, Path, SliceOptions};
+use crate::process::{plan_process, ProcessParameters, ProcessPlan};
+use crate::toolaxis::{tool_axes, ToolAxes, ToolAxisOptions};
+use crate::Error;
+
+/// Wall-clock time of each slicing stage (s).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct SliceTimes {
+    /// Slicing (s).
+    pub slice: f64,
+    /// Distance map (s).
+    pub distance_map: f64,
+    /// Tool axes (s).
+    pub tool_axes: f64,
+}
+
+/// A sliced part: the deposition path (part frame, mm), its local
+/// interlayer distances, one local frame per point and the process plan.
+///
+/// Serialises (serde) as `{ "summary": …, "layers": [{ "points", "tool_axis",
+/// "delta" }] }`: the summary is [`SlicedPart::summary`], the layers give each
+/// point's position (mm), tool axis (unit) and distance to the layer below
+/// (mm, `null` on the first layer), part frame.
+#[derive(Debug, Clone)]
+pub struct SlicedPart {
+    /// The part's name.
+    pub part_name: String,
+    /// The part file, as given.
+    pub part_file: String,
+    /// The slicing options used (the part's, with the overrides).
+    pub options: SliceOptions,
+    /// The deposition path, part frame (mm).
+    pub path: Path,
+    /// Local interlayer distances per layer and overall (mm).
+    pub map: DistanceMap,
+    /// The tool-axis settings used.
+    pub tool_axis: ToolAxisOptions,
+    /// One local frame per point (`axes.frames[layer][point]`), part frame.
+    pub axes: ToolAxes,
+    /// The process parameters used (validated; travel speed in mm/s).
+    pub process: ProcessParameters,
+    /// Per-point process values and the estimates (time, wire, mass).
+    pub process_plan: ProcessPlan,
+    /// Run times.
+    pub times: SliceTimes,
+}
+
+/// Slices `part` with its own settings: [`slice_part_with`] and no overrides.
+///
+/// # Errors
+/// As [`slice_part_with`].
+pub fn slice_part(part: &Part) -> Result<SlicedPart, Error> {
+    slice_part_with(part, &SliceOverrides::default(), &Control::default())
+}
+
+/// Slices `part` with its file's settings and `overrides`: path, distance
+/// map, tool axes and process plan. `control` reports progress and may cancel.
+///
+/// # Errors
+/// [`Error::InPart`] naming the part file around the stage's error (a bad
+/// option names its field, a failed root find its layer and point);
+/// [`Error::Cancelled`].
+pub fn slice_part_with(
+    part: &Part,
+    overrides: &SliceOverrides,
+    control: &Control,
+) -> Result<SlicedPart, Error> {
+    let in_part = |e: Error| Error::InPart {
+        file: part.file.clone(),
+        source: Box::new(e),
+    };
+    let options = overrides.apply(&part.slice_options());
+    let process = overrides.apply_process(&part.process);
+    process.validate().map_err(|e| in_part(e.into()))?;
+    let tool_axis = overrides.tool_axis.apply(&part.tool_axis);
+    tool_axis.validate().map_err(|e| in_part(e.into()))?;
+    control.check("slicing")?;
+    control.report("slicing", 0.0);
+    let t = Instant::now();
+    let path = slice(&part.tube, &part.substrate, &options).map_err(|e| in_part(e.into()))?;
+    let t_slice = t.elapsed().as_secs_f64();
+    control.check("slicing")?;
+    let t = Instant::now();
+    let map = distance_map(&path);
+    let t_map = t.elapsed().as_secs_f64();
+    control.report("tool axes", 0.5);
+    let t = Instant::now();
+    let axes = tool_axes(&path, Some(&part.tube), Some(&part.substrate), &tool_axis)
+        .map_err(|e| in_part(e.into()))?;
+    let t_axes = t.elapsed().as_secs_f64();
+    let process_plan =
+        plan_process(&path, &process, &Default::default()).map_err(|e| in_part(e.into()))?;
+    control.report("tool axes", 1.0);
+    Ok(SlicedPart {
+        part_name: part.name.clone(),
+        part_file: part.file.clone(),
+        options,
+        path,
+        map,
+        tool_axis,
+        axes,
+        process,
+        process_plan,
+        times: SliceTimes {
+            slice: t_slice,
+            distance_map: t_map,
+            tool_axes: t_axes,
+        },
+    })
+}
+
+impl SlicedPart {
+    /// What `slice` and `plan` report of the path (the shared part of
+    /// `summary.json`): strategy, Delta, layers, slices, points, arc starts,
+    /// bead length (mm), process estimates, tool-axis report and the local
+    /// interlayer distances overall and per layer.
+    pub fn path_summary(&self) -> Value {
+        let (path, map, params, axes) = (&self.path, &self.map, &self.process, &self.axes);
+        let est = self.process_plan.estimates;
+        json!({
+            "strategy": path.strategy.name(),
+            "delta_mm": path.delta_mm,
+            "layers": path.layers.len(),
+            "slices": path.num_slices(),
+            "points": path.num_points(),
+            "arc_starts": est.arc_starts,
+            "length_mm": path.length_mm(),
+            "process": {
+                "material": params.material,
+                "travel_speed_mm_s": params.travel_speed_mm_s,
+                "wire_feed_speed_mm_s": params.wire_feed_speed_mm_s,
+                "deposition_time_s": est.deposition_time_s,
+                "wire_length_mm": est.wire_length_mm,
+                "deposited_mass_g": est.deposited_mass_g,
+                "speed_window_violations": self.process_plan.violation_count,
+            },
+            "tool_axes": {
+                "normals": format!("{:?}", axes.report.normals),
+                "max_angle_from_z_deg": axes.report.max_angle_from_z_rad.to_degrees(),
+                "max_rate_deg_per_mm": axes.report.max_rate_rad_per_mm.to_degrees(),
+                "rule_active_points": axes.report.rule_active_points,
+                "rule_unreachable_points": axes.report.rule_unreachable_count,
+                "smoothed_points": axes.report.smoothed_points,
+            },
+            "distance": {
+                "overall": map.overall,
+                "per_layer": map.per_layer,
+            },
+        })
+    }
+
+    /// The content of `slice`'s `summary.json`: the part, what the slicer
+    /// did, the run times (s) and [`SlicedPart::path_summary`].
+    pub fn summary(&self) -> Value {
+        let r = &self.path.report;
+        let mut s = json!({
+            "part": self.part_name,
+            "part_file": self.part_file,
+            "slicer": {
+                "grid_points": r.grid_points,
+                "root_finds": r.root_finds,
+                "evaluations": r.evaluations,
+                "max_residual_mm": r.max_residual_mm,
+                "truncated_points": r.truncated_points,
+                "stop": format!("{:?}", r.stop),
+                "max_turn_before_deg": r.max_turn_before_rad.to_degrees(),
+                "max_turn_after_deg": r.max_turn_after_rad.to_degrees(),
+            },
+            "run_time_s": {
+                "slice": self.times.slice,
+                "distance_map": self.times.distance_map,
+                "tool_axes": self.times.tool_axes,
+            },
+        });
+        merge(&mut s, self.path_summary());
+        s
+    }
+
+    /// Writes `path.csv` (one row per point, see [`crate::io::path_csv`]).
+    ///
+    /// # Errors
+    /// I/O errors of `w`.
+    pub fn write_path_csv(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+        crate::io::path_csv::write_path_csv(w, &self.path.layers, &self.axes.frames)
+    }
+
+    /// Writes the deposited wall as binary STL: a bead section `width_mm` ×
+    /// the local distance swept along the path (part frame, mm).
+    ///
+    /// # Errors
+    /// I/O errors of `w`.
+    pub fn write_wall_stl(&self, w: &mut dyn std::io::Write, width_mm: f64) -> std::io::Result<()> {
+        let triangles =
+            crate::io::wall_stl::wall_triangles(&self.path, &self.axes.frames, width_mm);
+        crate::io::wall_stl::write_stl(w, &triangles)
+    }
+}
+
+/// Adds the keys of `extra` (an object) to `into` (an object).
+pub(crate) fn merge(into: &mut Value, extra: Value) {
+    if let (Some(into), Value::Object(extra)) = (into.as_object_mut(), extra) {
+        into.extend(extra);
+    }
+}
+
+/// The points of one layer, serialised as three parallel arrays.
+struct LayerView<'a> {
+    part: &'a SlicedPart,
+    layer: usize,
+}
+
+impl Serialize for LayerView<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let layer = &self.part.path.layers[self.layer];
+        let frames = &self.part.axes.frames[self.layer];
+        let points: Vec<[f64; 3]> = layer
+            .points
+            .iter()
+            .map(|p| [p.position.x, p.position.y, p.position.z])
+            .collect();
+        let axes: Vec<[f64; 3]> = frames
+            .iter()
+            .map(|f| [f.tool.x, f.tool.y, f.tool.z])
+            .collect();
+        let delta: Vec<Option<f64>> = layer.points.iter().map(|p| p.delta).collect();
+        let mut st = s.serialize_struct("Layer", 4)?;
+        st.serialize_field("slice", &layer.slice)?;
+        st.serialize_field("points", &points)?;
+        st.serialize_field("tool_axis", &axes)?;
+        st.serialize_field("delta", &delta)?;
+        st.end()
+    }
+}
+
+impl Serialize for SlicedPart {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let layers: Vec<LayerView<'_>> = (0..self.path.layers.len())
+            .map(|layer| LayerView { part: self, layer })
+            .collect();
+        let mut m = s.serialize_map(Some(2))?;
+        m.serialize_entry("summary", &self.summary())?;
+        m.serialize_entry("layers", &layers)?;
+        m.end()
+    }
+}
