@@ -60,6 +60,7 @@ pub mod optimise;
 pub mod path;
 pub mod process;
 pub mod program;
+pub mod report;
 pub mod robot;
 pub mod toolaxis;
 
