@@ -123,6 +123,8 @@ struct Field {
     unit: &'static str,
     /// Diverging fields are coloured symmetrically about zero.
     diverging: bool,
+    /// Least half-range of a diverging field's colours (its unit).
+    min_half_range: f64,
     values: Vec<f32>,
 }
 
@@ -196,6 +198,8 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             name: "interlayer distance − Delta",
             unit: "mm",
             diverging: true,
+            // 2 % of Delta: a constant-distance path's rounding noise stays neutral
+            min_half_range: 0.02 * delta,
             values: dev,
         },
         Field {
@@ -203,6 +207,7 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             name: "lean of the tool axis from part Z",
             unit: "deg",
             diverging: false,
+            min_half_range: 0.0,
             values: lean,
         },
     ];
@@ -212,6 +217,7 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             name: "travel speed",
             unit: "mm/s",
             diverging: false,
+            min_half_range: 0.0,
             values: speed,
         });
     }
@@ -221,6 +227,7 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             name: "R_Z (free angle about the tool axis)",
             unit: "deg",
             diverging: false,
+            min_half_range: 0.0,
             values: rz,
         });
         fields.push(Field {
@@ -228,6 +235,7 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             name: "smallest joint-limit margin",
             unit: "deg",
             diverging: false,
+            min_half_range: 0.0,
             values: margin,
         });
     }
@@ -331,6 +339,7 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
                 .str("name", f.name)
                 .str("unit", f.unit)
                 .raw("diverging", if f.diverging { "true" } else { "false" })
+                .num("min_half_range", f.min_half_range)
                 .str("data", &f32s(&f.values));
             j.finish()
         })

@@ -60,7 +60,7 @@
   var layerOf = new Float32Array(N);
   for (var l0 = 0; l0 < L; l0++) for (var j0 = layerStart[l0]; j0 < layerStart[l0 + 1]; j0++) layerOf[j0] = l0;
   var fields = D.fields.map(function (f) {
-    return { key: f.key, name: f.name, unit: f.unit, diverging: f.diverging, data: f32(f.data) };
+    return { key: f.key, name: f.name, unit: f.unit, diverging: f.diverging, min_half_range: f.min_half_range, data: f32(f.data) };
   });
   fields.push({ key: 'layer', name: 'layer', unit: '', diverging: false, data: layerOf });
   fields.forEach(function (f) {
@@ -70,7 +70,9 @@
       if (isFinite(v)) { if (v < lo) lo = v; if (v > hi) hi = v; }
     }
     if (!isFinite(lo)) { lo = 0; hi = 0; }
-    if (f.diverging) { var m = Math.max(Math.abs(lo), Math.abs(hi)) || 1e-9; lo = -m; hi = m; }
+    // a diverging field spans at least ±min_half_range, so that noise
+    // around zero is not painted as a full deviation
+    if (f.diverging) { var m = Math.max(Math.abs(lo), Math.abs(hi), f.min_half_range || 1e-9); lo = -m; hi = m; }
     if (hi - lo < 1e-12) { hi = lo + 1e-9; }
     f.lo = lo; f.hi = hi;
   });
@@ -311,7 +313,7 @@
     for (j = layerStart[l]; j < layerStart[l + 1]; j += axisStride) {
       var p = vtx(j), t = dir(tool, j);
       axP.push(p[0], p[1], p[2], p[0] + axisLen * t[0], p[1] + axisLen * t[1], p[2] + axisLen * t[2]);
-      axC.push(0.35, 0.35, 0.4, 0.85, 0.45, 0.1);
+      axC.push(0.75, 0.75, 0.8, 1.0, 0.55, 0.15);
     }
   }
   axStart[L] = axP.length / 3;
@@ -360,7 +362,7 @@
     for (j = 0; j < sp.length; j += 9) {
       var fn = unit(cross(sub([sp[j + 3], sp[j + 4], sp[j + 5]], [sp[j], sp[j + 1], sp[j + 2]]),
         sub([sp[j + 6], sp[j + 7], sp[j + 8]], [sp[j], sp[j + 1], sp[j + 2]])));
-      for (var v = 0; v < 9; v += 3) { sn[j + v] = fn[0]; sn[j + v + 1] = fn[1]; sn[j + v + 2] = fn[2]; sc[j + v] = 0.55; sc[j + v + 1] = 0.62; sc[j + v + 2] = 0.72; }
+      for (var v = 0; v < 9; v += 3) { sn[j + v] = fn[0]; sn[j + v + 1] = fn[1]; sn[j + v + 2] = fn[2]; sc[j + v] = 0.6; sc[j + v + 1] = 0.68; sc[j + v + 2] = 0.8; }
     }
     subMesh = mesh([sp, sc, sn]);
   }
@@ -370,7 +372,7 @@
     var mp = [], mc = [];
     marks.forEach(function (m) {
       if (m.layer < state.lo || m.layer > state.hi) return;
-      mp.push(m.at[0], m.at[1], m.at[2]); mc.push(0.9, 0.0, 0.1);
+      mp.push(m.at[0], m.at[1], m.at[2]); mc.push(1.0, 0.15, 0.2);
     });
     marksMesh = mp.length ? mesh([new Float32Array(mp), new Float32Array(mc)]) : null;
   }
@@ -483,7 +485,7 @@
   }
 
   // ---- drawing ----
-  var BG = [0.96, 0.965, 0.975];
+  var BG = [0.12, 0.135, 0.16];
   var needRender = false;
   function requestRender() {
     if (needRender) return;
@@ -531,7 +533,7 @@
     drawOverlay();
   }
   var triadMesh = mesh([new Float32Array([0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 1]),
-    new Float32Array([0.85, 0.1, 0.1, 0.85, 0.1, 0.1, 0.1, 0.6, 0.1, 0.1, 0.6, 0.1, 0.1, 0.25, 0.9, 0.1, 0.25, 0.9])]);
+    new Float32Array([1, 0.3, 0.3, 1, 0.3, 0.3, 0.3, 0.9, 0.3, 0.3, 0.9, 0.3, 0.35, 0.55, 1, 0.35, 0.55, 1])]);
   var TRIAD = 90;
   function triadRotation() { var r = new Float32Array(view); r[12] = r[13] = r[14] = 0; return r; }
   function drawTriad() {
@@ -549,7 +551,7 @@
     g.setTransform(dpr, 0, 0, dpr, 0, 0);
     g.clearRect(0, 0, s[0], s[1]);
     g.font = '12px sans-serif';
-    g.fillStyle = '#222';
+    g.fillStyle = '#e6e8ec';
     // triad labels
     var r = triadRotation();
     [['X', [1, 0, 0]], ['Y', [0, 1, 0]], ['Z', [0, 0, 1]]].forEach(function (a) {
@@ -567,7 +569,7 @@
     g.fillText((nice >= 1 ? String(nice) : nice.toPrecision(1)) + ' mm', x0 + px / 2, y0 - 7);
     g.textAlign = 'left';
     if (F && state.cell && !isFinite(F.chain[24 * state.frame])) {
-      g.fillStyle = '#b00020';
+      g.fillStyle = '#ff6b6b';
       g.fillText('no joint solution at this point', 8, 18);
     }
   }
@@ -600,7 +602,7 @@
     tip.hidden = false;
     tip.style.left = Math.min(x + 14, cssSize()[0] - tip.offsetWidth - 4) + 'px';
     tip.style.top = Math.max(4, y - tip.offsetHeight - 8) + 'px';
-    hoverMesh = mesh([new Float32Array(p), new Float32Array([0.05, 0.05, 0.05])]);
+    hoverMesh = mesh([new Float32Array(p), new Float32Array([1, 1, 1])]);
     requestRender();
     return { vertex: best, layer: l, point: idx, text: text };
   }
@@ -723,7 +725,7 @@
       setFrame(best);
     }
     setRange(Math.min(state.lo, m.layer), Math.max(state.hi, m.layer));
-    hoverMesh = mesh([new Float32Array(m.at), new Float32Array([0.05, 0.05, 0.05])]);
+    hoverMesh = mesh([new Float32Array(m.at), new Float32Array([1, 1, 1])]);
     requestRender();
   }
   if (F) {
@@ -763,6 +765,9 @@
   if (/selftest/.test(location.hash)) {
     setTimeout(function () {
       var out = { webgl: true, fields: [], errors_before: errorCount };
+      var cellWas = state.cell;
+      state.cell = false;
+      resetView();
       render();
       out.first = countDrawn();
       fields.forEach(function (f, k) { state.field = k; recolour(); render(); out.fields.push([f.key, countDrawn().colours]); });
@@ -780,12 +785,15 @@
       out.pick = pick ? { vertex: pick.vertex, wanted: mid, layer: pick.layer, text: pick.text } : null;
       setRange(0, L - 1);
       if (F) {
+        state.cell = true;
+        resetView();
         state.only = 'cell';
         setFrame(Math.floor(F.n / 2));
         render();
         out.robot_only = countDrawn();
         state.only = null;
-        state.cell = false; render(); out.part_view = countDrawn(); state.cell = true;
+        render();
+        out.cell_view = countDrawn();
         setFrame(0);
         state.playing = true; state.speed = 1000;
         for (var k = 0; k < 5; k++) advance(0.05);
@@ -793,6 +801,7 @@
         out.joint_rows = $('joints').rows.length;
         state.playing = false;
       }
+      state.cell = cellWas;
       resetView();
       render();
       out.last = countDrawn();

@@ -157,7 +157,11 @@ fn open_and_check(browser: &Path, html: &Path) -> serde_json::Value {
         "{}: script errors:\n{errors}",
         html.display()
     );
-    assert!(!dom.contains("SCRIPT ERROR"), "error in the title");
+    let title = &dom[dom.find("<title>").unwrap()..dom.find("</title>").unwrap()];
+    assert!(
+        !title.contains("SCRIPT ERROR"),
+        "error in the title: {title}"
+    );
     let record: serde_json::Value = serde_json::from_str(&element_text(&dom, "selftest")).unwrap();
     eprintln!("{}: {record}", html.display());
     assert_eq!(record["webgl"], true, "WebGL did not start: {record}");
