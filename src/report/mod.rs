@@ -258,7 +258,7 @@ fn write_page(w: &mut dyn Write, title: &str, data: &str) -> std::io::Result<()>
             + rest[start..]
                 .find("}}")
                 .ok_or_else(|| std::io::Error::other("report template: unclosed {{"))?;
-        w.write_all(rest[..start].as_bytes())?;
+        w.write_all(&rest.as_bytes()[..start])?;
         match &rest[start + 2..end] {
             "TITLE" => w.write_all(encode::html_escape(title).as_bytes())?,
             "CSS" => w.write_all(VIEWER_CSS.as_bytes())?,
