@@ -80,6 +80,7 @@ pub mod path;
 pub mod pipeline;
 pub mod process;
 pub mod program;
+pub mod report;
 pub mod robot;
 pub mod toolaxis;
 

@@ -1,0 +1,632 @@
+//! The page's data: checks the input against the path, decimates, computes
+//! the fields and the cell at every animation frame, and encodes it all as
+//! one JSON object whose arrays are base64 typed arrays.
+
+use super::cell_view::{snapshot, CHAIN_POINTS};
+use super::encode::{f32s, i8s, json_nums, json_str, u32s, unit_i8, JsonObject};
+use super::{PlanView, ReportError, ReportInput};
+use crate::geometry::Substrate;
+use crate::math::{Point3, Vector3};
+use crate::robot::Cell;
+
+/// Indices kept of a run of `n` points with stride `k`: `0, k, 2k, ...` and `n − 1`.
+pub(crate) fn kept(n: usize, k: usize) -> impl Iterator<Item = usize> {
+    let k = k.max(1);
+    let last = n.saturating_sub(1);
+    (0..n)
+        .step_by(k)
+        .chain((n > 0 && last % k != 0).then_some(last))
+}
+
+/// The stride that keeps at most about `bound` of `total` points.
+pub(crate) fn stride(total: usize, bound: usize) -> usize {
+    total.div_ceil(bound.max(1)).max(1)
+}
+
+fn check(input: &ReportInput) -> Result<(), ReportError> {
+    let path = input.path;
+    let o = &input.options;
+    for (field, v) in [
+        ("max_points", o.max_points),
+        ("max_frames", o.max_frames),
+        ("max_marks", o.max_marks),
+    ] {
+        if v < 2 {
+            return Err(ReportError::InvalidOption {
+                field,
+                value: v as f64,
+                reason: "must be at least 2",
+            });
+        }
+    }
+    if !(input.bead_width_mm > 0.0) || !input.bead_width_mm.is_finite() {
+        return Err(ReportError::InvalidOption {
+            field: "bead_width_mm",
+            value: input.bead_width_mm,
+            reason: "must be finite and > 0",
+        });
+    }
+    if path.num_points() == 0 {
+        return Err(ReportError::EmptyPath);
+    }
+    let shape = |what, layer, expected, got, unit| ReportError::Shape {
+        what,
+        layer,
+        expected,
+        got,
+        unit,
+    };
+    let per_layer = |what: &'static str, counts: Vec<usize>| -> Result<(), ReportError> {
+        if counts.len() != path.layers.len() {
+            return Err(shape(what, None, path.layers.len(), counts.len(), "layers"));
+        }
+        for (l, (layer, got)) in path.layers.iter().zip(counts).enumerate() {
+            if got != layer.points.len() {
+                return Err(shape(what, Some(l), layer.points.len(), got, "points"));
+            }
+        }
+        Ok(())
+    };
+    per_layer("frames", input.frames.iter().map(Vec::len).collect())?;
+    per_layer(
+        "distance map",
+        input.map.points.iter().map(Vec::len).collect(),
+    )?;
+    if let Some(p) = input.process {
+        per_layer("process", p.points.iter().map(Vec::len).collect())?;
+    }
+    if let Some(pv) = &input.plan {
+        per_layer(
+            "plan layers",
+            pv.layers.iter().map(|l| l.points.len()).collect(),
+        )?;
+        per_layer(
+            "plan",
+            pv.plan.layers.iter().map(|l| l.points.len()).collect(),
+        )?;
+        if !(pv.travel_speed_mm_s > 0.0) || !pv.travel_speed_mm_s.is_finite() {
+            return Err(ReportError::InvalidOption {
+                field: "travel_speed_mm_s",
+                value: pv.travel_speed_mm_s,
+                reason: "must be finite and > 0",
+            });
+        }
+    }
+    for (l, (layer, fr)) in path.layers.iter().zip(input.frames).enumerate() {
+        for (i, (p, f)) in layer.points.iter().zip(fr).enumerate() {
+            let bad = |what| ReportError::NonFinite {
+                what,
+                layer: l,
+                point: i,
+            };
+            if !p.position.iter().all(|v| v.is_finite()) {
+                return Err(bad("position"));
+            }
+            for (what, v) in [
+                ("tool axis", &f.tool),
+                ("surface normal", &f.normal),
+                ("build direction", &f.build),
+            ] {
+                if !v.iter().all(|c| c.is_finite()) {
+                    return Err(bad(what));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One colour field of the path.
+struct Field {
+    key: &'static str,
+    name: &'static str,
+    unit: &'static str,
+    /// Diverging fields are coloured symmetrically about zero.
+    diverging: bool,
+    /// Least half-range of a diverging field's colours (its unit).
+    min_half_range: f64,
+    values: Vec<f32>,
+}
+
+/// A marker on the path: a violation or a process-window problem.
+struct Mark {
+    layer: usize,
+    point: usize,
+    text: String,
+}
+
+/// Builds the page's data object (JSON text).
+pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
+    check(input)?;
+    let path = input.path;
+    let total = path.num_points();
+    let k = stride(total, input.options.max_points);
+    let delta = path.delta_mm;
+    let nl = path.layers.len();
+
+    let mut layer_start = Vec::with_capacity(nl + 1);
+    let (mut pos, mut tool, mut normal, mut build) = (vec![], vec![], vec![], vec![]);
+    let mut dev = vec![];
+    let mut lean = vec![];
+    let mut speed = vec![];
+    let mut rz = vec![];
+    let mut margin = vec![];
+    let robot = input.plan.as_ref().map(|pv| pv.cell.robot());
+    for (l, layer) in path.layers.iter().enumerate() {
+        layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
+        for i in kept(layer.points.len(), k) {
+            let p = &layer.points[i];
+            let f = &input.frames[l][i];
+            pos.extend([
+                p.position.x as f32,
+                p.position.y as f32,
+                p.position.z as f32,
+            ]);
+            for (out, v) in [
+                (&mut tool, f.tool),
+                (&mut normal, f.normal),
+                (&mut build, f.build),
+            ] {
+                let u = v.try_normalize(0.0).unwrap_or_else(Vector3::zeros);
+                out.extend([unit_i8(u.x), unit_i8(u.y), unit_i8(u.z)]);
+            }
+            dev.push(match input.map.points[l][i] {
+                Some((d, false)) => (d - delta) as f32,
+                _ => f32::NAN,
+            });
+            let t = f.tool.try_normalize(0.0).unwrap_or_else(Vector3::z);
+            lean.push(t.z.clamp(-1.0, 1.0).acos().to_degrees() as f32);
+            if let Some(pr) = input.process {
+                speed.push(pr.points[l][i].travel_speed_mm_s as f32);
+            }
+            if let (Some(pv), Some(robot)) = (&input.plan, robot) {
+                let pp = &pv.plan.layers[l].points[i];
+                rz.push(pp.r_z.to_degrees() as f32);
+                margin.push(match pp.joints {
+                    Some(q) => limit_margin_rad(robot, &q).to_degrees() as f32,
+                    None => f32::NAN,
+                });
+            }
+        }
+    }
+    layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
+    let shown = pos.len() / 3;
+
+    let mut fields = vec![
+        Field {
+            key: "deviation",
+            name: "interlayer distance − Delta",
+            unit: "mm",
+            diverging: true,
+            // 2 % of Delta: a constant-distance path's rounding noise stays neutral
+            min_half_range: 0.02 * delta,
+            values: dev,
+        },
+        Field {
+            key: "lean",
+            name: "lean of the tool axis from part Z",
+            unit: "deg",
+            diverging: false,
+            min_half_range: 0.0,
+            values: lean,
+        },
+    ];
+    if input.process.is_some() {
+        fields.push(Field {
+            key: "speed",
+            name: "travel speed",
+            unit: "mm/s",
+            diverging: false,
+            min_half_range: 0.0,
+            values: speed,
+        });
+    }
+    if input.plan.is_some() {
+        fields.push(Field {
+            key: "rz",
+            name: "R_Z (free angle about the tool axis)",
+            unit: "deg",
+            diverging: false,
+            min_half_range: 0.0,
+            values: rz,
+        });
+        fields.push(Field {
+            key: "margin",
+            name: "smallest joint-limit margin",
+            unit: "deg",
+            diverging: false,
+            min_half_range: 0.0,
+            values: margin,
+        });
+    }
+
+    let mut marks: Vec<Mark> = vec![];
+    if let Some(pv) = &input.plan {
+        marks.extend(pv.plan.violations().map(|v| Mark {
+            layer: v.layer,
+            point: v.point,
+            text: v.to_string(),
+        }));
+    }
+    if let Some(pr) = input.process {
+        marks.extend(pr.violations.iter().map(|v| Mark {
+            layer: v.layer,
+            point: v.point,
+            text: format!(
+                "layer {}, point {}: travel speed window: {:?} (local distance {:.3} mm{})",
+                v.layer,
+                v.point,
+                v.side,
+                v.delta_mm,
+                v.needed_mm_s
+                    .map(|s| format!(", needs {s:.2} mm/s"))
+                    .unwrap_or_default()
+            ),
+        }));
+    }
+    // A mark names a point of the path; anything else is dropped (counted).
+    marks.retain(|m| {
+        path.layers
+            .get(m.layer)
+            .is_some_and(|l| m.point < l.points.len())
+    });
+    let marks_total = marks.len();
+    marks.truncate(input.options.max_marks);
+
+    let mut notes: Vec<String> = vec![];
+    if k > 1 {
+        notes.push(format!(
+            "{total} path points: {shown} drawn (every {k}th point of each layer and its last); hover shows the drawn points' own indices."
+        ));
+    }
+    if marks_total > marks.len() {
+        notes.push(format!(
+            "{marks_total} violations: the first {} are marked.",
+            marks.len()
+        ));
+    }
+
+    let mut o = JsonObject::new();
+    o.num("version", 1.0)
+        .str("title", input.title)
+        .str("strategy", path.strategy.name())
+        .num("delta_mm", delta)
+        .num("bead_width_mm", input.bead_width_mm)
+        .num("points_total", total as f64)
+        .num("points_shown", shown as f64)
+        .num("stride", k as f64)
+        .num("length_mm", path.length_mm());
+    o.raw(
+        "layer_slice",
+        json_nums(
+            &path
+                .layers
+                .iter()
+                .map(|l| l.slice as f64)
+                .collect::<Vec<_>>(),
+        ),
+    );
+    o.raw(
+        "layer_closed",
+        json_nums(
+            &path
+                .layers
+                .iter()
+                .map(|l| f64::from(u8::from(l.closed)))
+                .collect::<Vec<_>>(),
+        ),
+    );
+    o.raw(
+        "layer_points",
+        json_nums(
+            &path
+                .layers
+                .iter()
+                .map(|l| l.points.len() as f64)
+                .collect::<Vec<_>>(),
+        ),
+    );
+    o.str("layer_start", &u32s(&layer_start));
+    o.str("pos", &f32s(&pos));
+    o.str("tool", &i8s(&tool));
+    o.str("normal", &i8s(&normal));
+    o.str("build", &i8s(&build));
+    let fields_json: Vec<String> = fields
+        .iter()
+        .map(|f| {
+            let mut j = JsonObject::new();
+            j.str("key", f.key)
+                .str("name", f.name)
+                .str("unit", f.unit)
+                .raw("diverging", if f.diverging { "true" } else { "false" })
+                .num("min_half_range", f.min_half_range)
+                .str("data", &f32s(&f.values));
+            j.finish()
+        })
+        .collect();
+    o.raw("fields", format!("[{}]", fields_json.join(",")));
+    let (substrate, substrate_note) = substrate_triangles(input.substrate, &pos);
+    match substrate {
+        Some(t) => o.str("substrate", &f32s(&t)),
+        None => o.raw("substrate", "null"),
+    };
+    if let Some(n) = substrate_note {
+        notes.push(n.into());
+    }
+    let marks_json: Vec<String> = marks
+        .iter()
+        .map(|m| {
+            let p = path.layers[m.layer].points[m.point].position;
+            let mut j = JsonObject::new();
+            j.num("layer", m.layer as f64)
+                .num("point", m.point as f64)
+                .str("text", &m.text)
+                .raw("at", json_nums(&[p.x, p.y, p.z]));
+            j.finish()
+        })
+        .collect();
+    o.raw("marks", format!("[{}]", marks_json.join(",")));
+    o.num("marks_total", marks_total as f64);
+    match &input.plan {
+        Some(pv) => {
+            let (plan_json, plan_notes) = plan_data(input, pv);
+            notes.extend(plan_notes);
+            o.raw("plan", plan_json)
+        }
+        None => o.raw("plan", "null"),
+    };
+    let notes: Vec<String> = notes.iter().map(|n| json_str(n)).collect();
+    o.raw("notes", format!("[{}]", notes.join(",")));
+    Ok(o.finish())
+}
+
+/// Smallest distance of `q` to its joint limits (rad; negative outside),
+/// unlimited joints left out; `+inf` if every joint is unlimited.
+pub(crate) fn limit_margin_rad(robot: &crate::robot::model::RobotModel, q: &[f64; 6]) -> f64 {
+    robot
+        .limits
+        .iter()
+        .zip(q)
+        .filter(|(l, _)| !l.is_unlimited())
+        .map(|(l, v)| (v - l.lower_rad).min(l.upper_rad - v))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Triangles (part frame, mm, 9 floats each) of the substrate around the
+/// drawn points `pos` (xyz triples), and a note when it is not drawn.
+fn substrate_triangles(
+    substrate: Option<&Substrate>,
+    pos: &[f32],
+) -> (Option<Vec<f32>>, Option<&'static str>) {
+    let Some(substrate) = substrate else {
+        return (None, None);
+    };
+    let pts: Vec<Point3> = pos
+        .chunks_exact(3)
+        .map(|c| Point3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])))
+        .collect();
+    let mut lo = Vector3::repeat(f64::INFINITY);
+    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+    for p in &pts {
+        lo = lo.inf(&p.coords);
+        hi = hi.sup(&p.coords);
+    }
+    let centre = Point3::from((lo + hi) * 0.5);
+    let size = (hi - lo).max().max(1.0);
+    let mut tris: Vec<f32> = vec![];
+    let mut push = |a: Point3, b: Point3, c: Point3| {
+        for p in [a, b, c] {
+            tris.extend([p.x as f32, p.y as f32, p.z as f32]);
+        }
+    };
+    match substrate {
+        Substrate::Plane { point, normal } => {
+            let n = normal.into_inner();
+            let c = centre - n * (centre - point).dot(&n);
+            let u = n.cross(&if n.x.abs() < 0.9 {
+                Vector3::x()
+            } else {
+                Vector3::y()
+            });
+            let u = u.normalize() * (0.75 * size);
+            let v = n.cross(&u);
+            let q = [c - u - v, c + u - v, c + u + v, c - u + v];
+            push(q[0], q[1], q[2]);
+            push(q[0], q[2], q[3]);
+        }
+        Substrate::Cylinder {
+            axis_point,
+            axis,
+            radius,
+        } => {
+            let a = axis.into_inner();
+            let (mut s0, mut s1) = (f64::INFINITY, f64::NEG_INFINITY);
+            for p in &pts {
+                let s = (p - axis_point).dot(&a);
+                s0 = s0.min(s);
+                s1 = s1.max(s);
+            }
+            let margin = 0.25 * size;
+            let (s0, s1) = (s0 - margin, s1 + margin);
+            let u = a
+                .cross(&if a.x.abs() < 0.9 {
+                    Vector3::x()
+                } else {
+                    Vector3::y()
+                })
+                .normalize();
+            let v = a.cross(&u);
+            let n = 48;
+            let ring = |k: usize, s: f64| {
+                let th = std::f64::consts::TAU * k as f64 / n as f64;
+                axis_point + a * s + (u * th.cos() + v * th.sin()) * *radius
+            };
+            for k in 0..n {
+                let (p0, p1) = (ring(k, s0), ring(k + 1, s0));
+                let (p2, p3) = (ring(k + 1, s1), ring(k, s1));
+                push(p0, p1, p2);
+                push(p0, p2, p3);
+            }
+        }
+        Substrate::Mesh(_) => return (None, Some("The mesh substrate is not drawn.")),
+    }
+    (Some(tris), None)
+}
+
+/// The plan part of the data: cell, limits and the cell at every frame.
+fn plan_data(input: &ReportInput, pv: &PlanView) -> (String, Vec<String>) {
+    let path = input.path;
+    let total: usize = pv.layers.iter().map(|l| l.points.len()).sum();
+    let k = stride(total, input.options.max_frames);
+    let robot = pv.cell.robot();
+    // The clock: time under the arc along every point (and across layer
+    // changes) at the process speed of the point, else the travel speed.
+    let speed_at = |l: usize, i: usize| -> f64 {
+        input
+            .process
+            .map(|p| p.points[l][i].travel_speed_mm_s)
+            .filter(|v| *v > 0.0 && v.is_finite())
+            .unwrap_or(pv.travel_speed_mm_s)
+    };
+    let (mut f_layer, mut f_point, mut f_time, mut f_rz) = (vec![], vec![], vec![], vec![]);
+    let (mut f_joints, mut f_chain, mut f_torch, mut f_table, mut f_part) =
+        (vec![], vec![], vec![], vec![], vec![]);
+    let mut clock = 0.0;
+    let mut prev: Option<Point3> = None;
+    let mut g = 0usize;
+    let last = total.saturating_sub(1);
+    let mut q8_hint = 0.0;
+    for (l, (lp, pl)) in pv.layers.iter().zip(&pv.plan.layers).enumerate() {
+        for (i, (cp, pp)) in lp.points.iter().zip(&pl.points).enumerate() {
+            if let Some(p0) = prev {
+                clock += (cp.position_mm - p0).norm() / speed_at(l, i);
+            }
+            prev = Some(cp.position_mm);
+            if let Some(e) = pp.positioner {
+                q8_hint = e[1];
+            }
+            if g % k == 0 || g == last {
+                f_layer.push(l as u32);
+                f_point.push(i as u32);
+                f_time.push(clock as f32);
+                f_rz.push(pp.r_z.to_degrees() as f32);
+                let q = pp.joints;
+                for j in 0..6 {
+                    f_joints.push(q.map_or(f32::NAN, |q| q[j].to_degrees() as f32));
+                }
+                for j in 0..2 {
+                    f_joints.push(pp.positioner.map_or(f32::NAN, |e| e[j].to_degrees() as f32));
+                }
+                let positioner = pp.positioner.or_else(|| match pv.cell {
+                    // without a planned positioner pose, turn it as the cell would
+                    Cell::TorchCarried(c) => c.positioner_angles(cp, q8_hint).ok(),
+                    Cell::PartCarried(_) => None,
+                });
+                let s = snapshot(pv.cell, q.as_ref(), positioner.as_ref(), cp, pp.r_z);
+                match s.chain {
+                    Some(c) => c
+                        .iter()
+                        .for_each(|p| f_chain.extend([p.x as f32, p.y as f32, p.z as f32])),
+                    None => f_chain.extend([f32::NAN; 3 * CHAIN_POINTS]),
+                }
+                for p in s.torch {
+                    f_torch.extend([p.x as f32, p.y as f32, p.z as f32]);
+                }
+                match s.positioner {
+                    Some((c7, c8, n)) => {
+                        for v in [c7.coords, c8.coords, n] {
+                            f_table.extend([v.x as f32, v.y as f32, v.z as f32]);
+                        }
+                    }
+                    None => f_table.extend([f32::NAN; 9]),
+                }
+                match s.base_from_part {
+                    Some(t) => {
+                        let r = t.rotation.to_rotation_matrix();
+                        // column-major 3×3, then the translation
+                        f_part.extend(r.matrix().iter().map(|v| *v as f32));
+                        f_part.extend(t.translation.vector.iter().map(|v| *v as f32));
+                    }
+                    None => f_part.extend([f32::NAN; 12]),
+                }
+            }
+            g += 1;
+        }
+    }
+    let frames = f_layer.len();
+    let limits: Vec<String> = robot
+        .limits
+        .iter()
+        .map(|l| json_nums(&[l.lower_rad.to_degrees(), l.upper_rad.to_degrees()]))
+        .chain(match pv.cell {
+            Cell::TorchCarried(c) => c
+                .positioner
+                .limits
+                .iter()
+                .map(|l| json_nums(&[l.lower_rad.to_degrees(), l.upper_rad.to_degrees()]))
+                .collect(),
+            Cell::PartCarried(_) => vec![],
+        })
+        .collect();
+    let g = &robot.geometry;
+    let mut o = JsonObject::new();
+    o.str(
+        "cell_kind",
+        match pv.cell {
+            Cell::PartCarried(_) => "part carried",
+            Cell::TorchCarried(_) => "torch carried",
+        },
+    )
+    .str("cell", pv.cell.name())
+    .str("robot", &robot.name)
+    .num(
+        "reach_mm",
+        g.upper_arm_mm + g.forearm_mm + g.wrist_to_flange_mm,
+    )
+    .raw("limits_deg", format!("[{}]", limits.join(",")))
+    .num(
+        "max_hose_deg",
+        match pv.cell {
+            Cell::TorchCarried(c) => c.max_hose_torsion_rad.to_degrees(),
+            Cell::PartCarried(_) => f64::NAN,
+        },
+    )
+    .raw(
+        "feasible",
+        if pv.plan.is_feasible() {
+            "true"
+        } else {
+            "false"
+        },
+    )
+    .raw(
+        "infeasible_layers",
+        json_nums(
+            &pv.plan
+                .infeasible_layers()
+                .map(|l| l.layer as f64)
+                .collect::<Vec<_>>(),
+        ),
+    )
+    .num("frames", frames as f64)
+    .num("points_total", total as f64)
+    .num("frame_stride", k as f64)
+    .num("duration_s", f_time.last().map_or(0.0, |t| f64::from(*t)))
+    .str("f_layer", &u32s(&f_layer))
+    .str("f_point", &u32s(&f_point))
+    .str("f_time", &f32s(&f_time))
+    .str("f_rz", &f32s(&f_rz))
+    .str("f_joints", &f32s(&f_joints))
+    .str("f_chain", &f32s(&f_chain))
+    .str("f_torch", &f32s(&f_torch))
+    .str("f_table", &f32s(&f_table))
+    .str("f_part", &f32s(&f_part));
+    let mut notes = vec![];
+    if k > 1 {
+        notes.push(format!(
+            "{total} planned points: the animation shows {frames} of them (every {k}th and the last)."
+        ));
+    }
+    let _ = path;
+    (o.finish(), notes)
+}
