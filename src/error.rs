@@ -47,6 +47,9 @@ pub enum Error {
     /// A path CSV could not be read.
     #[error(transparent)]
     PathCsv(#[from] PathCsvError),
+    /// The 3-D report could not be built or written.
+    #[error(transparent)]
+    Report(#[from] crate::report::ReportError),
     /// A joints CSV could not be read.
     #[error(transparent)]
     JointsCsv(#[from] JointsCsvError),

@@ -42,6 +42,11 @@ pub enum Command {
     /// Plan a part in a cell: slice, tool axes, R_Z optimisation, joints;
     /// writes joints.csv and summary.json in --out (exit 2 if infeasible).
     Plan(PlanArgs),
+    /// Place a part in a cell: search the deposition point (part carried) or the positioner's
+    /// pose (torch carried) and the mount's rotation within the cell file's [placement] bounds
+    /// so that every layer is feasible with the widest margin; writes cell.toml and placement.json
+    /// in --out (exit 0 found, 2 none found, 1 bad input).
+    Place(PlaceArgs),
     /// List the sample parts (and cells) with one line each.
     Parts {
         /// Folder holding the part files.
@@ -212,4 +217,29 @@ pub struct CheckArgs {
     /// The cell file (TOML, parts/cells/).
     #[arg(long)]
     pub cell: PathBuf,
+}
+
+/// Arguments of `place`.
+#[derive(Debug, clap::Args)]
+pub struct PlaceArgs {
+    /// The part file (TOML).
+    pub part: PathBuf,
+    /// The cell file (TOML, parts/cells/).
+    #[arg(long)]
+    pub cell: PathBuf,
+    /// Delta and the discretisation of each layer.
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// Tool axis and process.
+    #[command(flatten)]
+    pub axes: AxisArgs,
+    /// Coarse candidates sampled in the placement box.
+    #[arg(long, default_value_t = 64)]
+    pub samples: usize,
+    /// Half-width (mm) of the box searched when the cell file has no [placement] bounds.
+    #[arg(long, default_value_t = 400.0)]
+    pub half_box: f64,
+    /// Output folder (default out/<part name>-placed).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }

@@ -8,6 +8,7 @@
 //! Exit codes: 0 done, 1 bad input (the message names the file and field).
 
 mod args;
+mod place;
 mod plan;
 mod plots;
 mod progress;
@@ -31,6 +32,7 @@ fn main() -> ExitCode {
     let result = match &args.command {
         Command::Plan(a) => return plan::run(a, args.quiet),
         Command::Check(a) => return plan::check(a, args.quiet),
+        Command::Place(a) => return place::run(a, args.quiet),
         Command::Parts { dir } => list_parts(dir),
         Command::Geometry { part, points } => geometry(part, *points, args.quiet),
         Command::Slice(cmd) => slice::run(cmd, args.quiet),

@@ -65,6 +65,9 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     write_atomic(&csv, |w| planned.write_joints_csv(w))
         .map_err(|e| input(format!("{}: {e}", csv.display())))?;
     draw_joint_plots(&dir, &part.name, &planned).map_err(input)?;
+    planned
+        .write_report(&dir.join("report.html"), Some(&part.substrate))
+        .map_err(|e| input(e.to_string()))?;
     let mut summary = planned.summary();
     summary["run_time_s"]["read"] = t_read.into();
     let sj = dir.join("summary.json");

@@ -52,6 +52,9 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     let width = more.bead_width.unwrap_or(path.delta_mm);
     write_atomic(&stl, |w| sliced.write_wall_stl(w, width))
         .map_err(|e| format!("{}: {e}", stl.display()))?;
+    sliced
+        .write_report(&dir.join("report.html"), Some(&part.substrate), width)
+        .map_err(|e| e.to_string())?;
     // Pictures: written to temporary names, then renamed (no half-written file).
     let t4 = Instant::now();
     for (name, draw) in [
@@ -119,7 +122,7 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             );
         }
         println!(
-            "  wrote path.csv, summary.json, path.svg, distance.svg, wall.stl in {}",
+            "  wrote path.csv, summary.json, path.svg, distance.svg, wall.stl, report.html in {}",
             dir.display()
         );
     }

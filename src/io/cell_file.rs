@@ -81,6 +81,38 @@ pub struct CellFile {
     pub robot: RobotModel,
     /// The cell, if the file describes one.
     pub cell: Option<Cell>,
+    /// The `[placement]` table: bounds for `waam place`, if given.
+    pub placement: Option<PlacementSpec>,
+}
+
+/// The `[placement]` table of a cell file: the bounds of the placement
+/// search (robot base frame; mm and degrees). Each key is optional.
+///
+/// ```toml
+/// [placement]
+/// min_mm = [600, -900, 300]     # deposition point (part carried) or positioner origin (torch carried)
+/// max_mm = [1300, 300, 1200]
+/// rotation_deg = [-180, 180]    # part mount about the flange axis / positioner about the vertical
+/// fixed = ["z"]                 # variables kept at the file's value: x, y, z, rotation
+/// keep_out_min_mm = [-300, -300, -1000]   # a box the point may not enter
+/// keep_out_max_mm = [300, 300, 500]
+/// ```
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlacementSpec {
+    /// Lower corner of the box searched (mm).
+    pub min_mm: Option<[f64; 3]>,
+    /// Upper corner of the box searched (mm).
+    pub max_mm: Option<[f64; 3]>,
+    /// Range of the rotation (deg).
+    pub rotation_deg: Option<[f64; 2]>,
+    /// Variables kept at the file's value: `x`, `y`, `z`, `rotation`.
+    #[serde(default)]
+    pub fixed: Vec<String>,
+    /// Lower corner of the keep-out box (mm).
+    pub keep_out_min_mm: Option<[f64; 3]>,
+    /// Upper corner of the keep-out box (mm).
+    pub keep_out_max_mm: Option<[f64; 3]>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -92,6 +124,7 @@ struct FileDoc {
     robot: RobotSection,
     part_carried: Option<PartCarriedSection>,
     torch_carried: Option<TorchCarriedSection>,
+    placement: Option<PlacementSpec>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -345,10 +378,30 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
     if let Some(c) = &cell {
         c.validate().map_err(robot_err)?;
     }
+    if let Some(p) = &doc.placement {
+        for f in &p.fixed {
+            if !["x", "y", "z", "rotation"].contains(&f.as_str()) {
+                return Err(invalid(
+                    "placement.fixed",
+                    &format!("`{f}`: expected x, y, z or rotation"),
+                ));
+            }
+        }
+        if p.min_mm.is_some() != p.max_mm.is_some() {
+            return Err(invalid("placement.min_mm", "give both min_mm and max_mm"));
+        }
+        if p.keep_out_min_mm.is_some() != p.keep_out_max_mm.is_some() {
+            return Err(invalid(
+                "placement.keep_out_min_mm",
+                "give both keep_out_min_mm and keep_out_max_mm",
+            ));
+        }
+    }
     Ok(CellFile {
         name: doc.name,
         source: doc.source,
         robot,
         cell,
+        placement: doc.placement,
     })
 }

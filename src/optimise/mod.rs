@@ -85,6 +85,7 @@
 pub mod options;
 pub mod outcome;
 pub mod parameterisation;
+pub mod place;
 mod problem;
 mod sqp;
 

@@ -47,6 +47,15 @@ pub enum OptimiseError {
     /// The cell is invalid.
     #[error("cell: {0}")]
     Cell(#[from] RobotError),
+    /// A placement bound or setting is invalid (see
+    /// [`place`](crate::optimise::place::place)).
+    #[error("placement: `{field}`: {reason}")]
+    InvalidPlacement {
+        /// The variable or setting, as in the cell file's `[placement]` table.
+        field: String,
+        /// What is wrong.
+        reason: String,
+    },
 }
 
 /// A constraint of the per-layer problem [eq. 4.5–4.8].

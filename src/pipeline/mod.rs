@@ -25,6 +25,7 @@
 
 mod check;
 mod options;
+mod place;
 mod planned;
 mod sliced;
 
@@ -36,6 +37,7 @@ pub use check::{check_program, read_fanuc_with_calls};
 pub use options::{
     AxisOverrides, ParseOptionError, PlanOptions, ProgramFormat, RzLaw, SliceOverrides,
 };
+pub use place::{place_part, PlaceRequest, PlacedCell};
 pub use planned::{plan_part, program_name, PlanTimes, PlannedPart};
 pub use sliced::{slice_part, slice_part_with, SliceTimes, SlicedPart};
 
@@ -84,6 +86,10 @@ pub struct Cell {
     /// The robot, the deposition point or positioner, the torch: what the
     /// optimiser, the trajectory and the program stages take.
     pub layout: crate::robot::Cell,
+    /// The file's `[placement]` table (bounds of [`place_part`]), if any.
+    pub placement: Option<crate::io::cell_file::PlacementSpec>,
+    /// The file's text as read (a placed copy keeps its other keys).
+    pub text: String,
 }
 
 impl Cell {
@@ -93,8 +99,17 @@ impl Cell {
     /// [`CellFileError`] naming the file and the key; a file describing a
     /// robot only (no `[part_carried]` or `[torch_carried]` table) is refused.
     pub fn read(path: impl AsRef<FsPath>) -> Result<Cell, CellFileError> {
-        let shown = path.as_ref().display().to_string();
-        Self::from_file(read_cell_file(path)?, &shown)
+        let path = path.as_ref();
+        let shown = path.display().to_string();
+        // The reader's own checks first (its messages for a missing file).
+        let file = read_cell_file(path)?;
+        let text = std::fs::read_to_string(path).map_err(|source| CellFileError::Io {
+            path: shown.clone(),
+            source,
+        })?;
+        let mut cell = Self::from_file(file, &shown)?;
+        cell.text = text;
+        Ok(cell)
     }
 
     /// Parses and validates cell-file text; `origin` names it in errors.
@@ -102,10 +117,12 @@ impl Cell {
     /// # Errors
     /// As [`Cell::read`].
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Cell, CellFileError> {
-        Self::from_file(parse_cell_file(text, origin)?, origin)
+        let mut cell = Self::from_file(parse_cell_file(text, origin)?, origin)?;
+        cell.text = text.to_string();
+        Ok(cell)
     }
 
-    /// The cell of a read cell file.
+    /// The cell of a read cell file (its `text` left empty).
     ///
     /// # Errors
     /// [`CellFileError::Invalid`] when the file describes no cell.
@@ -120,6 +137,8 @@ impl Cell {
             source: file.source,
             file: origin.to_string(),
             layout,
+            placement: file.placement,
+            text: String::new(),
         })
     }
 

@@ -295,6 +295,41 @@ impl PlannedPart {
         Ok(files.iter().map(|f| dir.join(&f.name)).collect())
     }
 
+    /// Writes the interactive 3-D report of the plan (`report.html`: the path
+    /// and the robot animated through it, see [`crate::report`]) atomically
+    /// to `dest`; bead width = Delta.
+    ///
+    /// # Errors
+    /// [`Error::Report`] naming the input or the file.
+    pub fn write_report(
+        &self,
+        dest: &FsPath,
+        substrate: Option<&crate::geometry::Substrate>,
+    ) -> Result<(), Error> {
+        let title = format!(
+            "{} in {}: {} layers, {}",
+            self.sliced.part_name,
+            self.cell.name,
+            self.plan.layers.len(),
+            if self.is_feasible() {
+                "feasible"
+            } else {
+                "NOT feasible"
+            }
+        );
+        let mut input = self
+            .sliced
+            .report_input(&title, substrate, self.sliced.path.delta_mm);
+        input.plan = Some(crate::report::PlanView {
+            cell: &self.cell.layout,
+            layers: &self.layers,
+            plan: &self.plan,
+            travel_speed_mm_s: self.travel_speed_mm_s(),
+        });
+        crate::report::write_report(dest, &input)?;
+        Ok(())
+    }
+
     /// The content of `plan`'s `summary.json`: the part and cell files, the
     /// `R_Z` law, travel speed, feasibility, every violation, per layer the
     /// status, IK branch, law, objective, quality figures and solver counts,

@@ -207,6 +207,49 @@ impl SlicedPart {
     }
 }
 
+impl SlicedPart {
+    /// The report's input for this part: the path with its frames, distances
+    /// and process speeds, the substrate if given, bead width `width_mm`.
+    pub fn report_input<'a>(
+        &'a self,
+        title: &'a str,
+        substrate: Option<&'a crate::geometry::Substrate>,
+        width_mm: f64,
+    ) -> crate::report::ReportInput<'a> {
+        let mut input = crate::report::ReportInput::new(
+            title,
+            &self.path,
+            &self.axes.frames,
+            &self.map,
+            width_mm,
+        );
+        input.substrate = substrate;
+        input.process = Some(&self.process_plan);
+        input
+    }
+
+    /// Writes the interactive 3-D report (`report.html`, see
+    /// [`crate::report`]) atomically to `dest`.
+    ///
+    /// # Errors
+    /// [`Error::Report`] naming the input or the file.
+    pub fn write_report(
+        &self,
+        dest: &std::path::Path,
+        substrate: Option<&crate::geometry::Substrate>,
+        width_mm: f64,
+    ) -> Result<(), Error> {
+        let title = format!(
+            "{}: {} path, Delta = {} mm",
+            self.part_name,
+            self.path.strategy.name(),
+            self.path.delta_mm
+        );
+        crate::report::write_report(dest, &self.report_input(&title, substrate, width_mm))?;
+        Ok(())
+    }
+}
+
 /// Adds the keys of `extra` (an object) to `into` (an object).
 pub(crate) fn merge(into: &mut Value, extra: Value) {
     if let (Some(into), Value::Object(extra)) = (into.as_object_mut(), extra) {

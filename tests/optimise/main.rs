@@ -8,5 +8,6 @@ mod cli;
 mod hose;
 mod objectives;
 mod parts;
+mod place;
 mod spiral;
 mod support;

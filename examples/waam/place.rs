@@ -1,0 +1,104 @@
+//! `waam place`: part file + cell file → the library's `place_part` →
+//! `cell.toml` (a complete cell file with the placement found) and
+//! `placement.json` (the search). Exit codes: 0 found, 1 bad input, 2 no
+//! placement makes every layer feasible (the binding constraint is named).
+
+use crate::args::PlaceArgs;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use waam_slicer::io::atomic::write_atomic;
+use waam_slicer::pipeline::{place_part, PlaceRequest};
+use waam_slicer::{Cell, Part};
+
+/// Runs the command; prints errors itself and returns the exit code.
+pub fn run(a: &PlaceArgs, quiet: bool) -> ExitCode {
+    match place(a, quiet) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(2),
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
+    let part = Part::read(&a.part).map_err(|e| e.to_string())?;
+    let cell = Cell::read(&a.cell).map_err(|e| e.to_string())?;
+    if !(a.half_box.is_finite() && a.half_box > 0.0) {
+        return Err(format!(
+            "--half-box {}: must be positive and finite",
+            a.half_box
+        ));
+    }
+    let mut req = PlaceRequest {
+        half_box_mm: a.half_box,
+        ..PlaceRequest::default()
+    };
+    req.search.samples = a.samples;
+    a.grid.apply(&mut req.slice);
+    a.axes.apply(&mut req.slice);
+    let spinner = crate::progress::Stage::start(quiet, "placing");
+    let placed = place_part(&part, &cell, &req).map_err(|e| e.to_string())?;
+    drop(spinner);
+    let dir: PathBuf = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-placed", part.name)));
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let p = &placed.placement;
+    let json = dir.join("placement.json");
+    write_atomic(&json, |w| {
+        serde_json::to_writer_pretty(&mut *w, &placed.summary()).map_err(std::io::Error::other)?;
+        writeln!(w)
+    })
+    .map_err(|e| format!("{}: {e}", json.display()))?;
+    let toml = dir.join("cell.toml");
+    if p.feasible {
+        write_atomic(&toml, |w| w.write_all(placed.toml.as_bytes()))
+            .map_err(|e| format!("{}: {e}", toml.display()))?;
+    }
+    if !quiet {
+        let values: Vec<String> = placed
+            .bounds
+            .variables
+            .iter()
+            .zip(&p.values)
+            .map(|(v, x)| {
+                if v.name.ends_with("rotation") {
+                    format!("{} = {:.2} deg", v.name, x.to_degrees())
+                } else {
+                    format!("{} = {:.3} mm", v.name, x)
+                }
+            })
+            .collect();
+        println!(
+            "{}: {} candidates ({:.0} % feasible on the subsample) in {:.2} s",
+            part.name,
+            p.candidates,
+            100.0 * p.feasible_fraction,
+            p.time_s
+        );
+        println!("  {}", values.join(", "));
+        if p.feasible {
+            println!(
+                "  feasible: worst layer {:.2} deg from a joint stop, speed headroom {:.1} %, dexterity {:.4} -> {}",
+                p.margins.joint_limit_deg,
+                100.0 * p.margins.speed_headroom,
+                p.margins.dexterity,
+                toml.display()
+            );
+        }
+    }
+    if !p.feasible {
+        let why = match &p.binding {
+            Some((c, share)) => format!("{c} bound {:.0} % of the candidates", 100.0 * share),
+            None => "the best candidate on the subsample failed on the full path".into(),
+        };
+        eprintln!(
+            "no placement found: {why}; {} layer(s) infeasible in the best one (placement.json)",
+            p.margins.infeasible_layers
+        );
+    }
+    Ok(p.feasible)
+}

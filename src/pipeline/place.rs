@@ -1,0 +1,244 @@
+//! Placing a part in a cell in one call: slices the part, searches the
+//! cell's placement variables within the cell file's `[placement]` bounds
+//! ([`crate::optimise::place`]) and gives a complete cell file with the
+//! placement found, which [`Cell::read`] and [`plan_part`](super::plan_part)
+//! accept unchanged.
+
+use std::f64::consts::PI;
+
+use serde_json::{json, Value};
+
+use super::{slice_part_with, Cell, Part, SliceOverrides};
+use crate::optimise::place::{place, PlaceOptions, Placement, PlacementBounds};
+use crate::optimise::{layer_points, ConfigurationChoice, OptimiseError};
+use crate::robot::orientation::FanucPose;
+use crate::Error;
+
+/// What to place and how hard to search.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PlaceRequest {
+    /// Overrides of the part file's settings (Delta, points, travel speed…).
+    pub slice: SliceOverrides,
+    /// The search's settings; its `optimise.travel_speed_mm_s` is replaced by
+    /// the process's travel speed.
+    pub search: PlaceOptions,
+    /// Half-width (mm) of the box searched around the cell's placement when
+    /// its file gives no `[placement]` bounds; 0 takes the default, 400 mm.
+    pub half_box_mm: f64,
+}
+
+/// A placed cell: the search's account and the cell file to write.
+#[derive(Debug, Clone)]
+pub struct PlacedCell {
+    /// The search's result (values, margins, candidates, full plan).
+    pub placement: Placement,
+    /// The bounds searched (mm, rad).
+    pub bounds: PlacementBounds,
+    /// The placed cell, as [`Cell::from_toml_str`] reads `toml`.
+    pub cell: Cell,
+    /// A complete cell file: the original's keys with the placement's
+    /// values, the bounds searched as its `[placement]` table, and a comment
+    /// giving the margins achieved.
+    pub toml: String,
+}
+
+/// The bounds of `cell`'s `[placement]` table, or a box of `half_box_mm`
+/// around its placement.
+///
+/// # Errors
+/// [`OptimiseError::InvalidPlacement`] naming the variable.
+pub fn bounds_of(cell: &Cell, half_box_mm: f64) -> Result<PlacementBounds, OptimiseError> {
+    let mut b = PlacementBounds::around(&cell.layout, half_box_mm);
+    let Some(spec) = &cell.placement else {
+        b.validate()?;
+        return Ok(b);
+    };
+    if let (Some(lo), Some(hi)) = (spec.min_mm, spec.max_mm) {
+        for k in 0..3 {
+            b.variables[k].lower = lo[k];
+            b.variables[k].upper = hi[k];
+        }
+    }
+    if let Some([lo, hi]) = spec.rotation_deg {
+        b.variables[3].lower = lo.to_radians();
+        b.variables[3].upper = hi.to_radians();
+    }
+    for f in &spec.fixed {
+        let k = ["x", "y", "z", "rotation"]
+            .iter()
+            .position(|n| n == f)
+            .ok_or_else(|| OptimiseError::InvalidPlacement {
+                field: format!("fixed: {f}"),
+                reason: "expected x, y, z or rotation".into(),
+            })?;
+        b.variables[k].lower = b.variables[k].current;
+        b.variables[k].upper = b.variables[k].current;
+    }
+    if let (Some(lo), Some(hi)) = (spec.keep_out_min_mm, spec.keep_out_max_mm) {
+        b.keep_out = Some((lo, hi));
+    }
+    b.validate()?;
+    Ok(b)
+}
+
+/// Places `part` in `cell` (see the module doc).
+///
+/// # Errors
+/// Bad input: the part's or overrides' ([`Error::InPart`]), the bounds'
+/// ([`Error::Optimise`] naming the variable); the cell file's text when it
+/// cannot be rewritten. A part no placement makes feasible is a
+/// [`PlacedCell`] whose `placement.feasible` is `false`.
+pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<PlacedCell, Error> {
+    let half = if req.half_box_mm > 0.0 {
+        req.half_box_mm
+    } else {
+        400.0
+    };
+    let bounds = bounds_of(cell, half)?;
+    let sliced = slice_part_with(part, &req.slice, &Default::default())?;
+    let layers = layer_points(&sliced.path, &sliced.axes.frames);
+    let mut search = req.search.clone();
+    search.optimise.travel_speed_mm_s = sliced.process.travel_speed_mm_s;
+    search.optimise.configuration = ConfigurationChoice::Cell;
+    let placement = place(&cell.layout, &layers, &bounds, &search)?;
+    let toml = placed_toml(cell, &placement, &bounds)?;
+    let mut placed = Cell::from_toml_str(&toml, &cell.file)?;
+    placed.file = cell.file.clone();
+    Ok(PlacedCell {
+        placement,
+        bounds,
+        cell: placed,
+        toml,
+    })
+}
+
+fn toml_error(cell: &Cell, message: String) -> Error {
+    crate::io::cell_file::CellFileError::Syntax {
+        path: cell.file.clone(),
+        message,
+    }
+    .into()
+}
+
+/// The cell file's text with the placement's values and the bounds searched.
+fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<String, Error> {
+    let mut doc: toml::Table = cell
+        .text
+        .parse()
+        .map_err(|e: toml::de::Error| toml_error(cell, e.to_string()))?;
+    let arr =
+        |v: &[f64]| toml::Value::Array(v.iter().map(|x| toml::Value::Float(round6(*x))).collect());
+    match &p.cell {
+        crate::robot::Cell::PartCarried(c) => {
+            let t = doc
+                .get_mut("part_carried")
+                .and_then(toml::Value::as_table_mut)
+                .ok_or_else(|| toml_error(cell, "no [part_carried] table".into()))?;
+            t.insert(
+                "deposition_point_mm".into(),
+                arr(c.deposition_point_mm.coords.as_slice()),
+            );
+            if p.values[3] != 0.0 || t.contains_key("flange_from_part_xyzwpr") {
+                let pose = FanucPose::from_isometry(&c.flange_from_part).to_xyzwpr_deg();
+                t.insert("flange_from_part_xyzwpr".into(), arr(&pose));
+            }
+        }
+        crate::robot::Cell::TorchCarried(c) => {
+            let t = doc
+                .get_mut("torch_carried")
+                .and_then(toml::Value::as_table_mut)
+                .ok_or_else(|| toml_error(cell, "no [torch_carried] table".into()))?;
+            let pose = FanucPose::from_isometry(&c.base_from_positioner).to_xyzwpr_deg();
+            t.insert("positioner_pose_xyzwpr".into(), arr(&pose));
+        }
+    }
+    // The bounds searched, around the original placement, so that placing
+    // again from this file searches the same box.
+    let v = &bounds.variables;
+    let mut spec = toml::Table::new();
+    spec.insert("min_mm".into(), arr(&[v[0].lower, v[1].lower, v[2].lower]));
+    spec.insert("max_mm".into(), arr(&[v[0].upper, v[1].upper, v[2].upper]));
+    let (lo, hi) = (v[3].lower - p.values[3], v[3].upper - p.values[3]);
+    // The rotation is relative to the mount written above.
+    let span = (hi - lo).min(2.0 * PI);
+    spec.insert(
+        "rotation_deg".into(),
+        arr(&[lo.to_degrees(), (lo + span).to_degrees()]),
+    );
+    let fixed: Vec<toml::Value> = ["x", "y", "z", "rotation"]
+        .iter()
+        .zip(v)
+        .filter(|(_, var)| var.lower == var.upper)
+        .map(|(n, _)| toml::Value::String((*n).into()))
+        .collect();
+    if !fixed.is_empty() {
+        spec.insert("fixed".into(), toml::Value::Array(fixed));
+    }
+    if let Some((lo, hi)) = bounds.keep_out {
+        spec.insert("keep_out_min_mm".into(), arr(&lo));
+        spec.insert("keep_out_max_mm".into(), arr(&hi));
+    }
+    doc.insert("placement".into(), toml::Value::Table(spec));
+    let body = toml::to_string(&doc).map_err(|e| toml_error(cell, e.to_string()))?;
+    let m = &p.margins;
+    let b = &p.margins_before;
+    Ok(format!(
+        "# Placed by waam place from {} ({}).\n\
+         # Worst-layer margins after: {:.2} deg from a joint stop, speed headroom {:.1} %, dexterity {:.4}, {} infeasible layer(s).\n\
+         # Before: {:.2} deg, {:.1} %, {:.4}, {} infeasible layer(s).\n\
+         # Candidates {}, feasible on the subsample {:.0} %.\n{body}",
+        cell.file,
+        if p.feasible { "feasible" } else { "NOT feasible" },
+        m.joint_limit_deg,
+        100.0 * m.speed_headroom,
+        m.dexterity,
+        m.infeasible_layers,
+        b.joint_limit_deg,
+        100.0 * b.speed_headroom,
+        b.dexterity,
+        b.infeasible_layers,
+        p.candidates,
+        100.0 * p.feasible_fraction,
+    ))
+}
+
+fn round6(x: f64) -> f64 {
+    let r = (x * 1e6).round() / 1e6;
+    if r == 0.0 {
+        0.0
+    } else {
+        r
+    }
+}
+
+impl PlacedCell {
+    /// The content of `placement.json`: the bounds, the values found, the
+    /// margins before and after, candidates, feasible fraction, binding
+    /// constraint and time (s).
+    pub fn summary(&self) -> Value {
+        let p = &self.placement;
+        json!({
+            "feasible": p.feasible,
+            "variables": self.bounds.variables.iter().zip(&p.values).map(|(v, x)| {
+                let deg = v.name.ends_with("rotation");
+                let k = if deg { 180.0 / PI } else { 1.0 };
+                json!({
+                    "name": v.name,
+                    "unit": if deg { "deg" } else { "mm" },
+                    "lower": v.lower * k,
+                    "upper": v.upper * k,
+                    "given": v.current * k,
+                    "found": x * k,
+                })
+            }).collect::<Vec<_>>(),
+            "keep_out": self.bounds.keep_out.map(|(a, b)| json!({"min_mm": a, "max_mm": b})),
+            "margins": p.margins,
+            "margins_before": p.margins_before,
+            "candidates": p.candidates,
+            "feasible_fraction": p.feasible_fraction,
+            "binding": p.binding.as_ref().map(|(c, share)| json!({"constraint": c, "share": share})),
+            "infeasible_layers": p.plan.infeasible_layers().map(|l| json!({"layer": l.layer, "status": l.status.to_string()})).collect::<Vec<_>>(),
+            "time_s": p.time_s,
+        })
+    }
+}
