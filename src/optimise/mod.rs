@@ -18,7 +18,14 @@
 //! | the per-layer problem (objective, constraints, `dq/dR_Z`) | `problem` | — |
 //! | sequential QP with clarabel, trust region, elastic mode | `sqp` | — |
 //! | outcomes as data | [`outcome`] | [`Plan`], [`LayerPlan`], [`LayerStatus`] |
-//! | the driver | here | [`optimise`], [`optimise_spiral`], [`layer_points`] |
+//! | a layer's setup: times, angles, problem per branch, dexterity floors | `setup` | — |
+//! | seeds scored in every branch | `seed` | — |
+//! | branch choice and the per-branch solve | `branch` | — |
+//! | the polynomial degree loop | `degree` | — |
+//! | the point-by-point baseline [§4.1.4] | `point_by_point` | — |
+//! | a layer's status, objective figures and quality | `report` | — |
+//! | spiral paths, turn by turn | `spiral` | [`optimise_spiral`] |
+//! | the driver | here | [`optimise`], [`layer_points`], [`trajectory_inputs`] |
 //!
 //! How a layer is solved:
 //! 1. **Branch.** Every IK branch (FANUC `N/F U/D T/B`) is scored on a few
