@@ -64,11 +64,11 @@ pub fn validate_abb(
         (Some(t), Some(w)) => match (t.robhold, w.robhold) {
             (true, false) => Some(AbbFrames::Held {
                 flange_from_tool: t.pose,
-                base_from_wobj: w.pose,
+                base_from_work: w.pose,
             }),
             (false, true) => Some(AbbFrames::Stationary {
                 base_from_tool: t.pose,
-                flange_from_wobj: w.pose,
+                flange_from_work: w.pose,
             }),
             _ => {
                 push(
