@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use super::parameterisation::{cylindrical_angles, turns_about_z, Basis};
+use super::parameterisation::Basis;
 use super::point_by_point::point_by_point;
 use super::problem::{Evaluation, LayerProblem, PointFailure};
 use super::report::finish;
@@ -13,7 +13,7 @@ use super::setup::LayerSetup;
 use super::spiral::Anchor;
 use super::{degree, sqp, LayerPoints};
 use super::{
-    Abscissa, ConfigurationChoice, ConfigurationChoiceReport, LayerPlan, LayerQuality, LayerStatus,
+    ConfigurationChoice, ConfigurationChoiceReport, LayerPlan, LayerQuality, LayerStatus,
     ObjectiveReport, OptimiseOptions, Parameterisation, RzLaw, SolverReport,
 };
 use crate::robot::cell::Cell;
@@ -41,32 +41,7 @@ pub(super) fn optimise_layer(
     anchor: Option<Anchor>,
 ) -> (LayerPlan, f64) {
     let t0 = Instant::now();
-    let points = &lp.points;
-    let p = points.len();
-    let mut dt = vec![0.0; p];
-    for m in 1..p {
-        dt[m] = (points[m].position_mm - points[m - 1].position_mm).norm() / opts.travel_speed_mm_s;
-    }
-    let theta = cylindrical_angles(&points.iter().map(|c| c.position_mm).collect::<Vec<_>>());
-    let turning = turns_about_z(&theta);
-    let cylindrical = match opts.parameterisation {
-        Parameterisation::Polynomial { abscissa, .. } => match abscissa {
-            Abscissa::PointIndex => false,
-            Abscissa::CylindricalAngle => true,
-            Abscissa::Auto => turning,
-        },
-        _ => false,
-    };
-    let setup = LayerSetup {
-        cell,
-        opts,
-        points,
-        dt,
-        theta,
-        turning,
-        cylindrical,
-        anchor,
-    };
+    let setup = LayerSetup::new(cell, &lp.points, opts, anchor);
 
     // 1. branches
     let fixed = matches!(opts.parameterisation, Parameterisation::Fixed { .. });

@@ -101,6 +101,8 @@ mod seed;
 mod setup;
 mod spiral;
 mod sqp;
+#[cfg(test)]
+mod tests;
 
 pub use options::{
     Abscissa, ConfigurationChoice, DexterityFloor, Objective, OptimiseOptions, Parameterisation,

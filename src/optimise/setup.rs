@@ -3,9 +3,10 @@
 //! (rad), and the spiral anchor; builds the layer's [`LayerProblem`] in a
 //! branch and its dexterity floors [SPEC §7, eq. 4.6].
 
+use super::parameterisation::{cylindrical_angles, turns_about_z};
 use super::problem::{encoder_sigma_rad, LayerProblem};
 use super::spiral::Anchor;
-use super::{DexterityFloor, OptimiseOptions};
+use super::{Abscissa, DexterityFloor, OptimiseOptions, Parameterisation};
 use crate::robot::cell::{Cell, CellPoint};
 use crate::robot::ik::Configuration;
 use crate::robot::indices::{dexterity_warm, SvdWarmStart};
@@ -23,6 +24,44 @@ pub(super) struct LayerSetup<'a> {
 }
 
 impl<'a> LayerSetup<'a> {
+    /// The setup of `points` (a layer, or a spiral turn continuing from
+    /// `anchor`): times between points at the travel speed, cylindrical
+    /// angles, whether the layer turns about the part Z axis, and the
+    /// polynomial abscissa the options ask for.
+    pub(super) fn new(
+        cell: &'a Cell,
+        points: &'a [CellPoint],
+        opts: &'a OptimiseOptions,
+        anchor: Option<Anchor>,
+    ) -> Self {
+        let p = points.len();
+        let mut dt = vec![0.0; p];
+        for m in 1..p {
+            dt[m] =
+                (points[m].position_mm - points[m - 1].position_mm).norm() / opts.travel_speed_mm_s;
+        }
+        let theta = cylindrical_angles(&points.iter().map(|c| c.position_mm).collect::<Vec<_>>());
+        let turning = turns_about_z(&theta);
+        let cylindrical = match opts.parameterisation {
+            Parameterisation::Polynomial { abscissa, .. } => match abscissa {
+                Abscissa::PointIndex => false,
+                Abscissa::CylindricalAngle => true,
+                Abscissa::Auto => turning,
+            },
+            _ => false,
+        };
+        LayerSetup {
+            cell,
+            opts,
+            points,
+            dt,
+            theta,
+            turning,
+            cylindrical,
+            anchor,
+        }
+    }
+
     pub(super) fn problem(&self, cfg: Configuration, psi: Vec<f64>) -> LayerProblem<'a> {
         let robot = self.cell.robot();
         let margin = self.opts.joint_limit_margin_rad;
