@@ -7,12 +7,14 @@
 
 pub mod frame;
 pub mod guide;
+pub mod plane;
 pub mod profile;
 pub mod substrate;
 pub mod tube;
 
 pub use frame::{Frame, FrameField, FrameMethod};
 pub use guide::GuideCurve;
+pub use plane::Plane;
 pub use profile::{ProfileLaw, ProfilePiece};
 pub use substrate::{CurvePoint, MeshSubstrate, Substrate};
 pub use tube::{SurfacePoint, Tube, TubeRange};

@@ -6,6 +6,7 @@
 use crate::geometry::guide::{
     CircleArc, CubicSpline, ExprCurve, Expression, GuideCurve, Helix, Line, PipeRun, PipeSegment,
 };
+pub use crate::geometry::Plane;
 use crate::geometry::{
     FrameMethod, GeometryError, MeshSubstrate, ProfileLaw, ProfilePiece, Substrate, Tube, TubeRange,
 };
@@ -240,15 +241,6 @@ pub enum SubstrateSpec {
         /// STL file.
         file: String,
     },
-}
-
-/// A plane given by a point and a unit normal (part frame).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Plane {
-    /// A point of the plane (mm).
-    pub point: Point3,
-    /// Unit normal pointing out of the part (material is kept behind it).
-    pub normal: UnitVector3,
 }
 
 /// End-plane section: where layers generated past the end are cut (SPEC §3.5).

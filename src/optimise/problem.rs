@@ -14,14 +14,21 @@ use crate::robot::ik::Configuration;
 use crate::robot::indices::{
     dexterity, dexterity_warm, positioning_uncertainty, SvdWarmStart, UncertaintyFormula,
 };
-use crate::robot::model::Joints;
+use crate::robot::model::{Joints, RobotModel};
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::RobotError;
 
-/// Encoder resolutions of the ArcMate 120iC [table 4.2] (rad), used when the
+/// Encoder resolutions of the ArcMate 120iC [table 4.2] (deg), used when the
 /// robot model has none.
-pub(crate) const ARCMATE_SIGMA_DEG: [f64; 6] =
-    [3.63e-8, 3.63e-8, 3.81e-8, 16.45e-8, 14.12e-8, 63.18e-8];
+const ARCMATE_SIGMA_DEG: [f64; 6] = [3.63e-8, 3.63e-8, 3.81e-8, 16.45e-8, 14.12e-8, 63.18e-8];
+
+/// The joint resolutions of eq. 4.13 (rad): the robot model's encoder
+/// resolutions, or the ArcMate 120iC's [table 4.2] when it has none.
+pub(crate) fn encoder_sigma_rad(robot: &RobotModel) -> [f64; 6] {
+    robot
+        .encoder_sigma_rad
+        .unwrap_or(ARCMATE_SIGMA_DEG.map(f64::to_radians))
+}
 
 /// Where the dexterity bound is at least this multiple of the floor, the
 /// SVD is skipped (the constraint is inactive and its slope is not needed:
@@ -391,6 +398,33 @@ impl<'a> LayerProblem<'a> {
         }
     }
 
+    /// Bounds `[lo, hi]` of joint `j` (0-based) at joints `q` (rad): the
+    /// travel with the margin, and for J5 the wrist bounds on `q`'s side
+    /// ([`LayerProblem::j5_bounds`]).
+    pub(crate) fn joint_bounds(&self, j: usize, q: &Joints) -> (f64, f64) {
+        if j == 4 {
+            self.j5_bounds(q[4])
+        } else {
+            (self.lower[j], self.upper[j])
+        }
+    }
+
+    /// Centring of joints `q`: `sum_j ((q_j − mid_j) / range_j)²` over the
+    /// limited joints (dimensionless; the centring term of
+    /// [`OptimiseOptions::centring_weight`](super::OptimiseOptions::centring_weight)
+    /// at one point, before its weight).
+    pub(crate) fn centring_of(&self, q: &Joints) -> f64 {
+        let robot = self.cell.robot();
+        let mut c = 0.0;
+        for (j, qj) in q.iter().enumerate() {
+            if self.gamma[j] > 0.0 {
+                let l = &robot.limits[j];
+                c += ((qj - l.mid_rad()) / l.range_rad()).powi(2);
+            }
+        }
+        c
+    }
+
     /// Every constraint value `c ≤ 0` at `e` (rad, or relative for the
     /// dexterity), calling `sink(point, constraint, value, gradient along R_Z
     /// at point m and at m−1)`. Gradients of the dexterity are computed only
@@ -411,11 +445,7 @@ impl<'a> LayerProblem<'a> {
             let q = &e.q[m];
             let g = &e.g[m];
             for j in 0..6 {
-                let (lo, hi) = if j == 4 {
-                    self.j5_bounds(q[4])
-                } else {
-                    (self.lower[j], self.upper[j])
-                };
+                let (lo, hi) = self.joint_bounds(j, q);
                 let c = Constraint::JointLimit { joint: j + 1 };
                 if hi.is_finite() {
                     sink(m, c, q[j] - hi, g[j], 0.0);

@@ -16,7 +16,7 @@ pub mod strategy;
 pub use distance_map::{distance_map, spiral_distance_map, DistanceMap, DistanceStats};
 pub use march::slice;
 
-use crate::io::part_file::Plane;
+use crate::geometry::Plane;
 use crate::math::Point3;
 use serde::{Deserialize, Serialize};
 

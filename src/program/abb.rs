@@ -52,6 +52,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
 use crate::program::fmt::{ascii_comment, ceil_to, floor_to, Deg, Mm, Unitless};
+use crate::program::frames::ToolFrames;
 use crate::program::{
     check_name, check_vendor, positioner_moves, render, segment_length_mm, ArcFlag, EmittedFile,
     ProcessControl, Program, ProgramError,
@@ -104,54 +105,11 @@ impl Default for AbbOptions {
     }
 }
 
-/// The frames of a RAPID program (robot base = world frame, mm).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum AbbFrames {
-    /// Robot-held tool `flange_from_tool`, fixed work object `base_from_wobj`.
-    Held {
-        /// `tWaam.tframe`.
-        flange_from_tool: Isometry3,
-        /// `wWaam.uframe`.
-        base_from_wobj: Isometry3,
-    },
-    /// Stationary tool `base_from_tool`, robot-held work object `flange_from_wobj`.
-    Stationary {
-        /// `tWaam.tframe`.
-        base_from_tool: Isometry3,
-        /// `wWaam.uframe`.
-        flange_from_wobj: Isometry3,
-    },
-}
-
-impl AbbFrames {
-    /// The `robtarget` pose (tool in work object) at flange pose `base_from_flange`.
-    pub fn target(&self, base_from_flange: &Isometry3) -> Isometry3 {
-        match self {
-            AbbFrames::Held {
-                flange_from_tool,
-                base_from_wobj,
-            } => base_from_wobj.inverse() * base_from_flange * flange_from_tool,
-            AbbFrames::Stationary {
-                base_from_tool,
-                flange_from_wobj,
-            } => (base_from_flange * flange_from_wobj).inverse() * base_from_tool,
-        }
-    }
-
-    /// The flange pose reaching `robtarget` pose `target`.
-    pub fn flange(&self, target: &Isometry3) -> Isometry3 {
-        match self {
-            AbbFrames::Held {
-                flange_from_tool,
-                base_from_wobj,
-            } => base_from_wobj * target * flange_from_tool.inverse(),
-            AbbFrames::Stationary {
-                base_from_tool,
-                flange_from_wobj,
-            } => base_from_tool * target.inverse() * flange_from_wobj.inverse(),
-        }
-    }
-}
+/// The frames of a RAPID program (robot base = world frame, mm): `tWaam`
+/// is the tool (`flange_from_tool` or `base_from_tool`), `wWaam` the work
+/// object (`base_from_work` or `flange_from_work`), and a `robtarget` is
+/// [`ToolFrames::target`].
+pub type AbbFrames = ToolFrames;
 
 impl AbbOptions {
     /// The frames written for `cell`.
@@ -159,29 +117,13 @@ impl AbbOptions {
         let stationary = self
             .stationary_tool
             .unwrap_or(matches!(cell, Cell::PartCarried(_)));
-        if stationary {
-            AbbFrames::Stationary {
-                base_from_tool: self.fixed_tool.unwrap_or_else(|| match cell {
-                    Cell::PartCarried(c) => {
-                        crate::program::kuka::fixed_torch_at(&c.deposition_point_mm)
-                    }
-                    Cell::TorchCarried(_) => Isometry3::identity(),
-                }),
-                flange_from_wobj: self.flange_from_tool.unwrap_or(match cell {
-                    Cell::PartCarried(c) => c.flange_from_part,
-                    Cell::TorchCarried(_) => Isometry3::identity(),
-                }),
-            }
-        } else {
-            AbbFrames::Held {
-                flange_from_tool: match (self.flange_from_tool, cell) {
-                    (Some(t), _) => t,
-                    (None, Cell::TorchCarried(c)) => c.flange_from_tcp,
-                    (None, Cell::PartCarried(_)) => Isometry3::identity(),
-                },
-                base_from_wobj: self.base_from_user,
-            }
-        }
+        ToolFrames::new(
+            cell,
+            stationary,
+            self.flange_from_tool,
+            self.fixed_tool,
+            self.base_from_user,
+        )
     }
 
     /// Checks every field.
@@ -291,17 +233,17 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     let (tool_held, tool, wobj_held, wobj) = match frames {
         AbbFrames::Held {
             flange_from_tool,
-            base_from_wobj,
-        } => ("TRUE", flange_from_tool, "FALSE", base_from_wobj),
+            base_from_work,
+        } => ("TRUE", flange_from_tool, "FALSE", base_from_work),
         AbbFrames::Stationary {
             base_from_tool,
-            flange_from_wobj,
+            flange_from_work,
         } => {
             writeln!(
                 w,
                 "  ! stationary torch (tWaam), part held by the robot (wWaam): speeds are the torch's over the part"
             )?;
-            ("FALSE", base_from_tool, "TRUE", flange_from_wobj)
+            ("FALSE", base_from_tool, "TRUE", flange_from_work)
         }
     };
     writeln!(

@@ -69,6 +69,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
 use crate::program::fmt::{ascii_comment, ceil_to, floor_to, FanucDeg, FanucMm};
+use crate::program::frames::held_tool;
 use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
 use crate::program::{
     check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
@@ -253,11 +254,7 @@ impl FanucOptions {
 
     /// The tool frame used for Cartesian positions in `cell` (mm).
     pub fn tool_in(&self, cell: &Cell) -> Isometry3 {
-        match (self.flange_from_tool, cell) {
-            (Some(t), _) => t,
-            (None, Cell::TorchCarried(c)) => c.flange_from_tcp,
-            (None, Cell::PartCarried(_)) => Isometry3::identity(),
-        }
+        held_tool(cell, self.flange_from_tool)
     }
 }
 

@@ -68,6 +68,8 @@ use serde::{Deserialize, Serialize};
 use crate::math::Isometry3;
 use crate::program::fanuc::PositionMode;
 use crate::program::fmt::{ascii_comment, floor_to, Deg, Fixed, Mm};
+pub use crate::program::frames::fixed_torch_at;
+use crate::program::frames::{held_tool, ToolFrames};
 use crate::program::{
     check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
     ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
@@ -139,18 +141,21 @@ impl KukaOptions {
     /// frames Cartesian positions are written in, `$BASE · pos = flange ·
     /// $TOOL`.
     pub fn frames(&self, cell: &Cell) -> (Isometry3, Isometry3) {
-        if self.uses_external_tcp(cell) {
-            let fixed = self.fixed_tool.unwrap_or_else(|| match cell {
-                Cell::PartCarried(c) => fixed_torch_at(&c.deposition_point_mm),
-                Cell::TorchCarried(_) => Isometry3::identity(),
-            });
-            let part = self.flange_from_tool.unwrap_or(match cell {
-                Cell::PartCarried(c) => c.flange_from_part,
-                Cell::TorchCarried(_) => Isometry3::identity(),
-            });
-            (fixed, part)
-        } else {
-            (self.base_from_user, tool_of(self, cell))
+        match ToolFrames::new(
+            cell,
+            self.uses_external_tcp(cell),
+            self.flange_from_tool,
+            self.fixed_tool,
+            self.base_from_user,
+        ) {
+            ToolFrames::Held {
+                flange_from_tool,
+                base_from_work,
+            } => (base_from_work, flange_from_tool),
+            ToolFrames::Stationary {
+                base_from_tool,
+                flange_from_work,
+            } => (base_from_tool, flange_from_work),
         }
     }
 
@@ -281,26 +286,6 @@ pub fn turn(q: &Joints) -> u8 {
     })
 }
 
-/// A fixed torch at `d` (robot base frame, mm): z down (its approach
-/// direction, towards the part), x along the base X, y along −Y.
-pub fn fixed_torch_at(d: &crate::math::Point3) -> Isometry3 {
-    Isometry3::from_parts(
-        nalgebra::Translation3::from(d.coords),
-        nalgebra::UnitQuaternion::from_axis_angle(
-            &crate::math::Vector3::x_axis(),
-            std::f64::consts::PI,
-        ),
-    )
-}
-
-fn tool_of(opts: &KukaOptions, cell: &Cell) -> Isometry3 {
-    match (opts.flange_from_tool, cell) {
-        (Some(t), _) => t,
-        (None, Cell::TorchCarried(c)) => c.flange_from_tcp,
-        (None, Cell::PartCarried(_)) => Isometry3::identity(),
-    }
-}
-
 pub(crate) fn switch_statements(opts: &KukaOptions) -> (String, String) {
     match &opts.process {
         ProcessControl::Arc { schedule } => (
@@ -341,7 +326,7 @@ pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<
     let (p, a) = (&program.points[i], &program.points[i - 1]);
     let time_s = segment_length_mm(program, i) / p.speed_mm_s;
     let robot = &c.robot;
-    let tool = tool_of(opts, &program.cell);
+    let tool = held_tool(&program.cell, opts.flange_from_tool);
     let tcp = |q: &Joints| (robot.flange_pose(q) * tool).translation.vector;
     let tcp_mm = (tcp(&p.joints) - tcp(&a.joints)).norm();
     let (qp, qa) = (p.positioner?, a.positioner?);

@@ -18,6 +18,7 @@
 //! | readers of our FANUC, KUKA and ABB output | [`readback`] | [`readback::parse_ls`], [`readback::kuka::parse_krl`], [`readback::abb::parse_mod`] |
 //! | validator (file + cell) | [`validate`] | [`validate::validate_fanuc`], [`validate::validate_kuka`], [`validate::validate_abb`] |
 //! | approach and retract points | this module | [`build_program_with`], [`ProgramOptions`] |
+//! | tool and work frames of every emitter | [`frames`] | [`frames::ToolFrames`], [`frames::held_tool`] |
 //! | number formatting | [`fmt`] | [`fmt::Fixed`] |
 //!
 //! JSON of every point: [`Program`] implements `serde::Serialize`; serialise
@@ -30,6 +31,7 @@ pub mod abb;
 pub mod csv;
 pub mod fanuc;
 pub mod fmt;
+pub mod frames;
 pub mod kuka;
 pub mod readback;
 pub mod split;

@@ -18,7 +18,7 @@
 //! | calibration of the lengths (eq. 3.17) | [`calibration`] | [`calibration::calibrate_lengths`] |
 //!
 //! Cell files (TOML, degrees at the edge) are read by
-//! [`io::cell_file`](crate::io::cell_file).
+//! [`io::cell_file`](super::io::cell_file).
 //!
 //! # Example
 //! ```

@@ -314,7 +314,7 @@ pub enum ToolAxisError {
 /// slices, or degenerate tangents and facets (naming layer and point).
 ///
 /// # Example
-/// ```no_run
+/// ```
 /// # use waam_slicer::{io::part_file::read_part_file, path::slice, toolaxis::*};
 /// let part = read_part_file(std::path::Path::new("parts/hemisphere.toml")).unwrap();
 /// let path = slice(&part.tube, &part.substrate, &part.slice_options()).unwrap();

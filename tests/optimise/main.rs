@@ -5,6 +5,7 @@ mod common;
 
 mod circle;
 mod cli;
+mod determinism;
 mod hose;
 mod objectives;
 mod parts;

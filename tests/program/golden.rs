@@ -1,7 +1,7 @@
 //! Golden files of every emitter on two layers of the hemisphere (8 points
 //! per layer, with approach and retract points). Reviewed by eye once, then
-//! pinned: a missing golden file is written; `UPDATE_GOLDEN=1` rewrites them
-//! all.
+//! pinned: a missing or different golden file fails the test;
+//! `UPDATE_GOLDEN=1` writes (or rewrites) them all.
 //!
 //! What the review checked, against which (third-party, public) source:
 //! * FANUC `.ls`: section order `/PROG`, `/ATTR` (OWNER … LINE_COUNT …
@@ -72,11 +72,17 @@ pub fn check_golden(name: &str, text: &str) {
         panic!("{name}:{}: non-ASCII: {l}", line + 1);
     }
     let path = golden_dir().join(name);
-    if std::env::var_os("UPDATE_GOLDEN").is_some() || !path.exists() {
+    if updating_goldens() {
         std::fs::write(&path, text).unwrap();
         return;
     }
-    let want = std::fs::read_to_string(&path).unwrap();
+    let want = match std::fs::read_to_string(&path) {
+        Ok(want) => want,
+        Err(e) => panic!(
+            "{name}: no golden file at {} ({e}); UPDATE_GOLDEN=1 writes it",
+            path.display()
+        ),
+    };
     if want != text {
         let line = want
             .lines()
@@ -86,6 +92,30 @@ pub fn check_golden(name: &str, text: &str) {
             .unwrap_or(want.lines().count().min(text.lines().count()) + 1);
         panic!("{name} differs from its golden file from line {line} (UPDATE_GOLDEN=1 to re-pin)");
     }
+}
+
+/// `true` when the run was asked to (re)write the golden files.
+fn updating_goldens() -> bool {
+    std::env::var("UPDATE_GOLDEN").as_deref() == Ok("1")
+}
+
+#[test]
+fn a_missing_golden_file_fails_the_test() {
+    if updating_goldens() {
+        return; // it would be written instead
+    }
+    let name = "no_such_golden_file.txt";
+    assert!(!golden_dir().join(name).exists());
+    let err = std::panic::catch_unwind(|| check_golden(name, "text\n")).unwrap_err();
+    let msg = err.downcast_ref::<String>().cloned().unwrap_or_default();
+    assert!(
+        msg.contains("no golden file") && msg.contains(name),
+        "{msg}"
+    );
+    assert!(
+        !golden_dir().join(name).exists(),
+        "a failing check wrote the file"
+    );
 }
 
 fn check_all(prefix: &str, files: &[EmittedFile]) {

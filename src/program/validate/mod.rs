@@ -1,0 +1,291 @@
+//! Validator of robot programs from the files alone plus the cell [SPEC §8]:
+//! joint limits (arm and positioner), joint speeds at the programmed speeds
+//! (or segment times), reachability (Cartesian positions: IK with the file's
+//! configuration data — FANUC `CONFIG` string and turn numbers, KUKA Status
+//! and Turn, ABB `confdata` — then FK back within 0.01 mm; and, when the
+//! plan is given, the deposition point of every bead position within 0.01 mm
+//! of the planned one), configuration consistency (the cell's branch
+//! everywhere, no joint jumping by half a turn or more between consecutive
+//! linear moves), and that every bead starts and stops once. Every problem
+//! names its file and line; the report lists them all.
+//!
+//! Each controller's reader turns its files into the same [`Step`]s (motions
+//! with decoded joints, process on and off, in execution order); one checker
+//! ([`check_steps`], in `check`) validates them; the decoders of FANUC,
+//! KUKA and ABB files are `fanuc`, `kuka` and `abb`, one a controller,
+//! each taking its [`readback`](super::readback) reader's output. Bead points are the motions made with
+//! the process on plus the motion that reaches a bead's first point (the one
+//! before the process starts); the other motions (approach, retract,
+//! transitions) are checked for limits, configuration and speeds but not
+//! compared with the planned points.
+
+mod abb;
+mod check;
+mod fanuc;
+mod kuka;
+
+pub use abb::validate_abb;
+pub use check::check_steps;
+pub use fanuc::{parse_config, validate_fanuc};
+pub use kuka::validate_kuka;
+
+use std::fmt;
+
+use crate::math::{Isometry3, Point3};
+use crate::program::fanuc::MoveKind;
+use crate::robot::ik::wrap_pi;
+use crate::robot::{ArmSide, Cell, Configuration, Elbow, Joints, RobotModel, Vendor, Wrist};
+
+/// Largest accepted distance between a position and what it should reach (mm).
+pub const REACH_TOLERANCE_MM: f64 = 0.01;
+
+/// One problem found in a program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    /// Program (file) name.
+    pub file: String,
+    /// Line (1-based).
+    pub line: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}: {}", self.file, self.line, self.message)
+    }
+}
+
+/// Every problem of a set of programs, in execution order.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ValidationReport {
+    /// The problems.
+    pub problems: Vec<Problem>,
+    /// Motions checked.
+    pub motions: usize,
+    /// Beads (started and stopped once).
+    pub beads: usize,
+}
+
+impl ValidationReport {
+    /// `true` when no problem was found.
+    pub fn is_ok(&self) -> bool {
+        self.problems.is_empty()
+    }
+}
+
+impl fmt::Display for ValidationReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.problems.is_empty() {
+            return writeln!(f, "ok: {} motions, {} beads", self.motions, self.beads);
+        }
+        for p in &self.problems {
+            writeln!(f, "{p}")?;
+        }
+        Ok(())
+    }
+}
+
+/// How a motion's speed is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MotionSpeed {
+    /// Joint move (percentage or joint speed): not checked against the
+    /// travel speed.
+    Joint,
+    /// Linear move at this speed of the deposition point relative to the
+    /// part (mm/s).
+    Linear(f64),
+    /// Linear move taking this long (s).
+    Time(f64),
+    /// Linear move at the controller's TCP speed: the TCP (`flange ·
+    /// flange_from_tcp`) travels at `mm_s` in the robot base frame, and the
+    /// positioner's axes, moving with the path, arrive with it, each at most
+    /// at `extax_fraction` of its maximum speed: the move takes the longest
+    /// of these. This is what FANUC `mm/sec`/`cm/min`, ABB `v_tcp` with the
+    /// tool held by the robot and KUKA `$VEL.CP` outside the fixed-tool mode
+    /// mean; it equals [`MotionSpeed::Linear`] only where the part is still.
+    Tcp {
+        /// TCP speed in the robot base frame (mm/s).
+        mm_s: f64,
+        /// The TCP on the flange (mm).
+        flange_from_tcp: Isometry3,
+        /// Fraction (0–1] of each positioner axis's maximum speed allowed
+        /// for external axes moving with the path (KUKA `$VEL_EXTAX[n]/100`;
+        /// 1 elsewhere).
+        extax_fraction: [f64; 2],
+    },
+}
+
+/// One motion of a program, decoded.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Motion {
+    /// File (or program) of the motion instruction.
+    pub file: String,
+    /// Line of the motion instruction (1-based).
+    pub line: usize,
+    /// The target's name as written (`P[3]`, `P3`, `p3`).
+    pub label: String,
+    /// File of the target's record (the `.dat` for KUKA).
+    pub record_file: String,
+    /// Line of the target's record.
+    pub record_line: usize,
+    /// Line of each joint's value (the record line when one line holds them all).
+    pub value_lines: [usize; 6],
+    /// Robot joints (rad, controller convention); `None` when they could not
+    /// be decoded (a problem names why).
+    pub joints: Option<Joints>,
+    /// `true` when the joints were decoded from a Cartesian pose (its
+    /// configuration data were checked while decoding).
+    pub from_cartesian: bool,
+    /// Positioner joints `[q7, q8]` (rad), if the file gives them.
+    pub positioner: Option<[f64; 2]>,
+    /// Joint or linear move.
+    pub kind: MoveKind,
+    /// The speed.
+    pub speed: MotionSpeed,
+}
+
+/// One step of a program in execution order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Step {
+    /// A motion.
+    Motion(Box<Motion>),
+    /// The process (arc) starts here.
+    ProcessOn {
+        /// File.
+        file: String,
+        /// Line.
+        line: usize,
+    },
+    /// The process stops here.
+    ProcessOff {
+        /// File.
+        file: String,
+        /// Line.
+        line: usize,
+    },
+}
+
+/// Adds a problem to `report`.
+pub(crate) fn push(report: &mut ValidationReport, file: &str, line: usize, message: String) {
+    report.problems.push(Problem {
+        file: file.to_string(),
+        line,
+        message,
+    });
+}
+
+/// Deposition point in the part frame (mm) at joints `q`, positioner `qp`:
+/// the fixed torch's point seen from the part (part-carried cell), or the
+/// TCP seen from the part on the positioner (torch-carried cell).
+pub fn deposition_point(cell: &Cell, q: &Joints, qp: Option<[f64; 2]>) -> Option<Point3> {
+    let flange = cell.robot().flange_pose(q);
+    match cell {
+        Cell::PartCarried(c) => {
+            let base_from_part = flange * c.flange_from_part;
+            Some(base_from_part.inverse() * c.deposition_point_mm)
+        }
+        Cell::TorchCarried(c) => {
+            let tcp = flange * c.flange_from_tcp;
+            let base_from_part = c.base_from_part(&qp?);
+            Some(base_from_part.inverse() * Point3::from(tcp.translation.vector))
+        }
+    }
+}
+
+const NAMES: [&str; 6] = ["J1", "J2", "J3", "J4", "J5", "J6"];
+
+/// Joints reaching `base_from_flange` in branch `cfg` (J2, J3, J5 as the IK
+/// gives them), each of J1, J4, J6 turned by `turn(j, q)` (which gets the
+/// solution's value in `(-π, π]` and returns the joint value, or `None` when
+/// the file's turn data do not fit),
+/// checked by FK within [`REACH_TOLERANCE_MM`]. Problems are named `label`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn decode_pose(
+    robot: &RobotModel,
+    base_from_flange: &Isometry3,
+    cfg: Configuration,
+    mut turn: impl FnMut(usize, f64) -> Option<f64>,
+    label: &str,
+    file: &str,
+    line: usize,
+    report: &mut ValidationReport,
+) -> Option<Joints> {
+    let mut q = match robot.inverse(base_from_flange, cfg) {
+        Ok(q) => q,
+        Err(e) => {
+            push(report, file, line, format!("{label}: {e}"));
+            return None;
+        }
+    };
+    for j in [0, 3, 5] {
+        match turn(j, wrap_pi(q[j])) {
+            Some(v) => q[j] = v,
+            None => {
+                push(
+                    report,
+                    file,
+                    line,
+                    format!(
+                        "{label}: the turn data of {} do not fit its angle {:.4}°",
+                        NAMES[j],
+                        wrap_pi(q[j]).to_degrees()
+                    ),
+                );
+                return None;
+            }
+        }
+    }
+    let back = robot.flange_pose(&q);
+    let err = (back.translation.vector - base_from_flange.translation.vector).norm();
+    if err > REACH_TOLERANCE_MM {
+        push(
+            report,
+            file,
+            line,
+            format!("{label}: IK with the file's configuration reaches {err:.4} mm away"),
+        );
+    }
+    Some(q)
+}
+
+/// `false`, with the problem pushed (line 1 of `file`), when `cell`'s robot
+/// is not a `vendor` arm: its joints are in another controller's convention
+/// and nothing else in the file can be checked against it.
+pub(crate) fn vendor_matches(
+    cell: &Cell,
+    vendor: Vendor,
+    emitter: &'static str,
+    file: &str,
+    report: &mut ValidationReport,
+) -> bool {
+    match crate::program::check_vendor(cell, vendor, emitter) {
+        Ok(()) => true,
+        Err(e) => {
+            push(report, file, 1, e.to_string());
+            false
+        }
+    }
+}
+
+/// The branch whose wrist has controller J5 of sign `j5_positive`.
+pub(crate) fn wrist_of_j5(robot: &RobotModel, j5_positive: bool) -> Wrist {
+    // NoFlip when the canonical t5 = sign5·J5 is positive
+    if j5_positive == (robot.convention.sign[4] > 0.0) {
+        Wrist::NoFlip
+    } else {
+        Wrist::Flip
+    }
+}
+
+/// The arm side and elbow of `back`/`positive_cos` (KUKA Status bits 0
+/// and 1; ABB `cfx` bit 2 and the negation of bit 1).
+pub(crate) fn arm_of(back: bool, positive_cos: bool) -> (ArmSide, Elbow) {
+    let side = if back { ArmSide::Back } else { ArmSide::Front };
+    let elbow = if positive_cos != back {
+        Elbow::Up
+    } else {
+        Elbow::Down
+    };
+    (side, elbow)
+}

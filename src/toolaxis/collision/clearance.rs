@@ -1,0 +1,326 @@
+//! Clearance of the torch along a path: the obstacles at a slice (the
+//! layers laid before it as bead capsules, the substrate) and the smallest
+//! distance from the torch to them at every point (part frame, mm).
+
+use crate::geometry::Substrate;
+use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, UnitVector3, Vector3};
+use crate::path::Path;
+use crate::toolaxis::{LocalFrame, ToolAxisError};
+use parry3d_f64::query;
+use parry3d_f64::shape::{Cylinder, HalfSpace, Polyline, Shape};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::torch::{part_from_torch, Torch};
+
+/// Options of [`check_collisions`]. Plain data.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CollisionOptions {
+    /// Radius of the capsules standing for the deposited beads (mm, >= 0):
+    /// half the bead width.
+    pub bead_radius_mm: f64,
+    /// Check the torch against the substrate too.
+    pub check_substrate: bool,
+}
+
+impl Default for CollisionOptions {
+    fn default() -> Self {
+        Self {
+            bead_radius_mm: 2.0,
+            check_substrate: true,
+        }
+    }
+}
+
+impl CollisionOptions {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`ToolAxisError::InvalidOption`] naming the field.
+    pub fn validate(&self) -> Result<(), ToolAxisError> {
+        if !(self.bead_radius_mm.is_finite() && self.bead_radius_mm >= 0.0) {
+            return Err(ToolAxisError::InvalidOption {
+                field: "bead_radius_mm",
+                reason: format!("must be finite and >= 0, got {}", self.bead_radius_mm),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Clearance of the torch along one layer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayerClearance {
+    /// Layer index in `path.layers`.
+    pub layer: usize,
+    /// Smallest clearance over the layer (mm); `f64::INFINITY` when nothing
+    /// is there to hit.
+    pub min_clearance_mm: f64,
+    /// Point where it occurs.
+    pub min_at_point: usize,
+    /// First colliding point (clearance <= 0), in deposition order.
+    pub first_collision: Option<usize>,
+    /// Number of colliding points.
+    pub colliding_points: usize,
+}
+
+/// Result of [`check_collisions`]: per layer and overall.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CollisionReport {
+    /// One entry per layer.
+    pub layers: Vec<LayerClearance>,
+    /// First colliding point of the path, `(layer, point)`.
+    pub first_collision: Option<(usize, usize)>,
+    /// Colliding points in total.
+    pub colliding_points: usize,
+    /// Smallest clearance over the path (mm).
+    pub min_clearance_mm: f64,
+    /// Whether the substrate was part of the check (false for meshes or when
+    /// switched off).
+    pub substrate_checked: bool,
+}
+
+impl CollisionReport {
+    pub(super) fn from_layers(layers: Vec<LayerClearance>, substrate_checked: bool) -> Self {
+        let first_collision = layers
+            .iter()
+            .find_map(|l| l.first_collision.map(|p| (l.layer, p)));
+        Self {
+            colliding_points: layers.iter().map(|l| l.colliding_points).sum(),
+            min_clearance_mm: layers
+                .iter()
+                .map(|l| l.min_clearance_mm)
+                .fold(f64::INFINITY, f64::min),
+            first_collision,
+            layers,
+            substrate_checked,
+        }
+    }
+}
+
+/// The obstacles seen from one slice.
+pub(super) struct Obstacles<'a> {
+    built: Option<Polyline>,
+    bead_radius: f64,
+    substrate: Option<&'a (Isometry3, Box<dyn Shape>)>,
+}
+
+impl<'a> Obstacles<'a> {
+    pub(super) fn new(
+        path: &Path,
+        slice: usize,
+        substrate: Option<&'a (Isometry3, Box<dyn Shape>)>,
+        bead_radius: f64,
+    ) -> Self {
+        let mut vertices = Vec::new();
+        let mut indices: Vec<[u32; 2]> = Vec::new();
+        for l in path.layers.iter().filter(|l| l.slice < slice) {
+            let base = vertices.len() as u32;
+            let n = l.points.len() as u32;
+            vertices.extend(l.points.iter().map(|p| p.position));
+            indices.extend((0..n.saturating_sub(1)).map(|i| [base + i, base + i + 1]));
+            if l.closed && n > 2 {
+                indices.push([base + n - 1, base]);
+            }
+        }
+        let built = (!indices.is_empty()).then(|| Polyline::new(vertices, Some(indices)));
+        Self {
+            built,
+            bead_radius,
+            substrate,
+        }
+    }
+
+    /// Whether the clearance of the torch at `point` with axis `tool` exceeds
+    /// `margin` (mm): bounded queries that only visit obstacles within the
+    /// margin, much cheaper than [`Obstacles::clearance`].
+    pub(super) fn is_clear(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin: f64,
+    ) -> Result<bool, ToolAxisError> {
+        let torch_pose = part_from_torch(point, tool);
+        for (local, part) in &torch.parts {
+            let pose = torch_pose * local;
+            let part = part.shape();
+            if let Some(built) = &self.built {
+                let q = query::closest_points(
+                    &pose,
+                    part,
+                    &Isometry3::identity(),
+                    built,
+                    margin + self.bead_radius,
+                )
+                .map_err(|_| ToolAxisError::UnsupportedQuery {
+                    what: "the built part",
+                })?;
+                if !matches!(q, query::ClosestPoints::Disjoint) {
+                    return Ok(false);
+                }
+            }
+            if let Some((iso, shape)) = self.substrate {
+                let q = query::closest_points(&pose, part, iso, shape.as_ref(), margin).map_err(
+                    |_| ToolAxisError::UnsupportedQuery {
+                        what: "the substrate",
+                    },
+                )?;
+                if !matches!(q, query::ClosestPoints::Disjoint) {
+                    return Ok(false);
+                }
+            }
+        }
+        Ok(true)
+    }
+
+    /// Clearance of the torch placed at `point` with axis `tool` (mm).
+    pub(super) fn clearance(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+    ) -> Result<f64, ToolAxisError> {
+        let torch_pose = part_from_torch(point, tool);
+        let mut best = f64::INFINITY;
+        for (local, part) in &torch.parts {
+            let pose = torch_pose * local;
+            let part = part.shape();
+            if let Some(built) = &self.built {
+                let d =
+                    query::distance(&pose, part, &Isometry3::identity(), built).map_err(|_| {
+                        ToolAxisError::UnsupportedQuery {
+                            what: "the built part",
+                        }
+                    })?;
+                best = best.min(d - self.bead_radius);
+            }
+            if let Some((iso, shape)) = self.substrate {
+                let d = query::distance(&pose, part, iso, shape.as_ref()).map_err(|_| {
+                    ToolAxisError::UnsupportedQuery {
+                        what: "the substrate",
+                    }
+                })?;
+                best = best.min(d);
+            }
+        }
+        Ok(best)
+    }
+}
+
+/// The substrate as a parry shape and its pose, sized from the path.
+pub(super) fn substrate_shape(
+    path: &Path,
+    substrate: &Substrate,
+) -> Option<(Isometry3, Box<dyn Shape>)> {
+    match substrate {
+        Substrate::Plane { point, normal } => Some((
+            Isometry3::translation(point.x, point.y, point.z),
+            Box::new(HalfSpace::new(*normal)),
+        )),
+        Substrate::Cylinder {
+            axis_point,
+            axis,
+            radius,
+        } => {
+            // Centre it on the path's projection on the axis, long enough to
+            // reach past the path and a torch in every direction.
+            let pts: Vec<&Point3> = path
+                .layers
+                .iter()
+                .flat_map(|l| l.points.iter().map(|p| &p.position))
+                .collect();
+            let n = pts.len().max(1) as f64;
+            let c = pts.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / n;
+            let s = (c - axis_point.coords).dot(axis);
+            let extent = pts
+                .iter()
+                .map(|p| (p.coords - c).norm())
+                .fold(0.0, f64::max);
+            let centre = axis_point + axis.into_inner() * s;
+            let rot = UnitQuaternion::rotation_between(&Vector3::y(), axis).unwrap_or_else(|| {
+                UnitQuaternion::from_axis_angle(
+                    &UnitVector3::new_normalize(Vector3::x()),
+                    std::f64::consts::PI,
+                )
+            });
+            Some((
+                Isometry3::from_parts(Translation3::from(centre.coords), rot),
+                Box::new(Cylinder::new(extent + 2.0 * radius + 500.0, *radius)),
+            ))
+        }
+        Substrate::Mesh(_) => None,
+    }
+}
+
+pub(super) fn check_shape(path: &Path, frames: &[Vec<LocalFrame>]) -> Result<(), ToolAxisError> {
+    crate::toolaxis::rules::check_shape(path, frames.iter().map(Vec::len))
+}
+
+pub(super) fn layer_clearances(
+    obstacles: &Obstacles,
+    torch: &Torch,
+    path: &Path,
+    li: usize,
+    axes: &[Vector3],
+) -> Result<Vec<f64>, ToolAxisError> {
+    path.layers[li]
+        .points
+        .iter()
+        .zip(axes)
+        .map(|(p, a)| obstacles.clearance(torch, &p.position, a))
+        .collect()
+}
+
+pub(super) fn summarise(li: usize, c: &[f64]) -> LayerClearance {
+    let (min_at_point, min_clearance_mm) = c
+        .iter()
+        .copied()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((0, f64::INFINITY));
+    LayerClearance {
+        layer: li,
+        min_clearance_mm,
+        min_at_point,
+        first_collision: c.iter().position(|&x| x <= 0.0),
+        colliding_points: c.iter().filter(|&&x| x <= 0.0).count(),
+    }
+}
+
+/// Checks the torch along the path with the tool axes of `frames`
+/// (`frames[layer][point].tool`, same shape as `path.layers`) against the
+/// part built so far and, when given, the substrate. Layers in parallel.
+///
+/// # Errors
+/// [`ToolAxisError`] for bad options, a shape mismatch, or an unsupported
+/// query.
+pub fn check_collisions(
+    path: &Path,
+    frames: &[Vec<LocalFrame>],
+    substrate: Option<&Substrate>,
+    torch: &Torch,
+    opts: &CollisionOptions,
+) -> Result<CollisionReport, ToolAxisError> {
+    opts.validate()?;
+    check_shape(path, frames)?;
+    let sub = substrate
+        .filter(|_| opts.check_substrate)
+        .and_then(|s| substrate_shape(path, s));
+    let layers = (0..path.layers.len())
+        .into_par_iter()
+        .map(|li| {
+            let obstacles = Obstacles::new(
+                path,
+                path.layers[li].slice,
+                sub.as_ref(),
+                opts.bead_radius_mm,
+            );
+            let axes: Vec<Vector3> = frames[li].iter().map(|f| f.tool).collect();
+            let c = layer_clearances(&obstacles, torch, path, li, &axes)?;
+            Ok(summarise(li, &c))
+        })
+        .collect::<Result<Vec<_>, ToolAxisError>>()?;
+    Ok(CollisionReport::from_layers(layers, sub.is_some()))
+}
