@@ -5,7 +5,7 @@ use waam_slicer::program::fanuc::{
     fanuc_files, write_ls, FanucOptions, MotionTiming, Op, PositionMode, TpProgram,
 };
 use waam_slicer::program::readback::parse_ls;
-use waam_slicer::program::validate::{validate_fanuc, ValidationReport};
+use waam_slicer::program::validate::{validate_fanuc, ProblemKind, ValidationReport};
 use waam_slicer::program::{build_program, ProgramError, TravelSpeed};
 use waam_slicer::robot::Cell;
 
@@ -86,6 +86,7 @@ fn a_joint_pushed_out_of_range_is_named_by_its_line() {
         .find(|p| p.message.contains("J5 = 170.0000°"))
         .unwrap_or_else(|| panic!("{r}"));
     assert_eq!(p.line, j5_line, "{r}");
+    assert_eq!(p.kind, ProblemKind::JointLimit, "{r}");
     assert!(
         p.to_string()
             .starts_with(&format!("HEMI:{j5_line}: P[3]: J5")),
@@ -130,6 +131,7 @@ fn a_dropped_arc_end_is_named_by_its_line() {
         .find(|p| p.message.contains("missing Arc End"))
         .unwrap_or_else(|| panic!("{r}"));
     assert_eq!(p.line, second_start, "{r}");
+    assert_eq!(p.kind, ProblemKind::Bead, "{r}");
     // and the last bead: dropping the final Arc End is reported at its start
     let mut tp2: TpProgram = parse_ls(&text, "HEMI.ls").unwrap();
     let k = tp2

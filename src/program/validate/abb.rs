@@ -9,6 +9,7 @@ use crate::program::fanuc::MoveKind;
 use crate::program::ProcessControl;
 use crate::robot::{Cell, Configuration, Vendor};
 
+use super::ProblemKind;
 use super::{arm_of, wrist_of_j5};
 use super::{
     check_steps, decode_pose, push, vendor_matches, Motion, MotionSpeed, Step, ValidationReport,
@@ -55,7 +56,7 @@ pub fn validate_abb(
     let slots = match opts.positioner_slots() {
         Ok(s) => s,
         Err(e) => {
-            push(&mut report, file, 1, e.to_string());
+            push(&mut report, ProblemKind::Options, file, 1, e.to_string());
             return report;
         }
     };
@@ -73,6 +74,7 @@ pub fn validate_abb(
             _ => {
                 push(
                     &mut report,
+                    ProblemKind::Declaration,
                     file,
                     t.line,
                     "tWaam and wWaam: exactly one of them must be held by the robot".into(),
@@ -83,6 +85,7 @@ pub fn validate_abb(
         _ => {
             push(
                 &mut report,
+                ProblemKind::Declaration,
                 file,
                 1,
                 "no `tooldata tWaam` or `wobjdata wWaam` declaration".into(),
@@ -115,6 +118,7 @@ pub fn validate_abb(
                     }),
                     _ => push(
                         &mut report,
+                        ProblemKind::Instruction,
                         file,
                         line,
                         format!("unexpected instruction `{s}`"),
@@ -134,6 +138,7 @@ pub fn validate_abb(
                 if arc && (start.is_some() || weld.as_ref() != end.as_ref()) {
                     push(
                         &mut report,
+                        ProblemKind::Options,
                         file,
                         line,
                         format!(
@@ -174,6 +179,7 @@ pub fn validate_abb(
         if kind == MoveKind::Linear && !conf_l {
             push(
                 &mut report,
+                ProblemKind::Configuration,
                 file,
                 line,
                 "linear move without `ConfL \\On`: the controller may change the configuration"
@@ -181,7 +187,13 @@ pub fn validate_abb(
             );
         }
         let Some(t) = module.targets.iter().find(|t| &t.name == target) else {
-            push(&mut report, file, line, format!("{target} is not declared"));
+            push(
+                &mut report,
+                ProblemKind::Declaration,
+                file,
+                line,
+                format!("{target} is not declared"),
+            );
             continue;
         };
         let (joints, from_cartesian) = match (&t.value, kind) {
@@ -197,7 +209,7 @@ pub fn validate_abb(
                 };
                 if !(0..8).contains(&conf[3]) || cfg != cell.configuration() {
                     push(
-                        &mut report,
+                        &mut report, ProblemKind::Configuration,
                         file,
                         t.line,
                         format!(
@@ -232,6 +244,7 @@ pub fn validate_abb(
             _ => {
                 push(
                     &mut report,
+                    ProblemKind::Declaration,
                     file,
                     line,
                     format!("{target}: wrong target type for this instruction"),

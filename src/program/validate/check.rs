@@ -8,6 +8,7 @@ use crate::math::Point3;
 use crate::program::fanuc::MoveKind;
 use crate::robot::{Cell, Joints};
 
+use super::ProblemKind;
 use super::{
     deposition_point, push, MotionSpeed, Step, ValidationReport, NAMES, REACH_TOLERANCE_MM,
 };
@@ -53,7 +54,7 @@ pub fn check_steps(
                     let msg = format!(
                         "bead starts while the bead started at {f}:{l} is still on (missing Arc End / end instruction)"
                     );
-                    push(report, file, *line, msg);
+                    push(report, ProblemKind::Bead, file, *line, msg);
                 }
                 arc_on = Some((file.clone(), *line));
                 continue;
@@ -62,6 +63,7 @@ pub fn check_steps(
                 if arc_on.take().is_none() {
                     push(
                         report,
+                        ProblemKind::Bead,
                         file,
                         *line,
                         "bead stops but none was started".into(),
@@ -80,7 +82,13 @@ pub fn check_steps(
             bead_motions += 1;
         }
         if m.kind == MoveKind::Joint && arc_on.is_some() {
-            push(report, &m.file, m.line, "joint move with the arc on".into());
+            push(
+                report,
+                ProblemKind::Bead,
+                &m.file,
+                m.line,
+                "joint move with the arc on".into(),
+            );
         }
         let Some(q) = m.joints else {
             prev = None;
@@ -91,6 +99,7 @@ pub fn check_steps(
             if !l.contains(q[j]) {
                 push(
                     report,
+                    ProblemKind::JointLimit,
                     &m.record_file,
                     m.value_lines[j],
                     format!(
@@ -107,6 +116,7 @@ pub fn check_steps(
         if !m.from_cartesian && cfg != cell.configuration() {
             push(
                 report,
+                ProblemKind::Configuration,
                 &m.record_file,
                 m.record_line,
                 format!(
@@ -121,6 +131,7 @@ pub fn check_steps(
             match qp {
                 None => push(
                     report,
+                    ProblemKind::Format,
                     &m.record_file,
                     m.record_line,
                     format!("{}: no positioner values", m.label),
@@ -130,6 +141,7 @@ pub fn check_steps(
                         if !l.contains(qp[n]) {
                             push(
                                 report,
+                                ProblemKind::JointLimit,
                                 &m.record_file,
                                 m.record_line,
                                 format!(
@@ -151,6 +163,7 @@ pub fn check_steps(
                 if e > REACH_TOLERANCE_MM {
                     push(
                         report,
+                        ProblemKind::Deviation,
                         &m.record_file,
                         m.value_lines[0],
                         format!(
@@ -167,11 +180,11 @@ pub fn check_steps(
             // joint moves (between beads) may rewind J4/J6; linear moves may not jump
             for j in (0..6).filter(|_| linear) {
                 if (q[j] - pq[j]).abs() >= PI {
-                    msgs.push(format!(
+                    msgs.push((ProblemKind::Configuration, format!(
                         "{} jumps by {:.2}° from the previous position (turn or configuration change)",
                         NAMES[j],
                         (q[j] - pq[j]).to_degrees()
-                    ));
+                    )));
                 }
             }
             let dt = match (m.speed, dep, pm) {
@@ -203,10 +216,10 @@ pub fn check_steps(
                     if t == 0.0 && crate::program::joints_move(&q, pq) {
                         // the controller then runs the move at its
                         // orientation speed, not at any planned speed
-                        msgs.push(format!(
+                        msgs.push((ProblemKind::Timing, format!(
                             "linear move at {mm_s:.3} mm/s TCP speed with the TCP still while the joints turn: \
                              the controller would turn at its orientation speed limit (write it time-based)"
-                        ));
+                        )));
                     }
                     (t > 0.0).then(|| (t, format!("at {mm_s:.3} mm/s TCP speed")))
                 }
@@ -214,7 +227,7 @@ pub fn check_steps(
                     if t > 0.0 {
                         Some((t, format!("in {:.0} ms", t * 1000.0)))
                     } else {
-                        msgs.push("zero duration".into());
+                        msgs.push((ProblemKind::Timing, "zero duration".into()));
                         None
                     }
                 }
@@ -224,11 +237,14 @@ pub fn check_steps(
                 for j in 0..6 {
                     let sp = (q[j] - pq[j]).abs() / dt;
                     if sp > robot.max_speed_rad_s[j] {
-                        msgs.push(format!(
-                            "{} needs {:.2}°/s {how}, maximum {:.1}°/s",
-                            NAMES[j],
-                            sp.to_degrees(),
-                            robot.max_speed_rad_s[j].to_degrees()
+                        msgs.push((
+                            ProblemKind::JointSpeed,
+                            format!(
+                                "{} needs {:.2}°/s {how}, maximum {:.1}°/s",
+                                NAMES[j],
+                                sp.to_degrees(),
+                                robot.max_speed_rad_s[j].to_degrees()
+                            ),
                         ));
                     }
                 }
@@ -236,17 +252,16 @@ pub fn check_steps(
                     for n in 0..2 {
                         let sp = (a[n] - b[n]).abs() / dt;
                         if sp > c.positioner.max_speed_rad_s[n] {
-                            msgs.push(format!(
-                                "positioner J{} needs {:.2}°/s",
-                                n + 1,
-                                sp.to_degrees()
+                            msgs.push((
+                                ProblemKind::JointSpeed,
+                                format!("positioner J{} needs {:.2}°/s", n + 1, sp.to_degrees()),
                             ));
                         }
                     }
                 }
             }
-            for msg in msgs {
-                push(report, &m.file, m.line, msg);
+            for (kind, msg) in msgs {
+                push(report, kind, &m.file, m.line, msg);
             }
         }
         prev = Some((q, qp, dep));
@@ -254,6 +269,7 @@ pub fn check_steps(
     if let Some((file, line)) = arc_on {
         push(
             report,
+            ProblemKind::Bead,
             &file,
             line,
             "bead started here never stops (no Arc End / end instruction before the program ends)"
@@ -264,6 +280,7 @@ pub fn check_steps(
         if p.len() != bead_motions {
             push(
                 report,
+                ProblemKind::Deviation,
                 first_file.as_deref().unwrap_or(""),
                 0,
                 format!(

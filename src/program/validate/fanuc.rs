@@ -11,6 +11,7 @@ use crate::program::ProcessControl;
 use crate::robot::orientation::FanucPose;
 use crate::robot::{Cell, Configuration, Vendor};
 
+use super::ProblemKind;
 use super::{
     check_steps, decode_pose, push, vendor_matches, Motion, MotionSpeed, Step, ValidationReport,
 };
@@ -70,6 +71,7 @@ fn fanuc_steps(
                 if depth > 4 {
                     push(
                         report,
+                        ProblemKind::Call,
                         file,
                         line,
                         format!("CALL {name}: calls nested too deep"),
@@ -78,7 +80,13 @@ fn fanuc_steps(
                 }
                 match programs.iter().find(|p| &p.name == name) {
                     Some(sub) => fanuc_steps(programs, sub, depth + 1, cell, opts, steps, report),
-                    None => push(report, file, line, format!("CALL {name}: no such program")),
+                    None => push(
+                        report,
+                        ProblemKind::Call,
+                        file,
+                        line,
+                        format!("CALL {name}: no such program"),
+                    ),
                 }
             }
             op if *op == start => steps.push(Step::ProcessOn {
@@ -92,18 +100,21 @@ fn fanuc_steps(
             Op::Remark(_) => {}
             Op::ArcStart(_) | Op::ArcEnd(_) | Op::Other(_) => push(
                 report,
+                ProblemKind::Instruction,
                 file,
                 line,
                 format!("unexpected instruction `{}`", ins.op.to_string().trim()),
             ),
             Op::UFrame(n) if *n != opts.user_frame => push(
                 report,
+                ProblemKind::Frame,
                 file,
                 line,
                 format!("UFRAME_NUM={n}, the options give {}", opts.user_frame),
             ),
             Op::UTool(n) if *n != opts.tool_frame => push(
                 report,
+                ProblemKind::Frame,
                 file,
                 line,
                 format!("UTOOL_NUM={n}, the options give {}", opts.tool_frame),
@@ -116,7 +127,13 @@ fn fanuc_steps(
                 ..
             } => {
                 let Some(pos) = tp.positions.iter().find(|p| p.index == *position) else {
-                    push(report, file, line, format!("P[{position}] has no record"));
+                    push(
+                        report,
+                        ProblemKind::Declaration,
+                        file,
+                        line,
+                        format!("P[{position}] has no record"),
+                    );
                     continue;
                 };
                 let label = format!("P[{}]", pos.index);
@@ -127,6 +144,7 @@ fn fanuc_steps(
                         let q = if pos.uf_ut != (opts.user_frame, opts.tool_frame) {
                             push(
                                 report,
+                                ProblemKind::Frame,
                                 file,
                                 pos.line,
                                 format!(
@@ -138,7 +156,7 @@ fn fanuc_steps(
                         } else if let Some((cfg, turns)) = parse_config(config) {
                             if cfg != cell.configuration() {
                                 push(
-                                    report,
+                                    report, ProblemKind::Configuration,
                                     file,
                                     cfg_line,
                                     format!(
@@ -170,6 +188,7 @@ fn fanuc_steps(
                         } else {
                             push(
                                 report,
+                                ProblemKind::Configuration,
                                 file,
                                 cfg_line,
                                 format!("{label}: bad CONFIG '{config}'"),

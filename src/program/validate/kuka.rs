@@ -8,6 +8,7 @@ use crate::math::{Isometry3, Point3};
 use crate::program::fanuc::MoveKind;
 use crate::robot::{Cell, Configuration, Joints, Vendor};
 
+use super::ProblemKind;
 use super::{arm_of, wrist_of_j5};
 use super::{
     check_steps, decode_pose, push, vendor_matches, Motion, MotionSpeed, Step, ValidationReport,
@@ -83,6 +84,7 @@ pub fn validate_kuka(
                 if *tcp != opts.uses_external_tcp(cell) {
                     push(
                         &mut report,
+                        ProblemKind::Frame,
                         src,
                         line,
                         format!(
@@ -102,6 +104,7 @@ pub fn validate_kuka(
                 if *n != want {
                     push(
                         &mut report,
+                        ProblemKind::Frame,
                         src,
                         line,
                         format!("{what}[{n}], the options give {want}"),
@@ -126,6 +129,7 @@ pub fn validate_kuka(
             } else {
                 push(
                     &mut report,
+                    ProblemKind::Instruction,
                     src,
                     l,
                     format!("unexpected trigger action `{action}`"),
@@ -141,6 +145,7 @@ pub fn validate_kuka(
         let Some(pos) = program.positions.iter().find(|p| &p.name == target) else {
             push(
                 &mut report,
+                ProblemKind::Declaration,
                 src,
                 line,
                 format!("{target} has no DECL in {dat}"),
@@ -151,7 +156,13 @@ pub fn validate_kuka(
             match vel {
                 Some(v) => MotionSpeed::Linear(v),
                 None => {
-                    push(&mut report, src, line, "LIN before any $VEL.CP".into());
+                    push(
+                        &mut report,
+                        ProblemKind::Timing,
+                        src,
+                        line,
+                        "LIN before any $VEL.CP".into(),
+                    );
                     MotionSpeed::Joint
                 }
             }
@@ -161,6 +172,7 @@ pub fn validate_kuka(
         if linear && matches!(pos.value, KrlValue::Axis(_)) {
             push(
                 &mut report,
+                ProblemKind::Declaration,
                 src,
                 line,
                 format!(
@@ -184,7 +196,7 @@ pub fn validate_kuka(
                 };
                 if cfg != cell.configuration() {
                     push(
-                        &mut report,
+                        &mut report, ProblemKind::Configuration,
                         dat,
                         pos.line,
                         format!(
@@ -262,6 +274,7 @@ pub fn validate_kuka(
     for (_, action, l) in pending {
         push(
             &mut report,
+            ProblemKind::Instruction,
             src,
             l,
             format!("trigger `{action}` without a motion after it"),

@@ -42,6 +42,8 @@ pub const REACH_TOLERANCE_MM: f64 = 0.01;
 /// One problem found in a program.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Problem {
+    /// What kind of problem, for a host program that branches on it.
+    pub kind: ProblemKind,
     /// Program (file) name.
     pub file: String,
     /// Line (1-based).
@@ -54,6 +56,41 @@ impl fmt::Display for Problem {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}:{}: {}", self.file, self.line, self.message)
     }
+}
+
+/// The kind of a [`Problem`]: what a host program may branch on (the
+/// message says the rest, with its file and line).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum ProblemKind {
+    /// The program is for another vendor's robot than the cell's.
+    Vendor,
+    /// The file disagrees with the emitter's options (weld data, I/O, axes).
+    Options,
+    /// An identifier or position is used but not declared, or has the wrong type.
+    Declaration,
+    /// An instruction the checker does not know or expect there.
+    Instruction,
+    /// A called program is missing or calls nest too deep.
+    Call,
+    /// Tool or user/base frame, or interpolation mode, not the expected one.
+    Frame,
+    /// A configuration flip, a turn jump or turn data that do not fit.
+    Configuration,
+    /// A position the arm cannot reach (no IK, or IK lands away from it).
+    Reach,
+    /// A joint (or positioner axis) outside its travel.
+    JointLimit,
+    /// A joint (or positioner axis) faster than its maximum at the programmed speed.
+    JointSpeed,
+    /// A move whose speed or time the controller would not run as planned.
+    Timing,
+    /// A deposition point away from the planned point, or a point count that differs.
+    Deviation,
+    /// Arc on/off out of order: a bead that never stops, stops twice, or a joint move with the arc on.
+    Bead,
+    /// A record that cannot be decoded (missing values).
+    Format,
 }
 
 /// Every problem of a set of programs, in execution order.
@@ -167,8 +204,15 @@ pub enum Step {
 }
 
 /// Adds a problem to `report`.
-pub(crate) fn push(report: &mut ValidationReport, file: &str, line: usize, message: String) {
+pub(crate) fn push(
+    report: &mut ValidationReport,
+    kind: ProblemKind,
+    file: &str,
+    line: usize,
+    message: String,
+) {
     report.problems.push(Problem {
+        kind,
         file: file.to_string(),
         line,
         message,
@@ -214,7 +258,13 @@ pub(crate) fn decode_pose(
     let mut q = match robot.inverse(base_from_flange, cfg) {
         Ok(q) => q,
         Err(e) => {
-            push(report, file, line, format!("{label}: {e}"));
+            push(
+                report,
+                ProblemKind::Reach,
+                file,
+                line,
+                format!("{label}: {e}"),
+            );
             return None;
         }
     };
@@ -224,6 +274,7 @@ pub(crate) fn decode_pose(
             None => {
                 push(
                     report,
+                    ProblemKind::Configuration,
                     file,
                     line,
                     format!(
@@ -241,6 +292,7 @@ pub(crate) fn decode_pose(
     if err > REACH_TOLERANCE_MM {
         push(
             report,
+            ProblemKind::Reach,
             file,
             line,
             format!("{label}: IK with the file's configuration reaches {err:.4} mm away"),
@@ -262,7 +314,7 @@ pub(crate) fn vendor_matches(
     match crate::program::check_vendor(cell, vendor, emitter) {
         Ok(()) => true,
         Err(e) => {
-            push(report, file, 1, e.to_string());
+            push(report, ProblemKind::Vendor, file, 1, e.to_string());
             false
         }
     }
