@@ -248,10 +248,7 @@ fn sample_cells() -> &'static [Cell; 6] {
         };
         macro_rules! cell {
             ($f:literal) => {
-                read(
-                    include_str!(concat!("../../parts/cells/", $f)),
-                    $f,
-                )
+                read(include_str!(concat!("../../parts/cells/", $f)), $f)
             };
         }
         [
@@ -281,12 +278,7 @@ pub fn fanuc_ls(selector: u8, text: &str) {
     match parse_ls(text, "FUZZ.LS") {
         Ok(tp) => {
             let cell = &sample_cells()[usize::from(selector % 2)];
-            let report = validate_fanuc(
-                std::slice::from_ref(&tp),
-                cell,
-                &Default::default(),
-                None,
-            );
+            let report = validate_fanuc(std::slice::from_ref(&tp), cell, &Default::default(), None);
             check_report(&report);
         }
         Err(e) => assert!(
