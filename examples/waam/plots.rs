@@ -25,6 +25,62 @@ fn colour(rel: f64, span: f64) -> RGBColor {
     }
 }
 
+/// Largest magnitude drawn on an axis: beyond it (a typo such as `1e308`,
+/// or a diverged value) a panel says so instead of asking plotters for the
+/// ticks of a range it cannot subdivide.
+const MAX_DRAWN: f64 = 1e12;
+
+/// The range of an axis over `values` (non-finite values ignored), padded
+/// by `pad` of its width; a constant series is widened to ±1 unit (or
+/// ±0.1 % of its value). `Err` says why there is nothing to draw: no
+/// finite value, or a value beyond [`MAX_DRAWN`].
+fn axis_range(values: impl IntoIterator<Item = f64>, pad: f64) -> Result<(f64, f64), String> {
+    let (lo, hi) = values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if lo > hi {
+        return Err("no data".to_string());
+    }
+    let big = lo.abs().max(hi.abs());
+    if big > MAX_DRAWN {
+        return Err(format!(
+            "no data: values up to {big:.3e}, beyond the drawable ±{MAX_DRAWN:.0e}"
+        ));
+    }
+    let width = hi - lo;
+    if width <= 1e-9 * big.max(1.0) {
+        let half = (1e-3 * big).max(1.0);
+        return Ok((lo - half, hi + half));
+    }
+    Ok((lo - pad * width, hi + pad * width))
+}
+
+/// Draws an empty panel with `caption` and the reason there is no plot.
+fn no_data_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    caption: &str,
+    reason: &str,
+    file: &FsPath,
+) -> Result<(), String> {
+    let (w, h) = area.dim_in_pixel();
+    area.draw(&Text::new(
+        caption.to_string(),
+        (10, 10),
+        ("sans-serif", 16),
+    ))
+    .map_err(|e| format!("{}: {e}", file.display()))?;
+    area.draw(&Text::new(
+        reason.to_string(),
+        (w as i32 / 2 - 120, h as i32 / 2),
+        ("sans-serif", 18).into_font().color(&RED),
+    ))
+    .map_err(|e| format!("{}: {e}", file.display()))?;
+    Ok(())
+}
+
 fn err<E: std::fmt::Display>(file: &FsPath) -> impl Fn(E) -> String + '_ {
     move |e| format!("{}: {e}", file.display())
 }
@@ -49,19 +105,25 @@ pub fn path_view(path: &Path, title: &str, file: &FsPath) -> Result<(), String> 
             })
         })
         .collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for (x, y, _) in &pts {
-        x0 = x0.min(*x);
-        x1 = x1.max(*x);
-        y0 = y0.min(*y);
-        y1 = y1.max(*y);
-    }
-    let pad = 0.05 * (x1 - x0).max(y1 - y0).max(1.0);
-    let span = (x1 - x0).max(y1 - y0) + 2.0 * pad;
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    // only points with both view coordinates finite are drawn
+    let pts: Vec<(f64, f64, Option<f64>)> = pts
+        .into_iter()
+        .filter(|p| p.0.is_finite() && p.1.is_finite())
+        .collect();
     let whole = SVGBackend::new(file, (900, 930)).into_drawing_area();
     whole.fill(&WHITE).map_err(err(file))?;
     let (root, note) = whole.split_vertically(900);
+    let ranges = axis_range(pts.iter().map(|p| p.0), 0.05)
+        .and_then(|x| Ok((x, axis_range(pts.iter().map(|p| p.1), 0.05)?)));
+    let ((x0, x1), (y0, y1)) = match ranges {
+        Ok(r) => r,
+        Err(reason) => {
+            no_data_panel(&root, title, &reason, file)?;
+            return whole.present().map_err(err(file));
+        }
+    };
+    let span = (x1 - x0).max(y1 - y0);
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
         .margin(20)
@@ -84,8 +146,9 @@ pub fn path_view(path: &Path, title: &str, file: &FsPath) -> Result<(), String> 
         .iter()
         .filter_map(|p| p.2)
         .map(|d| ((d - delta) / delta).abs())
+        .filter(|r| r.is_finite())
         .fold(0.0, f64::max);
-    let scale = max_dev.max(0.01);
+    let scale = max_dev.clamp(0.01, 1e6);
     chart
         .draw_series(pts.iter().map(|&(x, y, d)| {
             let c = d.map_or(RGBColor(150, 150, 150), |d| {
@@ -119,17 +182,34 @@ pub fn distance_plot(
         .collect();
     let root = SVGBackend::new(file, (900, 500)).into_drawing_area();
     root.fill(&WHITE).map_err(err(file))?;
-    let (lo, hi) = rows
-        .iter()
-        .fold((1.0_f64, 1.0_f64), |(a, b), r| (a.min(r.1), b.max(r.3)));
-    let pad = 0.1 * (hi - lo).max(0.002);
+    // rows with a non-finite ratio (Delta 0, a diverged distance) are not drawn
+    let rows: Vec<(usize, f64, f64, f64)> = rows
+        .into_iter()
+        .filter(|r| r.1.is_finite() && r.2.is_finite() && r.3.is_finite())
+        .collect();
+    let (lo, hi) = match axis_range(rows.iter().flat_map(|r| [r.1, r.3]).chain([1.0]), 0.1) {
+        Ok(r) if !rows.is_empty() => r,
+        Ok(_) => {
+            no_data_panel(
+                &root,
+                title,
+                "no data: no layer has a measured distance",
+                file,
+            )?;
+            return root.present().map_err(err(file));
+        }
+        Err(reason) => {
+            no_data_panel(&root, title, &reason, file)?;
+            return root.present().map_err(err(file));
+        }
+    };
     let n = path.layers.len().max(2);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
         .margin(20)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(0.0..(n - 1) as f64, (lo - pad)..(hi + pad))
+        .build_cartesian_2d(0.0..(n - 1) as f64, lo..hi)
         .map_err(err(file))?;
     chart
         .configure_mesh()
@@ -176,7 +256,9 @@ pub fn distance_plot(
 }
 
 /// Six panels (J1..J6) of a quantity against the point index, with the
-/// allowed band drawn as red lines (infinite bounds are not drawn).
+/// allowed band drawn as red lines (infinite bounds are not drawn). A
+/// panel with no finite point, or values beyond ±1e12, says "no data"
+/// (and why) instead of a chart.
 pub fn joint_panels(
     title: &str,
     y_unit: &str,
@@ -189,29 +271,41 @@ pub fn joint_panels(
     let whole = whole.titled(title, ("sans-serif", 22)).map_err(err(file))?;
     let panels = whole.split_evenly((3, 2));
     for (j, area) in panels.iter().enumerate() {
-        let data = &series[j];
-        let x_max = data.last().map_or(1.0, |p| p.0).max(1.0);
-        let (mut lo, mut hi) = data
+        let caption = format!("J{}", j + 1);
+        // only finite points are drawn; the bounds widen the axis only
+        // when there is something to draw
+        let data: Vec<(f64, f64)> = series[j]
             .iter()
-            .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+            .copied()
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect();
+        let drawn = |b: f64| b.is_finite() && b.abs() <= MAX_DRAWN;
         let (blo, bhi) = bounds[j];
-        if blo.is_finite() {
-            lo = lo.min(blo);
-        }
-        if bhi.is_finite() {
-            hi = hi.max(bhi);
-        }
-        if !(lo.is_finite() && hi.is_finite()) {
-            lo = -1.0;
-            hi = 1.0;
-        }
-        let pad = 0.05 * (hi - lo).max(1e-6);
+        let (blo, bhi) = (
+            if drawn(blo) { blo } else { f64::NAN },
+            if drawn(bhi) { bhi } else { f64::NAN },
+        );
+        let ranges = axis_range(data.iter().map(|p| p.0).chain([0.0]), 0.0).and_then(|x| {
+            if data.is_empty() {
+                return Err("no data".to_string());
+            }
+            let y = axis_range(data.iter().map(|p| p.1).chain([blo, bhi]), 0.05)?;
+            Ok((x, y))
+        });
+        let ((_, x_max), (lo, hi)) = match ranges {
+            Ok(r) => r,
+            Err(reason) => {
+                no_data_panel(area, &caption, &reason, file)?;
+                continue;
+            }
+        };
+        let x_max = x_max.max(1.0);
         let mut chart = ChartBuilder::on(area)
-            .caption(format!("J{}", j + 1), ("sans-serif", 16))
+            .caption(caption, ("sans-serif", 16))
             .margin(10)
             .x_label_area_size(30)
             .y_label_area_size(55)
-            .build_cartesian_2d(0.0..x_max, (lo - pad)..(hi + pad))
+            .build_cartesian_2d(0.0..x_max, lo..hi)
             .map_err(err(file))?;
         chart
             .configure_mesh()
@@ -220,15 +314,178 @@ pub fn joint_panels(
             .draw()
             .map_err(err(file))?;
         for b in [blo, bhi] {
-            if b.is_finite() {
+            if drawn(b) {
                 chart
                     .draw_series(LineSeries::new([(0.0, b), (x_max, b)], RED.stroke_width(2)))
                     .map_err(err(file))?;
             }
         }
         chart
-            .draw_series(LineSeries::new(data.iter().copied(), BLUE.stroke_width(1)))
+            .draw_series(LineSeries::new(data, BLUE.stroke_width(1)))
             .map_err(err(file))?;
     }
     whole.present().map_err(err(file))
+}
+
+#[cfg(test)]
+mod tests {
+    //! Every plot function on empty, constant, NaN and huge data: each must
+    //! return quickly with an SVG, a "no data" panel where nothing can be
+    //! drawn and a chart where something can (issue 22: a plan with no joint
+    //! values spun for minutes inside plotters' tick computation).
+
+    use super::*;
+    use std::time::{Duration, Instant};
+    use waam_slicer::math::Point3;
+    use waam_slicer::path::{DistanceStats, Layer, PathPoint, SliceReport, Strategy};
+
+    /// The inputs every plot is fed: (name, values, whether a chart is expected).
+    fn cases() -> Vec<(&'static str, Vec<f64>, bool)> {
+        vec![
+            ("empty", vec![], false),
+            ("constant", vec![2.5; 20], true),
+            ("nan", vec![f64::NAN; 20], false),
+            ("huge", vec![1e308, -1e308, 1e308], false),
+            ("infinite", vec![f64::INFINITY, f64::NEG_INFINITY], false),
+            ("ramp with a NaN", vec![0.0, 1.0, f64::NAN, 3.0], true),
+        ]
+    }
+
+    fn path_of(values: &[f64]) -> Path {
+        let points = values
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| PathPoint {
+                t: v,
+                v: 0.1 * i as f64,
+                position: Point3::new(v, 0.5 * v, v),
+                delta: Some(v),
+            })
+            .collect();
+        Path {
+            strategy: Strategy::Constant,
+            delta_mm: 2.5,
+            layers: vec![
+                Layer {
+                    slice: 0,
+                    points: Vec::new(),
+                    closed: true,
+                },
+                Layer {
+                    slice: 1,
+                    points,
+                    closed: true,
+                },
+            ],
+            report: SliceReport::default(),
+            spiral: None,
+        }
+    }
+
+    /// Statistics as the distance map gives them: NaN distances are not
+    /// counted, infinite and huge ones are.
+    fn stats_of(values: &[f64]) -> Option<DistanceStats> {
+        let values: Vec<f64> = values.iter().copied().filter(|v| !v.is_nan()).collect();
+        let (lo, hi) = values
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        (!values.is_empty()).then(|| DistanceStats {
+            count: values.len(),
+            min_mm: lo,
+            max_mm: hi,
+            mean_mm: values.iter().sum::<f64>() / values.len() as f64,
+            variation: (hi - lo) / 2.5,
+            min_rel: (lo - 2.5) / 2.5,
+            max_rel: (hi - 2.5) / 2.5,
+            boundary_points: 0,
+        })
+    }
+
+    /// Runs `draw` into a fresh file, checks it returned in under 10 s and
+    /// wrote an SVG, and returns the SVG text.
+    fn timed(name: &str, draw: impl FnOnce(&FsPath) -> Result<(), String>) -> String {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let file = dir.path().join("plot.svg");
+        let start = Instant::now();
+        draw(&file).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let took = start.elapsed();
+        assert!(took < Duration::from_secs(10), "{name}: took {took:?}");
+        let svg = std::fs::read_to_string(&file).expect("the plot was written");
+        assert!(svg.starts_with("<svg"), "{name}: not an SVG");
+        svg
+    }
+
+    fn check(name: &str, svg: &str, chart: bool) {
+        assert_eq!(
+            !svg.contains("no data"),
+            chart,
+            "{name}: expected {}",
+            if chart { "a chart" } else { "a no-data panel" }
+        );
+    }
+
+    #[test]
+    fn path_view_survives_degenerate_data() {
+        for (name, values, chart) in cases() {
+            let path = path_of(&values);
+            let svg = timed(name, |f| path_view(&path, name, f));
+            check(name, &svg, chart);
+        }
+    }
+
+    #[test]
+    fn distance_plot_survives_degenerate_data() {
+        for (name, values, chart) in cases() {
+            let path = path_of(&values);
+            let map = DistanceMap {
+                per_layer: vec![None, stats_of(&values)],
+                overall: stats_of(&values),
+                points: Vec::new(),
+            };
+            let svg = timed(name, |f| distance_plot(&path, &map, name, f));
+            check(name, &svg, chart);
+        }
+    }
+
+    #[test]
+    fn joint_panels_survive_degenerate_data() {
+        let limited = (-2.0, 2.0);
+        let unlimited = (f64::NEG_INFINITY, f64::INFINITY);
+        for (name, values, chart) in cases() {
+            let s: Vec<(f64, f64)> = values
+                .iter()
+                .enumerate()
+                .map(|(i, &v)| (i as f64, v))
+                .collect();
+            let series: [Vec<(f64, f64)>; 6] = std::array::from_fn(|_| s.clone());
+            // the issue's case: no joint values, unlimited J6
+            let bounds = [limited, limited, limited, limited, limited, unlimited];
+            let svg = timed(name, |f| joint_panels(name, "rad", &series, bounds, f));
+            let panels = svg.matches("no data").count();
+            assert_eq!(
+                panels,
+                if chart { 0 } else { 6 },
+                "{name}: {panels} no-data panels"
+            );
+        }
+        // huge x (point index) and a huge bound
+        let series: [Vec<(f64, f64)>; 6] = std::array::from_fn(|_| vec![(1e308, 1.0), (0.0, 2.0)]);
+        let svg = timed("huge x", |f| {
+            joint_panels("huge x", "rad", &series, [(-1e308, 1e308); 6], f)
+        });
+        assert_eq!(svg.matches("no data").count(), 6);
+    }
+
+    #[test]
+    fn axis_range_cases() {
+        assert!(axis_range([], 0.05).is_err());
+        assert!(axis_range([f64::NAN], 0.05).is_err());
+        assert!(axis_range([1e308], 0.05).is_err());
+        assert_eq!(axis_range([3.0, 3.0], 0.05), Ok((2.0, 4.0)));
+        assert_eq!(axis_range([5000.0], 0.05), Ok((4995.0, 5005.0)));
+        let (lo, hi) = axis_range([0.0, 10.0, f64::NAN], 0.1).unwrap();
+        assert!((lo + 1.0).abs() < 1e-12 && (hi - 11.0).abs() < 1e-12);
+    }
 }

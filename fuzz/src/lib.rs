@@ -172,3 +172,152 @@ pub fn stl(bytes: &[u8]) {
         }
     }
 }
+
+// ---------------------------------------------------------------------------
+// Cell files and the program readers behind `waam check`.
+
+use std::sync::OnceLock;
+use waam_slicer::io::cell_file::parse_cell_file;
+use waam_slicer::program::readback::{abb::parse_mod, kuka::parse_krl, parse_ls};
+use waam_slicer::program::validate::{validate_abb, validate_fanuc, validate_kuka};
+use waam_slicer::robot::{Cell, CellPoint};
+
+/// Cell-file target: text → `parse_cell_file`; errors must name the file.
+/// An accepted cell is asked for the joints of a few points near the part
+/// origin (tool axis vertical and tilted, several `R_Z`): each answer is a
+/// typed error or finite joints and a finite flange pose.
+pub fn cell_file(text: &str) {
+    let cell = match parse_cell_file(text, "fuzz.toml") {
+        Ok(f) => {
+            for q in f.robot.limits {
+                assert!(!q.lower_rad.is_nan() && !q.upper_rad.is_nan());
+            }
+            match f.cell {
+                Some(c) => c,
+                None => return,
+            }
+        }
+        Err(e) => {
+            assert!(
+                e.to_string().starts_with("fuzz.toml"),
+                "error does not name the file: {e}"
+            );
+            return;
+        }
+    };
+    let _ = format!("{cell:?}");
+    let axes = [
+        Vector3::z(),
+        Vector3::new(0.3, -0.2, 1.0),
+        Vector3::new(1.0, 0.0, 0.2),
+    ];
+    let mut near = None;
+    for (i, a) in axes.iter().enumerate() {
+        let p = CellPoint {
+            position_mm: Point3::new(10.0 * i as f64, -5.0, 2.0),
+            tool_axis: UnitVector3::new_normalize(*a),
+            build_direction: None,
+        };
+        for r_z in [0.0, 1.0, -2.5] {
+            if let Ok((q, pose)) = cell.joints(&p, r_z, near.as_ref(), 0.0) {
+                assert!(
+                    q.iter().all(|v| v.is_finite()),
+                    "non-finite joints {q:?} at point {i}, R_Z {r_z}"
+                );
+                let t = pose.base_from_flange.translation.vector;
+                assert!(t.iter().all(|v| v.is_finite()), "non-finite flange {t:?}");
+                if let Ok(d) = cell.dq_drz(&pose, &q) {
+                    assert!(d.iter().all(|v| v.is_finite()), "non-finite dq/dR_Z");
+                }
+                near = Some(q);
+            }
+        }
+    }
+}
+
+/// The sample cells programs are checked against: FANUC (ROBOWAM part and
+/// torch carried), KUKA KR 16-2 and ABB IRB 2600 (part and torch carried).
+fn sample_cells() -> &'static [Cell; 6] {
+    static CELLS: OnceLock<[Cell; 6]> = OnceLock::new();
+    CELLS.get_or_init(|| {
+        let read = |text: &str, name: &str| {
+            parse_cell_file(text, name)
+                .expect("sample cell reads")
+                .cell
+                .expect("sample file is a cell")
+        };
+        macro_rules! cell {
+            ($f:literal) => {
+                read(include_str!(concat!("../../parts/cells/", $f)), $f)
+            };
+        }
+        [
+            cell!("robowam_part_carried.toml"),
+            cell!("robowam_torch_carried.toml"),
+            cell!("kuka_kr16_2_part_carried.toml"),
+            cell!("kuka_kr16_2_torch_carried.toml"),
+            cell!("abb_irb2600_part_carried.toml"),
+            cell!("abb_irb2600_torch_carried.toml"),
+        ]
+    })
+}
+
+/// Every problem of a report has a line and a message.
+fn check_report(report: &waam_slicer::program::validate::ValidationReport) {
+    let _ = report.to_string();
+    for p in &report.problems {
+        assert!(p.line >= 1, "problem without a line: {p}");
+        assert!(!p.message.is_empty(), "problem without a message: {p}");
+    }
+}
+
+/// FANUC target: first byte picks the cell (part or torch carried), the rest
+/// is one `.ls` file (its `CALL`s are not followed). Errors name the file; a
+/// program that reads is validated against the cell.
+pub fn fanuc_ls(selector: u8, text: &str) {
+    match parse_ls(text, "FUZZ.LS") {
+        Ok(tp) => {
+            let cell = &sample_cells()[usize::from(selector % 2)];
+            let report = validate_fanuc(std::slice::from_ref(&tp), cell, &Default::default(), None);
+            check_report(&report);
+        }
+        Err(e) => assert!(
+            e.to_string().starts_with("FUZZ.LS"),
+            "error does not name the file: {e}"
+        ),
+    }
+}
+
+/// KUKA target: the bytes up to the first NUL are the `.src`, the rest the
+/// `.dat`; the first byte picks the cell. Errors name one of the two files.
+pub fn kuka_krl(selector: u8, src: &str, dat: &str) {
+    match parse_krl(src, "fuzz.src", dat, "fuzz.dat") {
+        Ok(program) => {
+            let cell = &sample_cells()[2 + usize::from(selector % 2)];
+            let report = validate_kuka(&program, cell, &Default::default(), None);
+            check_report(&report);
+        }
+        Err(e) => {
+            let s = e.to_string();
+            assert!(
+                s.starts_with("fuzz.src") || s.starts_with("fuzz.dat"),
+                "error does not name the file: {s}"
+            );
+        }
+    }
+}
+
+/// ABB target: first byte picks the cell, the rest is one `.mod` module.
+pub fn abb_mod(selector: u8, text: &str) {
+    match parse_mod(text, "fuzz.mod") {
+        Ok(module) => {
+            let cell = &sample_cells()[4 + usize::from(selector % 2)];
+            let report = validate_abb(&module, cell, &Default::default(), None);
+            check_report(&report);
+        }
+        Err(e) => assert!(
+            e.to_string().starts_with("fuzz.mod"),
+            "error does not name the file: {e}"
+        ),
+    }
+}

@@ -29,6 +29,13 @@ use crate::robot::{
     RobotError, RobotModel, RobotPreset, TorchCarriedCell, Vendor,
 };
 
+/// Part size the cell-file reader allows for when it checks that the arm
+/// reaches the work (mm): a cell is refused only if no path point within
+/// 1 m of the part frame origin could be reached
+/// ([`Cell::check_reach`]). A cell file names no part; a plan checks again
+/// with its path's own extent.
+pub const CELL_FILE_PART_RADIUS_MM: f64 = 1000.0;
+
 /// Errors reading a cell file; each names the file and the key at fault.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -377,6 +384,7 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
     };
     if let Some(c) = &cell {
         c.validate().map_err(robot_err)?;
+        c.check_reach(CELL_FILE_PART_RADIUS_MM).map_err(robot_err)?;
     }
     if let Some(p) = &doc.placement {
         for f in &p.fixed {

@@ -376,7 +376,7 @@ fn spiral_path(
 
 /// Computation grid: the requested points, or a fine grid for chord / spacing
 /// tolerances (output is decimated to the tolerance).
-fn grid_size(tube: &Tube, opts: &SliceOptions) -> usize {
+pub(super) fn grid_size(tube: &Tube, opts: &SliceOptions) -> usize {
     let r = tube.range();
     let (mut a_min, mut a_max) = (f64::MAX, 0.0_f64);
     for i in 0..=64 {

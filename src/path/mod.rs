@@ -8,12 +8,14 @@
 //! truncation by an end plane (§3.5) and seams (§3.3).
 
 pub mod distance_map;
+mod estimate;
 pub mod index;
 mod march;
 pub mod smooth;
 pub mod strategy;
 
 pub use distance_map::{distance_map, spiral_distance_map, DistanceMap, DistanceStats};
+pub use estimate::{estimate_work, WorkEstimate, BYTES_PER_POINT};
 pub use march::slice;
 
 use crate::geometry::Plane;

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::math::{
     Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, UnitVector3, Vector3,
 };
+use crate::robot::error::OutOfReach;
 use crate::robot::ik::Configuration;
 use crate::robot::jacobian::{twist_about_axis, Twist};
 use crate::robot::kinematics::{rot_x, rot_y, rot_z};
@@ -87,6 +88,104 @@ fn iso(r: Matrix3, p: Vector3) -> Isometry3 {
     )
 }
 
+/// Largest translation accepted in a cell's mounts (mm): 100 m. No cell is
+/// that large; a larger number is a typo or a unit mistake (`1e308` would
+/// overflow to infinity in the first product).
+pub const MAX_MOUNT_MM: f64 = 1.0e5;
+
+/// Checks that a rigid transform is finite and its translation within
+/// [`MAX_MOUNT_MM`], naming the cell-file `field`.
+fn check_mount(what: &str, field: &'static str, iso: &Isometry3) -> Result<(), RobotError> {
+    let t = iso.translation.vector;
+    let q = iso.rotation.coords;
+    if !(t.iter().chain(q.iter()).all(|v| v.is_finite())) {
+        return Err(RobotError::InvalidParameter {
+            what: what.to_string(),
+            field,
+            value: t
+                .iter()
+                .copied()
+                .find(|v| !v.is_finite())
+                .unwrap_or(f64::NAN),
+            reason: "must be finite",
+        });
+    }
+    let worst = t.amax();
+    if worst > MAX_MOUNT_MM {
+        return Err(RobotError::InvalidParameter {
+            what: what.to_string(),
+            field,
+            value: worst,
+            reason: "a translation beyond 100 m (1e5 mm) is not a robot cell",
+        });
+    }
+    Ok(())
+}
+
+/// Smallest and largest distance (mm) from `p` (base frame) to the circle
+/// the shoulder point (on the J2 axis, in the arm plane) describes as J1
+/// turns: radius `hypot(shoulder_offset, lateral_offset)` about the base Z
+/// axis at the shoulder height.
+fn shoulder_circle_distances(robot: &RobotModel, p: &Point3) -> (f64, f64) {
+    let g = &robot.geometry;
+    let radius = g.shoulder_offset_mm.hypot(g.lateral_offset_mm);
+    let rho = p.x.hypot(p.y);
+    let dz = p.z - g.shoulder_height_mm;
+    ((rho - radius).hypot(dz), (rho + radius).hypot(dz))
+}
+
+/// The reach test shared by both cells: the wrist centre is within
+/// `allowance_mm` of `anchor`, and within `[|c2 − k|, c2 + k]` of the
+/// shoulder point (`c2` the upper arm, `k` the J3 → wrist-centre distance),
+/// so the anchor must be within `allowance_mm` of that shell.
+fn check_anchor_reach(
+    robot: &RobotModel,
+    what: &str,
+    field: &'static str,
+    anchor: &Point3,
+    allowance_mm: f64,
+) -> Result<(), RobotError> {
+    let g = &robot.geometry;
+    let k = g.forearm_mm.hypot(g.elbow_offset_mm);
+    let arm_max = g.upper_arm_mm + k;
+    let arm_min = (g.upper_arm_mm - k).abs();
+    // rounding of the FK/IK chain; the test is a bound, not a decision at the edge
+    let slack = 1e-6 * arm_max;
+    let (near, far) = shoulder_circle_distances(robot, anchor);
+    let max_reach = arm_max + allowance_mm + slack;
+    let min_reach = (arm_min - allowance_mm - slack).max(0.0);
+    let distance = if !(near <= max_reach) {
+        near
+    } else if far < min_reach {
+        far
+    } else {
+        return Ok(());
+    };
+    Err(RobotError::OutOfReach(Box::new(OutOfReach {
+        what: what.to_string(),
+        field,
+        point_mm: [anchor.x, anchor.y, anchor.z],
+        distance_mm: distance,
+        min_reach_mm: min_reach,
+        max_reach_mm: max_reach,
+        arm_min_mm: arm_min,
+        arm_max_mm: arm_max,
+    })))
+}
+
+fn check_part_radius(what: &str, part_radius_mm: f64) -> Result<(), RobotError> {
+    if part_radius_mm.is_finite() && part_radius_mm >= 0.0 {
+        Ok(())
+    } else {
+        Err(RobotError::InvalidParameter {
+            what: what.to_string(),
+            field: "part_radius_mm",
+            value: part_radius_mm,
+            reason: "must be finite and >= 0",
+        })
+    }
+}
+
 /// Part carried ("pièce portée", fig. 3.2a, 3.5): the torch is fixed and
 /// vertical at `D_R`; the robot holds the part, whose frame is fixed to the flange.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -115,11 +214,53 @@ impl PartCarriedCell {
             return Err(RobotError::InvalidParameter {
                 what: self.name.clone(),
                 field: "deposition_point_mm",
-                value: f64::NAN,
+                value: self
+                    .deposition_point_mm
+                    .iter()
+                    .copied()
+                    .find(|v| !v.is_finite())
+                    .unwrap_or(f64::NAN),
                 reason: "must be finite",
             });
         }
-        Ok(())
+        check_mount(
+            &self.name,
+            "flange_from_part_xyzwpr",
+            &self.flange_from_part,
+        )
+    }
+
+    /// Refuses a cell that cannot reach its deposition point `D_R` for any
+    /// path point within `part_radius_mm` of the part frame origin.
+    ///
+    /// A sound bound, from the arm's lengths only: the deposition point is
+    /// a path point `M`, so the flange origin is within
+    /// `|M| + |flange_from_part|` of `D_R` and the wrist centre another
+    /// `wrist_to_flange_mm` away; the wrist centre is within
+    /// `[|c2 − k|, c2 + k]` of the shoulder point (`c2` upper arm,
+    /// `k = hypot(forearm, elbow_offset)`), which J1 turns on a circle. A
+    /// cell this refuses has no IK solution at any point of any such part;
+    /// one it accepts may still fail at some points (orientation, limits).
+    ///
+    /// `part_radius_mm`: the largest distance of a path point from the part
+    /// frame origin (mm); for a plan, the path's own.
+    ///
+    /// # Errors
+    /// [`RobotError::OutOfReach`] naming `deposition_point_mm`, its
+    /// distance from the shoulder circle and the arm's reach;
+    /// [`RobotError::InvalidParameter`] for a negative or non-finite radius.
+    pub fn check_reach(&self, part_radius_mm: f64) -> Result<(), RobotError> {
+        check_part_radius(&self.name, part_radius_mm)?;
+        let allowance = part_radius_mm
+            + self.flange_from_part.translation.vector.norm()
+            + self.robot.geometry.wrist_to_flange_mm;
+        check_anchor_reach(
+            &self.robot,
+            &self.name,
+            "deposition_point_mm",
+            &self.deposition_point_mm,
+            allowance,
+        )
     }
 
     /// `base_from_part` for path point `m` with tool axis `t` (part frame)
@@ -222,7 +363,51 @@ impl TorchCarriedCell {
                 reason: "must be > 0",
             });
         }
-        Ok(())
+        let tilt = self.positioner.tilt_to_table_mm;
+        if tilt.abs() > MAX_MOUNT_MM {
+            return Err(RobotError::InvalidParameter {
+                what: self.name.clone(),
+                field: "positioner.tilt_to_table_mm",
+                value: tilt,
+                reason: "a length beyond 100 m (1e5 mm) is not a positioner",
+            });
+        }
+        check_mount(
+            &self.name,
+            "positioner_pose_xyzwpr",
+            &self.base_from_positioner,
+        )?;
+        check_mount(&self.name, "tool_xyzwpr", &self.flange_from_tcp)?;
+        check_mount(&self.name, "table_from_part_xyzwpr", &self.table_from_part)
+    }
+
+    /// Refuses a cell whose arm cannot reach the work on the positioner for
+    /// any path point within `part_radius_mm` of the part frame origin.
+    ///
+    /// A sound bound, from the lengths only: the part origin is within
+    /// `|C7C8| + |table_from_part|` of the tilt centre C7 (the positioner
+    /// frame origin) at any positioner angles, the TCP is on a path point
+    /// (`part_radius_mm` further), the flange `|flange_from_tcp|` from the
+    /// TCP and the wrist centre `wrist_to_flange_mm` from the flange; the
+    /// arm is bounded as in [`PartCarriedCell::check_reach`].
+    ///
+    /// # Errors
+    /// [`RobotError::OutOfReach`] naming `positioner_pose_xyzwpr`;
+    /// [`RobotError::InvalidParameter`] for a negative or non-finite radius.
+    pub fn check_reach(&self, part_radius_mm: f64) -> Result<(), RobotError> {
+        check_part_radius(&self.name, part_radius_mm)?;
+        let allowance = part_radius_mm
+            + self.positioner.tilt_to_table_mm.abs()
+            + self.table_from_part.translation.vector.norm()
+            + self.flange_from_tcp.translation.vector.norm()
+            + self.robot.geometry.wrist_to_flange_mm;
+        check_anchor_reach(
+            &self.robot,
+            &self.name,
+            "positioner_pose_xyzwpr",
+            &Point3::from(self.base_from_positioner.translation.vector),
+            allowance,
+        )
     }
 
     /// Positioner angles that turn the point's build direction vertical,
@@ -316,6 +501,20 @@ impl Cell {
         match self {
             Cell::PartCarried(c) => c.validate(),
             Cell::TorchCarried(c) => c.validate(),
+        }
+    }
+
+    /// Refuses a cell that cannot reach its work for any path point within
+    /// `part_radius_mm` (mm) of the part frame origin; see
+    /// [`PartCarriedCell::check_reach`] and [`TorchCarriedCell::check_reach`].
+    ///
+    /// # Errors
+    /// [`RobotError::OutOfReach`] naming the cell-file field, the distance
+    /// and the reach.
+    pub fn check_reach(&self, part_radius_mm: f64) -> Result<(), RobotError> {
+        match self {
+            Cell::PartCarried(c) => c.check_reach(part_radius_mm),
+            Cell::TorchCarried(c) => c.check_reach(part_radius_mm),
         }
     }
 

@@ -41,6 +41,13 @@ pub enum RobotError {
         /// Largest reachable distance (arm stretched) (mm).
         max_reach_mm: f64,
     },
+    /// A cell puts its work out of the arm's reach: the point named by
+    /// the field (the part-carried deposition point, or the torch-carried
+    /// positioner's tilt centre) is too far from (or too near to) the
+    /// shoulder for any pose of the arm, whatever the path. See
+    /// [`Cell::check_reach`](crate::robot::Cell::check_reach).
+    #[error("{0}")]
+    OutOfReach(Box<OutOfReach>),
     /// The wrist centre lies on the J1 axis: J1 is undetermined.
     #[error(
         "shoulder singularity: the wrist centre is {distance_mm:.3e} mm from the J1 axis, J1 is undetermined"
@@ -125,4 +132,49 @@ pub enum RobotError {
         /// Why it is rejected.
         reason: &'static str,
     },
+}
+
+/// What [`RobotError::OutOfReach`] reports: the field, the point, its
+/// distance from the shoulder circle and the arm's reach.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "{what}: `{field}` = ({}, {}, {}) mm (base frame) is out of the arm's reach: \
+     {} mm from the shoulder (J2 axis) circle, where the arm with its mounts and \
+     the part reaches {}..{} mm (upper arm and forearm {}..{} mm, plus {} mm of \
+     wrist, mounts and part)",
+    Mm(point_mm[0]), Mm(point_mm[1]), Mm(point_mm[2]), Mm(*distance_mm), Mm(*min_reach_mm),
+    Mm(*max_reach_mm), Mm(*arm_min_mm), Mm(*arm_max_mm), Mm(*max_reach_mm - *arm_max_mm)
+)]
+pub struct OutOfReach {
+    /// The cell's name.
+    pub what: String,
+    /// The cell-file field at fault (`deposition_point_mm`, `positioner_pose_xyzwpr`).
+    pub field: &'static str,
+    /// The point, base frame (mm).
+    pub point_mm: [f64; 3],
+    /// Distance from the point to the shoulder circle (mm): the nearest
+    /// when the point is too far, the farthest when it is too near.
+    pub distance_mm: f64,
+    /// Smallest distance the cell can work at (mm): the folded arm less the allowance.
+    pub min_reach_mm: f64,
+    /// Largest distance the cell can work at (mm): the stretched arm plus the allowance.
+    pub max_reach_mm: f64,
+    /// Shoulder → wrist centre distance, arm folded (mm).
+    pub arm_min_mm: f64,
+    /// Shoulder → wrist centre distance, arm stretched (mm).
+    pub arm_max_mm: f64,
+}
+
+/// A length in mm for messages: one decimal, or three significant digits
+/// in exponent form beyond 10 km (a typo such as `1e308` stays readable).
+struct Mm(f64);
+
+impl std::fmt::Display for Mm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.0.is_finite() && self.0.abs() < 1e7 {
+            write!(f, "{:.1}", self.0)
+        } else {
+            write!(f, "{:.3e}", self.0)
+        }
+    }
 }

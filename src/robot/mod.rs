@@ -46,7 +46,7 @@ pub mod positioner;
 pub mod trajectory;
 
 pub use cell::{Cell, CellPoint, CellPose, PartCarriedCell, TorchCarriedCell};
-pub use error::RobotError;
+pub use error::{OutOfReach, RobotError};
 pub use ik::{ArmSide, Configuration, Elbow, FanucConfig, Wrist};
 pub use jacobian::{Jacobian, Twist};
 pub use model::{

@@ -227,10 +227,29 @@ fn unreachable_cell_names_the_layer_point_and_reach() {
                 "deposition_point_mm = [6000.0, 0.0, 653.167]",
             );
     assert!(cell_text.contains("6000.0"));
-    let cell = parse_cell_file(&cell_text, "far.toml")
-        .unwrap()
-        .cell
-        .unwrap();
+    // The reader refuses it up front (issue 22)...
+    let e = parse_cell_file(&cell_text, "far.toml").unwrap_err();
+    assert_mentions(
+        &e.to_string(),
+        &[
+            "far.toml",
+            "`deposition_point_mm`",
+            "out of the arm's reach",
+        ],
+    );
+    // ...and a cell built through the API, with no reach check, gets a plan
+    // whose every layer names the point and the reach.
+    let mut cell = parse_cell_file(
+        &std::fs::read_to_string(crate::common::part_path("cells/robowam_part_carried.toml"))
+            .unwrap(),
+        "near.toml",
+    )
+    .unwrap()
+    .cell
+    .unwrap();
+    if let waam_slicer::robot::Cell::PartCarried(c) = &mut cell {
+        c.deposition_point_mm = waam_slicer::math::Point3::new(6000.0, 0.0, 653.167);
+    }
     let part = parse_part(
         &crate::common::cylinder_part_text("far", 10.0, 6.0, 2.0),
         "far.toml",

@@ -5,8 +5,18 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+// The CLI's plots, for their degenerate-data tests (`plots::tests`). They
+// are not run as the example's own tests: `test = true` on the example
+// would stop `cargo test` from building the `waam` binary the CLI tests run.
+#[path = "../../examples/waam/plots.rs"]
+mod plots;
+
+mod determinism;
 mod hostile_inputs;
+mod random_cells;
+mod reach;
 mod regressions;
+mod work_estimate;
 
 use proptest::prelude::*;
 use std::path::Path;
