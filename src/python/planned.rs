@@ -230,7 +230,7 @@ impl PyPlannedPart {
             "PlannedPart({:?}, cell={:?}, feasible={}, layers={}, points={})",
             self.planned.sliced.part_name,
             self.planned.cell.name,
-            self.feasible(),
+            if self.feasible() { "True" } else { "False" },
             self.planned.layers.len(),
             self.__len__()
         )
