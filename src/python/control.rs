@@ -30,13 +30,11 @@ const STRATEGIES: [Strategy; 5] = [
     Strategy::Spiral,
 ];
 
-/// A count keyword: a whole number >= 1.
+/// A count keyword: a whole number, not negative (the library checks its
+/// range, naming the part file).
 fn count(name: &str, n: Option<i64>) -> PyResult<Option<usize>> {
     n.map(|n| {
-        usize::try_from(n)
-            .ok()
-            .filter(|&n| n >= 1)
-            .ok_or_else(|| waam_error(format!("{name} = {n}: must be a whole number >= 1")))
+        usize::try_from(n).map_err(|_| waam_error(format!("{name} = {n}: must not be negative")))
     })
     .transpose()
 }
