@@ -32,6 +32,6 @@ def test_stubs_match_the_module():
     } | {"__version__"}
     assert top == public
     for cls, names in members.items():
-        runtime = {n for n in dir(getattr(ws, cls)) if not n.startswith("_")}
+        runtime = {n for n in vars(getattr(ws, cls)) if not n.startswith("_")}
         runtime |= {n for n in names if n.startswith("__") and hasattr(getattr(ws, cls), n)}
         assert names == runtime, cls
