@@ -84,6 +84,9 @@ pub mod report;
 pub mod robot;
 pub mod toolaxis;
 
+#[cfg(feature = "python")]
+mod python;
+
 pub use error::Error;
 
 // The README's "Use as a library" block runs as a doctest.

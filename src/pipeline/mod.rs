@@ -206,6 +206,20 @@ impl Control {
         self
     }
 
+    /// The same control for a part of a run that spans `lo..=hi` of the
+    /// whole (fractions 0..=1): its reports of `f` arrive as `lo + f (hi - lo)`.
+    /// Shares the cancel flag.
+    pub fn within(&self, lo: f64, hi: f64) -> Self {
+        let progress = self.progress.clone().map(|f| {
+            Arc::new(move |stage: &str, x: f64| f(stage, lo + x.clamp(0.0, 1.0) * (hi - lo)))
+                as Arc<ProgressFn>
+        });
+        Self {
+            progress,
+            cancel: self.cancel.clone(),
+        }
+    }
+
     /// Reports `fraction` of the run done in `stage`.
     pub fn report(&self, stage: &str, fraction: f64) {
         if let Some(f) = &self.progress {

@@ -105,7 +105,8 @@ pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<Planned
     check_vendor(&cell.layout, format.vendor(), format.emitter())?;
     let control = &opts.control;
     let t = Instant::now();
-    let sliced = slice_part_with(part, &opts.slice, control)?;
+    // Slicing is the first tenth of a plan's progress.
+    let sliced = slice_part_with(part, &opts.slice, &control.within(0.0, 0.1))?;
     let t_slice = t.elapsed().as_secs_f64() - sliced.times.tool_axes;
     let t = Instant::now();
     let layers = layer_points(&sliced.path, &sliced.axes.frames);

@@ -212,3 +212,31 @@ fn a_cancel_flag_stops_the_run() {
     assert!(matches!(e, Error::Cancelled { .. }), "{e}");
     assert!(seen.lock().unwrap().is_empty());
 }
+
+/// A plan reports the fraction of the whole run: its slicing stage reports
+/// within the first tenth, and the fractions never go back.
+#[test]
+fn a_plans_progress_rises_from_0_to_1() {
+    let part = Part::read(part_path("hemisphere.toml")).unwrap();
+    let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
+    let seen = Arc::new(std::sync::Mutex::new(Vec::new()));
+    let s2 = seen.clone();
+    let opts = PlanOptions {
+        control: Control::default()
+            .with_progress(move |stage, f| s2.lock().unwrap().push((stage.to_string(), f))),
+        rz: "fixed:90".parse().unwrap(),
+        ..small(40)
+    };
+    plan_part(&part, &cell, &opts).unwrap();
+    let seen = seen.lock().unwrap();
+    let fractions: Vec<f64> = seen.iter().map(|s| s.1).collect();
+    assert!(fractions.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
+    assert_eq!(fractions.first(), Some(&0.0), "{seen:?}");
+    assert_eq!(fractions.last(), Some(&1.0), "{seen:?}");
+    assert!(
+        seen.iter()
+            .filter(|s| s.0 == "slicing" || s.0 == "tool axes")
+            .all(|s| s.1 <= 0.1),
+        "{seen:?}"
+    );
+}

@@ -1,0 +1,201 @@
+"""Plans wire-arc additive manufacturing (WAAM) of metal tubes on industrial
+robots: non-planar constant-distance layers, tool axes, layer-by-layer joint
+optimisation, FANUC/KUKA/ABB programs.
+
+Units: mm, degrees (joints, R_Z), mm/s. Part-frame geometry; joints in the
+robot controller's convention. Per-point data are read-only numpy arrays.
+Slicing, planning, writing and checking release the GIL.
+"""
+
+import os
+from pathlib import Path
+from typing import Any, Callable, Dict, List, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+_PathLike = Union[str, "os.PathLike[str]"]
+
+__version__: str
+
+class WaamError(ValueError):
+    """Bad input or a failed stage; the message names the file, field,
+    keyword, layer or point."""
+
+class InfeasiblePlan(WaamError):
+    """A program was asked of a plan with an infeasible layer."""
+
+class Part:
+    """A tube to build: geometry, substrate and the part file's slicing,
+    tool-axis and process settings. Part frame, mm."""
+
+    @staticmethod
+    def read(path: _PathLike) -> "Part":
+        """Reads and validates a part file (TOML, see parts/README.md).
+        Raises WaamError naming the file and the field."""
+    @staticmethod
+    def from_toml(text: str, name: str = "<string>") -> "Part":
+        """Parses part-file text; `name` stands for the file in messages and
+        relative paths in the text (an STL substrate) are resolved from its
+        folder."""
+    @property
+    def name(self) -> str:
+        """The part's name (the file's `name`)."""
+    @property
+    def file(self) -> str:
+        """The file it was read from, as given."""
+    def slice(
+        self,
+        *,
+        strategy: Optional[str] = None,
+        delta_mm: Optional[float] = None,
+        points: Optional[int] = None,
+        chord_mm: Optional[float] = None,
+        max_layers: Optional[int] = None,
+        travel_speed_mm_s: Optional[float] = None,
+        progress: Optional[Callable[[float], Any]] = None,
+    ) -> "SlicedPart":
+        """Slices the part with its file's settings; each keyword given
+        overrides one of them.
+
+        strategy: "constant", "iso", "perpendicular", "planar" or "spiral".
+        delta_mm: target interlayer distance Delta (mm).
+        points / chord_mm: points per layer, or max chord error (mm); one of them.
+        max_layers: stop after this many layers (or spiral turns).
+        travel_speed_mm_s: programmed torch speed (mm/s).
+        progress: called with the fraction of the run done (0..1); an
+            exception it raises stops the run and is re-raised.
+        """
+    def plan(
+        self,
+        cell: "Cell",
+        *,
+        delta_mm: Optional[float] = None,
+        points: Optional[int] = None,
+        chord_mm: Optional[float] = None,
+        strategy: Optional[str] = None,
+        rz: Optional[str] = None,
+        travel_speed_mm_s: Optional[float] = None,
+        max_layers: Optional[int] = None,
+        progress: Optional[Callable[[float], Any]] = None,
+    ) -> "PlannedPart":
+        """Plans the part in `cell`: slice, tool axes, layer-by-layer R_Z
+        optimisation, joint trajectory, program model. An infeasible layer
+        is data (`feasible`, `violations`), not an exception.
+
+        rz: the R_Z law, "fixed:DEG", "poly:N" (N <= 8, default "poly:4"),
+            "spline" or "point". Other keywords as in `slice`. Progress is
+            reported at stage boundaries (slicing, optimising, program).
+        """
+
+class Cell:
+    """A robot cell: the robot and its layout (part carried under a fixed
+    torch, or torch carried over a positioner). Robot base frame, mm."""
+
+    @staticmethod
+    def read(path: _PathLike) -> "Cell":
+        """Reads and validates a cell file (TOML, parts/cells/). A file
+        describing a robot only is refused."""
+    @staticmethod
+    def from_toml(text: str, name: str = "<string>") -> "Cell":
+        """Parses cell-file text; `name` stands for the file in messages."""
+    @property
+    def name(self) -> str:
+        """The cell's name (the file's `name`)."""
+    @property
+    def file(self) -> str:
+        """The file it was read from, as given."""
+    @property
+    def vendor(self) -> str:
+        """The controller's program format: "fanuc", "kuka" or "abb"."""
+    @property
+    def has_positioner(self) -> bool:
+        """True when the torch is carried over a positioner (joints have 8
+        columns)."""
+
+class SlicedPart:
+    """A sliced part: every point of the path in deposition order."""
+
+    @property
+    def points(self) -> npt.NDArray[np.float64]:
+        """Positions (N, 3), part frame, mm."""
+    @property
+    def layer(self) -> npt.NDArray[np.int64]:
+        """Layer index of each point (N,), from 0."""
+    @property
+    def delta(self) -> npt.NDArray[np.float64]:
+        """Local distance to the layer below (N,), mm; NaN on the first layer."""
+    @property
+    def tool_axis(self) -> npt.NDArray[np.float64]:
+        """Tool axis of each point (N, 3), unit vectors, part frame."""
+    @property
+    def delta_mm(self) -> float:
+        """The target interlayer distance Delta used (mm)."""
+    @property
+    def strategy(self) -> str:
+        """The strategy used."""
+    @property
+    def layers(self) -> int:
+        """Number of layers."""
+    def summary(self) -> Dict[str, Any]:
+        """The content of summary.json as `waam slice` writes it."""
+    def __len__(self) -> int:
+        """Number of points."""
+
+class PlannedPart:
+    """A part planned in a cell: every planned point in deposition order."""
+
+    @property
+    def feasible(self) -> bool:
+        """True when every layer is feasible and a program can be written."""
+    @property
+    def violations(self) -> List[Dict[str, Any]]:
+        """Every violation of the planned trajectory, in path order: dicts
+        with `layer`, `point` (index in the layer), `joint` (1-based, 7/8 for
+        the positioner, or None), `what` ("joint_limit", "joint_speed",
+        "wrist_singularity", "elbow_singularity", "shoulder_singularity",
+        "hose_torsion", "no_solution"), `amount` (how far past the limit; the
+        measure itself for a singularity; None without solution), `unit` and
+        `message`."""
+    @property
+    def refusal(self) -> Optional[str]:
+        """Why no program can be written; None when feasible."""
+    @property
+    def points(self) -> npt.NDArray[np.float64]:
+        """Positions of the planned points (N, 3), part frame, mm."""
+    @property
+    def tool_axis(self) -> npt.NDArray[np.float64]:
+        """Tool axes (N, 3), unit vectors, part frame."""
+    @property
+    def layer(self) -> npt.NDArray[np.int64]:
+        """Layer index of each point (N,)."""
+    @property
+    def rz_deg(self) -> npt.NDArray[np.float64]:
+        """R_Z of each point (N,), degrees."""
+    @property
+    def joints(self) -> npt.NDArray[np.float64]:
+        """Joints (N, 6), degrees, controller convention; (N, 8) with a
+        positioner (its two joints last); NaN where a point has no solution."""
+    @property
+    def travel_speed_mm_s(self) -> float:
+        """The travel speed planned (mm/s)."""
+    @property
+    def format(self) -> str:
+        """The program format written by default (the cell vendor's)."""
+    def summary(self) -> Dict[str, Any]:
+        """The content of summary.json as `waam plan` writes it."""
+    def write_program(self, dir: _PathLike, format: Optional[str] = None) -> List[Path]:
+        """Writes the robot program into `dir` (created if missing), each
+        file atomically; returns the written paths, the main program first.
+        format: "fanuc", "kuka", "abb" or None for the cell vendor's; another
+        vendor's is refused (WaamError). Raises InfeasiblePlan when a layer
+        is infeasible."""
+    def __len__(self) -> int:
+        """Number of planned points."""
+
+def check_program(path: _PathLike, cell: Cell) -> List[Dict[str, Any]]:
+    """Reads a program (FANUC .ls main program and the programs it calls,
+    KUKA .src/.dat, ABB .mod) and checks it against `cell`: joint limits,
+    speeds, reachability, configuration, beads. Returns every problem as a
+    dict (`file`, `line`, `message`); [] when clean. Raises WaamError when
+    the file cannot be read or parsed."""
