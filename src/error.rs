@@ -62,6 +62,22 @@ pub enum Error {
         /// The stage's error.
         source: Box<Error>,
     },
+    /// The run's estimated size is over the budget: refused before any work.
+    #[error("{file}: about {points} points ({layers} layers x {points_per_layer} points, ~{megabytes:.0} MB of path) would be computed, over the budget of {budget}: check Delta and the points per layer, or raise the budget (CLI --max-points, API SliceOverrides::max_points)")]
+    OverBudget {
+        /// The part file.
+        file: String,
+        /// Layers estimated.
+        layers: u64,
+        /// Points per layer estimated.
+        points_per_layer: u64,
+        /// Points estimated.
+        points: u64,
+        /// Memory of the path estimated (MB).
+        megabytes: f64,
+        /// The budget (points).
+        budget: u64,
+    },
     /// The host program asked to stop (see [`Control`](crate::pipeline::Control)).
     #[error("cancelled during {stage}")]
     Cancelled {

@@ -102,6 +102,9 @@ pub struct GridArgs {
     /// Max chord error in mm.
     #[arg(long)]
     pub chord: Option<f64>,
+    /// Refuse a run estimated at more computed points than this (default 5000000).
+    #[arg(long, value_name = "N")]
+    pub max_points: Option<u64>,
 }
 
 impl GridArgs {
@@ -115,6 +118,7 @@ impl GridArgs {
         if let Some(e) = self.chord {
             o.discretisation = Some(Discretisation::ChordError(e));
         }
+        o.max_points = self.max_points.or(o.max_points);
     }
 }
 

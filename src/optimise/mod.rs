@@ -201,19 +201,50 @@ pub fn optimise(
     layers: &[LayerPoints],
     opts: &OptimiseOptions,
 ) -> Result<Plan, OptimiseError> {
+    optimise_with(cell, layers, opts, &|_, _| true)
+}
+
+/// [`optimise`] with a host's hook: `on_layer(done, total)` is called as
+/// each layer is solved (from the worker threads, in any order); once it
+/// returns `false` the layers not yet started are skipped and the run ends
+/// with [`OptimiseError::Cancelled`]. The plan, when there is one, is the
+/// same as [`optimise`]'s.
+///
+/// # Errors
+/// As [`optimise`]; [`OptimiseError::Cancelled`].
+pub fn optimise_with(
+    cell: &Cell,
+    layers: &[LayerPoints],
+    opts: &OptimiseOptions,
+    on_layer: &(dyn Fn(usize, usize) -> bool + Sync),
+) -> Result<Plan, OptimiseError> {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     validate_input(cell, layers, opts)?;
     let t0 = Instant::now();
-    let plans: Vec<LayerPlan> = if opts.parallel {
-        layers
-            .par_iter()
-            .map(|l| optimise_layer(cell, l, opts, None).0)
-            .collect()
-    } else {
-        layers
-            .iter()
-            .map(|l| optimise_layer(cell, l, opts, None).0)
-            .collect()
+    let (done, stop) = (AtomicUsize::new(0), AtomicBool::new(false));
+    let total = layers.len();
+    let solve = |l: &LayerPoints| -> Option<LayerPlan> {
+        if stop.load(Ordering::Relaxed) {
+            return None;
+        }
+        let plan = optimise_layer(cell, l, opts, None).0;
+        if !on_layer(done.fetch_add(1, Ordering::Relaxed) + 1, total) {
+            stop.store(true, Ordering::Relaxed);
+        }
+        Some(plan)
     };
+    let plans: Vec<Option<LayerPlan>> = if opts.parallel {
+        layers.par_iter().map(solve).collect()
+    } else {
+        layers.iter().map(solve).collect()
+    };
+    if stop.load(Ordering::Relaxed) {
+        return Err(OptimiseError::Cancelled {
+            layers_done: done.load(Ordering::Relaxed),
+            layers: total,
+        });
+    }
+    let plans: Vec<LayerPlan> = plans.into_iter().flatten().collect();
     let transitions = transitions(cell, &plans);
     Ok(Plan {
         layers: plans,

@@ -47,6 +47,14 @@ pub enum OptimiseError {
     /// The cell is invalid.
     #[error("cell: {0}")]
     Cell(#[from] RobotError),
+    /// The host asked to stop (see [`optimise_with`](crate::optimise::optimise_with)).
+    #[error("cancelled after {layers_done} of {layers} layers")]
+    Cancelled {
+        /// Layers solved when the run stopped.
+        layers_done: usize,
+        /// Layers in all.
+        layers: usize,
+    },
     /// A placement bound or setting is invalid (see
     /// [`place`](crate::optimise::place::place)).
     #[error("placement: `{field}`: {reason}")]

@@ -34,6 +34,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 pub use check::{check_program, read_fanuc_with_calls};
+pub use options::DEFAULT_MAX_POINTS;
 pub use options::{
     AxisOverrides, ParseOptionError, PlanOptions, ProgramFormat, RzLaw, SliceOverrides,
 };

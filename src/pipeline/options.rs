@@ -41,7 +41,16 @@ pub struct SliceOverrides {
     /// Programmed travel speed of the torch over the part (mm/s): the process
     /// estimates, the joint-speed constraints and the program all use it.
     pub travel_speed_mm_s: Option<f64>,
+    /// Budget of computed points: a slice whose estimate
+    /// ([`estimate_work`](crate::path::estimate_work)) is larger is
+    /// refused before any work with [`Error::OverBudget`](crate::Error::OverBudget).
+    /// `None`: [`DEFAULT_MAX_POINTS`].
+    pub max_points: Option<u64>,
 }
+
+/// The default budget of computed points of a slice (5 M, about 1 GB of
+/// path, distance map and tool axes).
+pub const DEFAULT_MAX_POINTS: u64 = 5_000_000;
 
 /// Overrides of a part file's `[tool_axis]` table. Plain data.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

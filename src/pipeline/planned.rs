@@ -12,8 +12,8 @@ use serde_json::{json, Value};
 use super::sliced::merge;
 use super::{slice_part_with, Cell, Part, PlanOptions, ProgramFormat, RzLaw, SlicedPart};
 use crate::optimise::{
-    layer_points, optimise, trajectory_inputs, ConfigurationChoice, LayerPoints, OptimiseOptions,
-    Plan,
+    layer_points, optimise_with, trajectory_inputs, ConfigurationChoice, LayerPoints,
+    OptimiseOptions, Plan,
 };
 use crate::program::{
     build_program, check_vendor, write_files, Program, ProgramError, TravelSpeed,
@@ -120,7 +120,16 @@ pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<Planned
     optimise_opts.validate()?;
     control.check("optimising")?;
     control.report("optimising", 0.1);
-    let plan = optimise(&cell.layout, &layers, &optimise_opts)?;
+    let plan = optimise_with(&cell.layout, &layers, &optimise_opts, &|done, total| {
+        control.report("optimising", 0.1 + 0.85 * done as f64 / total.max(1) as f64);
+        !control.is_cancelled()
+    })
+    .map_err(|e| match e {
+        crate::optimise::OptimiseError::Cancelled { .. } => Error::Cancelled {
+            stage: "optimising",
+        },
+        e => e.into(),
+    })?;
     control.check("optimising")?;
     control.report("program", 0.95);
     let t = Instant::now();

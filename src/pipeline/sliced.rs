@@ -85,6 +85,19 @@ pub fn slice_part_with(
     process.validate().map_err(|e| in_part(e.into()))?;
     let tool_axis = overrides.tool_axis.apply(&part.tool_axis);
     tool_axis.validate().map_err(|e| in_part(e.into()))?;
+    options.validate().map_err(|e| in_part(e.into()))?;
+    let estimate = crate::path::estimate_work(&part.tube, &part.substrate, &options);
+    let budget = overrides.max_points.unwrap_or(super::DEFAULT_MAX_POINTS);
+    if estimate.points > budget || estimate.over_path_limit {
+        return Err(Error::OverBudget {
+            file: part.file.clone(),
+            layers: estimate.layers,
+            points_per_layer: estimate.points_per_layer,
+            points: estimate.points,
+            megabytes: estimate.bytes as f64 / 1e6,
+            budget,
+        });
+    }
     control.check("slicing")?;
     control.report("slicing", 0.0);
     let t = Instant::now();

@@ -240,3 +240,65 @@ fn a_plans_progress_rises_from_0_to_1() {
         "{seen:?}"
     );
 }
+
+#[test]
+fn a_run_over_the_point_budget_is_refused_before_any_work() {
+    // `--delta 0.01 --points 2000` (meant `--delta 1`): ~20 M points.
+    let part = Part::read(part_path("quarter-torus.toml")).unwrap();
+    let o = SliceOverrides {
+        delta_mm: Some(0.01),
+        discretisation: Some(waam_slicer::path::Discretisation::Points(2000)),
+        ..SliceOverrides::default()
+    };
+    let t = std::time::Instant::now();
+    let e = waam_slicer::slice_part_with(&part, &o, &Control::default()).unwrap_err();
+    assert!(t.elapsed().as_secs_f64() < 2.0);
+    match &e {
+        Error::OverBudget { points, budget, .. } => {
+            assert!(*points > 10_000_000 && *budget == waam_slicer::pipeline::DEFAULT_MAX_POINTS)
+        }
+        other => panic!("expected OverBudget, got {other}"),
+    }
+    let m = e.to_string();
+    assert!(
+        m.contains("quarter-torus.toml") && m.contains("--max-points"),
+        "{m}"
+    );
+    // Raised budget: the same request passes the gate (checked with a
+    // smaller part of the work: one layer).
+    let o = SliceOverrides {
+        max_points: Some(u64::MAX),
+        max_layers: Some(2),
+        ..o
+    };
+    assert!(waam_slicer::slice_part_with(&part, &o, &Control::default()).is_ok());
+}
+
+#[test]
+fn a_cancel_during_optimisation_stops_between_layers() {
+    let part = Part::read(part_path("hemisphere.toml")).unwrap();
+    let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
+    let flag = Arc::new(AtomicBool::new(false));
+    let f2 = flag.clone();
+    let opts = PlanOptions {
+        control: Control::default()
+            .with_cancel(flag)
+            .with_progress(move |stage, f| {
+                // the host presses "stop" once a layer is done
+                if stage == "optimising" && f > 0.1 {
+                    f2.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+            }),
+        ..small(60)
+    };
+    let e = plan_part(&part, &cell, &opts).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::Cancelled {
+                stage: "optimising"
+            }
+        ),
+        "{e}"
+    );
+}
