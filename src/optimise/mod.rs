@@ -161,7 +161,7 @@ pub fn layer_points(path: &Path, frames: &[Vec<LocalFrame>]) -> Vec<LayerPoints>
         .collect()
 }
 
-/// The input of [`joint_trajectory`] and of the program stage: every point
+/// The input of [`joint_trajectory`](crate::robot::trajectory::joint_trajectory) and of the program stage: every point
 /// of `layers`, in order, with the `R_Z` that `plan` chose for it (`plan`
 /// made from the same `layers`).
 pub fn trajectory_inputs(layers: &[LayerPoints], plan: &Plan) -> Vec<PathPointInput> {

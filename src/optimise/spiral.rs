@@ -29,7 +29,7 @@ use crate::robot::model::Joints;
 /// continuous but leave `R_Z` free on the shared point.
 ///
 /// # Errors
-/// As [`optimise`]; [`OptimiseError::InvalidOption`] when `per_turn < 2`.
+/// As [`optimise`](super::optimise()); [`OptimiseError::InvalidOption`] when `per_turn < 2`.
 pub fn optimise_spiral(
     cell: &Cell,
     spiral: &LayerPoints,

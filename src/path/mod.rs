@@ -1,5 +1,5 @@
-//! **Stage 2 — deposition paths.** Takes a validated [`Tube`] and its
-//! [`Substrate`] (part frame, mm) and returns a [`Path`]: layers of points
+//! **Stage 2 — deposition paths.** Takes a validated [`Tube`](crate::geometry::Tube) and its
+//! [`Substrate`](crate::geometry::Substrate) (part frame, mm) and returns a [`Path`]: layers of points
 //! carrying `(t, v)`, position and the local distance to the layer below.
 //! Four strategies (SPEC §3.1): planar Z slices, slices perpendicular to the
 //! guide, iso-parametric layers, and the core method — **constant local
@@ -77,7 +77,7 @@ pub enum EndRule {
     EvaluableRange,
 }
 
-/// Options of [`slice`]. Plain data; [`SliceOptions::validate`] names the field.
+/// Options of [`slice`](fn@slice). Plain data; [`SliceOptions::validate`] names the field.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SliceOptions {
     /// Strategy.
