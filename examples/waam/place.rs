@@ -92,8 +92,12 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
     }
     if !p.feasible {
         let why = match &p.binding {
+            Some((c, share)) if c.ends_with("(on the full path)") => format!(
+                "{c}: feasible on the subsample, it binds {:.0} % of the layers of the best candidate",
+                100.0 * share
+            ),
             Some((c, share)) => format!("{c} bound {:.0} % of the candidates", 100.0 * share),
-            None => "the best candidate on the subsample failed on the full path".into(),
+            None => "no candidate was feasible".into(),
         };
         eprintln!(
             "no placement found: {why}; {} layer(s) infeasible in the best one (placement.json)",

@@ -183,8 +183,11 @@ pub struct Placement {
     pub candidates: usize,
     /// Fraction of them feasible on the subsample.
     pub feasible_fraction: f64,
-    /// The constraint that bound most candidates (the first infeasible
-    /// layer's), with the share of candidates it bound, when none was feasible.
+    /// Why no placement was found: when no candidate was feasible on the
+    /// subsample, the constraint that bound most of them (the first
+    /// infeasible layer's) with the share of candidates it bound; when the
+    /// best failed on the full path, the full plan's first binding
+    /// constraint with the share of its layers that are infeasible.
     pub binding: Option<(String, f64)>,
     /// The full plan in the placed cell.
     pub plan: Plan,
@@ -497,6 +500,14 @@ pub fn place(
         (x, cell.clone(), before_plan.clone())
     });
     let m = margins(&plan, &placed);
+    // Not feasible on every point: name what binds the full plan.
+    let binding = match (plan.is_feasible(), binding) {
+        (false, None) => binding_of(&plan).map(|b| {
+            let share = plan.infeasible_layers().count() as f64 / plan.layers.len().max(1) as f64;
+            (format!("{b} (on the full path)"), share)
+        }),
+        (_, b) => b,
+    };
     Ok(Placement {
         feasible: plan.is_feasible(),
         margins: m,
