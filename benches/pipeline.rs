@@ -8,16 +8,18 @@ use criterion::{criterion_group, criterion_main};
 mod pipeline {
     pub mod optimise;
     pub mod path;
+    pub mod place;
     pub mod robot;
 }
 
-use pipeline::{optimise, path, robot};
+use pipeline::{optimise, path, place, robot};
 
 criterion_group!(
     benches,
     path::constant_distance,
     robot::kinematics,
     robot::hemisphere_trajectory,
-    optimise::whole_parts
+    optimise::whole_parts,
+    place::hemisphere_in_kuka_part_carried
 );
 criterion_main!(benches);
