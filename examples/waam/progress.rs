@@ -28,9 +28,17 @@ impl Stage {
     /// show the stage's name and percentage on this spinner.
     pub fn control(&self) -> waam_slicer::Control {
         let pb = self.0.clone();
+        let start = std::time::Instant::now();
         waam_slicer::Control::default().with_progress(move |stage, fraction| {
             if let Some(pb) = &pb {
-                pb.set_message(format!("{stage} ({:.0} %)", 100.0 * fraction));
+                // time left from the rate so far, once there is a rate
+                let t = start.elapsed().as_secs_f64();
+                let left = if fraction > 0.02 && t > 1.0 {
+                    format!(", about {:.0} s left", t * (1.0 - fraction) / fraction)
+                } else {
+                    String::new()
+                };
+                pb.set_message(format!("{stage} ({:.0} %{left})", 100.0 * fraction));
             }
         })
     }
