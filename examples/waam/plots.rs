@@ -87,6 +87,40 @@ fn err<E: std::fmt::Display>(file: &FsPath) -> impl Fn(E) -> String + '_ {
 
 /// The path seen from azimuth -50 deg, elevation 25 deg (part frame), each
 /// point coloured by (delta - Delta) / Delta; first layer in grey.
+/// Most points drawn in `path.svg` (about 100 bytes each: the file stays
+/// under 5 MB); above, every k-th point is drawn and the picture says so.
+pub const MAX_PATH_VIEW_POINTS: usize = 40_000;
+/// Most points drawn per joint panel; above, each bucket of consecutive
+/// points keeps its lowest and highest value (peaks and limits stay visible)
+/// and the title says so.
+pub const MAX_PANEL_POINTS: usize = 8_000;
+
+/// `data` (in x order) thinned to about `max` points: each bucket of
+/// consecutive points keeps its lowest and its highest value, in x order.
+fn keep_extremes(data: Vec<(f64, f64)>, max: usize) -> Vec<(f64, f64)> {
+    if data.len() <= max {
+        return data;
+    }
+    let k = data.len().div_ceil(max / 2);
+    data.chunks(k)
+        .flat_map(|c| {
+            let lo = c
+                .iter()
+                .copied()
+                .fold(c[0], |a, b| if b.1 < a.1 { b } else { a });
+            let hi = c
+                .iter()
+                .copied()
+                .fold(c[0], |a, b| if b.1 > a.1 { b } else { a });
+            if lo.0 <= hi.0 {
+                [lo, hi]
+            } else {
+                [hi, lo]
+            }
+        })
+        .collect()
+}
+
 pub fn path_view(path: &Path, title: &str, file: &FsPath) -> Result<(), String> {
     let (az, el) = ((-50.0_f64).to_radians(), 25.0_f64.to_radians());
     let project = |p: &waam_slicer::math::Point3| {
@@ -105,11 +139,19 @@ pub fn path_view(path: &Path, title: &str, file: &FsPath) -> Result<(), String> 
             })
         })
         .collect();
-    // only points with both view coordinates finite are drawn
+    // only points with both view coordinates finite are drawn; a large path
+    // is thinned to every k-th point (said under the picture)
     let pts: Vec<(f64, f64, Option<f64>)> = pts
         .into_iter()
         .filter(|p| p.0.is_finite() && p.1.is_finite())
         .collect();
+    let every = pts.len().div_ceil(MAX_PATH_VIEW_POINTS).max(1);
+    let thinned = if every > 1 {
+        format!(" Every {every}th of {} points drawn.", pts.len())
+    } else {
+        String::new()
+    };
+    let pts: Vec<(f64, f64, Option<f64>)> = pts.into_iter().step_by(every).collect();
     let whole = SVGBackend::new(file, (900, 930)).into_drawing_area();
     whole.fill(&WHITE).map_err(err(file))?;
     let (root, note) = whole.split_vertically(900);
@@ -158,7 +200,7 @@ pub fn path_view(path: &Path, title: &str, file: &FsPath) -> Result<(), String> 
         }))
         .map_err(err(file))?;
     note.draw(&Text::new(
-        format!("colour: (delta - Delta)/Delta, blue -{:.1} %, green 0, red +{:.1} %; grey: first layer", 100.0 * scale, 100.0 * scale),
+        format!("colour: (delta - Delta)/Delta, blue -{:.1} %, green 0, red +{:.1} %; grey: first layer.{thinned}", 100.0 * scale, 100.0 * scale),
         (30, 5),
         ("sans-serif", 15),
     ))
@@ -266,9 +308,17 @@ pub fn joint_panels(
     bounds: [(f64, f64); 6],
     file: &FsPath,
 ) -> Result<(), String> {
+    let longest = series.iter().map(Vec::len).max().unwrap_or(0);
+    let title = if longest > MAX_PANEL_POINTS {
+        format!("{title} [{longest} points: per bucket of points its min and max drawn]")
+    } else {
+        title.to_string()
+    };
     let whole = SVGBackend::new(file, (1200, 900)).into_drawing_area();
     whole.fill(&WHITE).map_err(err(file))?;
-    let whole = whole.titled(title, ("sans-serif", 22)).map_err(err(file))?;
+    let whole = whole
+        .titled(&title, ("sans-serif", 22))
+        .map_err(err(file))?;
     let panels = whole.split_evenly((3, 2));
     for (j, area) in panels.iter().enumerate() {
         let caption = format!("J{}", j + 1);
@@ -279,6 +329,7 @@ pub fn joint_panels(
             .copied()
             .filter(|p| p.0.is_finite() && p.1.is_finite())
             .collect();
+        let data = keep_extremes(data, MAX_PANEL_POINTS);
         let drawn = |b: f64| b.is_finite() && b.abs() <= MAX_DRAWN;
         let (blo, bhi) = bounds[j];
         let (blo, bhi) = (
@@ -476,6 +527,21 @@ mod tests {
             joint_panels("huge x", "rad", &series, [(-1e308, 1e308); 6], f)
         });
         assert_eq!(svg.matches("no data").count(), 6);
+    }
+
+    #[test]
+    fn thinning_keeps_each_buckets_extremes_and_bounds_the_count() {
+        let data: Vec<(f64, f64)> = (0..100_000)
+            .map(|i| (i as f64, ((i * 7919) % 1000) as f64))
+            .chain([(100_000.0, 5000.0)])
+            .collect();
+        let kept = keep_extremes(data.clone(), MAX_PANEL_POINTS);
+        assert!(kept.len() <= MAX_PANEL_POINTS + 2, "{}", kept.len());
+        // the global peak survives, x stays ordered
+        assert!(kept.iter().any(|p| p.1 == 5000.0));
+        assert!(kept.windows(2).all(|w| w[0].0 <= w[1].0));
+        let small: Vec<(f64, f64)> = data[..10].to_vec();
+        assert_eq!(keep_extremes(small.clone(), MAX_PANEL_POINTS), small);
     }
 
     #[test]
