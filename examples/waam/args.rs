@@ -84,6 +84,9 @@ pub struct SliceExtras {
     /// Bead width for wall.stl (mm; default Delta).
     #[arg(long, value_name = "MM")]
     pub bead_width: Option<f64>,
+    /// Do not write wall.stl.
+    #[arg(long)]
+    pub no_wall: bool,
     /// Stop after N layers (or spiral turns).
     #[arg(long, value_name = "N")]
     pub max_layers: Option<usize>,

@@ -5,6 +5,19 @@ use crate::args::{SliceArgs, StrategyArg};
 use std::path::{Path as FsPath, PathBuf};
 use std::time::Instant;
 use waam_slicer::io::atomic::write_atomic;
+
+/// `write_atomic` for a writer that returns a value.
+fn write_atomic_with<T>(
+    dest: &FsPath,
+    f: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<T>,
+) -> std::io::Result<T> {
+    let mut out = None;
+    write_atomic(dest, |w| {
+        out = Some(f(w)?);
+        Ok(())
+    })?;
+    out.ok_or_else(|| std::io::Error::other("nothing written"))
+}
 use waam_slicer::path::smooth::Smoothing;
 use waam_slicer::path::Strategy;
 use waam_slicer::{slice_part_with, Part, SliceOverrides};
@@ -50,8 +63,16 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
         .map_err(|e| format!("{}: {e}", csv.display()))?;
     let stl = dir.join("wall.stl");
     let width = more.bead_width.unwrap_or(path.delta_mm);
-    write_atomic(&stl, |w| sliced.write_wall_stl(w, width))
-        .map_err(|e| format!("{}: {e}", stl.display()))?;
+    if !more.no_wall {
+        let wall = write_atomic_with(&stl, |w| sliced.write_wall_stl(w, width))
+            .map_err(|e| format!("{}: {e}", stl.display()))?;
+        if wall.every > 1 && !quiet {
+            println!(
+                "  wall.stl: {} triangles, a section at every {}th point (triangle budget)",
+                wall.triangles, wall.every
+            );
+        }
+    }
     sliced
         .write_report(&dir.join("report.html"), Some(&part.substrate), width)
         .map_err(|e| e.to_string())?;

@@ -208,15 +208,25 @@ impl SlicedPart {
         crate::io::path_csv::write_path_csv(w, &self.path.layers, &self.axes.frames)
     }
 
-    /// Writes the deposited wall as binary STL: a bead section `width_mm` ×
-    /// the local distance swept along the path (part frame, mm).
+    /// Writes the deposited wall as binary STL, streamed: a bead section
+    /// `width_mm` × the local distance swept along the path (part frame,
+    /// mm), at most [`DEFAULT_MAX_WALL_TRIANGLES`](crate::io::wall_stl::DEFAULT_MAX_WALL_TRIANGLES)
+    /// triangles (sections at every k-th point above; the result says k).
     ///
     /// # Errors
     /// I/O errors of `w`.
-    pub fn write_wall_stl(&self, w: &mut dyn std::io::Write, width_mm: f64) -> std::io::Result<()> {
-        let triangles =
-            crate::io::wall_stl::wall_triangles(&self.path, &self.axes.frames, width_mm);
-        crate::io::wall_stl::write_stl(w, &triangles)
+    pub fn write_wall_stl(
+        &self,
+        w: &mut dyn std::io::Write,
+        width_mm: f64,
+    ) -> std::io::Result<crate::io::wall_stl::WallStl> {
+        crate::io::wall_stl::write_wall_stl(
+            w,
+            &self.path,
+            &self.axes.frames,
+            width_mm,
+            crate::io::wall_stl::DEFAULT_MAX_WALL_TRIANGLES,
+        )
     }
 }
 
