@@ -22,7 +22,7 @@ use crate::common::load_part;
 const CASE_BUDGET: Duration = Duration::from_secs(20);
 
 /// Three layers of the hemisphere, 36 points each, with their tool axes.
-fn hemisphere_layers() -> &'static [LayerPoints] {
+pub(crate) fn hemisphere_layers() -> &'static [LayerPoints] {
     static LAYERS: OnceLock<Vec<LayerPoints>> = OnceLock::new();
     LAYERS.get_or_init(|| {
         let part = load_part("hemisphere.toml");
@@ -150,7 +150,7 @@ fn torch_carried() -> impl Strategy<Value = String> {
 
 /// Reads `text` as a cell and plans the hemisphere in it; panics (the
 /// property fails) on anything but a clean end.
-fn plan_in(text: &str) -> Result<(), TestCaseError> {
+pub(crate) fn plan_in(text: &str) -> Result<(), TestCaseError> {
     let start = Instant::now();
     let cell = match parse_cell_file(text, "random.toml") {
         Ok(f) => f.cell.expect("the file describes a cell"),
@@ -194,5 +194,44 @@ proptest! {
     #[test]
     fn random_torch_carried_cells_end_cleanly(text in torch_carried()) {
         plan_in(&text)?;
+    }
+}
+
+/// Extreme numbers a typo gives, in an otherwise valid cell: speeds of
+/// 1e-300 and 1e300 deg/s, limits of ±1e300 deg, a hose limit of 1e300 deg.
+#[test]
+fn extreme_speeds_and_limits_end_cleanly() {
+    let base = std::fs::read_to_string(crate::common::part_path("cells/robowam_part_carried.toml"))
+        .unwrap();
+    for (from, to) in [
+        ("preset = \"arcmate120ic_nominal\"", "preset = \"arcmate120ic_nominal\"\nmax_speed_deg_s = [1e-300, 1e-300, 1e-300, 1e-300, 1e-300, 1e-300]"),
+        ("preset = \"arcmate120ic_nominal\"", "preset = \"arcmate120ic_nominal\"\nmax_speed_deg_s = [1e300, 1e300, 1e300, 1e300, 1e300, 1e300]"),
+        ("lower_deg = [-170, -100, -185, -200, -135, -inf]", "lower_deg = [-1e300, -1e300, -1e300, -1e300, -1e300, -1e300]"),
+    ] {
+        let text = base.replace(from, to);
+        assert_ne!(text, base);
+        plan_in(&text).unwrap_or_else(|e| panic!("{to}: {e}"));
+    }
+    let torch = std::fs::read_to_string(crate::common::part_path(
+        "cells/kuka_kr16_2_torch_carried.toml",
+    ))
+    .unwrap();
+    for (from, to) in [
+        (
+            "max_hose_torsion_deg = 120.0",
+            "max_hose_torsion_deg = 1e300",
+        ),
+        (
+            "max_speed_deg_s = [90.0, 180.0]",
+            "max_speed_deg_s = [1e-300, 1e-300]",
+        ),
+        (
+            "max_vertical_error_deg = 1.0",
+            "max_vertical_error_deg = 1e300",
+        ),
+    ] {
+        let text = torch.replace(from, to);
+        assert_ne!(text, torch);
+        plan_in(&text).unwrap_or_else(|e| panic!("{to}: {e}"));
     }
 }

@@ -117,3 +117,75 @@ fn ordinary_expressions_pass_the_limits() {
         }
     }
 }
+
+/// Probing the ABB reader behind `waam check` (issue 22): a `robtarget`
+/// whose brackets nest 20 000 deep overflowed the stack of the recursive
+/// aggregate parser (a 2 MiB test thread; `waam check`'s 8 MiB main thread
+/// at about 80 000). Nesting beyond 16 is refused at once.
+#[test]
+fn deeply_nested_abb_aggregate_is_refused() {
+    for depth in [17usize, 20_000, 1_000_000] {
+        let text = format!(
+            "MODULE X\n  CONST robtarget p1 := {}1{};\nENDMODULE\n",
+            "[".repeat(depth),
+            "]".repeat(depth)
+        );
+        let e = waam_slicer::program::readback::abb::parse_mod(&text, "deep.mod").unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with("deep.mod:2: ") && msg.contains("nest more than 16 deep"),
+            "{}",
+            &msg[..msg.len().min(200)]
+        );
+    }
+}
+
+/// Probes of the program readers behind `waam check` with large inputs:
+/// each answers (accepts or refuses) in well under a second per megabyte.
+#[test]
+fn program_readers_answer_large_inputs_quickly() {
+    use waam_slicer::program::readback::{abb::parse_mod, kuka::parse_krl, parse_ls};
+    let golden = |name: &str| {
+        std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/program/golden")
+                .join(name),
+        )
+        .unwrap()
+    };
+    let long_line = "x".repeat(1 << 20);
+    let start = std::time::Instant::now();
+    let _ = parse_ls(&long_line, "long.ls");
+    let _ = parse_mod(&long_line, "long.mod");
+    let _ = parse_krl(&long_line, "long.src", &long_line, "long.dat");
+    // a golden with its motion lines repeated 20 000 times
+    let ls = golden("fanuc_cartesian_HEMI.ls");
+    let motion = ls
+        .lines()
+        .find(|l| l.contains(":L P["))
+        .unwrap()
+        .to_string()
+        + "\n";
+    let _ = parse_ls(&ls.replacen(&motion, &motion.repeat(20_000), 1), "many.ls");
+    let src = golden("kuka_cartesian_HEMI.src");
+    let dat = golden("kuka_cartesian_HEMI.dat");
+    let _ = parse_krl(
+        &src.replacen("  LIN P2\n", &"  LIN P2\n".repeat(20_000), 1),
+        "many.src",
+        &dat,
+        "many.dat",
+    );
+    let m = golden("abb_HEMI.mod");
+    let target = m
+        .lines()
+        .find(|l| l.contains("CONST robtarget p2 "))
+        .unwrap()
+        .to_string()
+        + "\n";
+    let _ = parse_mod(&m.replacen(&target, &target.repeat(20_000), 1), "many.mod");
+    assert!(
+        start.elapsed().as_secs_f64() < 10.0,
+        "{:?}",
+        start.elapsed()
+    );
+}

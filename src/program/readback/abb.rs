@@ -80,9 +80,33 @@ fn pose_of(t: &Node, q: &Node) -> Result<Isometry3, String> {
     ))
 }
 
+/// Deepest nesting of brackets accepted in an aggregate: the RAPID data
+/// written here nest three deep (`tooldata`); a deeper one is refused
+/// before the recursive parser could overflow its stack.
+pub const MAX_AGGREGATE_DEPTH: usize = 16;
+
 /// Parses one aggregate `[...]` (the whole of `s`).
+///
+/// # Errors
+/// A message saying what is malformed, or that brackets nest deeper than
+/// [`MAX_AGGREGATE_DEPTH`].
 pub fn parse_aggregate(s: &str) -> Result<Node, String> {
     let chars: Vec<char> = s.trim().chars().collect();
+    let mut depth = 0usize;
+    for c in &chars {
+        match c {
+            '[' => {
+                depth += 1;
+                if depth > MAX_AGGREGATE_DEPTH {
+                    return Err(format!(
+                        "brackets nest more than {MAX_AGGREGATE_DEPTH} deep"
+                    ));
+                }
+            }
+            ']' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
     let mut i = 0;
     let n = parse_node(&chars, &mut i)?;
     if i != chars.len() {
