@@ -108,6 +108,19 @@ pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<Planned
     // Slicing is the first tenth of a plan's progress.
     let sliced = slice_part_with(part, &opts.slice, &control.within(0.0, 0.1))?;
     let t_slice = t.elapsed().as_secs_f64() - sliced.times.tool_axes;
+    // Reach up front, with this part's own extent (the cell reader allowed
+    // a generic 1 m part): a point out of reach fails before optimising.
+    let radius = sliced
+        .path
+        .layers
+        .iter()
+        .flat_map(|l| &l.points)
+        .map(|p| p.position.coords.norm())
+        .fold(0.0, f64::max);
+    cell.layout.check_reach(radius).map_err(|e| Error::InPart {
+        file: cell.file.clone(),
+        source: Box::new(e.into()),
+    })?;
     let t = Instant::now();
     let layers = layer_points(&sliced.path, &sliced.axes.frames);
     let t_axes = sliced.times.tool_axes + t.elapsed().as_secs_f64();
