@@ -197,5 +197,7 @@ def check_program(path: _PathLike, cell: Cell) -> List[Dict[str, Any]]:
     """Reads a program (FANUC .ls main program and the programs it calls,
     KUKA .src/.dat, ABB .mod) and checks it against `cell`: joint limits,
     speeds, reachability, configuration, beads. Returns every problem as a
-    dict (`file`, `line`, `message`); [] when clean. Raises WaamError when
+    dict (`file`, `line`, `kind`, `message`; `kind` is one of vendor,
+    options, declaration, instruction, call, frame, configuration, reach,
+    joint_limit, joint_speed, timing, deviation, bead, format); [] when clean. Raises WaamError when
     the file cannot be read or parsed."""

@@ -53,7 +53,8 @@ pub(crate) fn json_to_py<'py>(
 /// Reads the program at `path` (FANUC `.ls` main program and the programs it
 /// calls, KUKA `.src`/`.dat`, ABB `.mod`) and checks it against `cell`:
 /// joint limits, speeds, reachability, configuration, beads. Returns every
-/// problem as a dict (`file`, `line`, `message`), `[]` when clean.
+/// problem as a dict (`file`, `line`, `kind`, `message`; `kind` as
+/// `ProblemKind::name`, e.g. `joint_limit`), `[]` when clean.
 #[pyfunction]
 fn check_program<'py>(
     py: Python<'py>,
@@ -70,6 +71,7 @@ fn check_program<'py>(
             let d = PyDict::new(py);
             d.set_item("file", &p.file)?;
             d.set_item("line", p.line)?;
+            d.set_item("kind", p.kind.name())?;
             d.set_item("message", &p.message)?;
             Ok(d)
         })

@@ -104,8 +104,11 @@ def test_check_program_round_trip(feasible, part_carried, tmp_path):
     target.write_text(text[:start] + "J5=   170.0000 " + text[end:])
     problems = ws.check_program(files[0], part_carried)
     assert problems, "a J5 of 170° in a ±135° cell must be found"
-    assert any(target.stem in p["file"] and "J5" in p["message"] for p in problems), problems
-    assert all({"file", "line", "message"} <= p.keys() for p in problems)
+    assert any(
+        target.stem in p["file"] and "J5" in p["message"] and p["kind"] == "joint_limit"
+        for p in problems
+    ), problems
+    assert all({"file", "line", "kind", "message"} <= p.keys() for p in problems)
 
 
 def test_write_program_in_another_vendors_format_is_refused(feasible, tmp_path):

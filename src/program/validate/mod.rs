@@ -93,6 +93,28 @@ pub enum ProblemKind {
     Format,
 }
 
+impl ProblemKind {
+    /// The kind's name in reports and bindings, snake case (`joint_limit`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Vendor => "vendor",
+            Self::Options => "options",
+            Self::Declaration => "declaration",
+            Self::Instruction => "instruction",
+            Self::Call => "call",
+            Self::Frame => "frame",
+            Self::Configuration => "configuration",
+            Self::Reach => "reach",
+            Self::JointLimit => "joint_limit",
+            Self::JointSpeed => "joint_speed",
+            Self::Timing => "timing",
+            Self::Deviation => "deviation",
+            Self::Bead => "bead",
+            Self::Format => "format",
+        }
+    }
+}
+
 /// Every problem of a set of programs, in execution order.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ValidationReport {
