@@ -42,7 +42,7 @@ pub use place::{place_part, PlaceRequest, PlacedCell};
 pub use planned::{plan_part, program_name, PlanTimes, PlannedPart};
 pub use sliced::{slice_part, slice_part_with, SliceTimes, SlicedPart};
 
-use crate::io::cell_file::{parse_cell_file, read_cell_file, CellFile, CellFileError};
+use crate::io::cell_file::{parse_cell_file, CellFile, CellFileError};
 use crate::io::part_file::{parse_part, read_part_file, PartFileError};
 use crate::robot::RobotModel;
 
@@ -102,15 +102,12 @@ impl Cell {
     pub fn read(path: impl AsRef<FsPath>) -> Result<Cell, CellFileError> {
         let path = path.as_ref();
         let shown = path.display().to_string();
-        // The reader's own checks first (its messages for a missing file).
-        let file = read_cell_file(path)?;
+        // Read once: the text is kept (a placed copy rewrites it).
         let text = std::fs::read_to_string(path).map_err(|source| CellFileError::Io {
             path: shown.clone(),
             source,
         })?;
-        let mut cell = Self::from_file(file, &shown)?;
-        cell.text = text;
-        Ok(cell)
+        Self::from_toml_str(&text, &shown)
     }
 
     /// Parses and validates cell-file text; `origin` names it in errors.
