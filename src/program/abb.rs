@@ -88,6 +88,12 @@ pub struct AbbOptions {
     /// letter) holding the positioner's tilt `q7` and turn `q8` (deg), as
     /// the system's mechanical units are configured. Default `['a', 'b']`.
     pub positioner_axes: [char; 2],
+    /// The vendor-independent options (home, dwell, interpass wait,
+    /// payload, transit, coordination) the validator checks the file
+    /// against; not a key of `[program.<vendor>]` (set from `[program]` by
+    /// [`crate::program::ProgramSettings`]).
+    #[serde(skip)]
+    pub common: crate::program::ProgramOptions,
 }
 
 impl Default for AbbOptions {
@@ -101,6 +107,7 @@ impl Default for AbbOptions {
             stationary_tool: None,
             fixed_tool: None,
             positioner_axes: ['a', 'b'],
+            common: Default::default(),
         }
     }
 }

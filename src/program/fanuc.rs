@@ -172,6 +172,12 @@ pub struct FanucOptions {
     /// whole beads, so it must be at least the longest bead's point count
     /// (approach and retract included). Default 15 000 (R-30iB Plus).
     pub point_limit: usize,
+    /// The vendor-independent options (home, dwell, interpass wait,
+    /// payload, transit, coordination) the validator checks the file
+    /// against; not a key of `[program.<vendor>]` (set from `[program]` by
+    /// [`crate::program::ProgramSettings`]).
+    #[serde(skip)]
+    pub common: crate::program::ProgramOptions,
 }
 
 impl Default for FanucOptions {
@@ -188,6 +194,7 @@ impl Default for FanucOptions {
             base_from_user: Isometry3::identity(),
             flange_from_tool: None,
             point_limit: DEFAULT_POINT_LIMIT,
+            common: Default::default(),
         }
     }
 }

@@ -111,6 +111,12 @@ pub struct KukaOptions {
     /// base frame (mm); `None`: at the cell's `D_R`, z down (towards the
     /// part), x along the robot's X.
     pub fixed_tool: Option<Isometry3>,
+    /// The vendor-independent options (home, dwell, interpass wait,
+    /// payload, transit, coordination) the validator checks the file
+    /// against; not a key of `[program.<vendor>]` (set from `[program]` by
+    /// [`crate::program::ProgramSettings`]).
+    #[serde(skip)]
+    pub common: crate::program::ProgramOptions,
 }
 
 impl Default for KukaOptions {
@@ -126,6 +132,7 @@ impl Default for KukaOptions {
             flange_from_tool: None,
             external_tcp: None,
             fixed_tool: None,
+            common: Default::default(),
         }
     }
 }

@@ -200,6 +200,10 @@ pub struct Program {
     pub configuration: Configuration,
     /// The points.
     pub points: Vec<ProgramPoint>,
+    /// Home position: the first and last motion (`None`: no home moves).
+    pub home: Option<HomePosition>,
+    /// What happens before each bead, one per bead in order (empty: nothing).
+    pub bead_setup: Vec<BeadSetup>,
 }
 
 impl Program {
@@ -297,7 +301,16 @@ pub fn build_program(
     )
 }
 
-/// Options of [`build_program_with`]. Plain data.
+/// Options of [`build_program_with`], and the vendor-independent keys of a
+/// cell file's `[program]` table (see [`ProgramSettings`]). Plain data.
+///
+/// Every program is built the same way whatever the controller: an optional
+/// home move first and last, one bead per layer between an approach and a
+/// retract point, and before each bead the set-up of its [`BeadSetup`]
+/// (payload update, interlayer dwell, interpass wait). The emitters write
+/// them in each controller's instructions; the validators read them back and
+/// check them against these options (the `common` field of each vendor's
+/// options).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ProgramOptions {
@@ -311,6 +324,53 @@ pub struct ProgramOptions {
     /// first point, last point → retract point), relative to the part
     /// (mm/s, > 0). Default 20 mm/s.
     pub approach_speed_mm_s: f64,
+    /// Home position of the arm, joints in the controller's convention
+    /// (deg): the program's first and last motion, a joint move with the arc
+    /// off. `None` (default): no home moves (the program starts with the
+    /// first bead's approach; the cell file should say where home is).
+    pub home_deg: Option<[f64; 6]>,
+    /// Positioner joints `[q7, q8]` at home (deg), torch-carried cells;
+    /// `None`: `[0, 0]`.
+    pub home_positioner_deg: Option<[f64; 2]>,
+    /// Interlayer dwell (s, ≥ 0): before each bead after the first, the
+    /// program waits this long with the arc off at the previous bead's
+    /// retract point, so that the wall cools. Default 0.
+    pub dwell_s: f64,
+    /// Interpass wait: before each bead after the first, the program waits
+    /// for this digital input to be on (the interpass temperature is
+    /// reached): FANUC `DI[n]`, KUKA `$IN[n]`, ABB the signal of
+    /// [`abb::AbbOptions`]. `None` (default): no wait.
+    pub interpass_input: Option<u32>,
+    /// Payload update every this many layers in the part-carried cell (the
+    /// robot carries the part as it grows; 0: never). Before bead 0 and
+    /// before every `N`-th bead the program sets the payload to the
+    /// substrate and fixture ([`ProgramOptions::payload_base_kg`]) plus the
+    /// metal deposited so far. Default 0.
+    pub payload_every_layers: u32,
+    /// Mass carried on the flange before the first layer: substrate and
+    /// fixture (kg, ≥ 0). Default 0.
+    pub payload_base_kg: f64,
+    /// Centre of gravity of that mass, flange frame (mm). Default origin.
+    pub payload_base_cog_mm: [f64; 3],
+    /// Check every arc-off joint move (retract → next approach, home moves)
+    /// against the wall deposited so far with the torch's collision model
+    /// ([`crate::toolaxis::collision`]), and where one collides move the
+    /// retract and approach points of that transition further along the tool
+    /// axis, up to [`ProgramOptions::transit_max_clearance_mm`]. Default on.
+    pub transit_check: bool,
+    /// Largest retract and approach distance a transit may use (mm, ≥
+    /// `clearance_mm`). Default 160 mm.
+    pub transit_max_clearance_mm: f64,
+    /// Radius of the deposited beads in the transit check (mm, > 0): the
+    /// wall is the bead points as capsules of this radius. Default 2 mm.
+    pub bead_radius_mm: f64,
+    /// Positioner motion coordinated with the arm in torch-carried cells
+    /// (FANUC `COORD`, KUKA math-coupled base, ABB `ufmec` work object).
+    /// Default on.
+    pub coordinated: bool,
+    /// FANUC remote TCP (`RTCP`) in the part-carried cell: linear moves are
+    /// about the fixed torch. Default on.
+    pub remote_tcp: bool,
 }
 
 impl Default for ProgramOptions {
@@ -318,6 +378,18 @@ impl Default for ProgramOptions {
         Self {
             clearance_mm: 20.0,
             approach_speed_mm_s: 20.0,
+            home_deg: None,
+            home_positioner_deg: None,
+            dwell_s: 0.0,
+            interpass_input: None,
+            payload_every_layers: 0,
+            payload_base_kg: 0.0,
+            payload_base_cog_mm: [0.0; 3],
+            transit_check: true,
+            transit_max_clearance_mm: 160.0,
+            bead_radius_mm: 2.0,
+            coordinated: true,
+            remote_tcp: true,
         }
     }
 }
@@ -328,21 +400,169 @@ impl ProgramOptions {
     /// # Errors
     /// [`ProgramError::InvalidOptions`] naming the field.
     pub fn validate(&self) -> Result<(), ProgramError> {
+        let bad = |field: &'static str, value: String, reason: &'static str| {
+            Err(ProgramError::InvalidOptions {
+                field,
+                value,
+                reason,
+            })
+        };
         if !(self.clearance_mm.is_finite() && self.clearance_mm >= 0.0) {
-            return Err(ProgramError::InvalidOptions {
-                field: "clearance_mm",
-                value: self.clearance_mm.to_string(),
-                reason: "must be finite and >= 0",
-            });
+            return bad(
+                "clearance_mm",
+                self.clearance_mm.to_string(),
+                "must be finite and >= 0",
+            );
         }
         if !(self.approach_speed_mm_s.is_finite() && self.approach_speed_mm_s > 0.0) {
-            return Err(ProgramError::InvalidOptions {
-                field: "approach_speed_mm_s",
-                value: self.approach_speed_mm_s.to_string(),
-                reason: "must be finite and > 0",
-            });
+            return bad(
+                "approach_speed_mm_s",
+                self.approach_speed_mm_s.to_string(),
+                "must be finite and > 0",
+            );
+        }
+        if let Some(h) = self.home_deg {
+            if !h.iter().all(|v| v.is_finite()) {
+                return bad("home_deg", format!("{h:?}"), "must be finite");
+            }
+        }
+        if let Some(h) = self.home_positioner_deg {
+            if !h.iter().all(|v| v.is_finite()) {
+                return bad("home_positioner_deg", format!("{h:?}"), "must be finite");
+            }
+        }
+        if !(self.dwell_s.is_finite() && (0.0..=86_400.0).contains(&self.dwell_s)) {
+            return bad(
+                "dwell_s",
+                self.dwell_s.to_string(),
+                "must be between 0 and 86400 s",
+            );
+        }
+        if self.interpass_input == Some(0) {
+            return bad("interpass_input", "0".into(), "must be >= 1");
+        }
+        if !(self.payload_base_kg.is_finite() && self.payload_base_kg >= 0.0) {
+            return bad(
+                "payload_base_kg",
+                self.payload_base_kg.to_string(),
+                "must be finite and >= 0",
+            );
+        }
+        if !self.payload_base_cog_mm.iter().all(|v| v.is_finite()) {
+            return bad(
+                "payload_base_cog_mm",
+                format!("{:?}", self.payload_base_cog_mm),
+                "must be finite",
+            );
+        }
+        if !(self.transit_max_clearance_mm.is_finite()
+            && self.transit_max_clearance_mm >= self.clearance_mm)
+        {
+            return bad(
+                "transit_max_clearance_mm",
+                self.transit_max_clearance_mm.to_string(),
+                "must be finite and >= clearance_mm",
+            );
+        }
+        if !(self.bead_radius_mm.is_finite() && self.bead_radius_mm > 0.0) {
+            return bad(
+                "bead_radius_mm",
+                self.bead_radius_mm.to_string(),
+                "must be finite and > 0",
+            );
         }
         Ok(())
+    }
+
+    /// The home position in controller units inside (rad), if any.
+    pub fn home(&self, cell: &Cell) -> Option<HomePosition> {
+        let h = self.home_deg?;
+        Some(HomePosition {
+            joints: h.map(f64::to_radians),
+            positioner: matches!(cell, Cell::TorchCarried(_)).then(|| {
+                self.home_positioner_deg
+                    .unwrap_or([0.0; 2])
+                    .map(f64::to_radians)
+            }),
+        })
+    }
+}
+
+/// The arm's (and positioner's) home position: the first and last motion of
+/// a program, a joint move with the arc off.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HomePosition {
+    /// Robot joints, controller convention (rad).
+    pub joints: Joints,
+    /// Positioner joints `[q7, q8]` (rad), torch-carried cell only.
+    pub positioner: Option<PositionerJoints>,
+}
+
+/// The payload carried on the flange (part-carried cell): substrate,
+/// fixture and the metal deposited so far.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Payload {
+    /// Mass (kg).
+    pub mass_kg: f64,
+    /// Centre of gravity, flange frame (mm).
+    pub cog_mm: Point3,
+}
+
+/// What a program does before a bead, from [`ProgramOptions`]: written
+/// before the bead's approach move, in this order: payload, dwell, wait.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BeadSetup {
+    /// Layer of the bead.
+    pub layer: usize,
+    /// New payload before this bead (`None`: unchanged).
+    pub payload: Option<Payload>,
+    /// Dwell before this bead (s; 0: none). Always 0 on the first bead.
+    pub dwell_s: f64,
+    /// Digital input to wait for before this bead (`None`: no wait; always
+    /// `None` on the first bead).
+    pub wait_input: Option<u32>,
+}
+
+/// A cell file's `[program]` table: the vendor-independent
+/// [`ProgramOptions`] and each vendor's emitter options
+/// (`[program.fanuc]`, `[program.kuka]`, `[program.abb]`), whose `common`
+/// field is set from the former by [`ProgramSettings::fanuc`] and its
+/// siblings.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct ProgramSettings {
+    /// The vendor-independent options.
+    pub common: ProgramOptions,
+    /// `[program.fanuc]`.
+    pub fanuc: fanuc::FanucOptions,
+    /// `[program.kuka]`.
+    pub kuka: kuka::KukaOptions,
+    /// `[program.abb]`.
+    pub abb: abb::AbbOptions,
+}
+
+impl ProgramSettings {
+    /// The FANUC emitter's options, `common` set.
+    pub fn fanuc(&self) -> fanuc::FanucOptions {
+        fanuc::FanucOptions {
+            common: self.common,
+            ..self.fanuc.clone()
+        }
+    }
+
+    /// The KUKA emitter's options, `common` set.
+    pub fn kuka(&self) -> kuka::KukaOptions {
+        kuka::KukaOptions {
+            common: self.common,
+            ..self.kuka.clone()
+        }
+    }
+
+    /// The ABB emitter's options, `common` set.
+    pub fn abb(&self) -> abb::AbbOptions {
+        abb::AbbOptions {
+            common: self.common,
+            ..self.abb.clone()
+        }
     }
 }
 
@@ -532,6 +752,8 @@ pub fn build_program_with(
         cell: cell.clone(),
         configuration: trajectory.configuration,
         points: out,
+        home: None,
+        bead_setup: Vec::new(),
     })
 }
 

@@ -280,6 +280,6 @@ pub fn validate_abb(
             None => {}
         }
     }
-    check_steps(&steps, cell, planned, &mut report);
+    check_steps(&steps, cell, planned, &opts.common, &mut report);
     report
 }

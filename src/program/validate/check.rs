@@ -20,8 +20,10 @@ pub fn check_steps(
     steps: &[Step],
     cell: &Cell,
     planned: Option<&[Point3]>,
+    common: &crate::program::ProgramOptions,
     report: &mut ValidationReport,
 ) {
+    let _ = common;
     // which motions are bead points: made with the process on, or the last
     // motion before the process starts
     let mut bead = vec![false; steps.len()];
@@ -40,6 +42,7 @@ pub fn check_steps(
                 on = true;
             }
             Step::ProcessOff { .. } => on = false,
+            Step::Wait { .. } | Step::Payload { .. } => {}
         }
     }
     let robot = cell.robot();
@@ -73,6 +76,7 @@ pub fn check_steps(
                 }
                 continue;
             }
+            Step::Wait { .. } | Step::Payload { .. } => continue,
             Step::Motion(m) => m,
         };
         first_file.get_or_insert_with(|| m.file.clone());

@@ -44,7 +44,7 @@ pub fn validate_fanuc(
     if let Some(main) = programs.first() {
         fanuc_steps(programs, main, 0, cell, opts, &mut steps, &mut report);
     }
-    check_steps(&steps, cell, planned, &mut report);
+    check_steps(&steps, cell, planned, &opts.common, &mut report);
     report
 }
 

@@ -280,6 +280,6 @@ pub fn validate_kuka(
             format!("trigger `{action}` without a motion after it"),
         );
     }
-    check_steps(&steps, cell, planned, &mut report);
+    check_steps(&steps, cell, planned, &opts.common, &mut report);
     report
 }

@@ -223,6 +223,29 @@ pub enum Step {
         /// Line.
         line: usize,
     },
+    /// The program waits here: a dwell (`seconds`) or a digital input
+    /// (`input`, waited for to be on).
+    Wait {
+        /// File.
+        file: String,
+        /// Line.
+        line: usize,
+        /// Dwell (s), if this is a timed wait.
+        seconds: Option<f64>,
+        /// Digital input number waited for, if this is an input wait.
+        input: Option<u32>,
+    },
+    /// The payload on the flange is set here.
+    Payload {
+        /// File.
+        file: String,
+        /// Line.
+        line: usize,
+        /// Mass (kg).
+        mass_kg: f64,
+        /// Centre of gravity, flange frame (mm).
+        cog_mm: Point3,
+    },
 }
 
 /// Adds a problem to `report`.
