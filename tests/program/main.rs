@@ -7,6 +7,7 @@ mod fixture;
 mod formats;
 mod golden;
 mod parts;
+mod setup;
 #[path = "../common/mod.rs"]
 mod shared;
 mod split;
