@@ -441,10 +441,12 @@ fn program_settings(
     ) -> Result<T, CellFileError> {
         match table.remove(key) {
             None => Ok(T::default()),
-            Some(v) => v.try_into().map_err(|e: toml::de::Error| CellFileError::Syntax {
-                path: path.to_string(),
-                message: format!("[program.{key}]: {}", e.message()),
-            }),
+            Some(v) => v
+                .try_into()
+                .map_err(|e: toml::de::Error| CellFileError::Syntax {
+                    path: path.to_string(),
+                    message: format!("[program.{key}]: {}", e.message()),
+                }),
         }
     }
     let fanuc: crate::program::fanuc::FanucOptions = sub(path, &mut table, "fanuc")?;
@@ -459,9 +461,11 @@ fn program_settings(
             })?;
     let invalid = |e: crate::program::ProgramError| {
         let (key, reason) = match &e {
-            crate::program::ProgramError::InvalidOptions { field, value, reason } => {
-                (field.to_string(), format!("{value}: {reason}"))
-            }
+            crate::program::ProgramError::InvalidOptions {
+                field,
+                value,
+                reason,
+            } => (field.to_string(), format!("{value}: {reason}")),
             other => (String::new(), other.to_string()),
         };
         CellFileError::Invalid {

@@ -389,7 +389,9 @@ impl ProcessPlan {
         estimate::layer_lengths_and_times(path, &speeds)
             .into_iter()
             // mm³ × kg/m³ × 1e-9 m³/mm³ = kg
-            .map(|(_, t)| params.wire_feed_speed_mm_s * t * section_mm2 * params.density_kg_m3 * 1e-9)
+            .map(|(_, t)| {
+                params.wire_feed_speed_mm_s * t * section_mm2 * params.density_kg_m3 * 1e-9
+            })
             .collect()
     }
 }
