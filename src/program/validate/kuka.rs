@@ -32,8 +32,6 @@ pub fn validate_kuka(
     opts: &crate::program::kuka::KukaOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
-    use crate::program::readback::kuka::{KrlOp, KrlValue};
-    use crate::robot::orientation::KukaAbc;
     let mut report = ValidationReport::default();
     if !vendor_matches(
         cell,
@@ -44,6 +42,24 @@ pub fn validate_kuka(
     ) {
         return report;
     }
+    let steps = kuka_steps(program, cell, opts, &mut report);
+    check_steps(&steps, cell, planned, &opts.common, &mut report);
+    report
+}
+
+/// The [`Step`]s of a KUKA program (motions decoded, process on and off,
+/// waits, payloads) in execution order, with the problems of the file
+/// itself (frames, triggers, ignition handshake, end times) added to
+/// `report_out`. The cell's robot must be a KUKA arm.
+pub(crate) fn kuka_steps(
+    program: &crate::program::readback::kuka::KrlProgram,
+    cell: &Cell,
+    opts: &crate::program::kuka::KukaOptions,
+    report_out: &mut ValidationReport,
+) -> Vec<Step> {
+    use crate::program::readback::kuka::{KrlOp, KrlValue};
+    use crate::robot::orientation::KukaAbc;
+    let mut report = std::mem::take(report_out);
     let robot = cell.robot();
     let (_, tool) = opts.frames(cell);
     let (on, off) = crate::program::kuka::switch_statements(opts);
@@ -685,8 +701,8 @@ pub fn validate_kuka(
             );
         }
     }
-    check_steps(&steps, cell, planned, &opts.common, &mut report);
-    report
+    *report_out = report;
+    steps
 }
 
 /// The ignition handshake after an arc on, as read so far.
@@ -769,6 +785,142 @@ fn missing_burn_back(
                 "arc off without the burn-back wait `WAIT SEC {:.3}` after it",
                 opts.burn_back_s
             ),
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{UnitVector3, Vector3};
+    use crate::program::kuka::{kuka_files, KukaOptions, HOME_NAME};
+    use crate::program::readback::kuka::parse_krl;
+    use crate::program::{build_program, BeadSetup, HomePosition, Payload, TravelSpeed};
+    use crate::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
+
+    /// Two layers of the hemisphere (R_s 45 mm, Delta 5 mm, 8 points) in
+    /// the KUKA part-carried example cell, `R_Z = 0`.
+    fn program() -> (crate::program::Program, Cell) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("parts/cells/kuka_kr16_2_part_carried.toml");
+        let cell = crate::io::cell_file::read_cell_file(&path)
+            .unwrap()
+            .cell
+            .unwrap();
+        let mut pts = Vec::new();
+        for layer in 0..2usize {
+            let phi = layer as f64 * 5.0 / 45.0;
+            for k in 0..8usize {
+                let v = std::f64::consts::TAU * k as f64 / 8.0;
+                pts.push(PathPointInput {
+                    layer,
+                    point: k,
+                    position_mm: Point3::new(
+                        45.0 * phi.cos() * v.cos(),
+                        45.0 * phi.cos() * v.sin(),
+                        45.0 * phi.sin(),
+                    ),
+                    tool_axis: UnitVector3::new_normalize(Vector3::new(
+                        -phi.sin() * v.cos(),
+                        -phi.sin() * v.sin(),
+                        phi.cos(),
+                    )),
+                    build_direction: None,
+                    r_z: 0.0,
+                });
+            }
+        }
+        let tr = joint_trajectory(&cell, &pts, 6.0, &TrajectoryOptions::default()).unwrap();
+        let prog = build_program("HEMI", &cell, &pts, &tr, &TravelSpeed::Constant(6.0)).unwrap();
+        (prog, cell)
+    }
+
+    /// The emitted home, payload, dwell and interpass wait come back as the
+    /// right steps in the right order: home first and last (joint moves to
+    /// the home joints), before bead 0 its payload, before bead 1 payload,
+    /// dwell, wait; the crater and burn-back waits and the ignition wait
+    /// are not dwell or interpass steps.
+    #[test]
+    fn emitted_setup_reads_back_as_steps() {
+        let (mut prog, cell) = program();
+        let home = [10.0, -80.0, 100.0, 0.0, 40.0, 0.0].map(f64::to_radians);
+        prog.home = Some(HomePosition {
+            joints: home,
+            positioner: None,
+        });
+        let load = |m: f64, z: f64| Payload {
+            mass_kg: m,
+            cog_mm: Point3::new(0.0, 0.0, z),
+        };
+        prog.bead_setup = vec![
+            BeadSetup {
+                layer: 0,
+                payload: Some(load(5.0, 60.0)),
+                dwell_s: 0.0,
+                wait_input: None,
+            },
+            BeadSetup {
+                layer: 1,
+                payload: Some(load(5.25, 61.5)),
+                dwell_s: 30.0,
+                wait_input: Some(7),
+            },
+        ];
+        let opts = KukaOptions::default();
+        let f = kuka_files(&prog, &opts).unwrap();
+        let p = parse_krl(&f[0].text, &f[0].name, &f[1].text, &f[1].name).unwrap();
+        let mut report = ValidationReport::default();
+        let steps = kuka_steps(&p, &cell, &opts, &mut report);
+        assert!(report.is_ok(), "{report}");
+        let motions: Vec<&Motion> = steps
+            .iter()
+            .filter_map(|s| match s {
+                Step::Motion(m) => Some(m.as_ref()),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(motions.len(), 2 + 20);
+        for m in [motions[0], motions[motions.len() - 1]] {
+            assert_eq!((m.label.as_str(), m.kind), (HOME_NAME, MoveKind::Joint));
+            let q = m.joints.unwrap();
+            assert!(
+                q.iter().zip(home).all(|(a, b)| (a - b).abs() < 1e-7),
+                "{q:?}"
+            );
+        }
+        // the other steps in order, as (kind, value)
+        let rest: Vec<String> = steps
+            .iter()
+            .filter_map(|s| match s {
+                Step::Motion(_) => None,
+                Step::ProcessOn { .. } => Some("on".into()),
+                Step::ProcessOff { .. } => Some("off".into()),
+                Step::Wait { seconds, input, .. } => Some(format!("wait {seconds:?} {input:?}")),
+                Step::Payload {
+                    mass_kg, cog_mm, ..
+                } => Some(format!("load {mass_kg} {}", cog_mm.z)),
+            })
+            .collect();
+        assert_eq!(
+            rest,
+            [
+                "load 5 60",
+                "on",
+                "off",
+                "load 5.25 61.5",
+                "wait Some(30.0) None",
+                "wait None Some(7)",
+                "on",
+                "off"
+            ]
+        );
+        // each set-up is before its bead's approach (the first PTP after home)
+        let pos = |pred: &dyn Fn(&Step) -> bool| steps.iter().position(pred).unwrap();
+        let wait7 = pos(&|s| matches!(s, Step::Wait { input: Some(7), .. }));
+        assert!(
+            matches!(&steps[wait7 + 1], Step::Motion(m) if m.kind == MoveKind::Joint && m.label == "P11"),
+            "{:?}",
+            steps[wait7 + 1]
         );
     }
 }
