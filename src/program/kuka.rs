@@ -11,22 +11,46 @@
 //!   inline forms write, and may be refused).
 //! * Each bead: `PTP` to its first point (exact stop), then `LIN` moves at
 //!   `$VEL.CP` (m/s) blended with `C_DIS` inside the bead, the last one
-//!   exact. The arc is switched by `TRIGGER WHEN DISTANCE=0` before the
-//!   first `LIN` (fires at the exact first point) and `TRIGGER WHEN
-//!   DISTANCE=1` before the last `LIN` (fires at its exact end point), so
-//!   blending never moves an arc switching point.
-//! * Arc process: output `$OUT[schedule]`; custom: the user's statements,
-//!   which a `TRIGGER ... DO` accepts only as an assignment or a subprogram
-//!   call ([`is_trigger_action`]; others are refused by
-//!   [`KukaOptions::validate`]).
-//! * The `INI` fold declares the usual stop-message interrupt (`GLOBAL
-//!   INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )`, `INTERRUPT ON
-//!   3`) before `BAS (#INITMOV,0 )`; tool and base are selected with `BAS
-//!   (#TOOL,n)` and `BAS (#BASE,n)` (which also set the tool's load
-//!   `$LOAD`), then `$IPO_MODE`.
-//! * With approach and retract points: `PTP` to the approach point, `LIN`
-//!   into the bead's first point (exact), the bead, `LIN` out to the retract
-//!   point, all at `$VEL.CP` = the program's approach speed.
+//!   exact.
+//! * **Arc process** (`$OUT[schedule]`): the arc is switched on at the
+//!   bead's first point, where the robot stands (exact stop), followed by
+//!   the ignition handshake: `$TIMER[t]` set to minus the timeout (ms) and
+//!   started, `WAIT FOR $IN[arc_ok] OR $TIMER_FLAG[t]` (KRL's `WAIT FOR`
+//!   has no timeout; the flag turns on when the timer reaches 0), and if
+//!   the input is still off: arc off, a message (`Set_KrlMsg(#QUIT, …)`,
+//!   KSS 8) and `HALT`. At the bead's last point (exact): `WAIT SEC
+//!   crater` with the arc on, arc off, `WAIT SEC burn-back`
+//!   ([`KukaOptions::arc_ok_input`], [`KukaOptions::ignition_timeout_s`],
+//!   [`KukaOptions::crater_fill_s`], [`KukaOptions::burn_back_s`]).
+//! * **Custom process**: the user's statements, switched by `TRIGGER WHEN
+//!   DISTANCE=0` before the first `LIN` (fires at the exact first point)
+//!   and `TRIGGER WHEN DISTANCE=1` before the last `LIN` (fires at its
+//!   exact end point), so blending never moves a switching point; a
+//!   `TRIGGER ... DO` accepts only an assignment or a subprogram call
+//!   ([`is_trigger_action`]; others are refused by
+//!   [`KukaOptions::validate`]), and a call gets `PRIO=-1`
+//!   ([`trigger_line`]).
+//! * **Frames stated**: after `BAS (#TOOL,n)`/`BAS (#BASE,n)` (numbers and
+//!   load) the program assigns `$TOOL = {X …,A …}` and `$BASE = {…}`, the
+//!   frames its positions assume ([`KukaOptions::frames`]): the torch
+//!   (its z axis along the torch, from the wire tip into it: not KUKA's
+//!   +X tool direction, so a torch measured on the controller is another
+//!   frame) over the user base, or in the fixed-tool mode the part on the
+//!   flange and the fixed torch.
+//! * **Coordinated positioner** (torch-carried cell,
+//!   [`crate::program::ProgramOptions::coordinated`], default on): `$BASE =
+//!   EK (MACHINE_DEF[m].ROOT, MACHINE_DEF[m].MECH_TYPE, {table_from_part})`
+//!   math-couples the base to the positioner (E1, E2), so `E6POS`
+//!   positions are the part frame at each point's E1, E2 and `$VEL.CP` is
+//!   the TCP's speed relative to the moving base: the planned travel speed
+//!   over the part, also where the positioner turns ([`KukaOptions::coordinated`]).
+//!   Assumes the controller's positioner kinematic is the cell's (root at
+//!   the positioner pose, flange = table frame at E1 = E2 = 0).
+//! * **Home and bead set-up**: `PTP PHOME` (an `E6AXIS` of the home joints
+//!   and positioner) first and last; before each bead's first motion its
+//!   payload (`$LOAD.M` kg, `$LOAD.CM` mm in the flange frame, `$LOAD.J`
+//!   of a point mass), dwell (`WAIT SEC`) and interpass wait (`WAIT FOR
+//!   $IN[n]`).
 //! * **Part-carried cell: external TCP.** `$VEL.CP` is the speed of the TCP;
 //!   the planned speed is the torch's relative to the part. In the
 //!   part-carried cell the emitter switches to KUKA's fixed-tool mode,
@@ -37,7 +61,7 @@
 //!   fixed torch travels over it at `$VEL.CP`, and `E6POS` positions are the
 //!   part frame in the torch frame ([`KukaOptions::external_tcp`]).
 //!
-//! * **Torch-carried cell, positioner turning.** `$VEL.CP` is the TCP's
+//! * **Torch-carried cell, positioner turning, not coordinated.** `$VEL.CP` is the TCP's
 //!   speed in the robot frame; where the positioner turns within a bead the
 //!   part moves under a nearly still torch, and the planned speed (over the
 //!   part) is not the TCP's. KRL's `LIN` has no time argument: such a `LIN`
