@@ -6,6 +6,7 @@ mod api;
 mod fixture;
 mod formats;
 mod golden;
+mod kuka_controller;
 mod parts;
 mod setup;
 #[path = "../common/mod.rs"]
