@@ -2,11 +2,13 @@
 //! emitter, read-back and validation of our FANUC output, corrupted files,
 //! splitting at a point limit, refusal of infeasible plans.
 
+mod abb_controller;
 mod api;
 mod fixture;
 mod formats;
 mod golden;
 mod parts;
+mod rapid_grammar;
 #[path = "../common/mod.rs"]
 mod shared;
 mod split;
