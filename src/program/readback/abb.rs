@@ -385,6 +385,7 @@ pub fn parse_mod(text: &str, file: &str) -> Result<RapidModule, ProgramError> {
         declarations: Vec::new(),
         instructions: Vec::new(),
     };
+    let mut names = std::collections::HashSet::new();
     let mut started = false;
     let mut in_main = false;
     let mut ended = false;
@@ -430,7 +431,7 @@ pub fn parse_mod(text: &str, file: &str) -> Result<RapidModule, ProgramError> {
             let op = parse_instruction(stmt).map_err(|r| err(n, r))?;
             m.instructions.push(RapidInstruction { line: n, op });
         } else {
-            parse_declaration(stmt, n, &mut m).map_err(|r| err(n, r))?;
+            parse_declaration(stmt, n, &mut m, &mut names).map_err(|r| err(n, r))?;
         }
     }
     if !ended {
@@ -473,7 +474,12 @@ fn loaddata(n: &Node) -> Result<RapidLoad, String> {
     })
 }
 
-fn parse_declaration(stmt: &str, line: usize, m: &mut RapidModule) -> Result<(), String> {
+fn parse_declaration(
+    stmt: &str,
+    line: usize,
+    m: &mut RapidModule,
+    names: &mut std::collections::HashSet<String>,
+) -> Result<(), String> {
     let (head, value) = stmt
         .split_once(":=")
         .ok_or_else(|| format!("expected a declaration `... := [...]`, got `{stmt}`"))?;
@@ -488,7 +494,7 @@ fn parse_declaration(stmt: &str, line: usize, m: &mut RapidModule) -> Result<(),
             "bad declaration `{head}`: PERS, CONST or VAR expected"
         ));
     }
-    if m.declaration(name).is_some() {
+    if !names.insert(name.to_string()) {
         return Err(format!("`{name}` is declared twice"));
     }
     let v = parse_aggregate(value)?;

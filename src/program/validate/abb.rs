@@ -233,10 +233,14 @@ fn file_frames(
     Some(frames)
 }
 
+/// The module's declarations by name.
+type Decls<'a> = std::collections::HashMap<&'a str, &'a crate::program::readback::abb::RapidDecl>;
+
 /// Pushes a Declaration problem unless `name` is declared with type `ty`
-/// (or is one of `predefined`).
+/// (or `predefined`); `true` when it is.
 fn check_declared(
     module: &RapidModule,
+    decls: &Decls,
     name: &str,
     ty: &str,
     predefined: bool,
@@ -246,7 +250,7 @@ fn check_declared(
     if predefined {
         return true;
     }
-    match module.declaration(name) {
+    match decls.get(name) {
         Some(d) if d.ty == ty => true,
         Some(d) => {
             push(
@@ -274,6 +278,7 @@ fn check_declared(
 /// Checks a motion's zone, tool and work object identifiers.
 fn check_motion_args(
     module: &RapidModule,
+    decls: &Decls,
     zone: &str,
     tool: &ToolArg,
     line: usize,
@@ -284,11 +289,19 @@ fn check_motion_args(
             .strip_prefix('z')
             .and_then(|n| n.parse::<u32>().ok())
             .is_some_and(|n| PREDEFINED_ZONES_MM.contains(&n));
-    check_declared(module, zone, "zonedata", predefined_zone, line, report);
-    check_declared(module, &tool.tool, "tooldata", false, line, report);
+    check_declared(
+        module,
+        decls,
+        zone,
+        "zonedata",
+        predefined_zone,
+        line,
+        report,
+    );
+    check_declared(module, decls, &tool.tool, "tooldata", false, line, report);
     let frame_of = |f: &Option<RapidFrame>| f.as_ref().map(|f| f.name.clone());
     if frame_of(&module.tool).as_deref() != Some(tool.tool.as_str())
-        && module.declaration(&tool.tool).is_some()
+        && decls.contains_key(tool.tool.as_str())
     {
         push(
             report,
@@ -300,7 +313,7 @@ fn check_motion_args(
     }
     match &tool.wobj {
         Some(w) => {
-            check_declared(module, w, "wobjdata", false, line, report);
+            check_declared(module, decls, w, "wobjdata", false, line, report);
         }
         None => push(
             report,
@@ -354,6 +367,16 @@ pub fn validate_abb(
     };
     let robot = cell.robot();
     let frames = file_frames(module, cell, opts, &mut report);
+    let decls: Decls = module
+        .declarations
+        .iter()
+        .map(|d| (d.name.as_str(), d))
+        .collect();
+    let targets: std::collections::HashMap<&str, _> = module
+        .targets
+        .iter()
+        .map(|t| (t.name.as_str(), t))
+        .collect();
     let (start, schedule) = match &opts.process {
         ProcessControl::Arc { schedule } => (None, Some(*schedule)),
         ProcessControl::Custom { start, end } => (Some((start.clone(), end.clone())), None),
@@ -415,7 +438,8 @@ pub fn validate_abb(
             RapidOp::GripLoad(name) => {
                 let load = if name == "load0" {
                     Some(crate::program::abb::LOAD0).map(|l| (l.mass_kg, Point3::from(l.cog_mm)))
-                } else if check_declared(module, name, "loaddata", false, line, &mut report) {
+                } else if check_declared(module, &decls, name, "loaddata", false, line, &mut report)
+                {
                     module
                         .loads
                         .iter()
@@ -455,7 +479,7 @@ pub fn validate_abb(
                 continue;
             }
             RapidOp::MoveAbsJ { target, zone, tool } => {
-                check_motion_args(module, zone, tool, line, &mut report);
+                check_motion_args(module, &decls, zone, tool, line, &mut report);
                 (target, None, MoveKind::Joint, None, None)
             }
             RapidOp::Linear {
@@ -469,7 +493,7 @@ pub fn validate_abb(
                 zone,
                 tool,
             } => {
-                check_motion_args(module, zone, tool, line, &mut report);
+                check_motion_args(module, &decls, zone, tool, line, &mut report);
                 let arc = instruction != "MoveL";
                 let mut v = *speed_mm_s;
                 if arc {
@@ -483,10 +507,10 @@ pub fn validate_abb(
                         );
                     }
                     if let Some(s) = seam {
-                        check_declared(module, s, "seamdata", false, line, &mut report);
+                        check_declared(module, &decls, s, "seamdata", false, line, &mut report);
                     }
                     let wd = weld.as_deref().unwrap_or("");
-                    if check_declared(module, wd, "welddata", false, line, &mut report) {
+                    if check_declared(module, &decls, wd, "welddata", false, line, &mut report) {
                         let d = module.welds.iter().find(|d| d.name == wd);
                         if let (Some(d), Some(sched)) = (d, schedule) {
                             if d.sched != sched as f64 {
@@ -571,7 +595,7 @@ pub fn validate_abb(
                     .into(),
             );
         }
-        let Some(t) = module.targets.iter().find(|t| &t.name == target) else {
+        let Some(t) = targets.get(target.as_str()).copied() else {
             push(
                 &mut report,
                 ProblemKind::Declaration,
