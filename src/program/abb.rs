@@ -10,13 +10,50 @@
 //!   axes `eax_a`, `eax_b` (deg; [`AbbOptions::positioner_axes`]), the
 //!   others `9E+09`.
 //! * `ConfL \On` so that the controller keeps our branch on linear moves.
-//! * Arc process: `ArcLStart` (`fine`) / `ArcL` (`z1`) / `ArcLEnd` (`fine`)
-//!   with `seam1` and `weld<schedule>`, which must exist in the system;
-//!   custom process: `MoveL` with the user's instructions after the first
+//! * **Every identifier the module uses is declared in it**, except the
+//!   controller data named in [`AbbOptions`] (the interpass input signal
+//!   [`AbbOptions::interpass_signal`], the positioner's mechanical unit
+//!   [`AbbOptions::ufmec`]) and RobotWare's predefined `fine`, `z<n>`:
+//!   `tWaam` (`tooldata`), `wWaam` (`wobjdata`), `seamWaam` (`seamdata`),
+//!   `weldWaam<k>` (`welddata`, one per planned travel speed),
+//!   `loadWaam<k>` (`loaddata`, one per payload update), `jHome`, `j<n>`,
+//!   `p<n>`.
+//! * Arc process (ArcWare, RobotWare 6 Arc data layouts): `ArcLStart`
+//!   (`fine`) / `ArcL` (`z<n>`) / `ArcLEnd` (`fine`) with `seamWaam` and
+//!   `weldWaam<k>`. ArcWare takes the speed of the arc-on moves (`ArcL`,
+//!   `ArcLEnd`) from `welddata.weld_speed` (mm/s), so there is one
+//!   `welddata` per planned travel speed (rounded down to its 4 written
+//!   decimals), and the inline `speeddata` of those moves carries the same
+//!   `v_tcp` (used when welding is blocked). `ArcLStart` moves with the arc
+//!   off at its `speeddata` (the approach speed) and names the welddata of
+//!   the bead's first segment. `welddata` = `[weld_speed, org_weld_speed,
+//!   main_arc, org_arc]`, `seamdata` = `[purge_time, preflow_time, ign_arc,
+//!   ign_move_delay, scrape_start, heat_speed, heat_time, heat_distance,
+//!   heat_arc, cool_time, fill_time, fill_arc, bback_time, rback_time,
+//!   bback_arc, postflow_time]`, `arcdata` = `[sched, mode, voltage,
+//!   wirefeed, control, current, voltage2, wirefeed2, control2]` with
+//!   `sched` = the process schedule (the power source's program or job)
+//!   and everything else 0: gas times, ignition, heat, crater fill and
+//!   burn-back are left to the power source's program (tune them on the
+//!   controller). The data are `LOCAL PERS` so that a program loaded after
+//!   another one does not inherit that one's persistent values.
+//!   Custom process: `MoveL` with the user's instructions after the first
 //!   and after the last point of each bead. Speeds as inline `speeddata`
-//!   `[v_tcp mm/s, 500, 5000, 1000]`.
-//! * `tWaam` (the tool) and `wWaam` (the work object) are declared from the
-//!   options with a 1 kg placeholder load: set the real load before running.
+//!   `[v_tcp mm/s, v_ori 500 °/s, v_leax 5000 mm/s, v_reax °/s]`.
+//! * Home ([`Program::home`]): `MoveAbsJ jHome` first and last, arc off.
+//! * Before each bead ([`Program::bead_setup`]), in this order: `GripLoad
+//!   loadWaam<k>` (payload), `WaitTime s` (dwell, s, rounded up to the ms)
+//!   and `WaitDI <interpass_signal>, 1` (interpass temperature reached).
+//! * Loads (`loaddata` `[mass kg, cog mm, aom, ix, iy, iz kg·m²]`, point
+//!   masses: `aom` identity, inertia 0): `tWaam.tload` is
+//!   [`AbbOptions::tool_load`], by default a 3 kg torch with its centre of
+//!   gravity half way to the TCP (robot-held tool) or, with a stationary
+//!   tool (where RAPID's `tload` is the load the robot holds besides the
+//!   payload), the `[program]` base payload when the program sets no
+//!   payload, else ABB's `load0` (`GripLoad` then carries everything). A
+//!   payload's centre of gravity is written in the tool frame (robot-held
+//!   tool) or in the robot-held work object's object frame (stationary
+//!   tool), as RAPID's `loaddata` says.
 //! * With approach and retract points: `MoveAbsJ` to the approach point's
 //!   `jointtarget`, `ArcLStart` (or `MoveL`) into the bead's first point at
 //!   the approach speed (the arc is off while it moves and ignites there),
@@ -29,33 +66,42 @@
 //!   `uframe` = the cell's `flange_from_part`): the speeds are then the
 //!   torch's over the part, as planned, and `robtarget`s are the torch in
 //!   the part frame.
-//! * **Torch-carried cell, positioner turning.** Where the positioner moves
-//!   within a bead ([`positioner_moves`])
-//!   the TCP's speed in the world frame is not the torch's over the part
-//!   (the work object is not coordinated with the positioner here): such
-//!   moves carry the optional argument `\T` (`ArcL p13, [6,500,5000,1000]
-//!   \T:=5.705, ...`), the segment time in seconds = the segment's length
-//!   in the part frame / the planned speed, which RAPID uses instead of the
-//!   `speeddata` (`Speed [\V] | [\T]` of `MoveL`/`MoveC`/`MoveAbsJ`;
-//!   uncoordinated external axes reach their targets with the robot). Not
-//!   verified: that ArcWare honours `\T` on `ArcL` while welding, when it
-//!   takes the arc-on speed from `weld<n>.weld_speed` (see below); if it
-//!   does not, the turning segments run at the weld speed as a TCP speed.
-//! * Weld speed: ArcWare takes the speed of the arc-on moves (`ArcL`,
-//!   `ArcLEnd`) from `weld<n>.weld_speed`; the inline `speeddata` (the planned
-//!   speed) applies when welding is blocked. The weld data must give the
-//!   planned travel speed (a modulated speed needs one `welddata` per value).
+//! * **Torch-carried cell, coordinated** (`[program] coordinated`, the
+//!   default): the work object moves with the positioner's mechanical unit
+//!   ([`AbbOptions::ufmec`]): `wWaam = [FALSE, FALSE, "STN1", uframe,
+//!   oframe]`, whose user frame the controller takes from its system
+//!   parameters (the written `uframe` is the identity and unused): it must
+//!   be the positioner's *table frame* (origin at the table centre, Z the
+//!   table normal, [`crate::robot::positioner`]) at the unit's joints, and
+//!   `oframe` = the cell's `table_from_part`. `robtarget`s are then the
+//!   torch in the part frame, and `v_tcp` (and `weld_speed`) are the
+//!   torch's speed over the moving part: the planned travel speed, with no
+//!   time argument.
+//! * **Torch-carried cell, not coordinated.** Where the positioner moves
+//!   within a bead ([`positioner_moves`]) the TCP's speed in the world
+//!   frame is not the torch's over the part: such moves carry the optional
+//!   argument `\T` (`ArcL p13, [6,500,5000,7.8869]\T:=5.705, ...`), the
+//!   segment time in seconds = the segment's length in the part frame / the
+//!   planned speed, which RAPID uses instead of the `speeddata` (`Speed
+//!   [\V] | [\T]` of `MoveL`/`MoveC`/`MoveAbsJ`; uncoordinated external
+//!   axes reach their targets with the robot). ArcWare may take the arc-on
+//!   speed from `weld_speed` instead of `\T`; the `speeddata`'s `v_reax`
+//!   (°/s) is then bounded by the positioner's planned rate on that segment
+//!   (its largest axis turn / the segment time, rounded down), so that the
+//!   move takes at least the planned time either way (the positioner's
+//!   axes are rotational: `v_leax` stays 5000 mm/s). The work object is
+//!   fixed (`[FALSE, TRUE, "", uframe, oframe]`).
 
 use std::io::Write;
 
 use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
-use crate::program::fmt::{ascii_comment, ceil_to, floor_to, Deg, Mm, Unitless};
+use crate::program::fmt::{ascii_comment, ceil_to, floor_to, Deg, Fixed, Mm, Unitless};
 use crate::program::frames::ToolFrames;
 use crate::program::{
-    check_name, check_vendor, positioner_moves, render, segment_length_mm, ArcFlag, EmittedFile,
-    ProcessControl, Program, ProgramError,
+    check_name, check_vendor, opens_bead, positioner_moves, render, segment_length_mm, ArcFlag,
+    EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::abb_quaternion;
 use crate::robot::{Cell, Joints, RobotModel, Vendor};
@@ -63,17 +109,71 @@ use crate::robot::{Cell, Joints, RobotModel, Vendor};
 /// The emitter's name in [`ProgramError::VendorMismatch`].
 pub const EMITTER: &str = "ABB RAPID";
 
+/// The zones RobotWare predefines (`z0` .. `z200`, mm): the only values of
+/// [`AbbOptions::zone_mm`] whose `z<n>` exists without a declaration.
+pub const PREDEFINED_ZONES_MM: [u32; 14] = [0, 1, 5, 10, 15, 20, 30, 40, 50, 60, 80, 100, 150, 200];
+
+/// ABB's predefined `load0` (`[0.001, [0, 0, 0.001], [1, 0, 0, 0], 0, 0,
+/// 0]`): no load.
+pub const LOAD0: AbbLoad = AbbLoad {
+    mass_kg: 0.001,
+    cog_mm: [0.0, 0.0, 0.001],
+    inertia_kg_m2: [0.0; 3],
+};
+
+/// Mass of the default robot-held torch load (kg): the order of a
+/// MIG/MAG robot torch with its neck and the first part of its hose
+/// package (a published controller program's identified arc torch load is
+/// 3.1 kg). Identify the real one (`LoadIdentify`) and give it as
+/// [`AbbOptions::tool_load`].
+pub const DEFAULT_TORCH_MASS_KG: f64 = 3.0;
+
+/// A RAPID `loaddata` as a point mass or with principal inertia about axes
+/// parallel to the frame's (`aom` identity). Plain data.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AbbLoad {
+    /// Mass (kg, > 0).
+    pub mass_kg: f64,
+    /// Centre of gravity (mm): in the flange (wrist) frame for a tool load.
+    pub cog_mm: [f64; 3],
+    /// Moments of inertia about the centre of gravity, `ix iy iz`
+    /// (kg·m², ≥ 0; all 0: a point mass).
+    #[serde(default)]
+    pub inertia_kg_m2: [f64; 3],
+}
+
+impl AbbLoad {
+    /// `[mass,[x,y,z],[1,0,0,0],ix,iy,iz]` with the centre of gravity `cog`
+    /// (mm, in the frame the reader expects).
+    fn line(&self, cog: [f64; 3]) -> String {
+        format!(
+            "[{},[{},{},{}],[1,0,0,0],{},{},{}]",
+            Fixed::new(self.mass_kg, 4),
+            Mm(cog[0]),
+            Mm(cog[1]),
+            Mm(cog[2]),
+            Fixed::new(self.inertia_kg_m2[0], 6),
+            Fixed::new(self.inertia_kg_m2[1], 6),
+            Fixed::new(self.inertia_kg_m2[2], 6),
+        )
+    }
+}
+
 /// Options of the ABB emitter. Plain data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct AbbOptions {
-    /// Arc instructions or user-given instructions. Default `weld1`.
+    /// Arc instructions or user-given instructions. Default schedule 1
+    /// (`arcdata.sched` of the declared `welddata`/`seamdata`).
     pub process: ProcessControl,
-    /// Joint move speed to bead starts (mm/s of the TCP, `v<n>`). Default 100.
+    /// Joint move speed to bead starts and home (mm/s of the TCP,
+    /// `v_tcp`). Default 100.
     pub approach_speed_mm_s: f64,
-    /// Zone inside beads (mm). Default 1 (`z1`).
+    /// Zone inside beads (mm, one of [`PREDEFINED_ZONES_MM`]). Default 1 (`z1`).
     pub zone_mm: u32,
-    /// Work object in the robot base frame (mm). Default identity.
+    /// Work object in the robot base frame (mm). Default identity. Not used
+    /// with a coordinated work object (its user frame is the positioner's).
     pub base_from_user: Isometry3,
     /// Tool on the flange (`tool0`) (mm); `None`: the cell's torch; with a
     /// stationary tool the part on the flange (`flange_from_part`).
@@ -88,6 +188,17 @@ pub struct AbbOptions {
     /// letter) holding the positioner's tilt `q7` and turn `q8` (deg), as
     /// the system's mechanical units are configured. Default `['a', 'b']`.
     pub positioner_axes: [char; 2],
+    /// The positioner's mechanical unit (controller data, the system
+    /// parameters' name), the `ufmec` of the coordinated work object in the
+    /// torch-carried cell. Default `"STN1"`.
+    pub ufmec: String,
+    /// The digital input signal (controller data, a RAPID name) that
+    /// `[program] interpass_input = n` waits for: `WaitDI
+    /// <interpass_signal>, 1` (the number `n` is written in a comment above
+    /// it). Default `"diInterpass"`.
+    pub interpass_signal: String,
+    /// The tool load `tWaam.tload` (flange frame); `None`: module doc.
+    pub tool_load: Option<AbbLoad>,
     /// The vendor-independent options (home, dwell, interpass wait,
     /// payload, transit, coordination) the validator checks the file
     /// against; not a key of `[program.<vendor>]` (set from `[program]` by
@@ -107,6 +218,9 @@ impl Default for AbbOptions {
             stationary_tool: None,
             fixed_tool: None,
             positioner_axes: ['a', 'b'],
+            ufmec: "STN1".into(),
+            interpass_signal: "diInterpass".into(),
+            tool_load: None,
             common: Default::default(),
         }
     }
@@ -118,19 +232,37 @@ impl Default for AbbOptions {
 /// [`ToolFrames::target`].
 pub type AbbFrames = ToolFrames;
 
+/// `true` when `s` is a RAPID identifier: a letter, then letters, digits
+/// or `_`, at most 32 characters.
+pub fn is_rapid_name(s: &str) -> bool {
+    !s.is_empty()
+        && s.len() <= 32
+        && s.starts_with(|c: char| c.is_ascii_alphabetic())
+        && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
 impl AbbOptions {
     /// The frames written for `cell`.
     pub fn frames(&self, cell: &Cell) -> AbbFrames {
-        let stationary = self
-            .stationary_tool
-            .unwrap_or(matches!(cell, Cell::PartCarried(_)));
         ToolFrames::new(
             cell,
-            stationary,
+            self.stationary(cell),
             self.flange_from_tool,
             self.fixed_tool,
             self.base_from_user,
         )
+    }
+
+    fn stationary(&self, cell: &Cell) -> bool {
+        self.stationary_tool
+            .unwrap_or(matches!(cell, Cell::PartCarried(_)))
+    }
+
+    /// `true` when the work object is coordinated with the positioner's
+    /// mechanical unit: `[program] coordinated`, a torch-carried cell and a
+    /// robot-held tool.
+    pub fn coordinated(&self, cell: &Cell) -> bool {
+        self.common.coordinated && matches!(cell, Cell::TorchCarried(_)) && !self.stationary(cell)
     }
 
     /// Checks every field.
@@ -138,12 +270,56 @@ impl AbbOptions {
     /// # Errors
     /// [`ProgramError::InvalidOptions`] naming the field.
     pub fn validate(&self) -> Result<(), ProgramError> {
+        let bad = |field: &'static str, value: String, reason: &'static str| {
+            Err(ProgramError::InvalidOptions {
+                field,
+                value,
+                reason,
+            })
+        };
         if !(self.approach_speed_mm_s.is_finite() && self.approach_speed_mm_s > 0.0) {
-            return Err(ProgramError::InvalidOptions {
-                field: "approach_speed_mm_s",
-                value: self.approach_speed_mm_s.to_string(),
-                reason: "must be finite and > 0",
-            });
+            return bad(
+                "approach_speed_mm_s",
+                self.approach_speed_mm_s.to_string(),
+                "must be finite and > 0",
+            );
+        }
+        if !PREDEFINED_ZONES_MM.contains(&self.zone_mm) {
+            return bad(
+                "zone_mm",
+                self.zone_mm.to_string(),
+                "must be a zone RobotWare predefines: 0, 1, 5, 10, 15, 20, 30, 40, 50, 60, 80, 100, 150 or 200",
+            );
+        }
+        if !is_rapid_name(&self.ufmec) {
+            return bad(
+                "ufmec",
+                self.ufmec.clone(),
+                "a mechanical unit name: a letter, then letters, digits or `_`, at most 32 characters",
+            );
+        }
+        if !is_rapid_name(&self.interpass_signal) {
+            return bad(
+                "interpass_signal",
+                self.interpass_signal.clone(),
+                "a signal name: a letter, then letters, digits or `_`, at most 32 characters",
+            );
+        }
+        if let Some(l) = &self.tool_load {
+            let finite = l
+                .cog_mm
+                .iter()
+                .chain(&l.inertia_kg_m2)
+                .all(|v| v.is_finite());
+            if !(l.mass_kg.is_finite() && l.mass_kg > 0.0 && finite)
+                || l.inertia_kg_m2.iter().any(|v| *v < 0.0)
+            {
+                return bad(
+                    "tool_load",
+                    format!("{l:?}"),
+                    "mass finite and > 0 kg, centre of gravity finite, inertia finite and >= 0",
+                );
+            }
         }
         self.positioner_slots()?;
         self.process.validate()
@@ -219,6 +395,88 @@ fn extax(e: Option<[f64; 2]>, slots: [usize; 2]) -> String {
     format!("[{}]", v.join(","))
 }
 
+/// `jointtarget` `[[J1..J6],[extax]]` (joints rad, written in degrees).
+fn jointtarget(q: &Joints, e: Option<[f64; 2]>, slots: [usize; 2]) -> String {
+    let a = q.map(f64::to_degrees);
+    format!(
+        "[[{},{},{},{},{},{}],{}]",
+        Deg(a[0]),
+        Deg(a[1]),
+        Deg(a[2]),
+        Deg(a[3]),
+        Deg(a[4]),
+        Deg(a[5]),
+        extax(e, slots)
+    )
+}
+
+/// Inline `speeddata` `[v_tcp, 500, 5000, v_reax]`, `v_tcp` rounded down to
+/// its 4 written decimals (never faster than planned), `v_reax` (°/s) as
+/// given (already rounded down), or 1000 °/s (no bound) when `None`.
+fn speeddata(v_tcp_mm_s: f64, v_reax_deg_s: Option<f64>) -> String {
+    let v_reax = v_reax_deg_s.map_or("1000".to_string(), |v| Mm(v).to_string());
+    format!("[{},500,5000,{v_reax}]", Mm(floor_to(v_tcp_mm_s, 4)))
+}
+
+/// The welddata speeds of `program` (mm/s, as written: rounded down to 4
+/// decimals), in order of first use: one per planned travel speed of an
+/// arc-on move (a bead's first point carries its first segment's speed).
+fn weld_speeds(program: &Program) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::new();
+    for p in program.bead_points() {
+        let v = floor_to(p.speed_mm_s, 4);
+        if !out.contains(&v) {
+            out.push(v);
+        }
+    }
+    out
+}
+
+/// The frame a payload's centre of gravity is written in, from the flange
+/// frame: the tool frame (robot-held tool) or the robot-held work object's
+/// object frame (stationary tool), RAPID `loaddata.cog`.
+fn payload_frame_from_flange(frames: &AbbFrames) -> Isometry3 {
+    match frames {
+        AbbFrames::Held {
+            flange_from_tool, ..
+        } => flange_from_tool.inverse(),
+        AbbFrames::Stationary {
+            flange_from_work, ..
+        } => flange_from_work.inverse(),
+    }
+}
+
+/// The tool load written in `tWaam` (module doc).
+fn tool_load(program: &Program, opts: &AbbOptions, frames: &AbbFrames) -> AbbLoad {
+    if let Some(l) = opts.tool_load {
+        return l;
+    }
+    match frames {
+        AbbFrames::Held {
+            flange_from_tool, ..
+        } => {
+            let t = flange_from_tool.translation.vector * 0.5;
+            AbbLoad {
+                mass_kg: DEFAULT_TORCH_MASS_KG,
+                cog_mm: [t.x, t.y, t.z],
+                inertia_kg_m2: [0.0; 3],
+            }
+        }
+        AbbFrames::Stationary { .. } => {
+            let payloads = program.bead_setup.iter().any(|s| s.payload.is_some());
+            if !payloads && opts.common.payload_base_kg > 0.0 {
+                AbbLoad {
+                    mass_kg: opts.common.payload_base_kg,
+                    cog_mm: opts.common.payload_base_cog_mm,
+                    inertia_kg_m2: [0.0; 3],
+                }
+            } else {
+                LOAD0
+            }
+        }
+    }
+}
+
 /// Writes the `.mod` of `program`.
 ///
 /// # Errors
@@ -229,6 +487,11 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     let robot = program.cell.robot();
     let frames = opts.frames(&program.cell);
     let slots = opts.positioner_slots().map_err(std::io::Error::other)?;
+    // the coordinated work object: the part on the positioner's table
+    let coordinated = match (&program.cell, opts.coordinated(&program.cell)) {
+        (Cell::TorchCarried(c), true) => Some(c),
+        _ => None,
+    };
     writeln!(w, "MODULE {}", program.name)?;
     writeln!(
         w,
@@ -253,18 +516,116 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             ("FALSE", base_from_tool, "TRUE", flange_from_work)
         }
     };
+    let tload = tool_load(program, opts, &frames);
+    let load_note = match (opts.tool_load.is_some(), &frames) {
+        (true, _) => "[program.abb] tool_load",
+        (false, AbbFrames::Held { .. }) => {
+            "a 3 kg torch, centre of gravity half way to the TCP: identify the real one (LoadIdentify) and set [program.abb] tool_load"
+        }
+        (false, AbbFrames::Stationary { .. }) => {
+            if program.bead_setup.iter().any(|s| s.payload.is_some()) {
+                "load0: the payload updates (GripLoad) carry the part, substrate and fixture"
+            } else if opts.common.payload_base_kg > 0.0 {
+                "what the robot holds: [program] payload_base_kg (no payload updates)"
+            } else {
+                "load0: set [program] payload_base_kg or payload_every_layers for the part the robot holds"
+            }
+        }
+    };
+    writeln!(w, "  ! tWaam.tload: {load_note}")?;
     writeln!(
         w,
-        "  PERS tooldata tWaam := [{tool_held},{},[1,[0,0,1],[1,0,0,0],0,0,0]];",
-        pose_line(&tool)
+        "  PERS tooldata tWaam := [{tool_held},{},{}];",
+        pose_line(&tool),
+        tload.line(tload.cog_mm)
     )?;
-    writeln!(
-        w,
-        "  PERS wobjdata wWaam := [{wobj_held},TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];",
-        pose_line(&wobj)
-    )?;
+    match coordinated {
+        Some(c) => {
+            writeln!(
+                w,
+                "  ! wWaam moves with mechanical unit {}: its user frame is the positioner's table frame (system parameters), oframe the part on the table; speeds are the torch's over the part",
+                opts.ufmec
+            )?;
+            writeln!(
+                w,
+                "  PERS wobjdata wWaam := [FALSE,FALSE,\"{}\",[[0,0,0],[1,0,0,0]],{}];",
+                opts.ufmec,
+                pose_line(&c.table_from_part)
+            )?;
+        }
+        None => writeln!(
+            w,
+            "  PERS wobjdata wWaam := [{wobj_held},TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];",
+            pose_line(&wobj)
+        )?,
+    }
+    let weld_speeds = weld_speeds(program);
+    let weld_of = |v: f64| {
+        let v = floor_to(v, 4);
+        weld_speeds
+            .iter()
+            .position(|s| *s == v)
+            .map_or(1, |k| k + 1)
+    };
+    if let ProcessControl::Arc { schedule } = &opts.process {
+        writeln!(
+            w,
+            "  ! ArcWare data (RobotWare 6 Arc): process schedule {schedule} (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s)"
+        )?;
+        let zeros = "[0,0,0,0,0,0,0,0,0]";
+        let arc = format!("[{schedule},0,0,0,0,0,0,0,0]");
+        writeln!(
+            w,
+            "  LOCAL PERS seamdata seamWaam := [0,0,{arc},0,0,0,0,0,{zeros},0,0,{zeros},0,0,{zeros},0];"
+        )?;
+        for (k, v) in weld_speeds.iter().enumerate() {
+            writeln!(
+                w,
+                "  LOCAL PERS welddata weldWaam{} := [{},0,{arc},{zeros}];",
+                k + 1,
+                Mm(*v)
+            )?;
+        }
+    }
+    let cog_frame = payload_frame_from_flange(&frames);
+    let mut n_loads = 0;
+    for s in &program.bead_setup {
+        if let Some(p) = &s.payload {
+            n_loads += 1;
+            let c = cog_frame * p.cog_mm;
+            let l = AbbLoad {
+                mass_kg: p.mass_kg,
+                cog_mm: [c.x, c.y, c.z],
+                inertia_kg_m2: [0.0; 3],
+            };
+            writeln!(
+                w,
+                "  LOCAL PERS loaddata loadWaam{n_loads} := {};",
+                l.line(l.cog_mm)
+            )?;
+        }
+    }
+    if let Some(h) = &program.home {
+        writeln!(
+            w,
+            "  CONST jointtarget jHome := {};",
+            jointtarget(&h.joints, h.positioner, slots)
+        )?;
+    }
     for (i, p) in program.points.iter().enumerate() {
-        let pose = frames.target(&robot.flange_pose(&p.joints));
+        let flange = robot.flange_pose(&p.joints);
+        let pose = match (coordinated, p.positioner) {
+            (Some(c), Some(qp)) => {
+                let AbbFrames::Held {
+                    flange_from_tool, ..
+                } = frames
+                else {
+                    unreachable!("coordinated only with a robot-held tool")
+                };
+                c.base_from_part(&qp).inverse() * flange * flange_from_tool
+            }
+            _ => frames.target(&flange),
+        };
         let c = confdata(robot, &p.joints);
         let pl = pose_line(&pose);
         writeln!(
@@ -279,21 +640,12 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             extax(p.positioner, slots)
         )?;
         let prev = i.checked_sub(1).map(|k| program.points[k].arc);
-        if p.arc == ArcFlag::Approach
-            || (p.arc == ArcFlag::Start && prev != Some(ArcFlag::Approach))
-        {
-            let a = p.joints.map(f64::to_degrees);
+        if opens_bead(prev, p.arc) {
             writeln!(
                 w,
-                "  CONST jointtarget j{} := [[{},{},{},{},{},{}],{}];",
+                "  CONST jointtarget j{} := {};",
                 i + 1,
-                Deg(a[0]),
-                Deg(a[1]),
-                Deg(a[2]),
-                Deg(a[3]),
-                Deg(a[4]),
-                Deg(a[5]),
-                extax(p.positioner, slots)
+                jointtarget(&p.joints, p.positioner, slots)
             )?;
         }
     }
@@ -301,26 +653,61 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     writeln!(w, "    ConfL \\On;")?;
     let tw = "tWaam\\WObj:=wWaam";
     let zone = format!("z{}", opts.zone_mm);
-    let abs_j = |w: &mut dyn Write, k: usize| {
-        writeln!(
-            w,
-            "    MoveAbsJ j{k}, [{},500,5000,1000], fine, {tw};",
-            Mm(floor_to(opts.approach_speed_mm_s, 4))
-        )
-    };
-    // v_tcp rounded down to its 4 written decimals: never faster than planned
-    let speeddata = |mm_s: f64| format!("[{},500,5000,1000]", Mm(floor_to(mm_s, 4)));
+    let joint_speed = speeddata(opts.approach_speed_mm_s, None);
+    if program.home.is_some() {
+        writeln!(w, "    ! home")?;
+        writeln!(w, "    MoveAbsJ jHome, {joint_speed}, fine, {tw};")?;
+    }
+    let abs_j =
+        |w: &mut dyn Write, k: usize| writeln!(w, "    MoveAbsJ j{k}, {joint_speed}, fine, {tw};");
+    let mut bead = 0;
+    let mut load = 0;
     for (i, p) in program.points.iter().enumerate() {
         let k = i + 1;
         let prev = i.checked_sub(1).map(|k| &program.points[k]);
-        let mut v = speeddata(p.speed_mm_s);
-        if positioner_moves(program, i) {
+        if opens_bead(prev.map(|q| q.arc), p.arc) {
+            if let Some(s) = program.bead_setup.get(bead) {
+                if s.payload.is_some() {
+                    load += 1;
+                    writeln!(w, "    ! bead {bead} (layer {}): payload", s.layer)?;
+                    writeln!(w, "    GripLoad loadWaam{load};")?;
+                }
+                if s.dwell_s > 0.0 {
+                    writeln!(w, "    ! bead {bead} (layer {}): dwell (s)", s.layer)?;
+                    writeln!(w, "    WaitTime {};", Fixed::new(ceil_to(s.dwell_s, 3), 3))?;
+                }
+                if let Some(n) = s.wait_input {
+                    writeln!(
+                        w,
+                        "    ! bead {bead} (layer {}): interpass wait, [program] interpass_input {n} = signal {}",
+                        s.layer, opts.interpass_signal
+                    )?;
+                    writeln!(w, "    WaitDI {}, 1;", opts.interpass_signal)?;
+                }
+            }
+            bead += 1;
+        }
+        let mut v = speeddata(p.speed_mm_s, None);
+        if coordinated.is_none() && positioner_moves(program, i) {
             // the part turns under the torch: time the move (s)
             let t = segment_length_mm(program, i) / p.speed_mm_s;
             // rounded up to the ms: never faster than planned
             let t = ceil_to(t, 3).max(0.001);
-            v += &format!("\\T:={}", crate::program::fmt::Fixed::new(t, 3));
+            // and bound the positioner to its planned rate (°/s), for a
+            // controller that runs the move at weld_speed instead of \T
+            let (a, b) = (
+                p.positioner.unwrap_or([0.0; 2]),
+                prev.and_then(|q| q.positioner).unwrap_or([0.0; 2]),
+            );
+            let turn_deg = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).to_degrees();
+            let v_reax = floor_to(turn_deg / t, 4).max(1e-4);
+            v = format!(
+                "{}\\T:={}",
+                speeddata(p.speed_mm_s, Some(v_reax)),
+                Fixed::new(t, 3)
+            );
         }
+        let weld = |v: f64| format!("seamWaam, weldWaam{}", weld_of(v));
         match (&opts.process, p.arc) {
             (_, ArcFlag::Approach) => {
                 writeln!(w, "    ! bead {} (layer {}): approach", p.layer, p.layer)?;
@@ -330,34 +717,37 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             (_, ArcFlag::Start) => {
                 // into the bead: from the approach point at its speed, else
                 // a joint move to the first point
-                let v = match prev {
-                    Some(a) if a.arc == ArcFlag::Approach => speeddata(a.speed_mm_s),
+                let v_in = match prev {
+                    Some(a) if a.arc == ArcFlag::Approach => speeddata(a.speed_mm_s, None),
                     _ => {
                         writeln!(w, "    ! bead {} (layer {})", p.layer, p.layer)?;
                         abs_j(w, k)?;
                         // MoveAbsJ has reached the point: the arc start is a
                         // zero-length move, never timed
-                        speeddata(p.speed_mm_s)
+                        speeddata(p.speed_mm_s, None)
                     }
                 };
                 match &opts.process {
-                    ProcessControl::Arc { schedule } => writeln!(
+                    ProcessControl::Arc { .. } => writeln!(
                         w,
-                        "    ArcLStart p{k}, {v}, seam1, weld{schedule}, fine, {tw};"
+                        "    ArcLStart p{k}, {v_in}, {}, fine, {tw};",
+                        weld(p.speed_mm_s)
                     )?,
                     ProcessControl::Custom { start, .. } => {
-                        writeln!(w, "    MoveL p{k}, {v}, fine, {tw};")?;
+                        writeln!(w, "    MoveL p{k}, {v_in}, fine, {tw};")?;
                         writeln!(w, "    {start};")?;
                     }
                 }
             }
-            (ProcessControl::Arc { schedule }, ArcFlag::On) => writeln!(
+            (ProcessControl::Arc { .. }, ArcFlag::On) => writeln!(
                 w,
-                "    ArcL p{k}, {v}, seam1, weld{schedule}, {zone}, {tw};"
+                "    ArcL p{k}, {v}, {}, {zone}, {tw};",
+                weld(p.speed_mm_s)
             )?,
-            (ProcessControl::Arc { schedule }, ArcFlag::End) => writeln!(
+            (ProcessControl::Arc { .. }, ArcFlag::End) => writeln!(
                 w,
-                "    ArcLEnd p{k}, {v}, seam1, weld{schedule}, fine, {tw};"
+                "    ArcLEnd p{k}, {v}, {}, fine, {tw};",
+                weld(p.speed_mm_s)
             )?,
             (ProcessControl::Custom { .. }, ArcFlag::On) => {
                 writeln!(w, "    MoveL p{k}, {v}, {zone}, {tw};")?
@@ -368,8 +758,59 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             }
         }
     }
+    if program.home.is_some() {
+        writeln!(w, "    ! home")?;
+        writeln!(w, "    MoveAbsJ jHome, {joint_speed}, fine, {tw};")?;
+    }
     writeln!(w, "  ENDPROC")?;
     writeln!(w, "ENDMODULE")?;
+    Ok(())
+}
+
+/// Checks the program's home and per-bead set-up: one set-up per bead (or
+/// none), finite values, masses > 0 and dwells ≥ 0.
+fn check_setup(program: &Program) -> Result<(), ProgramError> {
+    let beads = program.num_beads();
+    let n = program.bead_setup.len();
+    if n != 0 && n != beads {
+        return Err(ProgramError::Mismatch {
+            index: n,
+            reason: format!("{n} bead set-ups for {beads} beads"),
+        });
+    }
+    for (index, s) in program.bead_setup.iter().enumerate() {
+        let bad = |field: &str| ProgramError::Mismatch {
+            index,
+            reason: format!(
+                "bead set-up {index} (layer {}): `{field}` is invalid",
+                s.layer
+            ),
+        };
+        if !(s.dwell_s.is_finite() && s.dwell_s >= 0.0) {
+            return Err(bad("dwell_s (finite, >= 0)"));
+        }
+        if let Some(p) = &s.payload {
+            if !(p.mass_kg.is_finite() && p.mass_kg > 0.0) {
+                return Err(bad("payload.mass_kg (finite, > 0)"));
+            }
+            if !p.cog_mm.iter().all(|v| v.is_finite()) {
+                return Err(bad("payload.cog_mm (finite)"));
+            }
+        }
+    }
+    if let Some(h) = &program.home {
+        let finite = h
+            .joints
+            .iter()
+            .chain(h.positioner.iter().flatten())
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err(ProgramError::Mismatch {
+                index: 0,
+                reason: "home: joints are not finite".into(),
+            });
+        }
+    }
     Ok(())
 }
 
@@ -377,10 +818,13 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
 ///
 /// # Errors
 /// [`ProgramError::InvalidOptions`] for bad options or name;
-/// [`ProgramError::VendorMismatch`] when the cell's robot is not an ABB arm.
+/// [`ProgramError::VendorMismatch`] when the cell's robot is not an ABB arm;
+/// [`ProgramError::Mismatch`] for a bead set-up list that does not fit the
+/// beads or holds non-finite values.
 pub fn abb_files(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile>, ProgramError> {
     check_vendor(&program.cell, Vendor::Abb, EMITTER)?;
     program.check_finite()?;
+    check_setup(program)?;
     opts.validate()?;
     check_name(&program.name)?;
     Ok(vec![EmittedFile {

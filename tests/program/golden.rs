@@ -218,26 +218,30 @@ fn abb_golden() {
         )
         .unwrap(),
     );
+    // torch carried, coordinated (default): the work object moves with
+    // STN1, v_tcp is the planned speed over the part, never timed
     let torch = abb_files(
         &small_in("abb_irb2600_torch_carried.toml"),
         &AbbOptions::default(),
     )
     .unwrap();
-    // layer 1: timed moves where the positioner turns, not in layer 0
+    assert!(torch[0].text.contains("[FALSE,FALSE,\"STN1\","));
     assert!(torch[0]
         .text
-        .contains("ArcL p13, [6.0000,500,5000,1000]\\T:=5.705, seam1"));
-    assert!(torch[0]
+        .contains("ArcL p13, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1"));
+    check_all("abb_torch_", &torch);
+    // not coordinated: timed moves where the positioner turns (layer 1),
+    // v_reax bounded to the planned 45 deg / 5.705 s, not in layer 0
+    let mut opts = AbbOptions::default();
+    opts.common.coordinated = false;
+    let free = abb_files(&small_in("abb_irb2600_torch_carried.toml"), &opts).unwrap();
+    assert!(free[0]
         .text
-        .contains("ArcL p3, [6.0000,500,5000,1000], seam1"));
-    check_all(
-        "abb_torch_",
-        &abb_files(
-            &small_in("abb_irb2600_torch_carried.toml"),
-            &AbbOptions::default(),
-        )
-        .unwrap(),
-    );
+        .contains("ArcL p13, [6.0000,500,5000,7.8878]\\T:=5.705, seamWaam, weldWaam1"));
+    assert!(free[0]
+        .text
+        .contains("ArcL p3, [6.0000,500,5000,1000], seamWaam, weldWaam1"));
+    check_all("abb_torch_uncoordinated_", &free);
 }
 
 /// A cell named with `§`, `°` and `·` (like the ROBOWAM cells' names)

@@ -2,12 +2,14 @@
 //! emitter, read-back and validation of our FANUC output, corrupted files,
 //! splitting at a point limit, refusal of infeasible plans.
 
+mod abb_controller;
 mod api;
 mod fixture;
 mod formats;
 mod golden;
 mod kuka_controller;
 mod parts;
+mod rapid_grammar;
 mod setup;
 #[path = "../common/mod.rs"]
 mod shared;

@@ -1,10 +1,11 @@
 //! Reader of our own ABB RAPID output (the subset
-//! [`write_mod`](crate::program::abb::write_mod) writes): the tool and work
-//! object declarations, `robtarget`s and `jointtarget`s, and the motion and
-//! process instructions of `main`. Errors name the file and line; a module
-//! without `ENDMODULE` (truncated) is an error.
+//! [`write_mod`](crate::program::abb::write_mod) writes): the declarations
+//! (`[LOCAL|TASK] PERS|CONST|VAR type name := value;`: tool, work object,
+//! `seamdata`, `welddata`, `loaddata`, `robtarget`s and `jointtarget`s), and
+//! the motion, process, wait and payload instructions of `main`. Errors name
+//! the file and line; a module without `ENDMODULE` (truncated) is an error.
 
-use crate::math::{Isometry3, Vector3};
+use crate::math::{Isometry3, Point3, Vector3};
 use crate::program::ProgramError;
 use crate::robot::orientation::rotation_from_abb_quaternion;
 
@@ -175,12 +176,65 @@ fn split_top(s: &str) -> Vec<String> {
 /// A `tooldata` or `wobjdata` declaration.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RapidFrame {
+    /// Name.
+    pub name: String,
     /// Declaration line.
     pub line: usize,
     /// `robhold`.
     pub robhold: bool,
     /// `tframe` (tool) or `uframe · oframe` (work object) (mm).
     pub pose: Isometry3,
+    /// Work object: `ufprog` (`true` for a tool).
+    pub ufprog: bool,
+    /// Work object: `ufmec`, the mechanical unit moving it, unquoted (`""`
+    /// for a tool).
+    pub ufmec: String,
+    /// Work object: `oframe` (mm; the identity for a tool).
+    pub oframe: Isometry3,
+    /// Tool: `tload` (`None` for a work object).
+    pub load: Option<RapidLoad>,
+}
+
+/// A `loaddata` value: `[mass, cog, aom, ix, iy, iz]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RapidLoad {
+    /// Mass (kg).
+    pub mass_kg: f64,
+    /// Centre of gravity (mm), in the frame RAPID defines for its use.
+    pub cog_mm: Point3,
+    /// Axes of moment (quaternion `w x y z`).
+    pub aom: [f64; 4],
+    /// Moments of inertia `ix iy iz` (kg·m²).
+    pub inertia_kg_m2: [f64; 3],
+}
+
+/// A `welddata` declaration (RobotWare 6 Arc: `[weld_speed,
+/// org_weld_speed, main_arc, org_arc]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidWeld {
+    /// Name.
+    pub name: String,
+    /// Line.
+    pub line: usize,
+    /// `weld_speed` (mm/s).
+    pub weld_speed_mm_s: f64,
+    /// `main_arc.sched`.
+    pub sched: f64,
+}
+
+/// Any declaration: storage class, type and name.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidDecl {
+    /// `PERS`, `CONST` or `VAR`.
+    pub storage: String,
+    /// `LOCAL` or `TASK` if written.
+    pub scope: Option<String>,
+    /// Data type.
+    pub ty: String,
+    /// Name.
+    pub name: String,
+    /// Line.
+    pub line: usize,
 }
 
 /// A target.
@@ -210,13 +264,26 @@ pub struct RapidTarget {
     pub external: [Option<f64>; 6],
 }
 
+/// The tool and work object arguments of a motion (`tWaam\\WObj:=wWaam`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ToolArg {
+    /// The tool.
+    pub tool: String,
+    /// The work object, if given.
+    pub wobj: Option<String>,
+}
+
 /// One instruction of `main`.
 #[derive(Debug, Clone, PartialEq)]
 pub enum RapidOp {
-    /// `MoveAbsJ target, speed, ...`.
+    /// `MoveAbsJ target, speed, zone, tool\WObj:=wobj`.
     MoveAbsJ {
         /// Target.
         target: String,
+        /// Zone (`fine`, `z1`).
+        zone: String,
+        /// Tool and work object.
+        tool: ToolArg,
     },
     /// `MoveL`, `ArcLStart`, `ArcL`, `ArcLEnd`: instruction name, target and
     /// `v_tcp` (mm/s).
@@ -227,13 +294,32 @@ pub enum RapidOp {
         target: String,
         /// `v_tcp` of the speeddata (mm/s).
         speed_mm_s: f64,
-        /// Weld data name for arc instructions (`weld1`).
+        /// `v_reax` of the speeddata (°/s).
+        v_reax_deg_s: f64,
+        /// Seam data name for arc instructions (`seamWaam`).
+        seam: Option<String>,
+        /// Weld data name for arc instructions (`weldWaam1`).
         weld: Option<String>,
         /// The move's time (s) when the speed argument carries `\T:=t`.
         time_s: Option<f64>,
+        /// Zone (`fine`, `z1`).
+        zone: String,
+        /// Tool and work object.
+        tool: ToolArg,
     },
     /// `ConfL \On` (`true`) or `\Off`.
     ConfL(bool),
+    /// `WaitTime s` (s).
+    WaitTime(f64),
+    /// `WaitDI signal, value`.
+    WaitDi {
+        /// The signal.
+        signal: String,
+        /// The awaited value (0 or 1).
+        value: u8,
+    },
+    /// `GripLoad load`.
+    GripLoad(String),
     /// Any other statement, as written without `;`.
     Other(String),
 }
@@ -254,14 +340,27 @@ pub struct RapidModule {
     pub name: String,
     /// File name (for messages).
     pub file: String,
-    /// `tWaam`.
+    /// The (last) `tooldata` declared.
     pub tool: Option<RapidFrame>,
-    /// `wWaam`.
+    /// The (last) `wobjdata` declared.
     pub wobj: Option<RapidFrame>,
     /// Targets.
     pub targets: Vec<RapidTarget>,
+    /// `welddata` declarations.
+    pub welds: Vec<RapidWeld>,
+    /// `loaddata` declarations: name, line, value.
+    pub loads: Vec<(String, usize, RapidLoad)>,
+    /// Every declaration, in order.
+    pub declarations: Vec<RapidDecl>,
     /// `main`'s instructions.
     pub instructions: Vec<RapidInstruction>,
+}
+
+impl RapidModule {
+    /// The declaration of `name`, if any.
+    pub fn declaration(&self, name: &str) -> Option<&RapidDecl> {
+        self.declarations.iter().find(|d| d.name == name)
+    }
 }
 
 /// Parses one `.mod` written by [`write_mod`](crate::program::abb::write_mod).
@@ -281,8 +380,12 @@ pub fn parse_mod(text: &str, file: &str) -> Result<RapidModule, ProgramError> {
         tool: None,
         wobj: None,
         targets: Vec::new(),
+        welds: Vec::new(),
+        loads: Vec::new(),
+        declarations: Vec::new(),
         instructions: Vec::new(),
     };
+    let mut names = std::collections::HashSet::new();
     let mut started = false;
     let mut in_main = false;
     let mut ended = false;
@@ -328,7 +431,7 @@ pub fn parse_mod(text: &str, file: &str) -> Result<RapidModule, ProgramError> {
             let op = parse_instruction(stmt).map_err(|r| err(n, r))?;
             m.instructions.push(RapidInstruction { line: n, op });
         } else {
-            parse_declaration(stmt, n, &mut m).map_err(|r| err(n, r))?;
+            parse_declaration(stmt, n, &mut m, &mut names).map_err(|r| err(n, r))?;
         }
     }
     if !ended {
@@ -341,40 +444,137 @@ pub fn parse_mod(text: &str, file: &str) -> Result<RapidModule, ProgramError> {
     Ok(m)
 }
 
-fn parse_declaration(stmt: &str, line: usize, m: &mut RapidModule) -> Result<(), String> {
+/// Components of an `arcdata` inside `seamdata` and `welddata` (RobotWare 6
+/// Arc): `[sched, mode, voltage, wirefeed, control, current, voltage2,
+/// wirefeed2, control2]`.
+const ARCDATA_LEN: usize = 9;
+
+fn arcdata(n: &Node, what: &str) -> Result<[f64; ARCDATA_LEN], String> {
+    n.nums::<ARCDATA_LEN>()
+        .map_err(|e| format!("{what}: arcdata [sched, mode, voltage, wirefeed, control, current, voltage2, wirefeed2, control2]: {e}"))
+}
+
+fn loaddata(n: &Node) -> Result<RapidLoad, String> {
+    let v = n.list()?;
+    if v.len() != 6 {
+        return Err("loaddata: expected [mass, [x,y,z], [q1,q2,q3,q4], ix, iy, iz]".into());
+    }
+    let mass_kg = v[0].num()?;
+    let c = v[1].nums::<3>()?;
+    let aom = v[2].nums::<4>()?;
+    let inertia_kg_m2 = [v[3].num()?, v[4].num()?, v[5].num()?];
+    if mass_kg < 0.0 || inertia_kg_m2.iter().any(|i| *i < 0.0) {
+        return Err("loaddata: negative mass or inertia".into());
+    }
+    Ok(RapidLoad {
+        mass_kg,
+        cog_mm: Point3::new(c[0], c[1], c[2]),
+        aom,
+        inertia_kg_m2,
+    })
+}
+
+fn parse_declaration(
+    stmt: &str,
+    line: usize,
+    m: &mut RapidModule,
+    names: &mut std::collections::HashSet<String>,
+) -> Result<(), String> {
     let (head, value) = stmt
         .split_once(":=")
         .ok_or_else(|| format!("expected a declaration `... := [...]`, got `{stmt}`"))?;
     let words: Vec<&str> = head.split_whitespace().collect();
-    let [_, ty, name] = words.as_slice() else {
-        return Err(format!("bad declaration `{head}`"));
+    let (scope, storage, ty, name) = match words.as_slice() {
+        [s @ ("LOCAL" | "TASK"), st, ty, name] => (Some(s.to_string()), *st, *ty, *name),
+        [st, ty, name] => (None, *st, *ty, *name),
+        _ => return Err(format!("bad declaration `{head}`")),
     };
+    if !matches!(storage, "PERS" | "CONST" | "VAR") {
+        return Err(format!(
+            "bad declaration `{head}`: PERS, CONST or VAR expected"
+        ));
+    }
+    if !names.insert(name.to_string()) {
+        return Err(format!("`{name}` is declared twice"));
+    }
     let v = parse_aggregate(value)?;
     let items = v.list()?;
     let ext = |n: &Node| -> Result<[Option<f64>; 6], String> {
         Ok(n.nums::<6>()?.map(|e| (e < 8.9e9).then_some(e)))
     };
-    match *ty {
+    match ty {
         "tooldata" => {
             if items.len() != 3 {
                 return Err("tooldata: expected [robhold, tframe, tload]".into());
             }
             m.tool = Some(RapidFrame {
+                name: name.to_string(),
                 line,
                 robhold: items[0].bool()?,
                 pose: items[1].pose()?,
+                ufprog: true,
+                ufmec: String::new(),
+                oframe: Isometry3::identity(),
+                load: Some(loaddata(&items[2]).map_err(|e| format!("tooldata tload: {e}"))?),
             });
         }
         "wobjdata" => {
             if items.len() != 5 {
                 return Err("wobjdata: expected [robhold, ufprog, ufmec, uframe, oframe]".into());
             }
+            let ufmec = match &items[2] {
+                Node::Atom(a) if a.len() >= 2 && a.starts_with('"') && a.ends_with('"') => {
+                    a[1..a.len() - 1].to_string()
+                }
+                _ => return Err("wobjdata: ufmec must be a string".into()),
+            };
+            let oframe = items[4].pose()?;
             m.wobj = Some(RapidFrame {
+                name: name.to_string(),
                 line,
                 robhold: items[0].bool()?,
-                pose: items[3].pose()? * items[4].pose()?,
+                pose: items[3].pose()? * oframe,
+                ufprog: items[1].bool()?,
+                ufmec,
+                oframe,
+                load: None,
             });
         }
+        "seamdata" => {
+            // RobotWare 6 Arc: 16 components, arcdata at 2, 8, 11, 14
+            if items.len() != 16 {
+                return Err(format!(
+                    "seamdata: expected 16 components (RobotWare 6 Arc), got {}",
+                    items.len()
+                ));
+            }
+            for (k, it) in items.iter().enumerate() {
+                if matches!(k, 2 | 8 | 11 | 14) {
+                    arcdata(it, "seamdata")?;
+                } else {
+                    it.num()?;
+                }
+            }
+        }
+        "welddata" => {
+            if items.len() != 4 {
+                return Err(
+                    "welddata: expected [weld_speed, org_weld_speed, main_arc, org_arc] (RobotWare 6 Arc)"
+                        .into(),
+                );
+            }
+            let weld_speed_mm_s = items[0].num()?;
+            items[1].num()?;
+            let main = arcdata(&items[2], "welddata main_arc")?;
+            arcdata(&items[3], "welddata org_arc")?;
+            m.welds.push(RapidWeld {
+                name: name.to_string(),
+                line,
+                weld_speed_mm_s,
+                sched: main[0],
+            });
+        }
+        "loaddata" => m.loads.push((name.to_string(), line, loaddata(&v)?)),
         "robtarget" => {
             if items.len() != 4 {
                 return Err("robtarget: expected [trans, rot, robconf, extax]".into());
@@ -406,7 +606,29 @@ fn parse_declaration(stmt: &str, line: usize, m: &mut RapidModule) -> Result<(),
         }
         _ => return Err(format!("unsupported type `{ty}`")),
     }
+    m.declarations.push(RapidDecl {
+        storage: storage.to_string(),
+        scope,
+        ty: ty.to_string(),
+        name: name.to_string(),
+        line,
+    });
     Ok(())
+}
+
+/// `tool\WObj:=wobj` (or `tool` alone).
+fn tool_arg(a: &str) -> Result<ToolArg, String> {
+    let (tool, wobj) = match a.split_once("\\WObj:=") {
+        Some((t, w)) => (t.trim(), Some(w.trim().to_string())),
+        None => (a.trim(), None),
+    };
+    if tool.is_empty() || wobj.as_ref().is_some_and(|w| w.is_empty()) {
+        return Err(format!("bad tool argument `{a}`"));
+    }
+    Ok(ToolArg {
+        tool: tool.to_string(),
+        wobj,
+    })
 }
 
 fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
@@ -421,13 +643,15 @@ fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
     let args = split_top(rest);
     match name {
         "MoveAbsJ" => {
-            if args.len() < 4 {
+            if args.len() != 4 {
                 return Err(format!(
                     "MoveAbsJ: expected target, speed, zone, tool: `{stmt}`"
                 ));
             }
             Ok(RapidOp::MoveAbsJ {
                 target: args[0].clone(),
+                zone: args[2].clone(),
+                tool: tool_arg(&args[3])?,
             })
         }
         "MoveL" | "ArcLStart" | "ArcL" | "ArcLEnd" => {
@@ -454,17 +678,46 @@ fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
             let speed = parse_aggregate(&speed_arg)
                 .and_then(|n| n.nums::<4>())
                 .map_err(|e| format!("{name}: speeddata: {e}"))?;
-            if !(speed[0] > 0.0) {
-                return Err(format!("{name}: v_tcp {} must be > 0", speed[0]));
+            if !(speed[0] > 0.0) || !(speed[3] > 0.0) {
+                return Err(format!(
+                    "{name}: v_tcp {} and v_reax {} must be > 0",
+                    speed[0], speed[3]
+                ));
             }
             Ok(RapidOp::Linear {
                 instruction: name.to_string(),
                 target: args[0].clone(),
                 speed_mm_s: speed[0],
+                v_reax_deg_s: speed[3],
+                seam: arc.then(|| args[2].clone()),
                 weld: arc.then(|| args[3].clone()),
                 time_s,
+                zone: args[want - 2].clone(),
+                tool: tool_arg(&args[want - 1])?,
             })
         }
+        "WaitTime" => {
+            let t: f64 = rest
+                .trim()
+                .parse()
+                .ok()
+                .filter(|t: &f64| t.is_finite() && *t >= 0.0)
+                .ok_or_else(|| format!("WaitTime: bad time `{}`", rest.trim()))?;
+            Ok(RapidOp::WaitTime(t))
+        }
+        "WaitDI" => match args.as_slice() {
+            [signal, v] if !signal.is_empty() && (v == "0" || v == "1") => Ok(RapidOp::WaitDi {
+                signal: signal.clone(),
+                value: v.parse().expect("0 or 1"),
+            }),
+            _ => Err(format!("WaitDI: expected `signal, 0|1`: `{stmt}`")),
+        },
+        "GripLoad" => match args.as_slice() {
+            [load] if !load.is_empty() && !load.contains(' ') => {
+                Ok(RapidOp::GripLoad(load.clone()))
+            }
+            _ => Err(format!("GripLoad: expected one loaddata: `{stmt}`")),
+        },
         _ => Ok(RapidOp::Other(stmt.to_string())),
     }
 }

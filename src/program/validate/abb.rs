@@ -1,11 +1,18 @@
 //! ABB modules as [`Step`]s: the module read by
 //! [`parse_mod`](crate::program::readback::abb::parse_mod), each
-//! `robtarget` decoded with its `confdata` in the file's own frames.
+//! `robtarget` decoded with its `confdata` in the file's own frames (a
+//! fixed, robot-held or positioner-coordinated work object), every
+//! identifier the module uses checked to be declared in it (or to be the
+//! controller data named in the options, or RobotWare's predefined `fine`,
+//! `z<n>`, `load0`), ArcWare's weld speed taken from the `welddata`, and
+//! `WaitTime`, `WaitDI` and `GripLoad` read as waits and payloads.
 
 use std::f64::consts::TAU;
 
-use crate::math::Point3;
+use crate::math::{Isometry3, Point3};
+use crate::program::abb::{AbbOptions, PREDEFINED_ZONES_MM};
 use crate::program::fanuc::MoveKind;
+use crate::program::readback::abb::{RapidFrame, RapidModule, ToolArg};
 use crate::program::ProcessControl;
 use crate::robot::{Cell, Configuration, Vendor};
 
@@ -26,21 +33,319 @@ fn abb_quadrant(q: f64, cf: i32) -> Option<f64> {
     (v >= lo - 1e-6 && v <= lo + quarter + 1e-6).then_some(v)
 }
 
+/// The frames of the file: its tool and work object.
+#[derive(Debug, Clone, Copy)]
+enum FileFrames {
+    /// Robot-held tool over a fixed work object.
+    Held {
+        flange_from_tool: Isometry3,
+        base_from_work: Isometry3,
+    },
+    /// Robot-held tool over a work object moved by the positioner: the
+    /// object frame is `base_from_positioner · positioner_from_table(q) ·
+    /// oframe` at the positioner's joints `q`.
+    Coordinated {
+        flange_from_tool: Isometry3,
+        oframe: Isometry3,
+    },
+    /// Stationary tool, robot-held work object.
+    Stationary {
+        base_from_tool: Isometry3,
+        flange_from_work: Isometry3,
+    },
+}
+
+impl FileFrames {
+    /// `tooldata`/`wobjdata` as a [`crate::program::frames::ToolFrames`] at
+    /// positioner joints `qp` (`None` when a coordinated work object has
+    /// no positioner joints or no positioner).
+    fn at(&self, cell: &Cell, qp: Option<[f64; 2]>) -> Option<crate::program::abb::AbbFrames> {
+        use crate::program::abb::AbbFrames;
+        Some(match *self {
+            FileFrames::Held {
+                flange_from_tool,
+                base_from_work,
+            } => AbbFrames::Held {
+                flange_from_tool,
+                base_from_work,
+            },
+            FileFrames::Coordinated {
+                flange_from_tool,
+                oframe,
+            } => {
+                let Cell::TorchCarried(c) = cell else {
+                    return None;
+                };
+                AbbFrames::Held {
+                    flange_from_tool,
+                    base_from_work: c.base_from_positioner
+                        * c.positioner.positioner_from_table(&qp?)
+                        * oframe,
+                }
+            }
+            FileFrames::Stationary {
+                base_from_tool,
+                flange_from_work,
+            } => AbbFrames::Stationary {
+                base_from_tool,
+                flange_from_work,
+            },
+        })
+    }
+
+    /// The flange frame from the frame a payload's centre of gravity is
+    /// written in (RAPID `loaddata.cog`: the tool frame, or the object frame
+    /// of a robot-held work object).
+    fn flange_from_payload_frame(&self) -> Isometry3 {
+        match *self {
+            FileFrames::Held {
+                flange_from_tool, ..
+            }
+            | FileFrames::Coordinated {
+                flange_from_tool, ..
+            } => flange_from_tool,
+            FileFrames::Stationary {
+                flange_from_work, ..
+            } => flange_from_work,
+        }
+    }
+}
+
+/// The file's frames from its `tooldata` and `wobjdata`, with problems
+/// pushed for a combination the controller or the cell cannot run, and for
+/// a coordination that differs from the options.
+fn file_frames(
+    module: &RapidModule,
+    cell: &Cell,
+    opts: &AbbOptions,
+    report: &mut ValidationReport,
+) -> Option<FileFrames> {
+    let file = &module.file;
+    let (Some(t), Some(w)) = (&module.tool, &module.wobj) else {
+        push(
+            report,
+            ProblemKind::Declaration,
+            file,
+            1,
+            "no `tooldata` or `wobjdata` declaration".into(),
+        );
+        return None;
+    };
+    let frames = match (t.robhold, w.robhold, w.ufprog) {
+        (true, false, true) => FileFrames::Held {
+            flange_from_tool: t.pose,
+            base_from_work: w.pose,
+        },
+        (true, false, false) => {
+            if !matches!(cell, Cell::TorchCarried(_)) {
+                push(
+                    report,
+                    ProblemKind::Frame,
+                    file,
+                    w.line,
+                    format!(
+                        "{}: moved by mechanical unit \"{}\" (ufprog FALSE), but the cell has no positioner",
+                        w.name, w.ufmec
+                    ),
+                );
+                return None;
+            }
+            if w.ufmec != opts.ufmec {
+                push(
+                    report,
+                    ProblemKind::Options,
+                    file,
+                    w.line,
+                    format!(
+                        "{}: ufmec \"{}\", the options give \"{}\"",
+                        w.name, w.ufmec, opts.ufmec
+                    ),
+                );
+            }
+            FileFrames::Coordinated {
+                flange_from_tool: t.pose,
+                oframe: w.oframe,
+            }
+        }
+        (false, true, true) => FileFrames::Stationary {
+            base_from_tool: t.pose,
+            flange_from_work: w.pose,
+        },
+        (false, true, false) => {
+            push(
+                report,
+                ProblemKind::Frame,
+                file,
+                w.line,
+                format!(
+                    "{}: a robot-held work object cannot be moved by another unit (ufprog FALSE)",
+                    w.name
+                ),
+            );
+            return None;
+        }
+        _ => {
+            push(
+                report,
+                ProblemKind::Declaration,
+                file,
+                t.line,
+                format!(
+                    "{} and {}: exactly one of them must be held by the robot",
+                    t.name, w.name
+                ),
+            );
+            return None;
+        }
+    };
+    let coordinated = matches!(frames, FileFrames::Coordinated { .. });
+    let want = opts.coordinated(cell) && !matches!(frames, FileFrames::Stationary { .. });
+    if coordinated != want {
+        push(
+            report,
+            ProblemKind::Options,
+            file,
+            w.line,
+            format!(
+                "{}: {} the positioner, the options say coordinated = {}",
+                w.name,
+                if coordinated {
+                    "coordinated with"
+                } else {
+                    "not coordinated with"
+                },
+                opts.common.coordinated
+            ),
+        );
+    }
+    if t.robhold && t.load.is_some_and(|l| l.mass_kg <= 0.0) {
+        push(
+            report,
+            ProblemKind::Declaration,
+            file,
+            t.line,
+            format!(
+                "{}: a robot-held tool needs its load (tload mass > 0 kg)",
+                t.name
+            ),
+        );
+    }
+    Some(frames)
+}
+
+/// The module's declarations by name.
+type Decls<'a> = std::collections::HashMap<&'a str, &'a crate::program::readback::abb::RapidDecl>;
+
+/// Pushes a Declaration problem unless `name` is declared with type `ty`
+/// (or `predefined`); `true` when it is.
+fn check_declared(
+    module: &RapidModule,
+    decls: &Decls,
+    name: &str,
+    ty: &str,
+    predefined: bool,
+    line: usize,
+    report: &mut ValidationReport,
+) -> bool {
+    if predefined {
+        return true;
+    }
+    match decls.get(name) {
+        Some(d) if d.ty == ty => true,
+        Some(d) => {
+            push(
+                report,
+                ProblemKind::Declaration,
+                &module.file,
+                line,
+                format!("{name} is a {} (line {}), not a {ty}", d.ty, d.line),
+            );
+            false
+        }
+        None => {
+            push(
+                report,
+                ProblemKind::Declaration,
+                &module.file,
+                line,
+                format!("{ty} {name} is not declared in the module"),
+            );
+            false
+        }
+    }
+}
+
+/// Checks a motion's zone, tool and work object identifiers.
+fn check_motion_args(
+    module: &RapidModule,
+    decls: &Decls,
+    zone: &str,
+    tool: &ToolArg,
+    line: usize,
+    report: &mut ValidationReport,
+) {
+    let predefined_zone = zone == "fine"
+        || zone
+            .strip_prefix('z')
+            .and_then(|n| n.parse::<u32>().ok())
+            .is_some_and(|n| PREDEFINED_ZONES_MM.contains(&n));
+    check_declared(
+        module,
+        decls,
+        zone,
+        "zonedata",
+        predefined_zone,
+        line,
+        report,
+    );
+    check_declared(module, decls, &tool.tool, "tooldata", false, line, report);
+    let frame_of = |f: &Option<RapidFrame>| f.as_ref().map(|f| f.name.clone());
+    if frame_of(&module.tool).as_deref() != Some(tool.tool.as_str())
+        && decls.contains_key(tool.tool.as_str())
+    {
+        push(
+            report,
+            ProblemKind::Frame,
+            &module.file,
+            line,
+            format!("tool {} is not the module's tool", tool.tool),
+        );
+    }
+    match &tool.wobj {
+        Some(w) => {
+            check_declared(module, decls, w, "wobjdata", false, line, report);
+        }
+        None => push(
+            report,
+            ProblemKind::Frame,
+            &module.file,
+            line,
+            "motion without \\WObj: the controller would use wobj0, not the module's work object"
+                .into(),
+        ),
+    }
+}
+
 /// Validates an ABB module read by
 /// [`parse_mod`](crate::program::readback::abb::parse_mod) against `cell`
-/// with the process of `opts`; the frames are the file's own `tWaam` and
-/// `wWaam` (held or stationary tool). `robtarget`s are decoded with their
-/// `confdata`: `cfx` gives the branch (checked against the cell's), `cf1`,
-/// `cf4`, `cf6` the quadrant of J1, J4, J6 (`ConfL \On` makes the controller
-/// keep them on linear moves). A cell whose robot is not an ABB arm is
-/// refused: the report holds that one problem (line 1 of the module).
+/// with the options `opts`; the frames are the file's own `tooldata` and
+/// `wobjdata` (held, coordinated with the positioner, or stationary tool).
+/// `robtarget`s are decoded with their `confdata`: `cfx` gives the branch
+/// (checked against the cell's), `cf1`, `cf4`, `cf6` the quadrant of J1,
+/// J4, J6 (`ConfL \On` makes the controller keep them on linear moves).
+/// Arc-on moves run at their `welddata`'s `weld_speed` (checked equal to
+/// the `speeddata`'s `v_tcp`); timed moves (`\T`) must not let the
+/// positioner outrun the time at their `v_reax`. `WaitTime` becomes a
+/// [`Step::Wait`] with seconds, `WaitDI <interpass_signal>, 1` one with
+/// `[program] interpass_input`, `GripLoad` a [`Step::Payload`] (centre of
+/// gravity back in the flange frame). A cell whose robot is not an ABB arm
+/// is refused: the report holds that one problem (line 1 of the module).
 pub fn validate_abb(
-    module: &crate::program::readback::abb::RapidModule,
+    module: &RapidModule,
     cell: &Cell,
-    opts: &crate::program::abb::AbbOptions,
+    opts: &AbbOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
-    use crate::program::abb::AbbFrames;
     use crate::program::readback::abb::{RapidOp, RapidTargetValue};
     let mut report = ValidationReport::default();
     if !vendor_matches(
@@ -61,49 +366,96 @@ pub fn validate_abb(
         }
     };
     let robot = cell.robot();
-    let frames = match (&module.tool, &module.wobj) {
-        (Some(t), Some(w)) => match (t.robhold, w.robhold) {
-            (true, false) => Some(AbbFrames::Held {
-                flange_from_tool: t.pose,
-                base_from_work: w.pose,
-            }),
-            (false, true) => Some(AbbFrames::Stationary {
-                base_from_tool: t.pose,
-                flange_from_work: w.pose,
-            }),
-            _ => {
-                push(
-                    &mut report,
-                    ProblemKind::Declaration,
-                    file,
-                    t.line,
-                    "tWaam and wWaam: exactly one of them must be held by the robot".into(),
-                );
-                None
-            }
-        },
-        _ => {
-            push(
-                &mut report,
-                ProblemKind::Declaration,
-                file,
-                1,
-                "no `tooldata tWaam` or `wobjdata wWaam` declaration".into(),
-            );
-            None
-        }
-    };
-    let (start, end) = match &opts.process {
-        ProcessControl::Arc { schedule } => (None, Some(format!("weld{schedule}"))),
+    let frames = file_frames(module, cell, opts, &mut report);
+    let decls: Decls = module
+        .declarations
+        .iter()
+        .map(|d| (d.name.as_str(), d))
+        .collect();
+    let targets: std::collections::HashMap<&str, _> = module
+        .targets
+        .iter()
+        .map(|t| (t.name.as_str(), t))
+        .collect();
+    let (start, schedule) = match &opts.process {
+        ProcessControl::Arc { schedule } => (None, Some(*schedule)),
         ProcessControl::Custom { start, end } => (Some((start.clone(), end.clone())), None),
     };
     let mut steps = Vec::new();
     let mut conf_l = false;
+    let mut prev_positioner: Option<[f64; 2]> = None;
     for ins in &module.instructions {
         let line = ins.line;
-        let (target, speed, kind, event) = match &ins.op {
+        let wait = |seconds, input| Step::Wait {
+            file: file.clone(),
+            line,
+            seconds,
+            input,
+        };
+        let (target, speed, kind, event, v_reax_time) = match &ins.op {
             RapidOp::ConfL(on) => {
                 conf_l = *on;
+                continue;
+            }
+            RapidOp::WaitTime(t) => {
+                steps.push(wait(Some(*t), None));
+                continue;
+            }
+            RapidOp::WaitDi { signal, value } => {
+                if *signal != opts.interpass_signal {
+                    push(
+                        &mut report,
+                        ProblemKind::Declaration,
+                        file,
+                        line,
+                        format!(
+                            "signal {signal} is neither declared in the module nor the options' controller signal (interpass_signal = {})",
+                            opts.interpass_signal
+                        ),
+                    );
+                } else if *value != 1 {
+                    push(
+                        &mut report,
+                        ProblemKind::Instruction,
+                        file,
+                        line,
+                        format!("WaitDI {signal}, {value}: the interpass wait waits for 1"),
+                    );
+                } else {
+                    match opts.common.interpass_input {
+                        Some(n) => steps.push(wait(None, Some(n))),
+                        None => push(
+                            &mut report,
+                            ProblemKind::Options,
+                            file,
+                            line,
+                            format!("WaitDI {signal}: the options have no interpass_input"),
+                        ),
+                    }
+                }
+                continue;
+            }
+            RapidOp::GripLoad(name) => {
+                let load = if name == "load0" {
+                    Some(crate::program::abb::LOAD0).map(|l| (l.mass_kg, Point3::from(l.cog_mm)))
+                } else if check_declared(module, &decls, name, "loaddata", false, line, &mut report)
+                {
+                    module
+                        .loads
+                        .iter()
+                        .find(|(n, _, _)| n == name)
+                        .map(|(_, _, l)| (l.mass_kg, l.cog_mm))
+                } else {
+                    None
+                };
+                if let (Some((mass_kg, cog)), Some(f)) = (load, &frames) {
+                    steps.push(Step::Payload {
+                        file: file.clone(),
+                        line,
+                        mass_kg,
+                        cog_mm: f.flange_from_payload_frame() * cog,
+                    });
+                }
                 continue;
             }
             RapidOp::Other(s) => {
@@ -126,53 +478,110 @@ pub fn validate_abb(
                 }
                 continue;
             }
-            RapidOp::MoveAbsJ { target } => (target, MotionSpeed::Joint, MoveKind::Joint, None),
+            RapidOp::MoveAbsJ { target, zone, tool } => {
+                check_motion_args(module, &decls, zone, tool, line, &mut report);
+                (target, None, MoveKind::Joint, None, None)
+            }
             RapidOp::Linear {
                 instruction,
                 target,
                 speed_mm_s,
+                v_reax_deg_s,
+                seam,
                 weld,
                 time_s,
+                zone,
+                tool,
             } => {
+                check_motion_args(module, &decls, zone, tool, line, &mut report);
                 let arc = instruction != "MoveL";
-                if arc && (start.is_some() || weld.as_ref() != end.as_ref()) {
-                    push(
-                        &mut report,
-                        ProblemKind::Options,
-                        file,
-                        line,
-                        format!(
-                            "{instruction} with `{}`: the options give {}",
-                            weld.clone().unwrap_or_default(),
-                            end.clone().unwrap_or_else(|| "a custom process".into())
-                        ),
-                    );
+                let mut v = *speed_mm_s;
+                if arc {
+                    if start.is_some() {
+                        push(
+                            &mut report,
+                            ProblemKind::Options,
+                            file,
+                            line,
+                            format!("{instruction}: the options give a custom process"),
+                        );
+                    }
+                    if let Some(s) = seam {
+                        check_declared(module, &decls, s, "seamdata", false, line, &mut report);
+                    }
+                    let wd = weld.as_deref().unwrap_or("");
+                    if check_declared(module, &decls, wd, "welddata", false, line, &mut report) {
+                        let d = module.welds.iter().find(|d| d.name == wd);
+                        if let (Some(d), Some(sched)) = (d, schedule) {
+                            if d.sched != sched as f64 {
+                                push(
+                                    &mut report,
+                                    ProblemKind::Options,
+                                    file,
+                                    line,
+                                    format!(
+                                        "{instruction} with {wd}: schedule {} (main_arc.sched, line {}), the options give {sched}",
+                                        d.sched, d.line
+                                    ),
+                                );
+                            }
+                        }
+                        // ArcWare runs arc-on moves at weld_speed
+                        if let (Some(d), true) = (d, instruction != "ArcLStart") {
+                            if (d.weld_speed_mm_s - v).abs() > 1e-9 {
+                                push(
+                                    &mut report,
+                                    ProblemKind::Timing,
+                                    file,
+                                    line,
+                                    format!(
+                                        "{instruction}: {wd}.weld_speed {} mm/s (line {}) differs from the speeddata's v_tcp {v} mm/s",
+                                        d.weld_speed_mm_s, d.line
+                                    ),
+                                );
+                            }
+                            v = d.weld_speed_mm_s;
+                        }
+                    }
                 }
                 let event = match instruction.as_str() {
                     "ArcLStart" => Some(true),
                     "ArcLEnd" => Some(false),
                     _ => None,
                 };
+                let speed = match (time_s, &frames) {
+                    (Some(t), _) => MotionSpeed::Time(*t),
+                    // v_tcp is the speed of the robot-held tool in the world
+                    (
+                        None,
+                        Some(FileFrames::Held {
+                            flange_from_tool, ..
+                        }),
+                    ) => MotionSpeed::Tcp {
+                        mm_s: v,
+                        flange_from_tcp: *flange_from_tool,
+                        extax_fraction: match cell {
+                            Cell::TorchCarried(c) => [0, 1].map(|n| {
+                                let max = c.positioner.max_speed_rad_s[n];
+                                if max.is_finite() && max > 0.0 {
+                                    (v_reax_deg_s.to_radians() / max).min(1.0)
+                                } else {
+                                    1.0
+                                }
+                            }),
+                            Cell::PartCarried(_) => [1.0; 2],
+                        },
+                    },
+                    // a stationary tool or a coordinated work object: v_tcp
+                    // is the torch's speed over the part
+                    (None, _) => MotionSpeed::Linear(v),
+                };
                 (
                     target,
-                    match (time_s, &frames) {
-                        (Some(t), _) => MotionSpeed::Time(*t),
-                        // v_tcp is the speed of the robot-held tool
-                        (
-                            None,
-                            Some(AbbFrames::Held {
-                                flange_from_tool, ..
-                            }),
-                        ) => MotionSpeed::Tcp {
-                            mm_s: *speed_mm_s,
-                            flange_from_tcp: *flange_from_tool,
-                            extax_fraction: [1.0; 2],
-                        },
-                        // a stationary tool: v_tcp is its speed over the work object
-                        (None, _) => MotionSpeed::Linear(*speed_mm_s),
-                    },
+                    Some(speed),
                     MoveKind::Linear,
                     event,
+                    time_s.map(|t| (t, *v_reax_deg_s)),
                 )
             }
         };
@@ -186,7 +595,7 @@ pub fn validate_abb(
                     .into(),
             );
         }
-        let Some(t) = module.targets.iter().find(|t| &t.name == target) else {
+        let Some(t) = targets.get(target.as_str()).copied() else {
             push(
                 &mut report,
                 ProblemKind::Declaration,
@@ -194,8 +603,32 @@ pub fn validate_abb(
                 line,
                 format!("{target} is not declared"),
             );
+            prev_positioner = None;
             continue;
         };
+        let positioner = match (t.external[slots[0]], t.external[slots[1]]) {
+            (Some(a), Some(b)) => Some([a.to_radians(), b.to_radians()]),
+            _ => None,
+        };
+        if let (Some((time, v_reax)), Some(a), Some(b)) = (v_reax_time, positioner, prev_positioner)
+        {
+            // a controller running the move at weld_speed instead of \T
+            // is held back by v_reax only
+            let turn = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).to_degrees();
+            if turn / v_reax < time - 1e-3 {
+                push(
+                    &mut report,
+                    ProblemKind::Timing,
+                    file,
+                    line,
+                    format!(
+                        "v_reax {v_reax} deg/s lets the positioner turn {turn:.4} deg in {:.3} s, less than the \\T time {time} s",
+                        turn / v_reax
+                    ),
+                );
+            }
+        }
+        prev_positioner = positioner;
         let (joints, from_cartesian) = match (&t.value, kind) {
             (RapidTargetValue::Joint(a), MoveKind::Joint) => (Some(a.map(f64::to_radians)), false),
             (RapidTargetValue::Rob { pose, conf }, MoveKind::Linear) => {
@@ -220,7 +653,23 @@ pub fn validate_abb(
                         ),
                     );
                 }
-                let q = frames.and_then(|f| {
+                let f = frames.and_then(|f| {
+                    let at = f.at(cell, positioner);
+                    if at.is_none() {
+                        push(
+                            &mut report,
+                            ProblemKind::Format,
+                            file,
+                            t.line,
+                            format!(
+                                "{}: no positioner values for the coordinated work object",
+                                t.name
+                            ),
+                        );
+                    }
+                    at
+                });
+                let q = f.and_then(|f| {
                     decode_pose(
                         robot,
                         &f.flange(pose),
@@ -261,12 +710,9 @@ pub fn validate_abb(
             value_lines: [t.line; 6],
             joints,
             from_cartesian,
-            positioner: match (t.external[slots[0]], t.external[slots[1]]) {
-                (Some(a), Some(b)) => Some([a.to_radians(), b.to_radians()]),
-                _ => None,
-            },
+            positioner,
             kind,
-            speed,
+            speed: speed.unwrap_or(MotionSpeed::Joint),
         })));
         match event {
             Some(true) => steps.push(Step::ProcessOn {

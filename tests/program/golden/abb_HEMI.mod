@@ -1,8 +1,12 @@
 MODULE HEMI
   ! waam-slicer: ABB IRB 2600 part carried (example layout), 20 points, 2 beads
   ! stationary torch (tWaam), part held by the robot (wWaam): speeds are the torch's over the part
-  PERS tooldata tWaam := [FALSE,[[1000.0000,0.0000,900.0000],[0.0000000,1.0000000,0.0000000,0.0000000]],[1,[0,0,1],[1,0,0,0],0,0,0]];
+  ! tWaam.tload: load0: set [program] payload_base_kg or payload_every_layers for the part the robot holds
+  PERS tooldata tWaam := [FALSE,[[1000.0000,0.0000,900.0000],[0.0000000,1.0000000,0.0000000,0.0000000]],[0.0010,[0.0000,0.0000,0.0010],[1,0,0,0],0.000000,0.000000,0.000000]];
   PERS wobjdata wWaam := [TRUE,TRUE,"",[[0.0000,0.0000,0.0000],[0.7071068,0.0000000,-0.7071068,0.0000000]],[[0,0,0],[1,0,0,0]]];
+  ! ArcWare data (RobotWare 6 Arc): process schedule 1 (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s)
+  LOCAL PERS seamdata seamWaam := [0,0,[1,0,0,0,0,0,0,0,0],0,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],0];
+  LOCAL PERS welddata weldWaam1 := [6.0000,0,[1,0,0,0,0,0,0,0,0],[0,0,0,0,0,0,0,0,0]];
   CONST robtarget p1 := [[45.0000,0.0000,20.0000],[0.0000000,1.0000000,0.0000000,0.0000000],[0,0,0,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
   CONST jointtarget j1 := [[0.00000,4.04064,39.36673,0.00000,-43.40737,0.00000],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
   CONST robtarget p2 := [[45.0000,0.0000,0.0000],[0.0000000,1.0000000,0.0000000,0.0000000],[0,0,0,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
@@ -29,25 +33,25 @@ MODULE HEMI
     ConfL \On;
     ! bead 0 (layer 0): approach
     MoveAbsJ j1, [100.0000,500,5000,1000], fine, tWaam\WObj:=wWaam;
-    ArcLStart p2, [20.0000,500,5000,1000], seam1, weld1, fine, tWaam\WObj:=wWaam;
-    ArcL p3, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p4, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p5, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p6, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p7, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p8, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcLEnd p9, [6.0000,500,5000,1000], seam1, weld1, fine, tWaam\WObj:=wWaam;
+    ArcLStart p2, [20.0000,500,5000,1000], seamWaam, weldWaam1, fine, tWaam\WObj:=wWaam;
+    ArcL p3, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p4, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p5, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p6, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p7, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p8, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcLEnd p9, [6.0000,500,5000,1000], seamWaam, weldWaam1, fine, tWaam\WObj:=wWaam;
     MoveL p10, [20.0000,500,5000,1000], fine, tWaam\WObj:=wWaam;
     ! bead 1 (layer 1): approach
     MoveAbsJ j11, [100.0000,500,5000,1000], fine, tWaam\WObj:=wWaam;
-    ArcLStart p12, [20.0000,500,5000,1000], seam1, weld1, fine, tWaam\WObj:=wWaam;
-    ArcL p13, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p14, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p15, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p16, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p17, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcL p18, [6.0000,500,5000,1000], seam1, weld1, z1, tWaam\WObj:=wWaam;
-    ArcLEnd p19, [6.0000,500,5000,1000], seam1, weld1, fine, tWaam\WObj:=wWaam;
+    ArcLStart p12, [20.0000,500,5000,1000], seamWaam, weldWaam1, fine, tWaam\WObj:=wWaam;
+    ArcL p13, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p14, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p15, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p16, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p17, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p18, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcLEnd p19, [6.0000,500,5000,1000], seamWaam, weldWaam1, fine, tWaam\WObj:=wWaam;
     MoveL p20, [20.0000,500,5000,1000], fine, tWaam\WObj:=wWaam;
   ENDPROC
 ENDMODULE
