@@ -36,32 +36,73 @@
 //!
 //! **What the speed means.** The planned speed is the travel speed of the
 //! deposition point relative to the part (what the plan and the validator
-//! use). In the torch-carried cell with the torch as tool frame that is the
-//! controller's TCP speed, and linear moves carry it in `mm/sec` or `cm/min`.
-//! In the part-carried cell the controller's TCP (the flange, or the part
-//! frame on it) is not the point that must travel at that speed: the fixed
-//! torch is, relative to the part, while the flange mostly turns. A `mm/sec`
-//! speed would be applied to the wrong point (and a turn of the part about
-//! the torch would run at the controller's rotation speed limit). FANUC's
-//! remote-TCP motion (the `RTCP` motion option, a paid software option whose
-//! position data are written differently) would fix the reference point;
-//! instead, by default ([`MotionTiming::Auto`]), linear moves in the
-//! part-carried cell are **time-based**: `L P[n] 167msec CNT100`, the time
-//! being the segment's length in the part frame divided by the planned
-//! speed. This needs no option, keeps the positions as they are, and makes
-//! every segment take exactly the planned time (1 ms resolution), so the
-//! torch travels over the part at the planned speed on average over each
-//! segment (exactly at the points; between them the controller interpolates
-//! the flange pose, which for the short segments of a bead keeps the
-//! deposition point within a fraction of a millimetre of the chord).
+//! use). In the torch-carried cell with the torch as tool frame and the
+//! positioner still that is the controller's TCP speed. Where the part
+//! moves it is not, and the file says how it is kept:
 //!
-//! The same holds in the torch-carried cell on a segment where the
-//! positioner turns: the part moves under the torch, the TCP's travel in
-//! the robot frame is not the deposition point's travel over the part (the
-//! TCP may be nearly still while the part turns 45°), and a TCP speed would
-//! be wrong. [`MotionTiming::Auto`] writes every such segment time-based
-//! (segment length in the part frame / planned speed) and keeps `mm/sec`
-//! or `cm/min` where the positioner is still.
+//! * **Torch-carried cell, coordinated** (`common.coordinated`, default):
+//!   every linear move carries the `COORD` motion option, the positioner
+//!   (group 2) being the leader of a coordinated pair on the controller.
+//!   FANUC: "multiple motion groups move together to maintain the same
+//!   position relative to each other. Motion speed which is specified in
+//!   the line is relative speed for coordinated motion" (TP help, Motion
+//!   Options 6.5): the speed is the torch's over the part on the
+//!   positioner, the planned travel speed, also where the positioner turns
+//!   45° under a nearly still torch. Positions are unchanged (robot joints
+//!   plus the positioner's). Joint moves carry no `COORD` (it acts on
+//!   linear and circular moves).
+//! * **Part-carried cell without remote TCP** (default) and the
+//!   torch-carried cell without coordination: linear moves are
+//!   **time-based** ([`MotionTiming::Auto`]): `L P[n] 5741msec CNT100`,
+//!   the segment's length in the part frame divided by the planned speed,
+//!   rounded up to the millisecond (in the torch-carried cell only where
+//!   the positioner turns). This needs no option and makes every segment
+//!   take exactly the planned time; between the points the controller
+//!   interpolates the flange pose, which for the short segments of a bead
+//!   keeps the deposition point within a fraction of a millimetre of the
+//!   chord.
+//! * **Part-carried cell with remote TCP** (`common.remote_tcp`, off in
+//!   [`FanucOptions::default`]): every linear move carries `RTCP`, the user
+//!   frame being the remote TCP frame at the fixed torch
+//!   ([`FanucOptions::remote_tcp_frame`], [`FanucOptions::base_from_torch`]),
+//!   and `CONTROL_CODE = 00000001 00000000`, as a controller writes a
+//!   program with `RTCP` moves. FANUC: "In a motion instruction that
+//!   includes RTCP, the speed specified is the relative speed between the
+//!   workpiece and the tool" — the planned travel speed. Remote TCP is a
+//!   paid option, disabled on a controller with Coordinated Motion loaded,
+//!   and not supported with weaving or multi-group programs. Positions must
+//!   be joints: a controller writes the Cartesian positions of an RTCP
+//!   program as `RX RY RZ RW RP RR`, a representation FANUC does not
+//!   document (a post-processor author reports failing to reproduce it);
+//!   Cartesian positions with remote TCP are refused. That is why it is
+//!   off by default.
+//!
+//! Where a speed relative to the part (`COORD`, `RTCP`) would put a joint
+//! above [`JOINT_SPEED_MARGIN`] of its maximum, the segment is written
+//! time-based instead (rounded up), so that the positions' rounding cannot
+//! push it over.
+//!
+//! **Frames.** Each program opens with remarks stating the user and tool
+//! frames its positions assume, in FANUC `X,Y,Z,W,P,R` (mm, deg): `!
+//! UF1 X,Y=1045.747,-630.155`, `! UF1 Z,W=653.167,180.000`, `! UF1
+//! P,R=0.000,0.000`, the same for `UT`, then `UFRAME_NUM`/`UTOOL_NUM`
+//! ([`FanucOptions::frames`]): UFRAME 0 (world) or [`FanucOptions::user_frame`]
+//! with [`FanucOptions::base_from_user`], or the remote TCP frame; UTOOL
+//! [`FanucOptions::tool_frame`] = the torch (torch-carried cell) or the
+//! flange (part-carried cell) unless [`FanucOptions::flange_from_tool`]
+//! says otherwise. The program does not write the frames (that would
+//! overwrite what was taught on the controller); the validator checks the
+//! statements against the options and the cell.
+//!
+//! **Arc, home, set-up.** `/APPL` has `ARC : TRUE ;` and `ARC Welding
+//! Equipment` as an ArcTool program exported by a controller; beads start
+//! and stop with `Arc Start[s]`/`Arc End[s]` or, with
+//! [`FanucOptions::weld_procedure`], `Weld Start[p,s]`/`Weld End[p,s]`.
+//! With a home position the first and last motions are `J` moves to it.
+//! Before each bead: payload (`$PLST_GRP1[n].$PAYLOAD` kg,
+//! `$PAYLOAD_X/_Y/_Z` cm in the faceplate frame, then `PAYLOAD[n]`; the
+//! schedule's inertia is left as set on the controller), dwell (`WAIT
+//! 30.00(sec)`), interpass wait (`WAIT DI[n]=ON`).
 
 use std::io::Write;
 

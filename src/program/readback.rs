@@ -3,11 +3,13 @@
 //! [SPEC §8]. Errors name the file and line; a file without `/END`
 //! (truncated) is an error.
 //!
-//! KUKA and ABB output are read by [`kuka`] and [`abb`].
+//! KUKA and ABB output are read by [`kuka`] and [`abb`]; [`fanuc`] turns
+//! the TP programs into the validator's steps.
 //!
 //! [`write_ls`]: crate::program::fanuc::write_ls
 
 pub mod abb;
+pub mod fanuc;
 pub mod kuka;
 
 use crate::program::fanuc::{

@@ -3,6 +3,7 @@
 //! splitting at a point limit, refusal of infeasible plans.
 
 mod api;
+mod fanuc_controller;
 mod fixture;
 mod formats;
 mod golden;
