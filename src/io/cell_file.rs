@@ -23,6 +23,7 @@ use std::path::Path;
 use serde::Deserialize;
 
 use crate::math::{Isometry3, Point3};
+use crate::program::{ProgramOptions, ProgramSettings};
 use crate::robot::orientation::FanucPose;
 use crate::robot::{
     ArmGeometry, Cell, Configuration, JointConvention, JointLimit, PartCarriedCell, Positioner,
@@ -90,6 +91,10 @@ pub struct CellFile {
     pub cell: Option<Cell>,
     /// The `[placement]` table: bounds for `waam place`, if given.
     pub placement: Option<PlacementSpec>,
+    /// The `[program]` table (home, dwell, interpass wait, payload, transit,
+    /// coordination, and `[program.fanuc]`, `[program.kuka]`,
+    /// `[program.abb]`): defaults where absent.
+    pub program: ProgramSettings,
 }
 
 /// The `[placement]` table of a cell file: the bounds of the placement
@@ -132,6 +137,7 @@ struct FileDoc {
     part_carried: Option<PartCarriedSection>,
     torch_carried: Option<TorchCarriedSection>,
     placement: Option<PlacementSpec>,
+    program: Option<toml::Table>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -405,11 +411,106 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
             ));
         }
     }
+    let program = match doc.program {
+        Some(t) => program_settings(origin, t, cell.as_ref())?,
+        None => ProgramSettings::default(),
+    };
     Ok(CellFile {
         name: doc.name,
         source: doc.source,
         robot,
         cell,
         placement: doc.placement,
+        program,
+    })
+}
+
+/// The `[program]` table: its vendor sub-tables (`fanuc`, `kuka`, `abb`)
+/// are each vendor's emitter options, the rest the vendor-independent
+/// [`ProgramOptions`]; unknown keys are errors, and the home position must
+/// lie inside the cell's joint travel.
+fn program_settings(
+    path: &str,
+    mut table: toml::Table,
+    cell: Option<&Cell>,
+) -> Result<ProgramSettings, CellFileError> {
+    fn sub<T: serde::de::DeserializeOwned + Default>(
+        path: &str,
+        table: &mut toml::Table,
+        key: &str,
+    ) -> Result<T, CellFileError> {
+        match table.remove(key) {
+            None => Ok(T::default()),
+            Some(v) => v
+                .try_into()
+                .map_err(|e: toml::de::Error| CellFileError::Syntax {
+                    path: path.to_string(),
+                    message: format!("[program.{key}]: {}", e.message()),
+                }),
+        }
+    }
+    let fanuc: crate::program::fanuc::FanucOptions = sub(path, &mut table, "fanuc")?;
+    let kuka: crate::program::kuka::KukaOptions = sub(path, &mut table, "kuka")?;
+    let abb: crate::program::abb::AbbOptions = sub(path, &mut table, "abb")?;
+    let common: ProgramOptions =
+        toml::Value::Table(table)
+            .try_into()
+            .map_err(|e: toml::de::Error| CellFileError::Syntax {
+                path: path.to_string(),
+                message: format!("[program]: {}", e.message()),
+            })?;
+    let invalid = |e: crate::program::ProgramError| {
+        let (key, reason) = match &e {
+            crate::program::ProgramError::InvalidOptions {
+                field,
+                value,
+                reason,
+            } => (field.to_string(), format!("{value}: {reason}")),
+            other => (String::new(), other.to_string()),
+        };
+        CellFileError::Invalid {
+            path: path.to_string(),
+            key,
+            reason,
+        }
+    };
+    let prefixed = |vendor: &str, e: crate::program::ProgramError| {
+        let mut err = invalid(e);
+        if let CellFileError::Invalid { key, .. } = &mut err {
+            *key = format!("program.{vendor}.{key}");
+        }
+        err
+    };
+    common.validate().map_err(|e| {
+        let mut err = invalid(e);
+        if let CellFileError::Invalid { key, .. } = &mut err {
+            *key = format!("program.{key}");
+        }
+        err
+    })?;
+    fanuc.validate().map_err(|e| prefixed("fanuc", e))?;
+    kuka.validate().map_err(|e| prefixed("kuka", e))?;
+    abb.validate().map_err(|e| prefixed("abb", e))?;
+    if let Some((c, h)) = cell.and_then(|c| Some((c, common.home(c)?))) {
+        let limits = &c.robot().limits;
+        if let Some(j) = (0..6).find(|&j| !limits[j].contains(h.joints[j])) {
+            return Err(CellFileError::Invalid {
+                path: path.to_string(),
+                key: "program.home_deg".into(),
+                reason: format!(
+                    "J{} = {:.3}° is outside its travel [{:.1}°, {:.1}°]",
+                    j + 1,
+                    h.joints[j].to_degrees(),
+                    limits[j].lower_rad.to_degrees(),
+                    limits[j].upper_rad.to_degrees()
+                ),
+            });
+        }
+    }
+    Ok(ProgramSettings {
+        common,
+        fanuc,
+        kuka,
+        abb,
     })
 }

@@ -26,7 +26,9 @@ fn read_text(path: &FsPath) -> Result<String, ProgramError> {
 /// Reads the program at `path` — a FANUC `.ls` main program (the
 /// sub-programs it calls are read from the same folder), a KUKA `.src` or
 /// `.dat` (its pair beside it) or an ABB `.mod` — and validates it against
-/// `cell`. Problems found are data: the report lists each with its `file:line`.
+/// `cell`, with the emitter options and set-up (home, dwell, interpass
+/// wait, payload, transit) of the cell file's `[program]` table. Problems
+/// found are data: the report lists each with its `file:line`.
 ///
 /// # Errors
 /// [`ProgramError::Read`] naming the file and line when a file cannot be
@@ -52,15 +54,15 @@ pub fn check_program(path: impl AsRef<FsPath>, cell: &Cell) -> Result<Validation
                 &read_text(&dat)?,
                 &shown(&dat),
             )?;
-            validate_kuka(&program, layout, &Default::default(), None)
+            validate_kuka(&program, layout, &cell.program.kuka(), None)
         }
         "mod" => {
             let module = crate::program::readback::abb::parse_mod(&read_text(path)?, &shown(path))?;
-            validate_abb(&module, layout, &Default::default(), None)
+            validate_abb(&module, layout, &cell.program.abb(), None)
         }
         "ls" => {
             let programs = read_fanuc_with_calls(path)?;
-            validate_fanuc(&programs, layout, &Default::default(), None)
+            validate_fanuc(&programs, layout, &cell.program.fanuc(), None)
         }
         other => {
             return Err(ProgramError::Read {

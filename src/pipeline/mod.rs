@@ -89,6 +89,10 @@ pub struct Cell {
     pub layout: crate::robot::Cell,
     /// The file's `[placement]` table (bounds of [`place_part`]), if any.
     pub placement: Option<crate::io::cell_file::PlacementSpec>,
+    /// The file's `[program]` table: home, interlayer dwell, interpass wait,
+    /// payload updates, transit check, coordination, and each vendor's
+    /// emitter options (defaults where absent).
+    pub program: crate::program::ProgramSettings,
     /// The file's text as read (a placed copy keeps its other keys).
     pub text: String,
 }
@@ -136,6 +140,7 @@ impl Cell {
             file: origin.to_string(),
             layout,
             placement: file.placement,
+            program: file.program,
             text: String::new(),
         })
     }

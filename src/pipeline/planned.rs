@@ -16,7 +16,7 @@ use crate::optimise::{
     OptimiseOptions, Plan,
 };
 use crate::program::{
-    build_program, check_vendor, write_files, Program, ProgramError, TravelSpeed,
+    build_program_with, check_vendor, write_files, Program, ProgramError, TravelSpeed,
 };
 use crate::robot::trajectory::{joint_trajectory, TrajectoryOptions};
 use crate::Error;
@@ -147,7 +147,7 @@ pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<Planned
     control.report("program", 0.95);
     let t = Instant::now();
     let name = program_name(&part.name);
-    let (program, refusal) = match build(&name, cell, &layers, &plan, &optimise_opts) {
+    let (program, refusal) = match build(&name, cell, &sliced, &layers, &plan, &optimise_opts) {
         Ok(p) => (Some(p), None),
         Err(e) => (None, Some(e.to_string())),
     };
@@ -176,6 +176,7 @@ pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<Planned
 fn build(
     name: &str,
     cell: &Cell,
+    sliced: &SlicedPart,
     layers: &[LayerPoints],
     plan: &Plan,
     opts: &OptimiseOptions,
@@ -188,13 +189,27 @@ fn build(
             index: 0,
             reason: format!("joint trajectory: {e}"),
         })?;
-    build_program(
+    let common = &cell.program.common;
+    let mut program = build_program_with(
         name,
         &cell.layout,
         &inputs,
         &traj,
         &TravelSpeed::Constant(speed),
-    )
+        common,
+    )?;
+    if common.payload_every_layers > 0 {
+        // the mass of each planned layer (bead), from the process model
+        let per_layer = sliced
+            .process_plan
+            .layer_masses_kg(&sliced.path, &sliced.process);
+        let masses: Vec<f64> = layers
+            .iter()
+            .map(|l| per_layer.get(l.layer).copied().unwrap_or(0.0))
+            .collect();
+        program.set_payloads(common, &masses)?;
+    }
+    Ok(program)
 }
 
 /// No layer may vanish between the plan and the program: each layer of the
@@ -289,12 +304,11 @@ impl PlannedPart {
                 count: 1,
                 first: self.refusal.clone().unwrap_or_default(),
             })?;
+        let settings = &self.cell.program;
         Ok(match format {
-            ProgramFormat::Fanuc => {
-                crate::program::fanuc::fanuc_files(program, &Default::default())?
-            }
-            ProgramFormat::Kuka => crate::program::kuka::kuka_files(program, &Default::default())?,
-            ProgramFormat::Abb => crate::program::abb::abb_files(program, &Default::default())?,
+            ProgramFormat::Fanuc => crate::program::fanuc::fanuc_files(program, &settings.fanuc())?,
+            ProgramFormat::Kuka => crate::program::kuka::kuka_files(program, &settings.kuka())?,
+            ProgramFormat::Abb => crate::program::abb::abb_files(program, &settings.abb())?,
         })
     }
 

@@ -32,22 +32,9 @@ pub(crate) fn estimate(
     wire_feed_speed_mm_s: f64,
     density_kg_m3: f64,
 ) -> Estimates {
-    let mut length = 0.0;
-    let mut time = 0.0;
-    for (l, v) in path.layers.iter().zip(speeds) {
-        let n = l.points.len();
-        let segs = if l.closed && n > 2 {
-            n
-        } else {
-            n.saturating_sub(1)
-        };
-        for i in 0..segs {
-            let j = (i + 1) % n;
-            let d = (l.points[j].position - l.points[i].position).norm();
-            length += d;
-            time += d * 0.5 * (1.0 / v[i] + 1.0 / v[j]);
-        }
-    }
+    let (length, time) = layer_lengths_and_times(path, speeds)
+        .into_iter()
+        .fold((0.0, 0.0), |(a, b), (l, t)| (a + l, b + t));
     let wire_length_mm = wire_feed_speed_mm_s * time;
     let wire_volume_mm3 = wire_length_mm * std::f64::consts::PI * wire_diameter_mm.powi(2) / 4.0;
     Estimates {
@@ -60,4 +47,28 @@ pub(crate) fn estimate(
         // 1 mm³ = 1e-9 m³; kg -> g: × 1e3.
         deposited_mass_g: wire_volume_mm3 * density_kg_m3 * 1e-6,
     }
+}
+
+/// Length under the arc (mm) and time (s) of each layer of `path` at the
+/// travel speeds `speeds[layer][point]` (mm/s), as [`estimate`] counts them:
+/// each segment at the mean of the inverse speeds of its ends, closing
+/// segments of closed layers included.
+pub(crate) fn layer_lengths_and_times(path: &Path, speeds: &[Vec<f64>]) -> Vec<(f64, f64)> {
+    path.layers
+        .iter()
+        .zip(speeds)
+        .map(|(l, v)| {
+            let n = l.points.len();
+            let segs = if l.closed && n > 2 {
+                n
+            } else {
+                n.saturating_sub(1)
+            };
+            (0..segs).fold((0.0, 0.0), |(length, time), i| {
+                let j = (i + 1) % n;
+                let d = (l.points[j].position - l.points[i].position).norm();
+                (length + d, time + d * 0.5 * (1.0 / v[i] + 1.0 / v[j]))
+            })
+        })
+        .collect()
 }

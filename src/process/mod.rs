@@ -373,6 +373,29 @@ pub struct ProcessPlan {
     pub estimates: Estimates,
 }
 
+impl ProcessPlan {
+    /// Mass deposited in each layer of `path` (kg): the wire fed while the
+    /// layer is laid (its time at the planned travel speeds, as in
+    /// [`Estimates`]) times the wire's section and the density of
+    /// `params`; the layers sum to [`Estimates::deposited_mass_g`]. `path`
+    /// is the path this plan was made for.
+    pub fn layer_masses_kg(&self, path: &Path, params: &ProcessParameters) -> Vec<f64> {
+        let speeds: Vec<Vec<f64>> = self
+            .points
+            .iter()
+            .map(|l| l.iter().map(|p| p.travel_speed_mm_s).collect())
+            .collect();
+        let section_mm2 = std::f64::consts::PI * params.wire_diameter_mm.powi(2) / 4.0;
+        estimate::layer_lengths_and_times(path, &speeds)
+            .into_iter()
+            // mm³ × kg/m³ × 1e-9 m³/mm³ = kg
+            .map(|(_, t)| {
+                params.wire_feed_speed_mm_s * t * section_mm2 * params.density_kg_m3 * 1e-9
+            })
+            .collect()
+    }
+}
+
 /// Errors of the process stage; each names the field, layer or point.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]

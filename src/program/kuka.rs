@@ -11,22 +11,46 @@
 //!   inline forms write, and may be refused).
 //! * Each bead: `PTP` to its first point (exact stop), then `LIN` moves at
 //!   `$VEL.CP` (m/s) blended with `C_DIS` inside the bead, the last one
-//!   exact. The arc is switched by `TRIGGER WHEN DISTANCE=0` before the
-//!   first `LIN` (fires at the exact first point) and `TRIGGER WHEN
-//!   DISTANCE=1` before the last `LIN` (fires at its exact end point), so
-//!   blending never moves an arc switching point.
-//! * Arc process: output `$OUT[schedule]`; custom: the user's statements,
-//!   which a `TRIGGER ... DO` accepts only as an assignment or a subprogram
-//!   call ([`is_trigger_action`]; others are refused by
-//!   [`KukaOptions::validate`]).
-//! * The `INI` fold declares the usual stop-message interrupt (`GLOBAL
-//!   INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )`, `INTERRUPT ON
-//!   3`) before `BAS (#INITMOV,0 )`; tool and base are selected with `BAS
-//!   (#TOOL,n)` and `BAS (#BASE,n)` (which also set the tool's load
-//!   `$LOAD`), then `$IPO_MODE`.
-//! * With approach and retract points: `PTP` to the approach point, `LIN`
-//!   into the bead's first point (exact), the bead, `LIN` out to the retract
-//!   point, all at `$VEL.CP` = the program's approach speed.
+//!   exact.
+//! * **Arc process** (`$OUT[schedule]`): the arc is switched on at the
+//!   bead's first point, where the robot stands (exact stop), followed by
+//!   the ignition handshake: `$TIMER[t]` set to minus the timeout (ms) and
+//!   started, `WAIT FOR $IN[arc_ok] OR $TIMER_FLAG[t]` (KRL's `WAIT FOR`
+//!   has no timeout; the flag turns on when the timer reaches 0), and if
+//!   the input is still off: arc off, a message (`Set_KrlMsg(#QUIT, …)`,
+//!   KSS 8) and `HALT`. At the bead's last point (exact): `WAIT SEC
+//!   crater` with the arc on, arc off, `WAIT SEC burn-back`
+//!   ([`KukaOptions::arc_ok_input`], [`KukaOptions::ignition_timeout_s`],
+//!   [`KukaOptions::crater_fill_s`], [`KukaOptions::burn_back_s`]).
+//! * **Custom process**: the user's statements, switched by `TRIGGER WHEN
+//!   DISTANCE=0` before the first `LIN` (fires at the exact first point)
+//!   and `TRIGGER WHEN DISTANCE=1` before the last `LIN` (fires at its
+//!   exact end point), so blending never moves a switching point; a
+//!   `TRIGGER ... DO` accepts only an assignment or a subprogram call
+//!   ([`is_trigger_action`]; others are refused by
+//!   [`KukaOptions::validate`]), and a call gets `PRIO=-1`
+//!   ([`trigger_line`]).
+//! * **Frames stated**: after `BAS (#TOOL,n)`/`BAS (#BASE,n)` (numbers and
+//!   load) the program assigns `$TOOL = {X …,A …}` and `$BASE = {…}`, the
+//!   frames its positions assume ([`KukaOptions::frames`]): the torch
+//!   (its z axis along the torch, from the wire tip into it: not KUKA's
+//!   +X tool direction, so a torch measured on the controller is another
+//!   frame) over the user base, or in the fixed-tool mode the part on the
+//!   flange and the fixed torch.
+//! * **Coordinated positioner** (torch-carried cell,
+//!   [`crate::program::ProgramOptions::coordinated`], default on): `$BASE =
+//!   EK (MACHINE_DEF[m].ROOT, MACHINE_DEF[m].MECH_TYPE, {table_from_part})`
+//!   math-couples the base to the positioner (E1, E2), so `E6POS`
+//!   positions are the part frame at each point's E1, E2 and `$VEL.CP` is
+//!   the TCP's speed relative to the moving base: the planned travel speed
+//!   over the part, also where the positioner turns ([`KukaOptions::coordinated`]).
+//!   Assumes the controller's positioner kinematic is the cell's (root at
+//!   the positioner pose, flange = table frame at E1 = E2 = 0).
+//! * **Home and bead set-up**: `PTP PHOME` (an `E6AXIS` of the home joints
+//!   and positioner) first and last; before each bead's first motion its
+//!   payload (`$LOAD.M` kg, `$LOAD.CM` mm in the flange frame, `$LOAD.J`
+//!   of a point mass), dwell (`WAIT SEC`) and interpass wait (`WAIT FOR
+//!   $IN[n]`).
 //! * **Part-carried cell: external TCP.** `$VEL.CP` is the speed of the TCP;
 //!   the planned speed is the torch's relative to the part. In the
 //!   part-carried cell the emitter switches to KUKA's fixed-tool mode,
@@ -37,7 +61,7 @@
 //!   fixed torch travels over it at `$VEL.CP`, and `E6POS` positions are the
 //!   part frame in the torch frame ([`KukaOptions::external_tcp`]).
 //!
-//! * **Torch-carried cell, positioner turning.** `$VEL.CP` is the TCP's
+//! * **Torch-carried cell, positioner turning, not coordinated.** `$VEL.CP` is the TCP's
 //!   speed in the robot frame; where the positioner turns within a bead the
 //!   part moves under a nearly still torch, and the planned speed (over the
 //!   part) is not the TCP's. KRL's `LIN` has no time argument: such a `LIN`
@@ -72,7 +96,7 @@ pub use crate::program::frames::fixed_torch_at;
 use crate::program::frames::{held_tool, ToolFrames};
 use crate::program::{
     check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
-    ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    ArcFlag, BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::KukaAbc;
 use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel, Vendor};
@@ -111,6 +135,35 @@ pub struct KukaOptions {
     /// base frame (mm); `None`: at the cell's `D_R`, z down (towards the
     /// part), x along the robot's X.
     pub fixed_tool: Option<Isometry3>,
+    /// Digital input `$IN[n]` on once the power source reports the arc
+    /// established (arc process only): after switching the arc on at a
+    /// bead's first point the program waits for it at most
+    /// [`KukaOptions::ignition_timeout_s`], then stops with a message.
+    /// Default 1 (our choice: the input paired with the default arc output
+    /// `$OUT[1]`; the controller's I/O mapping decides).
+    pub arc_ok_input: u32,
+    /// Longest wait for the arc-established input (s, > 0, at most 60).
+    /// Default 1 s: twice the 0.5 s start time `START_T` of the ArcTech
+    /// start data that RoboDK's ArcTech post writes (module doc, sources);
+    /// a CMT/GMAW arc ignites well within it.
+    pub ignition_timeout_s: f64,
+    /// `$TIMER[n]` used for that timeout (1–16, present on KR C2 and KR C4).
+    /// Default 1.
+    pub ignition_timer: u8,
+    /// Crater fill (s, 0–60): at a bead's last point the robot stands still
+    /// with the arc on this long before the arc is switched off (arc process
+    /// only; 0: none). Default 0.2 s (our choice, a short GMAW/CMT crater
+    /// time; set it from the weld schedule).
+    pub crater_fill_s: f64,
+    /// Burn-back (s, 0–60): after switching the arc off the robot waits
+    /// this long at the last point, so that the wire burns back before the
+    /// torch leaves (arc process only; 0: none). Default 0.1 s (our choice,
+    /// as above).
+    pub burn_back_s: f64,
+    /// `MACHINE_DEF[n]` of the positioner (an external base kinematic) in
+    /// the math-coupled base `$BASE = EK(...)` of a torch-carried cell
+    /// (2–32; 1 is the robot). Default 2, the first external kinematic.
+    pub ek_machine: u8,
     /// The vendor-independent options (home, dwell, interpass wait,
     /// payload, transit, coordination) the validator checks the file
     /// against; not a key of `[program.<vendor>]` (set from `[program]` by
@@ -132,6 +185,12 @@ impl Default for KukaOptions {
             flange_from_tool: None,
             external_tcp: None,
             fixed_tool: None,
+            arc_ok_input: 1,
+            ignition_timeout_s: 1.0,
+            ignition_timer: 1,
+            crater_fill_s: 0.2,
+            burn_back_s: 0.1,
+            ek_machine: 2,
             common: Default::default(),
         }
     }
@@ -166,6 +225,43 @@ impl KukaOptions {
         }
     }
 
+    /// `true` when the positioner is math-coupled to the base (`$BASE =
+    /// EK(...)`): a torch-carried cell outside the fixed-tool mode with
+    /// [`crate::program::ProgramOptions::coordinated`] on (module doc).
+    pub fn coordinated(&self, cell: &Cell) -> bool {
+        self.common.coordinated
+            && matches!(cell, Cell::TorchCarried(_))
+            && !self.uses_external_tcp(cell)
+    }
+
+    /// The `$BASE` a program states for `cell` (module doc, "Frames").
+    pub fn stated_base(&self, cell: &Cell) -> StatedBase {
+        match cell {
+            Cell::TorchCarried(c) if self.coordinated(cell) => StatedBase::Coupled {
+                machine: self.ek_machine,
+                offset: c.table_from_part,
+            },
+            _ => StatedBase::Fixed(self.frames(cell).0),
+        }
+    }
+
+    /// The base frame (robot base frame, mm) Cartesian positions are
+    /// written in at positioner joints `positioner` (rad): with a coupled
+    /// base the part frame on the positioner there, else
+    /// [`KukaOptions::frames`]' base.
+    pub fn base_at(&self, cell: &Cell, positioner: Option<[f64; 2]>) -> Isometry3 {
+        match (cell, positioner) {
+            (Cell::TorchCarried(c), Some(q)) if self.coordinated(cell) => c.base_from_part(&q),
+            _ => self.frames(cell).0,
+        }
+    }
+
+    /// `true` when the bead is switched by the arc output with the ignition
+    /// handshake and end times (process [`ProcessControl::Arc`]).
+    pub fn arc_process(&self) -> bool {
+        matches!(self.process, ProcessControl::Arc { .. })
+    }
+
     /// Checks every field.
     ///
     /// # Errors
@@ -196,6 +292,42 @@ impl KukaOptions {
         if !(1..=16).contains(&self.tool) {
             return Err(bad("tool", self.tool.to_string(), "must be in 1..=16"));
         }
+        if self.arc_ok_input == 0 {
+            return Err(bad("arc_ok_input", "0".into(), "must be >= 1"));
+        }
+        for (field, v, min_exclusive) in [
+            ("ignition_timeout_s", self.ignition_timeout_s, true),
+            ("crater_fill_s", self.crater_fill_s, false),
+            ("burn_back_s", self.burn_back_s, false),
+        ] {
+            let ok = v.is_finite() && v <= 60.0 && if min_exclusive { v > 0.0 } else { v >= 0.0 };
+            if !ok {
+                return Err(bad(
+                    field,
+                    v.to_string(),
+                    if min_exclusive {
+                        "must be > 0 and <= 60 s"
+                    } else {
+                        "must be between 0 and 60 s"
+                    },
+                ));
+            }
+        }
+        if !(1..=16).contains(&self.ignition_timer) {
+            return Err(bad(
+                "ignition_timer",
+                self.ignition_timer.to_string(),
+                "must be in 1..=16",
+            ));
+        }
+        if !(2..=32).contains(&self.ek_machine) {
+            return Err(bad(
+                "ek_machine",
+                self.ek_machine.to_string(),
+                "must be in 2..=32 (MACHINE_DEF[1] is the robot)",
+            ));
+        }
+        self.common.validate()?;
         self.process.validate()?;
         if let ProcessControl::Custom { start, end } = &self.process {
             for (field, line) in [("process.start", start), ("process.end", end)] {
@@ -210,6 +342,55 @@ impl KukaOptions {
         }
         Ok(())
     }
+}
+
+/// The `$BASE` a program states (module doc, "Frames").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StatedBase {
+    /// `$BASE = {X …, A …}`: a fixed frame in the robot base frame (mm).
+    Fixed(Isometry3),
+    /// `$BASE = EK (MACHINE_DEF[machine].ROOT, MACHINE_DEF[machine].MECH_TYPE,
+    /// {offset})`: the base moves with the positioner; `offset` is the part
+    /// frame in the positioner's flange (table) frame (mm).
+    Coupled {
+        /// `MACHINE_DEF` index of the positioner.
+        machine: u8,
+        /// The part frame on the table (mm).
+        offset: Isometry3,
+    },
+}
+
+/// A KRL `FRAME` aggregate `{X …,Y …,Z …,A …,B …,C …}` of `f` (mm, deg).
+pub fn frame_literal(f: &Isometry3) -> String {
+    let t = f.translation.vector;
+    let abc = KukaAbc::from_rotation(&f.rotation.to_rotation_matrix()).to_degrees();
+    format!(
+        "{{X {},Y {},Z {},A {},B {},C {}}}",
+        Mm(t.x),
+        Mm(t.y),
+        Mm(t.z),
+        Deg(abc[0]),
+        Deg(abc[1]),
+        Deg(abc[2])
+    )
+}
+
+/// `true` when `s` is a subprogram call `NAME(...)` (which a KRL `TRIGGER`
+/// must give a priority: `PRIO=-1`).
+pub fn is_call(s: &str) -> bool {
+    let s = s.trim();
+    let name_len = s
+        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '$'))
+        .unwrap_or(s.len());
+    name_len > 0 && s[name_len..].trim_start().starts_with('(') && s.ends_with(')')
+}
+
+/// `TRIGGER WHEN DISTANCE=d DELAY=0 DO action`, with ` PRIO=-1` when the
+/// action is a subprogram call (KRL requires a priority there; `-1` lets
+/// the controller choose a free one).
+pub fn trigger_line(distance: u8, action: &str) -> String {
+    let prio = if is_call(action) { " PRIO=-1" } else { "" };
+    format!("TRIGGER WHEN DISTANCE={distance} DELAY=0 DO {action}{prio}")
 }
 
 /// `true` when `s` is a statement a KRL `TRIGGER WHEN ... DO` accepts: an
@@ -327,7 +508,10 @@ pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<
     let Cell::TorchCarried(c) = &program.cell else {
         return None;
     };
-    if opts.uses_external_tcp(&program.cell) || !positioner_moves(program, i) {
+    if opts.uses_external_tcp(&program.cell)
+        || opts.coordinated(&program.cell)
+        || !positioner_moves(program, i)
+    {
         return None;
     }
     let (p, a) = (&program.points[i], &program.points[i - 1]);
@@ -349,6 +533,9 @@ pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<
     })
 }
 
+/// Name of the home position in the `.dat` (an `E6AXIS`).
+pub const HOME_NAME: &str = "PHOME";
+
 /// Writes the `.src` of `program`.
 ///
 /// # Errors
@@ -357,6 +544,7 @@ pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<
 pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> std::io::Result<()> {
     check_vendor(&program.cell, Vendor::Kuka, EMITTER).map_err(std::io::Error::other)?;
     let (on, off) = switch_statements(opts);
+    let arc = opts.arc_process();
     writeln!(w, "&ACCESS RVP")?;
     writeln!(w, "&REL 1")?;
     writeln!(w, "DEF {}( )", program.name)?;
@@ -367,6 +555,13 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
         program.points.len(),
         program.num_beads()
     )?;
+    if arc {
+        // the message of a failed ignition (KSS 8 Set_KrlMsg)
+        writeln!(w, "  DECL KRLMSG_T WAAM_MSG")?;
+        writeln!(w, "  DECL KRLMSGPAR_T WAAM_PAR[3]")?;
+        writeln!(w, "  DECL KRLMSGOPT_T WAAM_OPT")?;
+        writeln!(w, "  DECL INT WAAM_H")?;
+    }
     writeln!(w, "  ;FOLD INI")?;
     writeln!(
         w,
@@ -376,14 +571,38 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     writeln!(w, "  BAS (#INITMOV,0 )")?;
     writeln!(w, "  ;ENDFOLD")?;
     writeln!(w, "  $BWDSTART = FALSE")?;
-    // BAS sets $TOOL and $LOAD (TOOL_DATA[n], LOAD_DATA[n]), and $BASE
+    // BAS sets $TOOL and $LOAD (TOOL_DATA[n], LOAD_DATA[n]), and $BASE;
+    // the frames the positions assume are then stated explicitly
     writeln!(w, "  BAS (#TOOL,{})", opts.tool)?;
     writeln!(w, "  BAS (#BASE,{})", opts.base)?;
+    let (_, tool) = opts.frames(&program.cell);
     if opts.uses_external_tcp(&program.cell) {
         writeln!(
             w,
-            "  ; external TCP: the tool is the part on the flange, the base the fixed torch"
+            "  ; external TCP: the tool is the part on the flange, the base the fixed torch (z towards the part)"
         )?;
+    } else if matches!(program.cell, Cell::TorchCarried(_)) && opts.flange_from_tool.is_none() {
+        writeln!(
+            w,
+            "  ; the tool is the torch, its z axis along the torch away from the wire tip (not KUKA's +X tool direction)"
+        )?;
+    }
+    writeln!(w, "  $TOOL = {}", frame_literal(&tool))?;
+    match opts.stated_base(&program.cell) {
+        StatedBase::Fixed(base) => writeln!(w, "  $BASE = {}", frame_literal(&base))?,
+        StatedBase::Coupled { machine, offset } => {
+            writeln!(
+                w,
+                "  ; positioner math-coupled: the base is the part on the positioner, $VEL.CP the speed over it"
+            )?;
+            writeln!(
+                w,
+                "  $BASE = EK (MACHINE_DEF[{machine}].ROOT, MACHINE_DEF[{machine}].MECH_TYPE, {})",
+                frame_literal(&offset)
+            )?;
+        }
+    }
+    if opts.uses_external_tcp(&program.cell) {
         writeln!(w, "  $IPO_MODE = #TCP")?;
     } else {
         writeln!(w, "  $IPO_MODE = #BASE")?;
@@ -412,9 +631,20 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
         }
         Ok(())
     };
+    if program.home.is_some() {
+        writeln!(w, "  ; home, arc off")?;
+        writeln!(w, "  PTP {HOME_NAME}")?;
+    }
+    let mut bead = 0usize;
     for (i, p) in program.points.iter().enumerate() {
         let name = format!("P{}", i + 1);
         let prev = i.checked_sub(1).map(|k| &program.points[k]);
+        if joint_move_target(program, i) {
+            if let Some(setup) = program.bead_setup.get(bead) {
+                write_bead_setup(w, setup)?;
+            }
+            bead += 1;
+        }
         match p.arc {
             ArcFlag::Approach => {
                 writeln!(
@@ -425,17 +655,22 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                 restore_ptp(w, &mut extax)?;
                 writeln!(w, "  PTP {name}")?;
             }
-            ArcFlag::Start => match prev {
-                Some(a) if a.arc == ArcFlag::Approach => {
-                    set_vel(w, a.speed_mm_s)?;
-                    writeln!(w, "  LIN {name}")?;
+            ArcFlag::Start => {
+                match prev {
+                    Some(a) if a.arc == ArcFlag::Approach => {
+                        set_vel(w, a.speed_mm_s)?;
+                        writeln!(w, "  LIN {name}")?;
+                    }
+                    _ => {
+                        writeln!(w, "  ; bead {} (layer {}), arc off", p.layer, p.layer)?;
+                        restore_ptp(w, &mut extax)?;
+                        writeln!(w, "  PTP {name}")?;
+                    }
                 }
-                _ => {
-                    writeln!(w, "  ; bead {} (layer {}), arc off", p.layer, p.layer)?;
-                    restore_ptp(w, &mut extax)?;
-                    writeln!(w, "  PTP {name}")?;
+                if arc {
+                    write_ignition(w, opts, &on, &off, p.layer)?;
                 }
-            },
+            }
             ArcFlag::On | ArcFlag::End => match timed_segment(program, opts, i) {
                 Some(t) => {
                     set_vel(w, t.vel_cp_mm_s)?;
@@ -460,12 +695,17 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
         match p.arc {
             ArcFlag::Approach | ArcFlag::Start => {}
             ArcFlag::On | ArcFlag::End => {
-                if prev.is_some_and(|q| q.arc == ArcFlag::Start) {
-                    writeln!(w, "  TRIGGER WHEN DISTANCE=0 DELAY=0 DO {on}")?;
+                if !arc && prev.is_some_and(|q| q.arc == ArcFlag::Start) {
+                    writeln!(w, "  {}", trigger_line(0, &on))?;
                 }
                 if p.arc == ArcFlag::End {
-                    writeln!(w, "  TRIGGER WHEN DISTANCE=1 DELAY=0 DO {off}")?;
+                    if !arc {
+                        writeln!(w, "  {}", trigger_line(1, &off))?;
+                    }
                     writeln!(w, "  LIN {name}")?;
+                    if arc {
+                        write_arc_end(w, opts, &off)?;
+                    }
                 } else {
                     writeln!(w, "  LIN {name} C_DIS")?;
                 }
@@ -476,7 +716,104 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
             }
         }
     }
+    if program.home.is_some() {
+        writeln!(w, "  ; home, arc off")?;
+        restore_ptp(w, &mut extax)?;
+        writeln!(w, "  PTP {HOME_NAME}")?;
+    }
     writeln!(w, "END")?;
+    Ok(())
+}
+
+/// Seconds as written in `WAIT SEC` (3 decimals).
+fn sec(s: f64) -> Fixed {
+    Fixed::new(s, 3)
+}
+
+/// What happens before a bead: payload, dwell, interpass wait (module doc).
+fn write_bead_setup(w: &mut dyn Write, setup: &BeadSetup) -> std::io::Result<()> {
+    if let Some(load) = &setup.payload {
+        writeln!(
+            w,
+            "  ; payload: substrate, fixture and the metal deposited so far (kg; CoG mm, flange frame; J of a point mass)"
+        )?;
+        writeln!(w, "  $LOAD.M = {}", Fixed::new(load.mass_kg, 3))?;
+        let c = load.cog_mm;
+        writeln!(
+            w,
+            "  $LOAD.CM = {{X {},Y {},Z {},A 0.0,B 0.0,C 0.0}}",
+            Mm(c.x),
+            Mm(c.y),
+            Mm(c.z)
+        )?;
+        writeln!(w, "  $LOAD.J = {{X 0.0,Y 0.0,Z 0.0}}")?;
+    }
+    if setup.dwell_s > 0.0 {
+        writeln!(w, "  ; interlayer dwell")?;
+        writeln!(w, "  WAIT SEC {}", sec(setup.dwell_s))?;
+    }
+    if let Some(n) = setup.wait_input {
+        writeln!(w, "  ; interpass temperature reached")?;
+        writeln!(w, "  WAIT FOR $IN[{n}]")?;
+    }
+    Ok(())
+}
+
+/// Arc on at a bead's first point (the robot stands there, exact stop),
+/// then the ignition handshake: wait for the arc-established input with a
+/// `$TIMER` timeout, and if it did not come, arc off, a message and `HALT`.
+fn write_ignition(
+    w: &mut dyn Write,
+    opts: &KukaOptions,
+    on: &str,
+    off: &str,
+    layer: usize,
+) -> std::io::Result<()> {
+    let (t, n) = (opts.ignition_timer, opts.arc_ok_input);
+    let ms = (opts.ignition_timeout_s * 1000.0).round() as i64;
+    writeln!(
+        w,
+        "  ; arc on, then wait at most {} s for the arc (IN {n})",
+        sec(opts.ignition_timeout_s)
+    )?;
+    writeln!(w, "  {on}")?;
+    writeln!(w, "  $TIMER_STOP[{t}] = TRUE")?;
+    writeln!(w, "  $TIMER[{t}] = -{ms}")?;
+    writeln!(w, "  $TIMER_STOP[{t}] = FALSE")?;
+    writeln!(w, "  WAIT FOR $IN[{n}] OR $TIMER_FLAG[{t}]")?;
+    writeln!(w, "  $TIMER_STOP[{t}] = TRUE")?;
+    writeln!(w, "  IF NOT $IN[{n}] THEN")?;
+    writeln!(w, "    {off}")?;
+    writeln!(
+        w,
+        "    WAAM_MSG = {{MODUL[] \"WAAM\",NR 1,MSG_TXT[] \"No arc: IN {n} off {} s after arc on, layer {layer}\"}}",
+        sec(opts.ignition_timeout_s)
+    )?;
+    writeln!(
+        w,
+        "    WAAM_OPT = {{VL_STOP TRUE,CLEAR_P_RESET TRUE,CLEAR_P_SAW FALSE,LOG_TO_DB TRUE}}"
+    )?;
+    writeln!(
+        w,
+        "    WAAM_H = SET_KRLMSG(#QUIT,WAAM_MSG,WAAM_PAR[],WAAM_OPT)"
+    )?;
+    writeln!(w, "    HALT")?;
+    writeln!(w, "  ENDIF")?;
+    Ok(())
+}
+
+/// At a bead's last point (exact stop): crater fill with the arc on, arc
+/// off, burn-back wait.
+fn write_arc_end(w: &mut dyn Write, opts: &KukaOptions, off: &str) -> std::io::Result<()> {
+    if opts.crater_fill_s > 0.0 {
+        writeln!(w, "  ; crater fill, arc on")?;
+        writeln!(w, "  WAIT SEC {}", sec(opts.crater_fill_s))?;
+    }
+    writeln!(w, "  {off}")?;
+    if opts.burn_back_s > 0.0 {
+        writeln!(w, "  ; burn-back")?;
+        writeln!(w, "  WAIT SEC {}", sec(opts.burn_back_s))?;
+    }
     Ok(())
 }
 
@@ -488,32 +825,44 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
 pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> std::io::Result<()> {
     check_vendor(&program.cell, Vendor::Kuka, EMITTER).map_err(std::io::Error::other)?;
     let robot = program.cell.robot();
-    let (base, tool) = opts.frames(&program.cell);
-    let user_from_base = base.inverse();
-    writeln!(w, "&ACCESS RVP")?;
-    writeln!(w, "&REL 1")?;
-    writeln!(w, "DEFDAT {}", program.name)?;
-    for (i, p) in program.points.iter().enumerate() {
-        let e = p.positioner.unwrap_or([0.0; 2]).map(f64::to_degrees);
-        let ext = format!(
+    let (_, tool) = opts.frames(&program.cell);
+    let ext_of = |q: Option<[f64; 2]>| {
+        let e = q.unwrap_or([0.0; 2]).map(f64::to_degrees);
+        format!(
             "E1 {},E2 {},E3 0.0,E4 0.0,E5 0.0,E6 0.0",
             Deg(e[0]),
             Deg(e[1])
-        );
+        )
+    };
+    let axis = |q: &Joints| {
+        let a = q.map(f64::to_degrees);
+        format!(
+            "A1 {},A2 {},A3 {},A4 {},A5 {},A6 {}",
+            Deg(a[0]),
+            Deg(a[1]),
+            Deg(a[2]),
+            Deg(a[3]),
+            Deg(a[4]),
+            Deg(a[5])
+        )
+    };
+    writeln!(w, "&ACCESS RVP")?;
+    writeln!(w, "&REL 1")?;
+    writeln!(w, "DEFDAT {}", program.name)?;
+    if let Some(h) = &program.home {
+        writeln!(
+            w,
+            "  DECL E6AXIS {HOME_NAME}={{{},{}}}",
+            axis(&h.joints),
+            ext_of(h.positioner)
+        )?;
+    }
+    for (i, p) in program.points.iter().enumerate() {
+        let ext = ext_of(p.positioner);
+        let user_from_base = opts.base_at(&program.cell, p.positioner).inverse();
         match (opts.positions, joint_move_target(program, i)) {
             (PositionMode::Joint, true) => {
-                let a = p.joints.map(f64::to_degrees);
-                writeln!(
-                    w,
-                    "  DECL E6AXIS P{}={{A1 {},A2 {},A3 {},A4 {},A5 {},A6 {},{ext}}}",
-                    i + 1,
-                    Deg(a[0]),
-                    Deg(a[1]),
-                    Deg(a[2]),
-                    Deg(a[3]),
-                    Deg(a[4]),
-                    Deg(a[5])
-                )?;
+                writeln!(w, "  DECL E6AXIS P{}={{{},{ext}}}", i + 1, axis(&p.joints))?;
             }
             (PositionMode::Cartesian, _) | (PositionMode::Joint, false) => {
                 let pose = user_from_base * robot.flange_pose(&p.joints) * tool;

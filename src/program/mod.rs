@@ -35,13 +35,14 @@ pub mod frames;
 pub mod kuka;
 pub mod readback;
 pub mod split;
+pub mod transit;
 pub mod validate;
 
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::math::{Point3, UnitVector3};
+use crate::math::{Point3, UnitVector3, Vector3};
 use crate::robot::cell::CellPoint;
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::trajectory::{JointTrajectory, PathPointInput};
@@ -249,6 +250,98 @@ impl Program {
     /// The bead points (approach and retract points left out), in order.
     pub fn bead_points(&self) -> impl Iterator<Item = &ProgramPoint> {
         self.points.iter().filter(|p| p.arc.is_bead())
+    }
+
+    /// Sets the payload updates of a part-carried program (the robot
+    /// carries the part as it grows): before bead 0 and before every
+    /// `opts.payload_every_layers`-th bead, the substrate and fixture
+    /// (`payload_base_kg` at `payload_base_cog_mm`, flange frame) plus the
+    /// metal of the beads before it, bead `k` weighing `bead_mass_kg[k]`
+    /// (kg) with its centre at the mean of its points (part frame, taken into
+    /// the flange frame by the cell's `flange_from_part`). Nothing in a
+    /// torch-carried cell (the positioner carries the part, not the arm) or
+    /// with `payload_every_layers = 0`.
+    ///
+    /// # Errors
+    /// [`ProgramError::Mismatch`] when `bead_mass_kg` has not one mass per
+    /// bead or a mass is negative or not finite; [`ProgramError::InvalidOptions`]
+    /// for bad options.
+    pub fn set_payloads(
+        &mut self,
+        opts: &ProgramOptions,
+        bead_mass_kg: &[f64],
+    ) -> Result<(), ProgramError> {
+        opts.validate()?;
+        let beads = self.num_beads();
+        if bead_mass_kg.len() != beads {
+            return Err(ProgramError::Mismatch {
+                index: bead_mass_kg.len().min(beads),
+                reason: format!("{} bead masses for {beads} beads", bead_mass_kg.len()),
+            });
+        }
+        if let Some(k) = bead_mass_kg
+            .iter()
+            .position(|m| !(m.is_finite() && *m >= 0.0))
+        {
+            return Err(ProgramError::Mismatch {
+                index: k,
+                reason: format!(
+                    "bead {k}: mass {} kg is not finite and >= 0",
+                    bead_mass_kg[k]
+                ),
+            });
+        }
+        let Cell::PartCarried(c) = &self.cell else {
+            return Ok(());
+        };
+        if opts.payload_every_layers == 0 {
+            return Ok(());
+        }
+        if self.bead_setup.len() != beads {
+            self.bead_setup = self
+                .points
+                .iter()
+                .filter(|p| p.arc == ArcFlag::Start)
+                .map(|p| BeadSetup {
+                    layer: p.layer,
+                    payload: None,
+                    dwell_s: 0.0,
+                    wait_input: None,
+                })
+                .collect();
+        }
+        // the centre of each bead, flange frame
+        let mut centres = Vec::with_capacity(beads);
+        let (mut sum, mut n) = (Vector3::zeros(), 0usize);
+        for p in self.bead_points() {
+            sum += p.position_mm.coords;
+            n += 1;
+            if p.arc == ArcFlag::End {
+                centres.push(c.flange_from_part * Point3::from(sum / n as f64));
+                (sum, n) = (Vector3::zeros(), 0);
+            }
+        }
+        let mut mass = opts.payload_base_kg;
+        let mut moment = Vector3::from(opts.payload_base_cog_mm) * opts.payload_base_kg;
+        let every = opts.payload_every_layers as usize;
+        for (k, setup) in self.bead_setup.iter_mut().enumerate() {
+            if k % every == 0 {
+                let cog_mm = if mass > 0.0 {
+                    Point3::from(moment / mass)
+                } else {
+                    Point3::from(opts.payload_base_cog_mm)
+                };
+                setup.payload = Some(Payload {
+                    mass_kg: mass,
+                    cog_mm,
+                });
+            }
+            mass += bead_mass_kg[k];
+            if let Some(centre) = centres.get(k) {
+                moment += centre.coords * bead_mass_kg[k];
+            }
+        }
+        Ok(())
     }
 
     /// Number of beads (arc starts).
@@ -747,14 +840,276 @@ pub fn build_program_with(
         }
         out = all;
     }
-    Ok(Program {
+    let home = opts.home(cell);
+    if let Some(h) = &home {
+        check_home(cell, h)?;
+    }
+    let bead_setup = out
+        .iter()
+        .filter(|p| p.arc == ArcFlag::Start)
+        .enumerate()
+        .map(|(k, p)| BeadSetup {
+            layer: p.layer,
+            payload: None,
+            dwell_s: if k > 0 { opts.dwell_s } else { 0.0 },
+            wait_input: if k > 0 { opts.interpass_input } else { None },
+        })
+        .collect();
+    let mut program = Program {
         name: name.to_string(),
         cell: cell.clone(),
         configuration: trajectory.configuration,
         points: out,
-        home: None,
-        bead_setup: Vec::new(),
-    })
+        home,
+        bead_setup,
+    };
+    if opts.transit_check {
+        safe_transits(&mut program, points, opts)?;
+    }
+    Ok(program)
+}
+
+/// Refuses a home position outside the arm's (or positioner's) travel.
+fn check_home(cell: &Cell, h: &HomePosition) -> Result<(), ProgramError> {
+    let bad = |what: String| ProgramError::InvalidOptions {
+        field: "home_deg",
+        value: what,
+        reason: "the home position must be inside the joints' travel",
+    };
+    if let Some((j, v)) = cell.robot().limit_violations(&h.joints).next() {
+        return Err(bad(format!("J{} = {:.3}°", j + 1, v.to_degrees())));
+    }
+    if let (Cell::TorchCarried(c), Some(qp)) = (cell, h.positioner) {
+        for (i, (l, v)) in c.positioner.limits.iter().zip(qp).enumerate() {
+            if !l.contains(v) {
+                return Err(ProgramError::InvalidOptions {
+                    field: "home_positioner_deg",
+                    value: format!("J{} = {:.3}°", i + 7, v.to_degrees()),
+                    reason: "the home position must be inside the positioner's travel",
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The points of one bead's block in a program: indices of its first point
+/// (approach, or the bead's first point), its bead's first and last points,
+/// its last point (retract, or the bead's last point), and of the bead's
+/// first point among the path points.
+#[derive(Debug, Clone, Copy)]
+struct Block {
+    first: usize,
+    start: usize,
+    end: usize,
+    last: usize,
+    start_input: usize,
+}
+
+fn blocks(points: &[ProgramPoint]) -> Vec<Block> {
+    let mut out = Vec::new();
+    let mut bead_points = 0;
+    let mut cur: Option<Block> = None;
+    for (i, p) in points.iter().enumerate() {
+        match p.arc {
+            ArcFlag::Approach => {
+                cur = Some(Block {
+                    first: i,
+                    start: i + 1,
+                    end: i + 1,
+                    last: i + 1,
+                    start_input: bead_points,
+                })
+            }
+            ArcFlag::Start => {
+                let b = cur.get_or_insert(Block {
+                    first: i,
+                    start: i,
+                    end: i,
+                    last: i,
+                    start_input: bead_points,
+                });
+                b.start = i;
+                b.start_input = bead_points;
+            }
+            ArcFlag::End => {
+                if let Some(b) = cur.as_mut() {
+                    b.end = i;
+                    b.last = i;
+                }
+            }
+            ArcFlag::Retract => {
+                if let Some(b) = cur.as_mut() {
+                    b.last = i;
+                }
+            }
+            ArcFlag::On => {}
+        }
+        if p.arc.is_bead() {
+            bead_points += 1;
+        }
+        let closes = match p.arc {
+            ArcFlag::Retract => true,
+            ArcFlag::End => points.get(i + 1).map(|n| n.arc) != Some(ArcFlag::Retract),
+            _ => false,
+        };
+        if closes {
+            out.extend(cur.take());
+        }
+    }
+    out
+}
+
+/// Checks every arc-off joint move between two beads (and the last one, to
+/// home) against the wall deposited so far ([`transit`]); where one
+/// collides, moves that transition's retract and approach points further
+/// along the tool axis (2, 4, 8… times `clearance_mm`, up to
+/// `transit_max_clearance_mm`) until it clears.
+fn safe_transits(
+    program: &mut Program,
+    inputs: &[PathPointInput],
+    opts: &ProgramOptions,
+) -> Result<(), ProgramError> {
+    use rayon::prelude::*;
+    let torch = crate::toolaxis::collision::Torch::new(&Default::default()).map_err(|e| {
+        ProgramError::InvalidOptions {
+            field: "transit_check",
+            value: e.to_string(),
+            reason: "the torch model for the transit check is invalid",
+        }
+    })?;
+    let blocks = blocks(&program.points);
+    let beads: Vec<Vec<Point3>> = blocks
+        .iter()
+        .map(|b| {
+            program.points[b.start..=b.end]
+                .iter()
+                .map(|p| p.position_mm)
+                .collect()
+        })
+        .collect();
+    let n = blocks.len();
+    let target = |program: &Program, k: usize| -> Option<(Joints, Option<PositionerJoints>)> {
+        if k + 1 < n {
+            let p = &program.points[blocks[k + 1].first];
+            Some((p.joints, p.positioner))
+        } else {
+            program.home.map(|h| (h.joints, h.positioner))
+        }
+    };
+    let check = |program: &Program, k: usize| -> Result<transit::TransitClearance, ProgramError> {
+        let inf = transit::TransitClearance {
+            min_clearance_mm: f64::INFINITY,
+            at_fraction: 0.0,
+            tip_mm: Point3::origin(),
+        };
+        let Some((qb, pb)) = target(program, k) else {
+            return Ok(inf);
+        };
+        let wall = transit::wall_of(beads[..=k].iter().map(Vec::as_slice), opts.bead_radius_mm);
+        let from = &program.points[blocks[k].last];
+        transit::joint_move_clearance(
+            &program.cell,
+            &wall,
+            &torch,
+            (&from.joints, from.positioner),
+            (&qb, pb),
+        )
+        .map_err(|e| ProgramError::Infeasible {
+            count: 1,
+            first: format!("layer {}: transit check: {e}", from.layer),
+        })
+    };
+    let first: Vec<Result<transit::TransitClearance, ProgramError>> =
+        (0..n).into_par_iter().map(|k| check(program, k)).collect();
+    for (k, r) in first.into_iter().enumerate() {
+        let r = r?;
+        if r.min_clearance_mm > 0.0 {
+            continue;
+        }
+        let layer = program.points[blocks[k].end].layer;
+        let to_what = if k + 1 < n {
+            format!(
+                "layer {}'s approach",
+                program.points[blocks[k + 1].start].layer
+            )
+        } else {
+            "home".to_string()
+        };
+        let refuse = |why: String| ProgramError::Infeasible {
+            count: 1,
+            first: format!(
+                "layer {layer}: the arc-off joint move to {to_what} passes {:.1} mm into the \
+                 deposited wall at {:.0}% of the move (torch tip at [{:.1}, {:.1}, {:.1}] mm, \
+                 part frame){why}",
+                -r.min_clearance_mm,
+                100.0 * r.at_fraction,
+                r.tip_mm.x,
+                r.tip_mm.y,
+                r.tip_mm.z
+            ),
+        };
+        let has_retract = program.points[blocks[k].last].arc == ArcFlag::Retract;
+        let next_approach = (k + 1 < n)
+            .then(|| blocks[k + 1])
+            .filter(|b| program.points[b.first].arc == ArcFlag::Approach);
+        if opts.clearance_mm <= 0.0 || !has_retract {
+            return Err(refuse(
+                " and the program has no retract points to raise (clearance_mm = 0)".into(),
+            ));
+        }
+        let mut c = opts.clearance_mm;
+        let mut fixed = false;
+        while c < opts.transit_max_clearance_mm && !fixed {
+            c = (2.0 * c).min(opts.transit_max_clearance_mm);
+            let end = program.points[blocks[k].end];
+            let end_input = &inputs[blocks[k].start_input + (blocks[k].end - blocks[k].start)];
+            let Ok(retract) =
+                clearance_point(&program.cell, &end, end_input, ArcFlag::Retract, opts, c)
+            else {
+                continue;
+            };
+            let approach = match next_approach {
+                Some(b) => {
+                    let start = program.points[b.start];
+                    match clearance_point(
+                        &program.cell,
+                        &start,
+                        &inputs[b.start_input],
+                        ArcFlag::Approach,
+                        opts,
+                        c,
+                    ) {
+                        Ok(a) => Some((b.first, a)),
+                        Err(_) => continue,
+                    }
+                }
+                None => None,
+            };
+            let old_retract = program.points[blocks[k].last];
+            let old_approach = approach.map(|(i, _)| program.points[i]);
+            program.points[blocks[k].last] = retract;
+            if let Some((i, a)) = approach {
+                program.points[i] = a;
+            }
+            if check(program, k)?.min_clearance_mm > 0.0 {
+                fixed = true;
+            } else {
+                program.points[blocks[k].last] = old_retract;
+                if let (Some((i, _)), Some(a)) = (approach, old_approach) {
+                    program.points[i] = a;
+                }
+            }
+        }
+        if !fixed {
+            return Err(refuse(format!(
+                ", even with the retract and approach points raised up to {} mm along the tool \
+                 axis (transit_max_clearance_mm)",
+                opts.transit_max_clearance_mm
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The approach or retract point of bead point `p` at `clearance_mm`, or,

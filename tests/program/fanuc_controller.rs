@@ -54,8 +54,6 @@
 //! the coordinated pair (positioner leader, robot follower) needs nothing
 //! else in the program (the pair is set up on the controller).
 
-use std::f64::consts::FRAC_PI_2;
-
 use waam_slicer::math::Point3;
 use waam_slicer::program::fanuc::{
     fanuc_files, joint_speed_ratio, FanucOptions, Op, PositionMode, TpProgram, JOINT_SPEED_MARGIN,
@@ -73,14 +71,10 @@ use waam_slicer::robot::Cell;
 use crate::fixture::{cell, part_carried, program};
 use crate::golden::check_golden;
 
-/// Home joints (deg) in the cell's wrist branch: FANUC `F` (J5 > 0) in the
-/// part-carried cell, `N` in the torch-carried one.
-fn home_deg(cell: &Cell) -> [f64; 6] {
-    let j5 = match cell {
-        Cell::PartCarried(_) => 90.0,
-        Cell::TorchCarried(_) => -90.0,
-    };
-    [0.0, 0.0, 0.0, 0.0, j5, 0.0]
+/// Home joints (deg): the last retract point's (the top of the wall, in
+/// the cell's branch), so that neither home move sweeps through the wall.
+fn home_deg(prog: &Program) -> [f64; 6] {
+    prog.points.last().unwrap().joints.map(f64::to_degrees)
 }
 
 /// Two layers of 8 points with a home position and a set-up before each
@@ -88,9 +82,10 @@ fn home_deg(cell: &Cell) -> [f64; 6] {
 /// the flange's z), before the second a 30 s dwell and a wait for DI[3].
 fn with_setup(cell: &Cell) -> (Program, Vec<Point3>) {
     let (mut prog, path) = program(cell, 0..2, 8);
+    let last = *prog.points.last().unwrap();
     prog.home = Some(HomePosition {
-        joints: home_deg(cell).map(f64::to_radians),
-        positioner: matches!(cell, Cell::TorchCarried(_)).then_some([0.0, FRAC_PI_2]),
+        joints: last.joints,
+        positioner: last.positioner,
     });
     prog.bead_setup = vec![
         BeadSetup {
@@ -116,14 +111,19 @@ fn with_setup(cell: &Cell) -> (Program, Vec<Point3>) {
 }
 
 /// The options the set-up programs are written and checked with.
-fn setup_opts(cell: &Cell, remote_tcp: bool) -> FanucOptions {
+fn setup_opts(prog: &Program, remote_tcp: bool) -> FanucOptions {
     let mut opts = FanucOptions {
         weld_procedure: Some(2),
         ..Default::default()
     };
     opts.common = ProgramOptions {
-        home_deg: Some(home_deg(cell)),
-        home_positioner_deg: Some([0.0, 90.0]),
+        home_deg: Some(home_deg(prog)),
+        home_positioner_deg: prog
+            .points
+            .last()
+            .unwrap()
+            .positioner
+            .map(|q| q.map(f64::to_degrees)),
         dwell_s: 30.0,
         interpass_input: Some(3),
         payload_every_layers: 1,
@@ -181,7 +181,7 @@ fn setup_steps(steps: &[Step]) -> Vec<String> {
 fn setup_golden_reads_back_into_the_right_steps() {
     let cell = part_carried();
     let (prog, planned) = with_setup(&cell);
-    let opts = setup_opts(&cell, true);
+    let opts = setup_opts(&prog, true);
     let files = fanuc_files(&prog, &opts).unwrap();
     assert_eq!(files.len(), 1);
     let text = &files[0].text;
@@ -213,7 +213,7 @@ fn setup_golden_reads_back_into_the_right_steps() {
     assert_eq!(motions.len(), 1 + 2 * 10 + 1);
     for m in [motions[0], motions[motions.len() - 1]] {
         let q = motion_joints_deg(m).unwrap();
-        for (a, b) in q.iter().zip(home_deg(&cell)) {
+        for (a, b) in q.iter().zip(home_deg(&prog)) {
             assert!((a - b).abs() < 1e-4, "{q:?}");
         }
     }
@@ -253,7 +253,7 @@ fn split_programs_keep_home_in_the_main_program() {
     let (prog, planned) = with_setup(&cell);
     let opts = FanucOptions {
         point_limit: 10,
-        ..setup_opts(&cell, false)
+        ..setup_opts(&prog, false)
     };
     let files = fanuc_files(&prog, &opts).unwrap();
     assert_eq!(files.len(), 3);
@@ -289,15 +289,19 @@ fn torch_carried_programs_are_coordinated_with_a_positioner_home() {
     for positions in [PositionMode::Joint, PositionMode::Cartesian] {
         let opts = FanucOptions {
             positions,
-            ..setup_opts(&cell, false)
+            ..setup_opts(&prog, false)
         };
         let files = fanuc_files(&prog, &opts).unwrap();
         let tps = read_all(&files);
         let steps = steps_of(&tps, &cell, &opts);
+        let want = prog.points.last().unwrap().positioner.unwrap();
         match &steps[0] {
             Step::Motion(m) => {
-                let g = m.positioner.unwrap().map(f64::to_degrees);
-                assert!(g[0].abs() < 1e-9 && (g[1] - 90.0).abs() < 1e-9, "{g:?}");
+                let g = m.positioner.unwrap();
+                assert!(
+                    (g[0] - want[0]).abs() < 1e-5 && (g[1] - want[1]).abs() < 1e-5,
+                    "{g:?} {want:?}"
+                );
             }
             s => panic!("{s:?}"),
         }
@@ -356,7 +360,7 @@ fn find(r: &ValidationReport, kind: ProblemKind, needle: &str) -> (usize, String
 fn a_wrong_or_missing_utool_statement_is_a_frame_problem() {
     let cell = cell("robowam_torch_carried.toml");
     let (prog, planned) = with_setup(&cell);
-    let opts = setup_opts(&cell, false);
+    let opts = setup_opts(&prog, false);
     let text = fanuc_files(&prog, &opts).unwrap()[0].text.clone();
     assert!(check_text(&text, &cell, &opts, &planned).is_ok());
     let (bad, _) = edit(&text, "UT1 Z,W=406.000", 0, |l| {
@@ -430,7 +434,7 @@ fn renumbered(text: &str) -> TpProgram {
 fn missing_coord_arc_true_or_a_wrong_weld_schedule_are_caught() {
     let cell = cell("robowam_torch_carried.toml");
     let (prog, planned) = with_setup(&cell);
-    let opts = setup_opts(&cell, false);
+    let opts = setup_opts(&prog, false);
     let text = fanuc_files(&prog, &opts).unwrap()[0].text.clone();
     // COORD dropped on the 5th bead move of layer 1 (the positioner turns)
     let start = text
@@ -476,7 +480,7 @@ fn missing_coord_arc_true_or_a_wrong_weld_schedule_are_caught() {
 fn remote_tcp_programs_are_checked() {
     let cell = part_carried();
     let (prog, planned) = with_setup(&cell);
-    let opts = setup_opts(&cell, true);
+    let opts = setup_opts(&prog, true);
     let text = fanuc_files(&prog, &opts).unwrap()[0].text.clone();
     let (bad, line) = edit(&text, "RTCP", 0, |l| l.replace(" RTCP", ""));
     let r = check_text(&bad, &cell, &opts, &planned);
@@ -524,7 +528,7 @@ fn wait_times_in_the_controllers_form() {
     let cell = part_carried();
     let (mut prog, _) = with_setup(&cell);
     prog.bead_setup[1].dwell_s = 0.5;
-    let opts = setup_opts(&cell, false);
+    let opts = setup_opts(&prog, false);
     let text = fanuc_files(&prog, &opts).unwrap()[0].text.clone();
     assert!(text.contains("  WAIT    .50(sec) ;"), "{text}");
     prog.bead_setup[1].dwell_s = 0.501;
@@ -541,18 +545,18 @@ fn bad_setup_data_is_refused() {
     let cell = part_carried();
     let (mut prog, _) = with_setup(&cell);
     prog.bead_setup.pop();
-    let e = fanuc_files(&prog, &setup_opts(&cell, false)).unwrap_err();
+    let e = fanuc_files(&prog, &setup_opts(&prog, false)).unwrap_err();
     assert!(
         e.to_string().contains("1 bead_setup entries for 2 beads"),
         "{e}"
     );
     let (mut prog, _) = with_setup(&cell);
     prog.bead_setup[1].dwell_s = f64::NAN;
-    let e = fanuc_files(&prog, &setup_opts(&cell, false)).unwrap_err();
+    let e = fanuc_files(&prog, &setup_opts(&prog, false)).unwrap_err();
     assert!(e.to_string().contains("bead_setup[1] (layer 1)"), "{e}");
     let (mut prog, _) = with_setup(&cell);
     prog.bead_setup[0].layer = 1;
-    let e = fanuc_files(&prog, &setup_opts(&cell, false)).unwrap_err();
+    let e = fanuc_files(&prog, &setup_opts(&prog, false)).unwrap_err();
     assert!(
         e.to_string().contains("bead_setup[0] is for layer 1"),
         "{e}"
@@ -566,8 +570,8 @@ fn bad_setup_data_is_refused() {
 #[test]
 fn a_segment_at_a_joints_limit_is_timed_under_rtcp() {
     let cell = part_carried();
-    let opts = setup_opts(&cell, true);
     let (base, planned) = with_setup(&cell);
+    let opts = setup_opts(&base, true);
     // the 4th bead point of layer 1: J6 turns the part under the torch
     let i = base
         .points

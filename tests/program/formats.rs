@@ -267,7 +267,9 @@ fn kuka_ini_fold_interrupt_and_bas_tool_base() {
         src.contains("\n  BAS (#TOOL,3)\n  BAS (#BASE,2)\n"),
         "{src}"
     );
-    assert!(!src.contains("$TOOL =") && !src.contains("$BASE ="));
+    // BAS selects the numbers (and the load); the frames the positions
+    // assume are then stated
+    assert!(src.contains("\n  $TOOL = {X ") && src.contains("\n  $BASE = {X "));
     let r = kuka_check(&f, src, &f[1].text, &c, &opts, &planned);
     assert!(r.is_ok(), "{r}");
     let other = KukaOptions {
@@ -337,8 +339,16 @@ fn kuka_corruptions_are_named_by_their_line() {
         "{r}"
     );
     // a dropped arc end: the next bead's start names it
-    let end = line_of(src, "DISTANCE=1", 0);
-    let next_start = line_of(src, "DISTANCE=0", end);
+    let exact = |needle: &str, after: usize| {
+        src.lines()
+            .enumerate()
+            .skip(after)
+            .find(|(_, l)| *l == needle)
+            .map(|(i, _)| i + 1)
+            .unwrap()
+    };
+    let end = exact("  $OUT[1]=FALSE", 0);
+    let next_start = exact("  $OUT[1]=TRUE", end);
     let dropped: String = src
         .lines()
         .enumerate()

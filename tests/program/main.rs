@@ -7,7 +7,9 @@ mod fanuc_controller;
 mod fixture;
 mod formats;
 mod golden;
+mod kuka_controller;
 mod parts;
+mod setup;
 #[path = "../common/mod.rs"]
 mod shared;
 mod split;

@@ -20,13 +20,65 @@ pub enum KrlOp {
     },
     /// `$VEL.CP = v` (m/s).
     VelCp(f64),
-    /// `TRIGGER WHEN DISTANCE=d DELAY=0 DO action`.
+    /// `TRIGGER WHEN DISTANCE=d DELAY=0 DO action [PRIO=p]`.
     Trigger {
         /// 0: at the next motion's start point, 1: at its end point.
         distance: u8,
         /// The statement switched.
         action: String,
+        /// `PRIO=p` (required when the action is a subprogram call).
+        prio: Option<i32>,
     },
+    /// `$TOOL = {X …,Y …,Z …,A …,B …,C …}` (mm, deg).
+    ToolFrame([f64; 6]),
+    /// `$BASE = {X …,Y …,Z …,A …,B …,C …}` (mm, deg).
+    BaseFrame([f64; 6]),
+    /// `$BASE = EK (MACHINE_DEF[m].ROOT, MACHINE_DEF[m].MECH_TYPE, {…})`:
+    /// the base math-coupled to external kinematic `m`, `offset` (mm, deg)
+    /// on its flange.
+    BaseEk {
+        /// `MACHINE_DEF` index.
+        machine: u8,
+        /// `[X, Y, Z, A, B, C]` (mm, deg).
+        offset: [f64; 6],
+    },
+    /// `$LOAD.M = m` (kg).
+    LoadMass(f64),
+    /// `$LOAD.CM = {X …,Y …,Z …,A …,B …,C …}` (mm, deg; flange frame).
+    LoadCm([f64; 6]),
+    /// `$LOAD.J = {X …,Y …,Z …}` (kg·m²).
+    LoadJ([f64; 3]),
+    /// `WAIT SEC s` (s).
+    WaitSec(f64),
+    /// `WAIT FOR $IN[n]`.
+    WaitIn(u32),
+    /// `WAIT FOR $IN[n] OR $TIMER_FLAG[t]`: an input wait with a timeout.
+    WaitInOrTimer {
+        /// Input `n`.
+        input: u32,
+        /// Timer `t`.
+        timer: u8,
+    },
+    /// `$TIMER[t] = v` (ms).
+    Timer {
+        /// Timer `t`.
+        timer: u8,
+        /// Value (ms).
+        ms: f64,
+    },
+    /// `$TIMER_STOP[t] = TRUE|FALSE`.
+    TimerStop {
+        /// Timer `t`.
+        timer: u8,
+        /// `TRUE`: stopped.
+        stop: bool,
+    },
+    /// `IF NOT $IN[n] THEN`.
+    IfNotIn(u32),
+    /// `ENDIF`.
+    EndIf,
+    /// `HALT`.
+    Halt,
     /// `$IPO_MODE = #TCP` (`true`) or `#BASE` (`false`).
     IpoTcp(bool),
     /// `$VEL_EXTAX[n] = p`: external axis `n` (1-based) at `p` % of its
@@ -250,11 +302,40 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
             let action = rest
                 .trim()
                 .strip_prefix("DELAY=0 DO ")
-                .ok_or_else(|| format!("bad TRIGGER `{l}`"))?;
+                .ok_or_else(|| format!("bad TRIGGER `{l}`"))?
+                .trim();
+            // a trailing `PRIO = p` (spaces optional)
+            let (action, prio) = match action.rfind("PRIO") {
+                Some(k) if action[..k].ends_with(' ') => {
+                    let v = action[k + 4..].trim_start();
+                    let v = v
+                        .strip_prefix('=')
+                        .map(str::trim)
+                        .ok_or_else(|| format!("bad PRIO in `{l}`"))?;
+                    let p: i32 = v.parse().map_err(|_| format!("bad PRIO `{v}` in `{l}`"))?;
+                    (action[..k].trim_end(), Some(p))
+                }
+                _ => (action, None),
+            };
             return Ok(KrlOp::Trigger {
                 distance,
-                action: action.trim().to_string(),
+                action: action.to_string(),
+                prio,
             });
+        }
+        Some("WAIT") => return parse_wait(l),
+        Some("HALT") if tokens.len() == 1 => return Ok(KrlOp::Halt),
+        Some("ENDIF") if tokens.len() == 1 => return Ok(KrlOp::EndIf),
+        Some("IF") => {
+            if let Some(n) = l
+                .strip_prefix("IF NOT ")
+                .and_then(|r| r.strip_suffix("THEN"))
+                .and_then(|r| index_of(r.trim(), "$IN["))
+            {
+                return Ok(KrlOp::IfNotIn(
+                    u32::try_from(n).map_err(|_| format!("bad input in `{l}`"))?,
+                ));
+            }
         }
         Some(b) if b.starts_with("BAS") => {
             if let Some(args) = l
@@ -312,6 +393,42 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
                     .ok_or_else(|| format!("bad {k} `{v}` (0 < % <= 100)"))?;
                 return Ok(KrlOp::VelExtax { axis, percent });
             }
+            "$LOAD.M" => {
+                let m: f64 = v
+                    .parse()
+                    .ok()
+                    .filter(|x: &f64| x.is_finite() && *x >= 0.0)
+                    .ok_or_else(|| format!("bad $LOAD.M `{v}` (kg >= 0)"))?;
+                return Ok(KrlOp::LoadMass(m));
+            }
+            "$LOAD.CM" => return Ok(KrlOp::LoadCm(frame_of(v)?)),
+            "$LOAD.J" => {
+                let f = aggregate(v)?;
+                let get = |k: &str| field(&f, k, v);
+                return Ok(KrlOp::LoadJ([get("X")?, get("Y")?, get("Z")?]));
+            }
+            _ if k.starts_with("$TIMER[") => {
+                let timer = index_of(k, "$TIMER[")
+                    .and_then(|n| u8::try_from(n).ok())
+                    .ok_or_else(|| format!("bad `{k}`"))?;
+                let ms: f64 = v
+                    .parse()
+                    .ok()
+                    .filter(|x: &f64| x.is_finite())
+                    .ok_or_else(|| format!("bad {k} `{v}`"))?;
+                return Ok(KrlOp::Timer { timer, ms });
+            }
+            _ if k.starts_with("$TIMER_STOP[") => {
+                let timer = index_of(k, "$TIMER_STOP[")
+                    .and_then(|n| u8::try_from(n).ok())
+                    .ok_or_else(|| format!("bad `{k}`"))?;
+                let stop = match v {
+                    "TRUE" => true,
+                    "FALSE" => false,
+                    _ => return Err(format!("bad {k} `{v}`")),
+                };
+                return Ok(KrlOp::TimerStop { timer, stop });
+            }
             "$IPO_MODE" => {
                 return match v {
                     "#TCP" => Ok(KrlOp::IpoTcp(true)),
@@ -319,6 +436,15 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
                     _ => Err(format!("bad $IPO_MODE `{v}`")),
                 };
             }
+            "$TOOL" | "$BASE" if v.starts_with('{') => {
+                let f = frame_of(v)?;
+                return Ok(if k == "$TOOL" {
+                    KrlOp::ToolFrame(f)
+                } else {
+                    KrlOp::BaseFrame(f)
+                });
+            }
+            "$BASE" if v.starts_with("EK") => return parse_ek(v),
             "$TOOL" | "$BASE" => {
                 let prefix = if k == "$TOOL" {
                     "TOOL_DATA["
@@ -340,6 +466,131 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
         }
     }
     Ok(KrlOp::Other(l.to_string()))
+}
+
+/// `n` of `PREFIX n]` at the start of `s` (`$IN[3]`, `$TIMER[1]`).
+fn index_of(s: &str, prefix: &str) -> Option<i64> {
+    s.strip_prefix(prefix)?
+        .strip_suffix(']')?
+        .trim()
+        .parse::<i64>()
+        .ok()
+        .filter(|n| *n >= 1)
+}
+
+/// `WAIT SEC s`, `WAIT FOR $IN[n]`, `WAIT FOR $IN[n] OR $TIMER_FLAG[t]`.
+fn parse_wait(l: &str) -> Result<KrlOp, String> {
+    if let Some(v) = l.strip_prefix("WAIT SEC") {
+        let s: f64 = v
+            .trim()
+            .parse()
+            .ok()
+            .filter(|x: &f64| x.is_finite() && *x >= 0.0)
+            .ok_or_else(|| format!("bad `{l}` (seconds >= 0)"))?;
+        return Ok(KrlOp::WaitSec(s));
+    }
+    let cond = l
+        .strip_prefix("WAIT FOR")
+        .map(str::trim)
+        .ok_or_else(|| format!("bad WAIT `{l}`"))?;
+    let input = |t: &str| {
+        index_of(t.trim(), "$IN[")
+            .and_then(|n| u32::try_from(n).ok())
+            .ok_or_else(|| format!("expected `$IN[n]` in `{l}`"))
+    };
+    match cond.split_once(" OR ") {
+        None => Ok(KrlOp::WaitIn(input(cond)?)),
+        Some((a, b)) => {
+            let timer = index_of(b.trim(), "$TIMER_FLAG[")
+                .and_then(|n| u8::try_from(n).ok())
+                .ok_or_else(|| format!("expected `$TIMER_FLAG[t]` in `{l}`"))?;
+            Ok(KrlOp::WaitInOrTimer {
+                input: input(a)?,
+                timer,
+            })
+        }
+    }
+}
+
+/// The `KEY value` fields of an aggregate `{KEY value,...}` (an optional
+/// `FRAME:` type prefix accepted).
+fn aggregate(v: &str) -> Result<Vec<(String, f64)>, String> {
+    let body = v
+        .trim()
+        .strip_prefix('{')
+        .and_then(|b| b.strip_suffix('}'))
+        .ok_or_else(|| format!("expected `{{...}}`, got `{v}`"))?;
+    let body = body.trim();
+    let body = body.strip_prefix("FRAME:").unwrap_or(body);
+    body.split(',')
+        .map(|part| {
+            let (k, x) = part
+                .trim()
+                .split_once(' ')
+                .ok_or_else(|| format!("expected `KEY value`, got `{}`", part.trim()))?;
+            let x: f64 = x
+                .trim()
+                .parse()
+                .ok()
+                .filter(|x: &f64| x.is_finite())
+                .ok_or_else(|| format!("bad number `{}` for {k}", x.trim()))?;
+            Ok((k.trim().to_ascii_uppercase(), x))
+        })
+        .collect()
+}
+
+fn field(f: &[(String, f64)], k: &str, v: &str) -> Result<f64, String> {
+    f.iter()
+        .find(|(n, _)| n == k)
+        .map(|(_, x)| *x)
+        .ok_or_else(|| format!("no {k} in `{v}`"))
+}
+
+/// `[X, Y, Z, A, B, C]` of a `FRAME` aggregate.
+fn frame_of(v: &str) -> Result<[f64; 6], String> {
+    let f = aggregate(v)?;
+    let mut out = [0.0; 6];
+    for (o, k) in out.iter_mut().zip(["X", "Y", "Z", "A", "B", "C"]) {
+        *o = field(&f, k, v)?;
+    }
+    Ok(out)
+}
+
+/// `EK (MACHINE_DEF[m].ROOT, MACHINE_DEF[m].MECH_TYPE, {…})`.
+fn parse_ek(v: &str) -> Result<KrlOp, String> {
+    let bad = || {
+        format!("bad `$BASE = {v}`: expected `EK (MACHINE_DEF[m].ROOT, MACHINE_DEF[m].MECH_TYPE, {{X …}})`")
+    };
+    let args = v
+        .strip_prefix("EK")
+        .map(str::trim)
+        .and_then(|r| r.strip_prefix('('))
+        .and_then(|r| r.strip_suffix(')'))
+        .ok_or_else(bad)?;
+    let brace = args.find('{').ok_or_else(bad)?;
+    let (head, offset) = args.split_at(brace);
+    let parts: Vec<&str> = head.split(',').map(str::trim).collect();
+    let [root, mech, ""] = parts[..] else {
+        return Err(bad());
+    };
+    let machine_of = |s: &str, field: &str| {
+        s.strip_prefix("MACHINE_DEF[")
+            .and_then(|r| r.strip_suffix(field))
+            .and_then(|r| r.strip_suffix(']'))
+            .and_then(|n| n.trim().parse::<u8>().ok())
+    };
+    let (Some(m), Some(m2)) = (machine_of(root, ".ROOT"), machine_of(mech, ".MECH_TYPE")) else {
+        return Err(bad());
+    };
+    if m != m2 {
+        return Err(format!(
+            "`$BASE = {v}`: ROOT of MACHINE_DEF[{m}], MECH_TYPE of MACHINE_DEF[{m2}]"
+        ));
+    }
+    Ok(KrlOp::BaseEk {
+        machine: m,
+        offset: frame_of(offset.trim())?,
+    })
 }
 
 fn parse_dat(text: &str, file: &str) -> Result<(String, Vec<KrlPosition>), ProgramError> {

@@ -6,11 +6,14 @@ use std::f64::consts::PI;
 
 use crate::math::Point3;
 use crate::program::fanuc::MoveKind;
+use crate::program::transit::{joint_move_clearance, wall_of};
+use crate::program::ProgramOptions;
 use crate::robot::{Cell, Joints};
+use crate::toolaxis::collision::Torch;
 
 use super::ProblemKind;
 use super::{
-    deposition_point, push, MotionSpeed, Step, ValidationReport, NAMES, REACH_TOLERANCE_MM,
+    deposition_point, push, Motion, MotionSpeed, Step, ValidationReport, NAMES, REACH_TOLERANCE_MM,
 };
 
 /// Checks decoded `steps` against `cell` (module doc), adding problems and
@@ -23,7 +26,6 @@ pub fn check_steps(
     common: &crate::program::ProgramOptions,
     report: &mut ValidationReport,
 ) {
-    let _ = common;
     // which motions are bead points: made with the process on, or the last
     // motion before the process starts
     let mut bead = vec![false; steps.len()];
@@ -280,6 +282,7 @@ pub fn check_steps(
                 .into(),
         );
     }
+    check_setup(steps, cell, common, &bead, report);
     if let Some(p) = planned {
         if p.len() != bead_motions {
             push(
@@ -292,6 +295,270 @@ pub fn check_steps(
                     p.len()
                 ),
             );
+        }
+    }
+}
+
+/// Largest difference between a home joint in the file and the cell's
+/// `home_deg` (rad): 0.01°, above the files' rounding.
+const HOME_TOLERANCE_RAD: f64 = 0.01 * PI / 180.0;
+
+/// Checks the program's set-up against the cell's `[program]` options
+/// (`common`): home as first and last motion, the dwell, interpass wait and
+/// payload updates between beads (never with the arc on), and every arc-off
+/// joint move against the wall deposited before it (the bead motions'
+/// deposition points, capsules of `bead_radius_mm`; the substrate is not in
+/// the files and is not checked). `bead[i]`: step `i` is a bead motion.
+fn check_setup(
+    steps: &[Step],
+    cell: &Cell,
+    common: &ProgramOptions,
+    bead: &[bool],
+    report: &mut ValidationReport,
+) {
+    let motions: Vec<(usize, &Motion)> = steps
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| match s {
+            Step::Motion(m) => Some((i, m.as_ref())),
+            _ => None,
+        })
+        .collect();
+    if let Some(h) = common.home(cell) {
+        let is_home = |m: &Motion| {
+            m.kind == MoveKind::Joint
+                && m.joints.is_some_and(|q| {
+                    q.iter()
+                        .zip(h.joints)
+                        .all(|(a, b)| (a - b).abs() <= HOME_TOLERANCE_RAD)
+                })
+                && match (h.positioner, m.positioner) {
+                    (Some(a), Some(b)) => a
+                        .iter()
+                        .zip(b)
+                        .all(|(x, y)| (x - y).abs() <= HOME_TOLERANCE_RAD),
+                    (None, _) => true,
+                    (Some(_), None) => false,
+                }
+        };
+        let home_deg = |h: &crate::program::HomePosition| {
+            h.joints
+                .iter()
+                .map(|v| format!("{:.3}", v.to_degrees()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        for (which, m) in [("first", motions.first()), ("last", motions.last())] {
+            match m {
+                Some((_, m)) if !is_home(m) => push(
+                    report,
+                    ProblemKind::Setup,
+                    &m.file,
+                    m.line,
+                    format!(
+                        "the {which} motion ({}) is not a joint move to the cell's home [{}] deg",
+                        m.label,
+                        home_deg(&h)
+                    ),
+                ),
+                None => push(
+                    report,
+                    ProblemKind::Setup,
+                    "",
+                    0,
+                    "no motion: the cell's home position is never reached".into(),
+                ),
+                _ => {}
+            }
+        }
+    }
+    // what happens before each bead: from the end of the previous bead (or
+    // the program start) to the bead's process-on
+    let part_carried = matches!(cell, Cell::PartCarried(_));
+    let mut on = false;
+    let mut beads_started = 0usize;
+    let mut waited_s = 0.0;
+    let mut waited_input = false;
+    let mut payload = false;
+    let mut last_mass: Option<f64> = None;
+    for s in steps {
+        match s {
+            Step::ProcessOn { file, line } => {
+                let k = beads_started;
+                let mut missing = Vec::new();
+                if k > 0 && common.dwell_s > 0.0 && waited_s + 0.005 < common.dwell_s {
+                    missing.push(format!(
+                        "an interlayer dwell of {} s (waits {waited_s} s)",
+                        common.dwell_s
+                    ));
+                }
+                if let (true, Some(n)) = (k > 0, common.interpass_input) {
+                    if !waited_input {
+                        missing.push(format!("an interpass wait on input {n}"));
+                    }
+                }
+                let every = common.payload_every_layers as usize;
+                if part_carried && every > 0 && k % every == 0 && !payload {
+                    missing.push("a payload update".into());
+                }
+                if !missing.is_empty() {
+                    push(
+                        report,
+                        ProblemKind::Setup,
+                        file,
+                        *line,
+                        format!(
+                            "bead {} starts without {} before it (cell [program] options)",
+                            k + 1,
+                            missing.join(", ")
+                        ),
+                    );
+                }
+                beads_started += 1;
+                on = true;
+            }
+            Step::ProcessOff { .. } => {
+                on = false;
+                waited_s = 0.0;
+                waited_input = false;
+                payload = false;
+            }
+            Step::Wait {
+                file,
+                line,
+                seconds,
+                input,
+            } => {
+                if on {
+                    push(
+                        report,
+                        ProblemKind::Setup,
+                        file,
+                        *line,
+                        "a wait with the arc on (the bead would burn through)".into(),
+                    );
+                }
+                waited_s += seconds.unwrap_or(0.0);
+                if input.is_some() && *input == common.interpass_input {
+                    waited_input = true;
+                }
+            }
+            Step::Payload {
+                file,
+                line,
+                mass_kg,
+                cog_mm,
+            } => {
+                if on {
+                    push(
+                        report,
+                        ProblemKind::Setup,
+                        file,
+                        *line,
+                        "a payload change with the arc on".into(),
+                    );
+                }
+                if !(mass_kg.is_finite() && *mass_kg >= 0.0 && cog_mm.iter().all(|v| v.is_finite()))
+                {
+                    push(
+                        report,
+                        ProblemKind::Setup,
+                        file,
+                        *line,
+                        format!("payload {mass_kg} kg at {cog_mm:?} is not a valid load"),
+                    );
+                } else if last_mass.is_some_and(|m| *mass_kg + 1e-3 < m) {
+                    push(
+                        report,
+                        ProblemKind::Setup,
+                        file,
+                        *line,
+                        format!(
+                            "payload {mass_kg:.3} kg is less than the previous {:.3} kg: the part only grows",
+                            last_mass.unwrap_or_default()
+                        ),
+                    );
+                } else if last_mass.is_none() && *mass_kg + 1e-3 < common.payload_base_kg {
+                    push(
+                        report,
+                        ProblemKind::Setup,
+                        file,
+                        *line,
+                        format!(
+                            "payload {mass_kg:.3} kg is less than the substrate and fixture ({} kg)",
+                            common.payload_base_kg
+                        ),
+                    );
+                }
+                last_mass = Some(*mass_kg);
+                payload = true;
+            }
+            Step::Motion(_) => {}
+        }
+    }
+    if common.transit_check {
+        check_transits(steps, cell, common, bead, report);
+    }
+}
+
+/// Every arc-off joint move against the wall of the beads before it.
+fn check_transits(
+    steps: &[Step],
+    cell: &Cell,
+    common: &ProgramOptions,
+    bead: &[bool],
+    report: &mut ValidationReport,
+) {
+    let Ok(torch) = Torch::new(&Default::default()) else {
+        return;
+    };
+    let mut beads: Vec<Vec<Point3>> = Vec::new();
+    let mut current: Vec<Point3> = Vec::new();
+    let mut prev: Option<(Joints, Option<[f64; 2]>)> = None;
+    for (i, s) in steps.iter().enumerate() {
+        match s {
+            Step::ProcessOff { .. } => {
+                if !current.is_empty() {
+                    beads.push(std::mem::take(&mut current));
+                }
+            }
+            Step::Motion(m) => {
+                let Some(q) = m.joints else {
+                    prev = None;
+                    continue;
+                };
+                if bead[i] {
+                    if let Some(d) = deposition_point(cell, &q, m.positioner) {
+                        current.push(d);
+                    }
+                }
+                if let (Some((pq, pp)), MoveKind::Joint) = (prev, m.kind) {
+                    if !beads.is_empty() {
+                        let wall = wall_of(beads.iter().map(Vec::as_slice), common.bead_radius_mm);
+                        match joint_move_clearance(cell, &wall, &torch, (&pq, pp), (&q, m.positioner)) {
+                            Ok(c) if c.min_clearance_mm <= 0.0 => push(
+                                report,
+                                ProblemKind::Collision,
+                                &m.file,
+                                m.line,
+                                format!(
+                                    "the joint move to {} sweeps the torch {:.1} mm into the deposited wall at {:.0}% of the move (torch tip at [{:.1}, {:.1}, {:.1}] mm, part frame)",
+                                    m.label,
+                                    -c.min_clearance_mm,
+                                    100.0 * c.at_fraction,
+                                    c.tip_mm.x,
+                                    c.tip_mm.y,
+                                    c.tip_mm.z
+                                ),
+                            ),
+                            Ok(_) => {}
+                            Err(e) => push(report, ProblemKind::Collision, &m.file, m.line, format!("transit check: {e}")),
+                        }
+                    }
+                }
+                prev = Some((q, m.positioner));
+            }
+            _ => {}
         }
     }
 }

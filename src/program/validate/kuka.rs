@@ -4,8 +4,11 @@
 
 use std::f64::consts::TAU;
 
+use std::ops::{Mul, Sub};
+
 use crate::math::{Isometry3, Point3};
 use crate::program::fanuc::MoveKind;
+use crate::program::kuka::StatedBase;
 use crate::robot::{Cell, Configuration, Joints, Vendor};
 
 use super::ProblemKind;
@@ -29,8 +32,6 @@ pub fn validate_kuka(
     opts: &crate::program::kuka::KukaOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
-    use crate::program::readback::kuka::{KrlOp, KrlValue};
-    use crate::robot::orientation::KukaAbc;
     let mut report = ValidationReport::default();
     if !vendor_matches(
         cell,
@@ -41,9 +42,34 @@ pub fn validate_kuka(
     ) {
         return report;
     }
+    let steps = kuka_steps(program, cell, opts, &mut report);
+    check_steps(&steps, cell, planned, &opts.common, &mut report);
+    report
+}
+
+/// The [`Step`]s of a KUKA program (motions decoded, process on and off,
+/// waits, payloads) in execution order, with the problems of the file
+/// itself (frames, triggers, ignition handshake, end times) added to
+/// `report_out`. The cell's robot must be a KUKA arm.
+pub(crate) fn kuka_steps(
+    program: &crate::program::readback::kuka::KrlProgram,
+    cell: &Cell,
+    opts: &crate::program::kuka::KukaOptions,
+    report_out: &mut ValidationReport,
+) -> Vec<Step> {
+    use crate::program::readback::kuka::{KrlOp, KrlValue};
+    use crate::robot::orientation::KukaAbc;
+    let mut report = std::mem::take(report_out);
     let robot = cell.robot();
-    let (base, tool) = opts.frames(cell);
+    let (_, tool) = opts.frames(cell);
     let (on, off) = crate::program::kuka::switch_statements(opts);
+    let same = |a: &str, b: &str| {
+        a.chars()
+            .filter(|c| !c.is_whitespace())
+            .eq(b.chars().filter(|c| !c.is_whitespace()))
+    };
+    let arc = opts.arc_process();
+    let coordinated = opts.coordinated(cell);
     let src = &program.src_file;
     let dat = &program.dat_file;
     let mut steps = Vec::new();
@@ -54,8 +80,60 @@ pub fn validate_kuka(
     // `$VEL_EXTAX[n]` left them (assumed 100 before either)
     let mut vel_extax = [100.0; 6];
     let external_tcp = opts.uses_external_tcp(cell);
+    // frames stated before the first motion
+    let mut tool_stated = false;
+    let mut base_stated = false;
+    let mut first_motion = true;
+    // the arc process: ignition handshake after each arc on, end times
+    let mut ign: Option<Ignition> = None;
+    let mut in_if: Option<(usize, bool)> = None; // (line, HALT seen)
+    let mut arc_is_on = false;
+    let mut crater: Option<(f64, usize)> = None;
+    let mut after_off: Option<usize> = None;
+    let mut mass: Option<(f64, usize)> = None;
+    let frame_problem = |report: &mut ValidationReport, line: usize, msg: String| {
+        push(report, ProblemKind::Frame, src, line, msg)
+    };
     for st in &program.statements {
         let line = st.line;
+        // the burn-back wait is the statement right after the arc off
+        if let Some(l) = after_off.take() {
+            if let KrlOp::WaitSec(s) = &st.op {
+                check_time(&mut report, src, line, "burn-back", *s, opts.burn_back_s);
+                continue;
+            }
+            missing_burn_back(&mut report, src, l, opts);
+        }
+        if let Some((l, halted)) = &mut in_if {
+            // inside `IF NOT $IN[n] THEN … ENDIF`: the failed-ignition branch
+            match &st.op {
+                KrlOp::Halt => *halted = true,
+                KrlOp::EndIf => {
+                    if let Some(g) = &mut ign {
+                        g.halt = *halted;
+                    }
+                    if !*halted {
+                        push(
+                            &mut report,
+                            ProblemKind::Instruction,
+                            src,
+                            *l,
+                            "the failed-ignition branch does not stop the program (no HALT)".into(),
+                        );
+                    }
+                    in_if = None;
+                }
+                KrlOp::Ptp(_) | KrlOp::Lin { .. } => push(
+                    &mut report,
+                    ProblemKind::Instruction,
+                    src,
+                    line,
+                    "motion inside the failed-ignition branch".into(),
+                ),
+                _ => {}
+            }
+            continue;
+        }
         let (target, linear) = match &st.op {
             KrlOp::Ptp(t) => (t, false),
             KrlOp::Lin { target, .. } => (target, true),
@@ -76,16 +154,39 @@ pub fn validate_kuka(
                 vel_extax = [*p; 6];
                 continue;
             }
-            KrlOp::Trigger { distance, action } => {
+            KrlOp::Trigger {
+                distance,
+                action,
+                prio,
+            } => {
+                if crate::program::kuka::is_call(action) && prio.is_none() {
+                    push(
+                        &mut report,
+                        ProblemKind::Instruction,
+                        src,
+                        line,
+                        format!("TRIGGER calls the subprogram `{action}` without PRIO (KRL requires one, e.g. PRIO=-1)"),
+                    );
+                }
+                if arc && same(action, &on) {
+                    push(
+                        &mut report,
+                        ProblemKind::Instruction,
+                        src,
+                        line,
+                        format!(
+                            "the arc is switched on by a TRIGGER while moving: no ignition wait for $IN[{}] is possible",
+                            opts.arc_ok_input
+                        ),
+                    );
+                }
                 pending.push((*distance, action.clone(), line));
                 continue;
             }
             KrlOp::IpoTcp(tcp) => {
                 if *tcp != opts.uses_external_tcp(cell) {
-                    push(
+                    frame_problem(
                         &mut report,
-                        ProblemKind::Frame,
-                        src,
                         line,
                         format!(
                             "$IPO_MODE = {}, the options give {}",
@@ -102,26 +203,318 @@ pub fn validate_kuka(
                     _ => ("BASE_DATA", opts.base),
                 };
                 if *n != want {
-                    push(
+                    frame_problem(
                         &mut report,
-                        ProblemKind::Frame,
-                        src,
                         line,
                         format!("{what}[{n}], the options give {want}"),
                     );
                 }
                 continue;
             }
-            KrlOp::Other(_) => continue,
+            KrlOp::ToolFrame(f) => {
+                tool_stated = true;
+                if let Some(d) = frame_differs(f, &tool) {
+                    frame_problem(
+                        &mut report,
+                        line,
+                        format!(
+                            "$TOOL = {} differs from the frame the positions assume, {} ({d})",
+                            show(f),
+                            crate::program::kuka::frame_literal(&tool)
+                        ),
+                    );
+                }
+                continue;
+            }
+            KrlOp::BaseFrame(f) => {
+                base_stated = true;
+                match opts.stated_base(cell) {
+                    StatedBase::Fixed(base) => {
+                        if let Some(d) = frame_differs(f, &base) {
+                            frame_problem(
+                                &mut report,
+                                line,
+                                format!(
+                                    "$BASE = {} differs from the frame the positions assume, {} ({d})",
+                                    show(f),
+                                    crate::program::kuka::frame_literal(&base)
+                                ),
+                            );
+                        }
+                    }
+                    StatedBase::Coupled { machine, .. } => frame_problem(
+                        &mut report,
+                        line,
+                        format!(
+                            "$BASE is a fixed frame: the positioner is not math-coupled (expected $BASE = EK (MACHINE_DEF[{machine}].ROOT, …) for coordinated motion)"
+                        ),
+                    ),
+                }
+                continue;
+            }
+            KrlOp::BaseEk { machine, offset } => {
+                base_stated = true;
+                match opts.stated_base(cell) {
+                    StatedBase::Coupled {
+                        machine: want,
+                        offset: want_offset,
+                    } => {
+                        if *machine != want {
+                            frame_problem(
+                                &mut report,
+                                line,
+                                format!("$BASE = EK of MACHINE_DEF[{machine}], the options give {want}"),
+                            );
+                        }
+                        if let Some(d) = frame_differs(offset, &want_offset) {
+                            frame_problem(
+                                &mut report,
+                                line,
+                                format!(
+                                    "EK offset {} is not the part frame on the table {} ({d})",
+                                    show(offset),
+                                    crate::program::kuka::frame_literal(&want_offset)
+                                ),
+                            );
+                        }
+                    }
+                    StatedBase::Fixed(_) => frame_problem(
+                        &mut report,
+                        line,
+                        "$BASE = EK (math-coupled positioner), but the options give a fixed base (coordinated motion off, no positioner, or the fixed-tool mode)".into(),
+                    ),
+                }
+                continue;
+            }
+            KrlOp::LoadMass(m) => {
+                mass = Some((*m, line));
+                continue;
+            }
+            KrlOp::LoadCm(c) => {
+                match mass.take() {
+                    Some((m, _)) => steps.push(Step::Payload {
+                        file: src.clone(),
+                        line,
+                        mass_kg: m,
+                        cog_mm: crate::math::Point3::new(c[0], c[1], c[2]),
+                    }),
+                    None => push(
+                        &mut report,
+                        ProblemKind::Instruction,
+                        src,
+                        line,
+                        "$LOAD.CM without a $LOAD.M before it".into(),
+                    ),
+                }
+                continue;
+            }
+            KrlOp::LoadJ(_) => continue,
+            KrlOp::WaitSec(s) => {
+                if arc_is_on {
+                    crater = Some((*s, line));
+                } else {
+                    steps.push(Step::Wait {
+                        file: src.clone(),
+                        line,
+                        seconds: Some(*s),
+                        input: None,
+                    });
+                }
+                continue;
+            }
+            KrlOp::WaitIn(n) => {
+                steps.push(Step::Wait {
+                    file: src.clone(),
+                    line,
+                    seconds: None,
+                    input: Some(*n),
+                });
+                continue;
+            }
+            KrlOp::Timer { timer, ms } => {
+                if let Some(g) = &mut ign {
+                    if *timer == opts.ignition_timer {
+                        g.timer_ms = Some(*ms);
+                    }
+                }
+                continue;
+            }
+            KrlOp::TimerStop { timer, stop } => {
+                if let Some(g) = &mut ign {
+                    if *timer == opts.ignition_timer && !stop && g.timer_ms.is_some() {
+                        g.started = true;
+                    }
+                }
+                continue;
+            }
+            KrlOp::WaitInOrTimer { input, timer } => {
+                match &mut ign {
+                    Some(g) => {
+                        if *input != opts.arc_ok_input || *timer != opts.ignition_timer {
+                            push(
+                                &mut report,
+                                ProblemKind::Options,
+                                src,
+                                line,
+                                format!(
+                                    "ignition wait on $IN[{input}] / $TIMER_FLAG[{timer}], the options give $IN[{}] / $TIMER_FLAG[{}]",
+                                    opts.arc_ok_input, opts.ignition_timer
+                                ),
+                            );
+                        }
+                        let want = -(opts.ignition_timeout_s * 1000.0).round();
+                        match (g.timer_ms, g.started) {
+                            (Some(ms), true) if (ms - want).abs() <= 0.5 => {}
+                            (Some(ms), true) => push(
+                                &mut report,
+                                ProblemKind::Options,
+                                src,
+                                line,
+                                format!(
+                                    "ignition timeout {:.3} s ($TIMER[{timer}] = {ms}), the options give {:.3} s",
+                                    -ms / 1000.0,
+                                    opts.ignition_timeout_s
+                                ),
+                            ),
+                            _ => push(
+                                &mut report,
+                                ProblemKind::Instruction,
+                                src,
+                                line,
+                                format!("ignition wait without its timer: $TIMER[{timer}] not set to minus the timeout and started"),
+                            ),
+                        }
+                        g.waited = Some(*input);
+                    }
+                    None => steps.push(Step::Wait {
+                        file: src.clone(),
+                        line,
+                        seconds: None,
+                        input: Some(*input),
+                    }),
+                }
+                continue;
+            }
+            KrlOp::IfNotIn(n) => {
+                if ign.as_ref().is_some_and(|g| g.waited == Some(*n)) {
+                    in_if = Some((line, false));
+                } else {
+                    push(
+                        &mut report,
+                        ProblemKind::Instruction,
+                        src,
+                        line,
+                        format!("`IF NOT $IN[{n}] THEN` outside an ignition check"),
+                    );
+                    in_if = Some((line, false));
+                }
+                continue;
+            }
+            KrlOp::EndIf | KrlOp::Halt => {
+                push(
+                    &mut report,
+                    ProblemKind::Instruction,
+                    src,
+                    line,
+                    format!(
+                        "unexpected `{}`",
+                        if st.op == KrlOp::Halt {
+                            "HALT"
+                        } else {
+                            "ENDIF"
+                        }
+                    ),
+                );
+                continue;
+            }
+            KrlOp::Other(text) => {
+                if same(text, &on) {
+                    steps.push(Step::ProcessOn {
+                        file: src.clone(),
+                        line,
+                    });
+                    arc_is_on = true;
+                    if arc {
+                        ign = Some(Ignition {
+                            line,
+                            ..Default::default()
+                        });
+                    }
+                } else if same(text, &off) {
+                    steps.push(Step::ProcessOff {
+                        file: src.clone(),
+                        line,
+                    });
+                    arc_is_on = false;
+                    if arc {
+                        let (s, _) = crater.take().unwrap_or((0.0, line));
+                        check_time(&mut report, src, line, "crater fill", s, opts.crater_fill_s);
+                        after_off = Some(line);
+                    }
+                }
+                continue;
+            }
         };
+        // a motion: the frames must have been stated, the ignition checked
+        if first_motion {
+            first_motion = false;
+            if !tool_stated {
+                frame_problem(
+                    &mut report,
+                    line,
+                    format!(
+                        "first motion before the program states $TOOL (expected $TOOL = {})",
+                        crate::program::kuka::frame_literal(&tool)
+                    ),
+                );
+            }
+            if !base_stated {
+                let want = match opts.stated_base(cell) {
+                    StatedBase::Fixed(b) => crate::program::kuka::frame_literal(&b),
+                    StatedBase::Coupled { machine, .. } => {
+                        format!("EK (MACHINE_DEF[{machine}].ROOT, …): the positioner is not math-coupled")
+                    }
+                };
+                frame_problem(
+                    &mut report,
+                    line,
+                    format!(
+                        "first motion before the program states $BASE (expected $BASE = {want})"
+                    ),
+                );
+            }
+        }
+        if let Some(g) = ign.take() {
+            if g.waited.is_none() || !g.halt {
+                push(
+                    &mut report,
+                    ProblemKind::Instruction,
+                    src,
+                    g.line,
+                    format!(
+                        "arc on without the ignition handshake before the next motion (WAIT FOR $IN[{}] OR $TIMER_FLAG[{}] with a {:.3} s timeout, then IF NOT $IN[{}] THEN … HALT ENDIF)",
+                        opts.arc_ok_input, opts.ignition_timer, opts.ignition_timeout_s, opts.arc_ok_input
+                    ),
+                );
+            }
+        }
+        if let Some((_, l)) = mass.take() {
+            push(
+                &mut report,
+                ProblemKind::Instruction,
+                src,
+                l,
+                "$LOAD.M without a $LOAD.CM after it".into(),
+            );
+        }
         let mut after = Vec::new();
         for (distance, action, l) in pending.drain(..) {
-            let step = if action == on {
+            let step = if same(&action, &on) {
                 Step::ProcessOn {
                     file: src.clone(),
                     line: l,
                 }
-            } else if action == off {
+            } else if same(&action, &off) {
                 Step::ProcessOff {
                     file: src.clone(),
                     line: l,
@@ -181,6 +574,8 @@ pub fn validate_kuka(
                 ),
             );
         }
+        let positioner =
+            matches!(cell, Cell::TorchCarried(_)).then(|| pos.external.map(f64::to_radians));
         let (joints, from_cartesian) = match &pos.value {
             KrlValue::Axis(a) => (Some(a.map(f64::to_radians)), false),
             KrlValue::Pos {
@@ -211,6 +606,8 @@ pub fn validate_kuka(
                     nalgebra::Translation3::new(xyzabc[0], xyzabc[1], xyzabc[2]),
                     nalgebra::UnitQuaternion::from_rotation_matrix(&rot),
                 );
+                // with a coupled base, the base at this position's E1, E2
+                let base = opts.base_at(cell, positioner);
                 let base_from_flange = base * pose * tool.inverse();
                 let q = decode_pose(
                     robot,
@@ -238,12 +635,14 @@ pub fn validate_kuka(
                 (q, true)
             }
         };
-        // Outside the fixed-tool mode $VEL.CP is the TCP's speed in the
-        // robot frame, and external axes move with the path at
-        // $VEL_EXTAX. (In the fixed-tool mode $VEL.CP is the torch's speed
-        // over the part, the planned meaning.)
+        // Outside the fixed-tool mode and without a coupled base $VEL.CP is
+        // the TCP's speed in the robot frame, and external axes move with
+        // the path at $VEL_EXTAX. (In the fixed-tool mode $VEL.CP is the
+        // torch's speed over the part; with the base coupled to the
+        // positioner it is the TCP's speed relative to the moving base, the
+        // part: both the planned meaning.)
         let speed = match speed {
-            MotionSpeed::Linear(v) if !external_tcp => MotionSpeed::Tcp {
+            MotionSpeed::Linear(v) if !external_tcp && !coordinated => MotionSpeed::Tcp {
                 mm_s: v,
                 flange_from_tcp: tool,
                 extax_fraction: [vel_extax[0] / 100.0, vel_extax[1] / 100.0],
@@ -260,8 +659,7 @@ pub fn validate_kuka(
             value_lines: [pos.line; 6],
             joints,
             from_cartesian,
-            positioner: matches!(cell, Cell::TorchCarried(_))
-                .then(|| pos.external.map(f64::to_radians)),
+            positioner,
             kind: if linear {
                 MoveKind::Linear
             } else {
@@ -280,6 +678,249 @@ pub fn validate_kuka(
             format!("trigger `{action}` without a motion after it"),
         );
     }
-    check_steps(&steps, cell, planned, &opts.common, &mut report);
-    report
+    if let Some(l) = after_off {
+        missing_burn_back(&mut report, src, l, opts);
+    }
+    if let Some((l, _)) = in_if {
+        push(
+            &mut report,
+            ProblemKind::Instruction,
+            src,
+            l,
+            "IF without ENDIF".into(),
+        );
+    }
+    if let Some(g) = ign {
+        if g.waited.is_none() || !g.halt {
+            push(
+                &mut report,
+                ProblemKind::Instruction,
+                src,
+                g.line,
+                "arc on without the ignition handshake".into(),
+            );
+        }
+    }
+    *report_out = report;
+    steps
+}
+
+/// The ignition handshake after an arc on, as read so far.
+#[derive(Debug, Default)]
+struct Ignition {
+    /// Line of the arc on.
+    line: usize,
+    /// `$TIMER[t] = v` (ms).
+    timer_ms: Option<f64>,
+    /// `$TIMER_STOP[t] = FALSE` after it.
+    started: bool,
+    /// The input waited for with the timeout.
+    waited: Option<u32>,
+    /// The failed-ignition branch stops the program.
+    halt: bool,
+}
+
+/// Largest difference between a stated frame and the expected one: 0.001
+/// mm (the `.src` prints 4 decimals) and 0.0001° (5 decimals).
+const FRAME_TOL_MM: f64 = 1e-3;
+const FRAME_TOL_DEG: f64 = 1e-4;
+
+/// `Some(how)` when the frame `[X, Y, Z, A, B, C]` (mm, deg) is not `want`.
+fn frame_differs(f: &[f64; 6], want: &Isometry3) -> Option<String> {
+    use crate::robot::orientation::KukaAbc;
+    let t = want.translation.vector;
+    let d = ((f[0] - t.x).powi(2) + (f[1] - t.y).powi(2) + (f[2] - t.z).powi(2)).sqrt();
+    let r = KukaAbc::from_degrees(f[3], f[4], f[5]).to_rotation();
+    let ang = (r.transpose() * want.rotation.to_rotation_matrix().matrix())
+        .trace()
+        .sub(1.0)
+        .mul(0.5)
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees();
+    (d > FRAME_TOL_MM || ang > FRAME_TOL_DEG).then(|| format!("{d:.4} mm, {ang:.5} deg apart"))
+}
+
+fn show(f: &[f64; 6]) -> String {
+    format!(
+        "{{X {},Y {},Z {},A {},B {},C {}}}",
+        f[0], f[1], f[2], f[3], f[4], f[5]
+    )
+}
+
+/// An end time (`what`) of `s` s written where the options give `want`.
+fn check_time(
+    report: &mut ValidationReport,
+    file: &str,
+    line: usize,
+    what: &str,
+    s: f64,
+    want: f64,
+) {
+    if (s - want).abs() > 5e-4 {
+        push(
+            report,
+            ProblemKind::Options,
+            file,
+            line,
+            format!("{what} {s:.3} s, the options give {want:.3} s"),
+        );
+    }
+}
+
+/// An arc off (line `l`) not followed by the burn-back wait the options give.
+fn missing_burn_back(
+    report: &mut ValidationReport,
+    file: &str,
+    l: usize,
+    opts: &crate::program::kuka::KukaOptions,
+) {
+    if opts.burn_back_s > 0.0 {
+        push(
+            report,
+            ProblemKind::Options,
+            file,
+            l,
+            format!(
+                "arc off without the burn-back wait `WAIT SEC {:.3}` after it",
+                opts.burn_back_s
+            ),
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{UnitVector3, Vector3};
+    use crate::program::kuka::{kuka_files, KukaOptions, HOME_NAME};
+    use crate::program::readback::kuka::parse_krl;
+    use crate::program::{build_program, BeadSetup, HomePosition, Payload, TravelSpeed};
+    use crate::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
+
+    /// Two layers of the hemisphere (R_s 45 mm, Delta 5 mm, 8 points) in
+    /// the KUKA part-carried example cell, `R_Z = 0`.
+    fn program() -> (crate::program::Program, Cell) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("parts/cells/kuka_kr16_2_part_carried.toml");
+        let cell = crate::io::cell_file::read_cell_file(&path)
+            .unwrap()
+            .cell
+            .unwrap();
+        let mut pts = Vec::new();
+        for layer in 0..2usize {
+            let phi = layer as f64 * 5.0 / 45.0;
+            for k in 0..8usize {
+                let v = std::f64::consts::TAU * k as f64 / 8.0;
+                pts.push(PathPointInput {
+                    layer,
+                    point: k,
+                    position_mm: Point3::new(
+                        45.0 * phi.cos() * v.cos(),
+                        45.0 * phi.cos() * v.sin(),
+                        45.0 * phi.sin(),
+                    ),
+                    tool_axis: UnitVector3::new_normalize(Vector3::new(
+                        -phi.sin() * v.cos(),
+                        -phi.sin() * v.sin(),
+                        phi.cos(),
+                    )),
+                    build_direction: None,
+                    r_z: 0.0,
+                });
+            }
+        }
+        let tr = joint_trajectory(&cell, &pts, 6.0, &TrajectoryOptions::default()).unwrap();
+        let prog = build_program("HEMI", &cell, &pts, &tr, &TravelSpeed::Constant(6.0)).unwrap();
+        (prog, cell)
+    }
+
+    /// The emitted home, payload, dwell and interpass wait come back as the
+    /// right steps in the right order: home first and last (joint moves to
+    /// the home joints), before bead 0 its payload, before bead 1 payload,
+    /// dwell, wait; the crater and burn-back waits and the ignition wait
+    /// are not dwell or interpass steps.
+    #[test]
+    fn emitted_setup_reads_back_as_steps() {
+        let (mut prog, cell) = program();
+        let home = [10.0, -80.0, 100.0, 0.0, 40.0, 0.0].map(f64::to_radians);
+        prog.home = Some(HomePosition {
+            joints: home,
+            positioner: None,
+        });
+        let load = |m: f64, z: f64| Payload {
+            mass_kg: m,
+            cog_mm: Point3::new(0.0, 0.0, z),
+        };
+        prog.bead_setup = vec![
+            BeadSetup {
+                layer: 0,
+                payload: Some(load(5.0, 60.0)),
+                dwell_s: 0.0,
+                wait_input: None,
+            },
+            BeadSetup {
+                layer: 1,
+                payload: Some(load(5.25, 61.5)),
+                dwell_s: 30.0,
+                wait_input: Some(7),
+            },
+        ];
+        let opts = KukaOptions::default();
+        let f = kuka_files(&prog, &opts).unwrap();
+        let p = parse_krl(&f[0].text, &f[0].name, &f[1].text, &f[1].name).unwrap();
+        let mut report = ValidationReport::default();
+        let steps = kuka_steps(&p, &cell, &opts, &mut report);
+        assert!(report.is_ok(), "{report}");
+        let motions: Vec<&Motion> = steps
+            .iter()
+            .filter_map(|s| match s {
+                Step::Motion(m) => Some(m.as_ref()),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(motions.len(), 2 + 20);
+        for m in [motions[0], motions[motions.len() - 1]] {
+            assert_eq!((m.label.as_str(), m.kind), (HOME_NAME, MoveKind::Joint));
+            let q = m.joints.unwrap();
+            assert!(
+                q.iter().zip(home).all(|(a, b)| (a - b).abs() < 1e-7),
+                "{q:?}"
+            );
+        }
+        // the other steps in order, as (kind, value)
+        let rest: Vec<String> = steps
+            .iter()
+            .filter_map(|s| match s {
+                Step::Motion(_) => None,
+                Step::ProcessOn { .. } => Some("on".into()),
+                Step::ProcessOff { .. } => Some("off".into()),
+                Step::Wait { seconds, input, .. } => Some(format!("wait {seconds:?} {input:?}")),
+                Step::Payload {
+                    mass_kg, cog_mm, ..
+                } => Some(format!("load {mass_kg} {}", cog_mm.z)),
+            })
+            .collect();
+        assert_eq!(
+            rest,
+            [
+                "load 5 60",
+                "on",
+                "off",
+                "load 5.25 61.5",
+                "wait Some(30.0) None",
+                "wait None Some(7)",
+                "on",
+                "off"
+            ]
+        );
+        // each set-up is before its bead's approach (the first PTP after home)
+        let pos = |pred: &dyn Fn(&Step) -> bool| steps.iter().position(pred).unwrap();
+        let wait7 = pos(&|s| matches!(s, Step::Wait { input: Some(7), .. }));
+        assert!(
+            matches!(&steps[wait7 + 1], Step::Motion(m) if m.kind == MoveKind::Joint && m.label == "P11"),
+            "{:?}",
+            steps[wait7 + 1]
+        );
+    }
 }

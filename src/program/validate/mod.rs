@@ -91,6 +91,12 @@ pub enum ProblemKind {
     Bead,
     /// A record that cannot be decoded (missing values).
     Format,
+    /// The program's set-up disagrees with the cell's `[program]` options:
+    /// home move missing or elsewhere, interlayer dwell, interpass wait or
+    /// payload update missing, or one made with the arc on.
+    Setup,
+    /// An arc-off joint move sweeps the torch through the deposited wall.
+    Collision,
 }
 
 impl ProblemKind {
@@ -111,6 +117,8 @@ impl ProblemKind {
             Self::Deviation => "deviation",
             Self::Bead => "bead",
             Self::Format => "format",
+            Self::Setup => "setup",
+            Self::Collision => "collision",
         }
     }
 }

@@ -209,6 +209,84 @@ impl<'a> Obstacles<'a> {
     }
 }
 
+/// Deposited beads as an obstacle for the torch placed anywhere (part
+/// frame, mm): each bead an open polyline of its points, standing for
+/// capsules of `bead_radius_mm`. Used to check arc-off moves (transits
+/// between layers) against the wall built so far.
+pub struct Wall {
+    obstacles: Obstacles<'static>,
+}
+
+impl std::fmt::Debug for Wall {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Wall")
+            .field("bead_radius_mm", &self.obstacles.bead_radius)
+            .field("empty", &self.obstacles.built.is_none())
+            .finish()
+    }
+}
+
+impl Wall {
+    /// The wall of `beads` (part frame, mm), capsules of `bead_radius_mm`
+    /// (≥ 0). Beads of fewer than two points are left out.
+    pub fn new<'b>(beads: impl IntoIterator<Item = &'b [Point3]>, bead_radius_mm: f64) -> Self {
+        let mut vertices = Vec::new();
+        let mut indices: Vec<[u32; 2]> = Vec::new();
+        for b in beads {
+            if b.len() < 2 {
+                continue;
+            }
+            let base = vertices.len() as u32;
+            vertices.extend_from_slice(b);
+            indices.extend((0..b.len() as u32 - 1).map(|i| [base + i, base + i + 1]));
+        }
+        let built = (!indices.is_empty()).then(|| Polyline::new(vertices, Some(indices)));
+        Self {
+            obstacles: Obstacles {
+                built,
+                bead_radius: bead_radius_mm.max(0.0),
+                substrate: None,
+            },
+        }
+    }
+
+    /// `true` when there is no bead.
+    pub fn is_empty(&self) -> bool {
+        self.obstacles.built.is_none()
+    }
+
+    /// Clearance of `torch` with its tip at `point` and its axis along
+    /// `tool` (towards the torch, part frame): smallest distance to the
+    /// beads' capsules (mm; `<= 0` is a collision, `+inf` without beads).
+    ///
+    /// # Errors
+    /// [`ToolAxisError::UnsupportedQuery`] if parry cannot answer.
+    pub fn clearance(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+    ) -> Result<f64, ToolAxisError> {
+        self.obstacles.clearance(torch, point, tool)
+    }
+
+    /// Whether the clearance of `torch` at `point` with axis `tool` exceeds
+    /// `margin_mm` (≥ 0): a bounded query that only visits beads within the
+    /// margin, much cheaper than [`Wall::clearance`].
+    ///
+    /// # Errors
+    /// [`ToolAxisError::UnsupportedQuery`] if parry cannot answer.
+    pub fn is_clear(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin_mm: f64,
+    ) -> Result<bool, ToolAxisError> {
+        self.obstacles.is_clear(torch, point, tool, margin_mm)
+    }
+}
+
 /// The substrate as a parry shape and its pose, sized from the path.
 pub(super) fn substrate_shape(
     path: &Path,

@@ -31,5 +31,5 @@ mod clearance;
 mod torch;
 
 pub use avoid::{avoid_collisions, AvoidanceOptions, AvoidanceReport};
-pub use clearance::{check_collisions, CollisionOptions, CollisionReport, LayerClearance};
+pub use clearance::{check_collisions, CollisionOptions, CollisionReport, LayerClearance, Wall};
 pub use torch::{part_from_torch, Torch, TorchSpec};

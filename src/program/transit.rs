@@ -1,0 +1,170 @@
+//! Arc-off transit moves against the deposited wall: where the torch is seen
+//! from the part at any joints ([`torch_in_part`]), and the smallest
+//! clearance between the torch and the wall along a joint move, sampled in
+//! joint space ([`joint_move_clearance`]). A synchronised joint move (FANUC
+//! `J`, KUKA `PTP`, ABB `MoveAbsJ`) is a straight line in joint space, so the
+//! samples follow the path the controller takes whatever its speed.
+//! [`build_program_with`](super::build_program_with) raises the retract and
+//! approach points of a transition that collides; the validator checks the
+//! joint moves it reads back. Part frame, mm, rad.
+
+use crate::math::{Point3, Vector3};
+use crate::robot::{Cell, Joints};
+use crate::toolaxis::collision::{Torch, Wall};
+
+/// Largest change of any joint between two samples of a joint move (rad,
+/// 0.5°): at 1.5 m from the axis a sample every ~13 mm, well under the
+/// torch's nozzle diameter, and the bead capsules' radius takes up the rest.
+pub const TRANSIT_STEP_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
+
+/// Most points a bead keeps in the wall of a transit check; a longer bead is
+/// decimated and the capsule radius grows by the largest distance of a
+/// dropped point from its chord, so that the check stays conservative.
+pub const WALL_POINTS_PER_BEAD: usize = 256;
+
+/// The torch seen from the part at robot joints `q` (controller convention,
+/// rad) and positioner joints `qp` (rad, torch-carried cell): the point it
+/// deposits at (part frame, mm) and its axis from that point towards the
+/// torch (part frame, unit), the [`part_from_torch`](crate::toolaxis::collision::part_from_torch)
+/// inputs. `None` in a torch-carried cell without positioner joints.
+pub fn torch_in_part(cell: &Cell, q: &Joints, qp: Option<[f64; 2]>) -> Option<(Point3, Vector3)> {
+    let base_from_flange = cell.robot().flange_pose(q);
+    match cell {
+        Cell::PartCarried(c) => {
+            // the torch is fixed at D_R, pointing down: its axis towards the
+            // torch is the base frame's +Z (eq. 3.8: A·T = +Z)
+            let part_from_base = (base_from_flange * c.flange_from_part).inverse();
+            Some((
+                part_from_base * c.deposition_point_mm,
+                part_from_base.rotation * Vector3::z(),
+            ))
+        }
+        Cell::TorchCarried(c) => {
+            let base_from_tcp = base_from_flange * c.flange_from_tcp;
+            let part_from_base = c.base_from_part(&qp?).inverse();
+            // the TCP's z axis points from the deposition point back into
+            // the torch (checked against the planned tool axes in every
+            // sample cell by the program tests)
+            let axis = base_from_tcp.rotation * Vector3::z();
+            Some((
+                part_from_base * Point3::from(base_from_tcp.translation.vector),
+                part_from_base.rotation * axis,
+            ))
+        }
+    }
+}
+
+/// The tightest sample of a joint move where the torch touches the wall;
+/// `min_clearance_mm = +inf` when it touches nowhere (the clearance is
+/// only measured where it is `<= 0`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TransitClearance {
+    /// Smallest clearance between the torch and the wall (mm; `<= 0`: a
+    /// collision; `+inf` for an empty wall).
+    pub min_clearance_mm: f64,
+    /// Where along the move (0 at its start, 1 at its end).
+    pub at_fraction: f64,
+    /// The torch's deposition point there (part frame, mm).
+    pub tip_mm: Point3,
+}
+
+/// Where the torch touches `wall` along the joint move from `(qa, pa)` to
+/// `(qb, pb)` (robot joints, positioner joints; rad), sampled every
+/// [`TRANSIT_STEP_RAD`] of the joint that moves most, both ends included:
+/// the deepest such sample, or `+inf` clearance when it clears everywhere.
+///
+/// # Errors
+/// A message when a sample has no torch pose (torch-carried cell without
+/// positioner joints) or parry cannot answer.
+pub fn joint_move_clearance(
+    cell: &Cell,
+    wall: &Wall,
+    torch: &Torch,
+    (qa, pa): (&Joints, Option<[f64; 2]>),
+    (qb, pb): (&Joints, Option<[f64; 2]>),
+) -> Result<TransitClearance, String> {
+    let mut best = TransitClearance {
+        min_clearance_mm: f64::INFINITY,
+        at_fraction: 0.0,
+        tip_mm: Point3::origin(),
+    };
+    if wall.is_empty() {
+        return Ok(best);
+    }
+    let mut largest = qa
+        .iter()
+        .zip(qb)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    if let (Some(a), Some(b)) = (pa, pb) {
+        largest = largest.max((a[0] - b[0]).abs()).max((a[1] - b[1]).abs());
+    }
+    let n = ((largest / TRANSIT_STEP_RAD).ceil() as usize).clamp(1, 100_000);
+    for i in 0..=n {
+        let s = i as f64 / n as f64;
+        let q: Joints = std::array::from_fn(|j| qa[j] + s * (qb[j] - qa[j]));
+        let p = match (pa, pb) {
+            (Some(a), Some(b)) => Some([a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])]),
+            _ => pa.or(pb),
+        };
+        let (tip, axis) = torch_in_part(cell, &q, p)
+            .ok_or_else(|| "a torch-carried move without positioner joints".to_string())?;
+        // a bounded query first; the distance only where the torch touches
+        if wall
+            .is_clear(torch, &tip, &axis, 0.0)
+            .map_err(|e| e.to_string())?
+        {
+            continue;
+        }
+        let c = wall
+            .clearance(torch, &tip, &axis)
+            .map_err(|e| e.to_string())?;
+        if c < best.min_clearance_mm {
+            best = TransitClearance {
+                min_clearance_mm: c,
+                at_fraction: s,
+                tip_mm: tip,
+            };
+        }
+    }
+    Ok(best)
+}
+
+/// The wall of `beads` (part frame, mm) for a transit check: each bead
+/// decimated to at most [`WALL_POINTS_PER_BEAD`] points, capsules of
+/// `bead_radius_mm` grown by the largest distance of a dropped point from
+/// its chord.
+pub fn wall_of<'b>(beads: impl IntoIterator<Item = &'b [Point3]>, bead_radius_mm: f64) -> Wall {
+    let mut kept: Vec<Vec<Point3>> = Vec::new();
+    let mut grow: f64 = 0.0;
+    for b in beads {
+        if b.len() <= WALL_POINTS_PER_BEAD {
+            kept.push(b.to_vec());
+            continue;
+        }
+        let step = b.len().div_ceil(WALL_POINTS_PER_BEAD - 1);
+        let mut idx: Vec<usize> = (0..b.len()).step_by(step).collect();
+        if idx.last() != Some(&(b.len() - 1)) {
+            idx.push(b.len() - 1);
+        }
+        for w in idx.windows(2) {
+            let (a, c) = (b[w[0]], b[w[1]]);
+            for p in &b[w[0] + 1..w[1]] {
+                grow = grow.max(point_segment_distance(p, &a, &c));
+            }
+        }
+        kept.push(idx.iter().map(|&i| b[i]).collect());
+    }
+    Wall::new(kept.iter().map(Vec::as_slice), bead_radius_mm + grow)
+}
+
+fn point_segment_distance(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    let ab = b - a;
+    let l2 = ab.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * t)).norm()
+}

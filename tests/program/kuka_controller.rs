@@ -1,0 +1,501 @@
+//! KUKA KRL programs a controller loads and a welder trusts (issue 18):
+//! `PRIO` on trigger calls, the arc switched on with an ignition handshake
+//! and off with crater fill and burn-back, the tool and base frames stated,
+//! the positioner math-coupled to the base, payload, dwell, interpass wait
+//! and home. Each test corrupts an emitted file and expects the validator
+//! to name the problem (kind and line), or checks a value against the cell
+//! file or the closed form of the path, not against our own output.
+//!
+//! Review of the constructs against public sources (found with the search
+//! tool; third-party, not KUKA's own manuals unless said):
+//! * `TRIGGER WHEN DISTANCE=0 DELAY=0 DO call() PRIO=-1`: a published KRL
+//!   post-processor writing ArcTech programs (ros-industrial-attic/
+//!   robodk_postprocessors `KUKA_KRC2_DAT_Arc.py`: `TRIGGER WHEN
+//!   DISTANCE=0 DELAY=0 DO TQM_START_MON(TM1) PRIO = -1`, and an assignment
+//!   trigger without PRIO); the KRC4 knowledge-base pages "KUKA multiple
+//!   triggers on linear motion" and "TRIGGER WHEN DISTANCE extruder timing"
+//!   (industrialmonitordirect.com: `DO Inter1() PRIO = -1`, "PRIO -1
+//!   required for subprogram calls").
+//! * Ignition timeout: "WAIT FOR has no built-in timeout, use $TIMER"
+//!   (industrialmonitordirect.com "KUKA KRL WAIT FOR timeout with error
+//!   message"); the `$TIMER_STOP`/`$TIMER`/`WAIT FOR (… OR $TIMER_FLAG[1])`
+//!   pattern of RoboDK's KUKA posts (`KUKA_KRC2.py`, same repository);
+//!   `$TIMER_FLAG` = "timer value >= 0" (a public KRL system-variable
+//!   table). We set `$TIMER` to minus the timeout in ms (the flag turns on
+//!   at 0) and test `$IN` afterwards; the unit (ms) is from memory of the
+//!   KSS system-variables manual (docslib "System Variables KSS 8.1-8.3",
+//!   only its table of contents was read), **unverified**. The message:
+//!   `Set_KrlMsg(#QUIT, KrlMsg_T, KrlMsgPar_T[], KrlMsgOpt_T)` with
+//!   `{MODUL[] …, NR …, MSG_TXT[] …}` as in the same knowledge-base page
+//!   (`set_krlmsg()` with `krlmsg_t`): KSS 8 (KR C4) only, field names
+//!   **unverified** on a controller. ArcTech's own inline forms (`A10
+//!   (#ARC_STRT)`, `A10 (#PRE_ARC_ON, …)` in the RoboDK ArcTech post) need
+//!   ArcTech data sets and options we cannot check; we switch the arc
+//!   output ourselves.
+//! * `$TOOL = {X …,Y …,Z …,A …,B …,C …}`, `$LOAD.M = m`, `$LOAD.CM =
+//!   {X …,…,A 0,B 0,C 0}`: Machina.NET's KUKA compiler
+//!   (RobotExMachina/Machina.NET `src/Machina/Compilers/CompilerKUKA.cs`);
+//!   `$LOAD.J` and `$DEF_L_J` in a Visual Components KUKA post; units kg,
+//!   mm (CoG in the flange frame), kg·m² from KUKA's robot data sheets
+//!   ("Mass kg, Lx Ly Lz mm, Ix Iy Iz kgm²", KR IONTEC manual on
+//!   easymanua.ls). `J` is written as a point mass (0): **an
+//!   underestimate** for a tube.
+//! * `$BASE = EK (MACHINE_DEF[2].ROOT, MACHINE_DEF[2].MECH_TYPE, {…})`:
+//!   RoboDK's KUKA posts (`setFrame` with external axes), robot-forum.com
+//!   thread "External axis DKP 400.1 syntax … $BASE=EK(MACHINE_DEF…",
+//!   robotauto.co.uk "KUKA robot configuration with external axes, part 2"
+//!   (`MACHINE_DEF[2]` the first external kinematic, `MECH_TYPE #EASYS`).
+//!   That `$VEL.CP` is then the TCP's speed relative to the moving base
+//!   (the part): the meaning of a coupled base in those sources, **not
+//!   checked in a KUKA manual**. **Assumed, not checked:** the
+//!   controller's positioner kinematic (machine data `$ETn_…`) is the
+//!   cell's: ROOT at the cell's positioner pose, its flange at E1 = E2 = 0
+//!   the cell's table frame, E1 the tilt and E2 the turn, both in the
+//!   cell's sense.
+//! * Tool direction: KUKA tools point along +X; the stated `$TOOL` is the
+//!   emitter's torch frame (z along the torch, from the wire tip into the
+//!   torch). A torch measured on the controller (X along the torch) is a
+//!   different frame: use the stated one or re-teach.
+//!
+//! Not verified: that a KR C2/KR C4 loads and runs these files (no
+//! controller or KUKA.OfficeLite was available).
+
+use waam_slicer::program::kuka::{kuka_files, KukaOptions, HOME_NAME};
+use waam_slicer::program::readback::kuka::{parse_krl, KrlOp};
+use waam_slicer::program::validate::{validate_kuka, ProblemKind, ValidationReport};
+use waam_slicer::program::{
+    BeadSetup, EmittedFile, HomePosition, Payload, ProcessControl, Program,
+};
+use waam_slicer::robot::Cell;
+
+use crate::fixture::{cell, program};
+use crate::golden::check_golden;
+
+const TORCH: &str = "kuka_kr16_2_torch_carried.toml";
+const PART: &str = "kuka_kr16_2_part_carried.toml";
+
+fn two_layers(file: &str) -> (Program, Cell) {
+    let c = cell(file);
+    (program(&c, 0..2, 8).0, c)
+}
+
+fn check(
+    files: &[EmittedFile],
+    src: &str,
+    dat: &str,
+    c: &Cell,
+    opts: &KukaOptions,
+) -> ValidationReport {
+    let p = parse_krl(src, &files[0].name, dat, &files[1].name).unwrap_or_else(|e| panic!("{e}"));
+    validate_kuka(&p, c, opts, None)
+}
+
+/// 1-based line of the first line of `text` after line `after` equal to `want`.
+fn line_eq(text: &str, want: &str, after: usize) -> usize {
+    text.lines()
+        .enumerate()
+        .skip(after)
+        .find(|(_, l)| *l == want)
+        .map(|(i, _)| i + 1)
+        .unwrap_or_else(|| panic!("`{want}` not in\n{text}"))
+}
+
+fn replace_line(text: &str, line: usize, with: Option<&str>) -> String {
+    text.lines()
+        .enumerate()
+        .filter_map(|(i, l)| {
+            if i + 1 == line {
+                with.map(str::to_string)
+            } else {
+                Some(l.to_string())
+            }
+        })
+        .map(|l| l + "\n")
+        .collect()
+}
+
+fn has(r: &ValidationReport, kind: ProblemKind, line: usize, words: &str) -> bool {
+    r.problems
+        .iter()
+        .any(|p| p.kind == kind && p.line == line && p.message.contains(words))
+}
+
+/// A custom process that calls subprograms gets `PRIO=-1` on its triggers,
+/// an assignment does not; a trigger call without PRIO is named.
+#[test]
+fn trigger_calls_need_prio() {
+    let (prog, c) = two_layers(PART);
+    let opts = KukaOptions {
+        process: ProcessControl::Custom {
+            start: "EXTRUDER_ON(3)".into(),
+            end: "$OUT[3]=FALSE".into(),
+        },
+        ..Default::default()
+    };
+    let f = kuka_files(&prog, &opts).unwrap();
+    let src = &f[0].text;
+    let on = "  TRIGGER WHEN DISTANCE=0 DELAY=0 DO EXTRUDER_ON(3) PRIO=-1";
+    assert_eq!(src.matches(on).count(), 2, "{src}");
+    assert_eq!(
+        src.matches("  TRIGGER WHEN DISTANCE=1 DELAY=0 DO $OUT[3]=FALSE\n")
+            .count(),
+        2
+    );
+    // no ignition handshake or end times for a custom process
+    assert!(
+        !src.contains("$TIMER") && !src.contains("WAIT SEC"),
+        "{src}"
+    );
+    let r = check(&f, src, &f[1].text, &c, &opts);
+    assert!(r.is_ok(), "{r}");
+    assert_eq!(r.beads, 2);
+    let l = line_eq(src, on, 0);
+    let bad = replace_line(src, l, Some(&on.replace(" PRIO=-1", "")));
+    let r = check(&f, &bad, &f[1].text, &c, &opts);
+    assert!(has(&r, ProblemKind::Instruction, l, "without PRIO"), "{r}");
+    // the reader keeps the priority
+    let p = parse_krl(src, "HEMI.src", &f[1].text, "HEMI.dat").unwrap();
+    assert!(p.statements.iter().any(|s| matches!(
+        &s.op,
+        KrlOp::Trigger { action, prio: Some(-1), distance: 0 } if action == "EXTRUDER_ON(3)"
+    )));
+}
+
+/// The arc process: arc on at the exact first point, then the ignition
+/// handshake; a program without the wait, without the HALT, with another
+/// timeout, or switching the arc by a trigger (no wait possible) is named.
+/// At the end: crater fill with the arc on, arc off, burn-back.
+#[test]
+fn the_arc_waits_for_ignition_and_ends_with_crater_and_burn_back() {
+    let (prog, c) = two_layers(PART);
+    let opts = KukaOptions {
+        arc_ok_input: 5,
+        ignition_timeout_s: 1.5,
+        ignition_timer: 3,
+        ..Default::default()
+    };
+    let f = kuka_files(&prog, &opts).unwrap();
+    let (src, dat) = (&f[0].text, &f[1].text);
+    let on = line_eq(src, "  $OUT[1]=TRUE", 0);
+    let lines: Vec<&str> = src.lines().collect();
+    assert_eq!(
+        lines[on..on + 6],
+        [
+            "  $TIMER_STOP[3] = TRUE",
+            "  $TIMER[3] = -1500",
+            "  $TIMER_STOP[3] = FALSE",
+            "  WAIT FOR $IN[5] OR $TIMER_FLAG[3]",
+            "  $TIMER_STOP[3] = TRUE",
+            "  IF NOT $IN[5] THEN",
+        ]
+    );
+    // the motion before the arc on reaches the bead's first point exactly
+    assert_eq!(lines[on - 3], "  LIN P2");
+    let off = line_eq(src, "  $OUT[1]=FALSE", 0);
+    assert_eq!(
+        lines[off - 4..off + 2],
+        [
+            "  LIN P9",
+            "  ; crater fill, arc on",
+            "  WAIT SEC 0.200",
+            "  $OUT[1]=FALSE",
+            "  ; burn-back",
+            "  WAIT SEC 0.100"
+        ]
+    );
+    assert!(!src.contains("TRIGGER"), "{src}");
+    let r = check(&f, src, dat, &c, &opts);
+    assert!(r.is_ok(), "{r}");
+    assert_eq!(r.beads, 2);
+    // no wait
+    let wait = line_eq(src, "  WAIT FOR $IN[5] OR $TIMER_FLAG[3]", 0);
+    let bad = replace_line(src, wait, Some("  ; WAIT removed"));
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            on,
+            "without the ignition handshake"
+        ),
+        "{r}"
+    );
+    // no HALT in the failed-ignition branch
+    let halt = line_eq(src, "    HALT", on);
+    let bad = replace_line(src, halt, Some("    ; no halt"));
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            on,
+            "without the ignition handshake"
+        ),
+        "{r}"
+    );
+    // another timeout than the options'
+    let other = KukaOptions {
+        ignition_timeout_s: 2.0,
+        ..opts.clone()
+    };
+    let r = check(&f, src, dat, &c, &other);
+    assert!(
+        has(&r, ProblemKind::Options, wait, "ignition timeout 1.500 s"),
+        "{r}"
+    );
+    // another arc-ok input
+    let other = KukaOptions {
+        arc_ok_input: 6,
+        ..opts.clone()
+    };
+    let r = check(&f, src, dat, &c, &other);
+    assert!(has(&r, ProblemKind::Options, wait, "$IN[5]"), "{r}");
+    // the old form: the arc switched on by a trigger while moving
+    let mut old = replace_line(
+        src,
+        on,
+        Some("  TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[1]=TRUE"),
+    );
+    for _ in 0..12 {
+        // drop the handshake after it (through ENDIF)
+        old = replace_line(&old, on + 1, None);
+    }
+    let r = check(&f, &old, dat, &c, &opts);
+    assert!(has(&r, ProblemKind::Instruction, on, "by a TRIGGER"), "{r}");
+    // crater and burn-back times other than the options'
+    let other = KukaOptions {
+        crater_fill_s: 0.5,
+        burn_back_s: 0.0,
+        ..opts.clone()
+    };
+    let r = check(&f, src, dat, &c, &other);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Options,
+            off,
+            "crater fill 0.200 s, the options give 0.500 s"
+        ),
+        "{r}"
+    );
+    assert!(
+        has(
+            &r,
+            ProblemKind::Options,
+            off + 2,
+            "burn-back 0.100 s, the options give 0.000 s"
+        ),
+        "{r}"
+    );
+}
+
+/// The stated frames are the cell file's: part carried (fixed-tool mode),
+/// `$TOOL` the part on the flange (`flange_from_part_xyzwpr = [0, 0, 0, 0,
+/// -90, 0]`: B = -90°) and `$BASE` the fixed torch at `D_R = [900, 0,
+/// 700]` pointing down (C = 180°); torch carried, `$TOOL` the torch
+/// (`tool_xyzwpr = [-86, 0, 406, -180, -36, 0]`). A frame off by 1 mm or
+/// missing is named.
+#[test]
+fn stated_frames_are_the_cell_files() {
+    let (prog, c) = two_layers(PART);
+    let opts = KukaOptions::default();
+    let f = kuka_files(&prog, &opts).unwrap();
+    let src = &f[0].text;
+    let tool = "  $TOOL = {X 0.0000,Y 0.0000,Z 0.0000,A 0.00000,B -90.00000,C 0.00000}";
+    let base = "  $BASE = {X 900.0000,Y 0.0000,Z 700.0000,A 0.00000,B 0.00000,C 180.00000}";
+    let (lt, lb) = (line_eq(src, tool, 0), line_eq(src, base, 0));
+    assert!(src.contains("\n  $IPO_MODE = #TCP\n"));
+    assert!(check(&f, src, &f[1].text, &c, &opts).is_ok());
+    let bad = replace_line(src, lt, Some(&tool.replace("Z 0.0000", "Z 1.0000")));
+    let r = check(&f, &bad, &f[1].text, &c, &opts);
+    assert!(
+        has(&r, ProblemKind::Frame, lt, "$TOOL = {X 0,Y 0,Z 1,"),
+        "{r}"
+    );
+    let bad = replace_line(src, lb, None);
+    let r = check(&f, &bad, &f[1].text, &c, &opts);
+    assert!(
+        r.problems.iter().any(|p| p.kind == ProblemKind::Frame
+            && p.message.contains("before the program states $BASE")),
+        "{r}"
+    );
+    // a fixed torch elsewhere than the options' (the controller's measured
+    // one): the file's stated base no longer matches
+    let moved = KukaOptions {
+        fixed_tool: Some(waam_slicer::program::kuka::fixed_torch_at(
+            &waam_slicer::math::Point3::new(900.0, 0.0, 710.0),
+        )),
+        ..Default::default()
+    };
+    let r = check(&f, src, &f[1].text, &c, &moved);
+    assert!(has(&r, ProblemKind::Frame, lb, "10.0000 mm"), "{r}");
+
+    let (prog, c) = two_layers(TORCH);
+    let f = kuka_files(&prog, &opts).unwrap();
+    let tool = "  $TOOL = {X -86.0000,Y 0.0000,Z 406.0000,A 0.00000,B -36.00000,C -180.00000}";
+    let lt = line_eq(&f[0].text, tool, 0);
+    let bad = replace_line(&f[0].text, lt, Some(&tool.replace("B -36.", "B -35.")));
+    let r = check(&f, &bad, &f[1].text, &c, &opts);
+    assert!(has(&r, ProblemKind::Frame, lt, "1.00000 deg apart"), "{r}");
+}
+
+/// Torch carried, coordinated (default): the base is math-coupled to the
+/// positioner, so every bead E6POS is the planned point in the part frame
+/// (closed form: radius 45 mm, layer 1 at z = 45 sin(5/45)) and `$VEL.CP`
+/// the planned 6 mm/s even where the positioner turns. A fixed `$BASE`
+/// instead (missing coupling) or a coupled file checked without
+/// coordination is named.
+#[test]
+fn the_positioner_is_math_coupled_when_coordinated() {
+    let (prog, c) = two_layers(TORCH);
+    let opts = KukaOptions::default();
+    let f = kuka_files(&prog, &opts).unwrap();
+    let (src, dat) = (&f[0].text, &f[1].text);
+    let ek = "  $BASE = EK (MACHINE_DEF[2].ROOT, MACHINE_DEF[2].MECH_TYPE, {X 0.0000,Y 0.0000,Z 0.0000,A 0.00000,B 0.00000,C 0.00000})";
+    let l = line_eq(src, ek, 0);
+    assert!(!src.contains("$VEL_EXTAX"));
+    let vels: Vec<&str> = src.lines().filter(|l| l.starts_with("  $VEL.CP")).collect();
+    assert!(
+        vels.iter()
+            .all(|v| v.ends_with("0.006000") || v.ends_with("0.020000")),
+        "{vels:?}"
+    );
+    let p = parse_krl(src, "HEMI.src", dat, "HEMI.dat").unwrap();
+    let z1 = 45.0 * (5.0f64 / 45.0).sin();
+    let r1 = 45.0 * (5.0f64 / 45.0).cos();
+    for (i, pt) in prog
+        .points
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.arc.is_bead())
+    {
+        let pos = &p.positions[i];
+        let waam_slicer::program::readback::kuka::KrlValue::Pos { xyzabc, .. } = pos.value else {
+            panic!("{} is not an E6POS", pos.name)
+        };
+        let v = std::f64::consts::TAU * pt.point as f64 / 8.0;
+        let (r, z) = if pt.layer == 0 { (45.0, 0.0) } else { (r1, z1) };
+        let want = [r * v.cos(), r * v.sin(), z];
+        for k in 0..3 {
+            assert!(
+                (xyzabc[k] - want[k]).abs() < 1e-3,
+                "{}: {xyzabc:?} vs {want:?}",
+                pos.name
+            );
+        }
+    }
+    let r = check(&f, src, dat, &c, &opts);
+    assert!(r.is_ok(), "{r}");
+    // missing coupling: a fixed base
+    let bad = replace_line(
+        src,
+        l,
+        Some("  $BASE = {X 0.0000,Y 0.0000,Z 0.0000,A 0.00000,B 0.00000,C 0.00000}"),
+    );
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(has(&r, ProblemKind::Frame, l, "not math-coupled"), "{r}");
+    // the coupled file checked as an uncoordinated program
+    let mut off = KukaOptions::default();
+    off.common.coordinated = false;
+    let r = check(&f, src, dat, &c, &off);
+    assert!(
+        has(&r, ProblemKind::Frame, l, "options give a fixed base"),
+        "{r}"
+    );
+    // another MACHINE_DEF than the options'
+    let other = KukaOptions {
+        ek_machine: 3,
+        ..Default::default()
+    };
+    let r = check(&f, src, dat, &c, &other);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Frame,
+            l,
+            "MACHINE_DEF[2], the options give 3"
+        ),
+        "{r}"
+    );
+    // without coordination the old behaviour: fixed base, timed segments
+    let f = kuka_files(&prog, &off).unwrap();
+    assert!(f[0].text.contains("$VEL_EXTAX[2]") && !f[0].text.contains("EK ("));
+    assert!(check(&f, &f[0].text, &f[1].text, &c, &off).is_ok());
+}
+
+/// Home, payload, dwell and interpass wait in the part-carried cell
+/// (set by hand on a built program), pinned as a golden file and read
+/// back: the reader sees the home PTP first and last, `$LOAD.M/CM/J`,
+/// `WAIT SEC 30.000`, `WAIT FOR $IN[7]` before the second bead's approach.
+#[test]
+fn home_dwell_interpass_payload_golden_and_read_back() {
+    let (mut prog, c) = two_layers(PART);
+    let home = [0.0, -90.0, 90.0, 0.0, -45.0, 0.0].map(f64::to_radians);
+    prog.home = Some(HomePosition {
+        joints: home,
+        positioner: None,
+    });
+    let load = |m: f64, z: f64| Payload {
+        mass_kg: m,
+        cog_mm: waam_slicer::math::Point3::new(0.0, 0.0, z),
+    };
+    prog.bead_setup = vec![
+        BeadSetup {
+            layer: 0,
+            payload: Some(load(4.0, 55.0)),
+            dwell_s: 0.0,
+            wait_input: None,
+        },
+        BeadSetup {
+            layer: 1,
+            payload: Some(load(4.125, 56.25)),
+            dwell_s: 30.0,
+            wait_input: Some(7),
+        },
+    ];
+    let opts = KukaOptions::default();
+    let f = kuka_files(&prog, &opts).unwrap();
+    for file in &f {
+        check_golden(&format!("kuka_setup_{}", file.name), &file.text);
+    }
+    let (src, dat) = (&f[0].text, &f[1].text);
+    assert!(dat.contains(&format!(
+        "\n  DECL E6AXIS {HOME_NAME}={{A1 0.00000,A2 -90.00000,A3 90.00000,A4 0.00000,A5 -45.00000,A6 0.00000,"
+    )));
+    let p = parse_krl(src, "HEMI.src", dat, "HEMI.dat").unwrap();
+    let ops: Vec<&KrlOp> = p
+        .statements
+        .iter()
+        .map(|s| &s.op)
+        .filter(|op| !matches!(op, KrlOp::Other(_) | KrlOp::VelCp(_) | KrlOp::VelPtp(_)))
+        .collect();
+    let motions: Vec<&KrlOp> = ops
+        .iter()
+        .copied()
+        .filter(|op| matches!(op, KrlOp::Ptp(_) | KrlOp::Lin { .. }))
+        .collect();
+    assert_eq!(motions.first(), Some(&&KrlOp::Ptp(HOME_NAME.into())));
+    assert_eq!(motions.last(), Some(&&KrlOp::Ptp(HOME_NAME.into())));
+    assert_eq!(motions.len(), 22);
+    // before the second approach (P11): payload, dwell, wait, in that order
+    let k = ops
+        .iter()
+        .position(|op| **op == KrlOp::Ptp("P11".into()))
+        .unwrap();
+    assert_eq!(
+        ops[k - 6..k],
+        [
+            &KrlOp::Lin {
+                target: "P10".into(),
+                blended: false
+            },
+            &KrlOp::LoadMass(4.125),
+            &KrlOp::LoadCm([0.0, 0.0, 56.25, 0.0, 0.0, 0.0]),
+            &KrlOp::LoadJ([0.0; 3]),
+            &KrlOp::WaitSec(30.0),
+            &KrlOp::WaitIn(7),
+        ]
+    );
+    let r = check(&f, src, dat, &c, &opts);
+    assert!(r.is_ok(), "{r}");
+}
