@@ -36,40 +36,81 @@
 //!
 //! **What the speed means.** The planned speed is the travel speed of the
 //! deposition point relative to the part (what the plan and the validator
-//! use). In the torch-carried cell with the torch as tool frame that is the
-//! controller's TCP speed, and linear moves carry it in `mm/sec` or `cm/min`.
-//! In the part-carried cell the controller's TCP (the flange, or the part
-//! frame on it) is not the point that must travel at that speed: the fixed
-//! torch is, relative to the part, while the flange mostly turns. A `mm/sec`
-//! speed would be applied to the wrong point (and a turn of the part about
-//! the torch would run at the controller's rotation speed limit). FANUC's
-//! remote-TCP motion (the `RTCP` motion option, a paid software option whose
-//! position data are written differently) would fix the reference point;
-//! instead, by default ([`MotionTiming::Auto`]), linear moves in the
-//! part-carried cell are **time-based**: `L P[n] 167msec CNT100`, the time
-//! being the segment's length in the part frame divided by the planned
-//! speed. This needs no option, keeps the positions as they are, and makes
-//! every segment take exactly the planned time (1 ms resolution), so the
-//! torch travels over the part at the planned speed on average over each
-//! segment (exactly at the points; between them the controller interpolates
-//! the flange pose, which for the short segments of a bead keeps the
-//! deposition point within a fraction of a millimetre of the chord).
+//! use). In the torch-carried cell with the torch as tool frame and the
+//! positioner still that is the controller's TCP speed. Where the part
+//! moves it is not, and the file says how it is kept:
 //!
-//! The same holds in the torch-carried cell on a segment where the
-//! positioner turns: the part moves under the torch, the TCP's travel in
-//! the robot frame is not the deposition point's travel over the part (the
-//! TCP may be nearly still while the part turns 45°), and a TCP speed would
-//! be wrong. [`MotionTiming::Auto`] writes every such segment time-based
-//! (segment length in the part frame / planned speed) and keeps `mm/sec`
-//! or `cm/min` where the positioner is still.
+//! * **Torch-carried cell, coordinated** (`common.coordinated`, default):
+//!   every linear move carries the `COORD` motion option, the positioner
+//!   (group 2) being the leader of a coordinated pair on the controller.
+//!   FANUC: "multiple motion groups move together to maintain the same
+//!   position relative to each other. Motion speed which is specified in
+//!   the line is relative speed for coordinated motion" (TP help, Motion
+//!   Options 6.5): the speed is the torch's over the part on the
+//!   positioner, the planned travel speed, also where the positioner turns
+//!   45° under a nearly still torch. Positions are unchanged (robot joints
+//!   plus the positioner's). Joint moves carry no `COORD` (it acts on
+//!   linear and circular moves).
+//! * **Part-carried cell without remote TCP** (default) and the
+//!   torch-carried cell without coordination: linear moves are
+//!   **time-based** ([`MotionTiming::Auto`]): `L P[n] 5741msec CNT100`,
+//!   the segment's length in the part frame divided by the planned speed,
+//!   rounded up to the millisecond (in the torch-carried cell only where
+//!   the positioner turns). This needs no option and makes every segment
+//!   take exactly the planned time; between the points the controller
+//!   interpolates the flange pose, which for the short segments of a bead
+//!   keeps the deposition point within a fraction of a millimetre of the
+//!   chord.
+//! * **Part-carried cell with remote TCP** (`common.remote_tcp`, off in
+//!   [`FanucOptions::default`]): every linear move carries `RTCP`, the user
+//!   frame being the remote TCP frame at the fixed torch
+//!   ([`FanucOptions::remote_tcp_frame`], [`FanucOptions::base_from_torch`]),
+//!   and `CONTROL_CODE = 00000001 00000000`, as a controller writes a
+//!   program with `RTCP` moves. FANUC: "In a motion instruction that
+//!   includes RTCP, the speed specified is the relative speed between the
+//!   workpiece and the tool" — the planned travel speed. Remote TCP is a
+//!   paid option, disabled on a controller with Coordinated Motion loaded,
+//!   and not supported with weaving or multi-group programs. Positions must
+//!   be joints: a controller writes the Cartesian positions of an RTCP
+//!   program as `RX RY RZ RW RP RR`, a representation FANUC does not
+//!   document (a post-processor author reports failing to reproduce it);
+//!   Cartesian positions with remote TCP are refused. That is why it is
+//!   off by default.
+//!
+//! Where a speed relative to the part (`COORD`, `RTCP`) would put a joint
+//! above [`JOINT_SPEED_MARGIN`] of its maximum, the segment is written
+//! time-based instead (rounded up), so that the positions' rounding cannot
+//! push it over.
+//!
+//! **Frames.** Each program opens with remarks stating the user and tool
+//! frames its positions assume, in FANUC `X,Y,Z,W,P,R` (mm, deg): `!
+//! UF1 X,Y=1045.747,-630.155`, `! UF1 Z,W=653.167,180.000`, `! UF1
+//! P,R=0.000,0.000`, the same for `UT`, then `UFRAME_NUM`/`UTOOL_NUM`
+//! ([`FanucOptions::frames`]): UFRAME 0 (world) or [`FanucOptions::user_frame`]
+//! with [`FanucOptions::base_from_user`], or the remote TCP frame; UTOOL
+//! [`FanucOptions::tool_frame`] = the torch (torch-carried cell) or the
+//! flange (part-carried cell) unless [`FanucOptions::flange_from_tool`]
+//! says otherwise. The program does not write the frames (that would
+//! overwrite what was taught on the controller); the validator checks the
+//! statements against the options and the cell.
+//!
+//! **Arc, home, set-up.** `/APPL` has `ARC : TRUE ;` and `ARC Welding
+//! Equipment` as an ArcTool program exported by a controller; beads start
+//! and stop with `Arc Start[s]`/`Arc End[s]` or, with
+//! [`FanucOptions::weld_procedure`], `Weld Start[p,s]`/`Weld End[p,s]`.
+//! With a home position the first and last motions are `J` moves to it.
+//! Before each bead: payload (`$PLST_GRP1[n].$PAYLOAD` kg,
+//! `$PAYLOAD_X/_Y/_Z` cm in the faceplate frame, then `PAYLOAD[n]`; the
+//! schedule's inertia is left as set on the controller), dwell (`WAIT
+//! 30.00(sec)`), interpass wait (`WAIT DI[n]=ON`).
 
 use std::io::Write;
 
 use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
-use crate::program::fmt::{ascii_comment, ceil_to, floor_to, FanucDeg, FanucMm};
-use crate::program::frames::held_tool;
+use crate::program::fmt::{ascii_comment, ceil_to, floor_to, FanucDeg, FanucMm, Fixed};
+use crate::program::frames::{fixed_torch_at, held_tool};
 use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
 use crate::program::{
     check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
@@ -168,6 +209,21 @@ pub struct FanucOptions {
     /// `None`: the cell's torch (`flange_from_tcp`) in the torch-carried
     /// cell, the flange itself in the part-carried cell.
     pub flange_from_tool: Option<Isometry3>,
+    /// `Weld Start[p,s]`/`Weld End[p,s]` (ArcTool weld procedure `p`,
+    /// schedule `s` = the process's schedule) instead of `Arc Start[s]`/`Arc
+    /// End[s]`. `None` (default): `Arc Start[s]`.
+    pub weld_procedure: Option<u32>,
+    /// `UFRAME_NUM` of the remote TCP frame in the part-carried cell with
+    /// remote TCP (`common.remote_tcp`): the user frame taught at the fixed
+    /// torch's tip (1–9). Default 1.
+    pub remote_tcp_frame: u8,
+    /// The remote TCP frame's pose in the robot base frame, as stored in
+    /// `UFRAME[remote_tcp_frame]` (mm). `None`: the cell's fixed torch at
+    /// `D_R`, z towards the part ([`fixed_torch_at`]).
+    pub base_from_torch: Option<Isometry3>,
+    /// Payload schedule (`PAYLOAD[n]`, `$PLST_GRP1[n]`, 1–10) the program
+    /// rewrites and selects at each payload update. Default 1.
+    pub payload_schedule: u8,
     /// Most positions in one program; more are split into sub-programs of
     /// whole beads, so it must be at least the longest bead's point count
     /// (approach and retract included). Default 15 000 (R-30iB Plus).
@@ -193,8 +249,16 @@ impl Default for FanucOptions {
             tool_frame: 1,
             base_from_user: Isometry3::identity(),
             flange_from_tool: None,
+            weld_procedure: None,
+            remote_tcp_frame: 1,
+            base_from_torch: None,
+            payload_schedule: 1,
             point_limit: DEFAULT_POINT_LIMIT,
-            common: Default::default(),
+            // remote TCP off by default (module doc, "Remote TCP")
+            common: crate::program::ProgramOptions {
+                remote_tcp: false,
+                ..Default::default()
+            },
         }
     }
 }
@@ -237,15 +301,57 @@ impl FanucOptions {
         if self.point_limit == 0 {
             return Err(bad("point_limit", "0".into(), "must be >= 1"));
         }
+        if !(1..=9).contains(&self.remote_tcp_frame) {
+            return Err(bad(
+                "remote_tcp_frame",
+                self.remote_tcp_frame.to_string(),
+                "must be in 1..=9 (a user frame; UFRAME 0 is the world frame)",
+            ));
+        }
+        if !(1..=10).contains(&self.payload_schedule) {
+            return Err(bad(
+                "payload_schedule",
+                self.payload_schedule.to_string(),
+                "must be in 1..=10",
+            ));
+        }
+        if self.weld_procedure == Some(0) {
+            return Err(bad("weld_procedure", "0".into(), "must be >= 1"));
+        }
+        if self.user_frame == 0 && !is_identity(&self.base_from_user) {
+            return Err(bad(
+                "base_from_user",
+                format!(
+                    "{:?}",
+                    FanucPose::from_isometry(&self.base_from_user).to_xyzwpr_deg()
+                ),
+                "UFRAME 0 is the world frame: `user_frame` = 0 needs the identity",
+            ));
+        }
+        for (field, iso) in [
+            ("base_from_user", Some(self.base_from_user)),
+            ("base_from_torch", self.base_from_torch),
+            ("flange_from_tool", self.flange_from_tool),
+        ] {
+            if let Some(iso) = iso {
+                let finite = iso.translation.vector.iter().all(|v| v.is_finite())
+                    && iso.rotation.coords.iter().all(|v| v.is_finite());
+                if !finite {
+                    return Err(bad(field, format!("{iso:?}"), "must be finite"));
+                }
+            }
+        }
+        self.common.validate()?;
         self.process.validate()
     }
 
     /// `true` when every linear move is written as a segment time in
     /// `cell` (see [`FanucOptions::segment_time_based`] for single
-    /// segments).
+    /// segments): with [`MotionTiming::Auto`], the part-carried cell
+    /// without remote TCP.
     pub fn time_based(&self, cell: &Cell) -> bool {
         match self.timing {
-            MotionTiming::Auto => matches!(cell, Cell::PartCarried(_)),
+            MotionTiming::Auto => matches!(cell, Cell::PartCarried(_)) && !self.remote_tcp(cell),
             MotionTiming::TcpSpeed => false,
             MotionTiming::Time => true,
         }
@@ -253,15 +359,194 @@ impl FanucOptions {
 
     /// `true` when the linear move into point `i` of `program` is written
     /// as a segment time: [`FanucOptions::time_based`], or with
-    /// [`MotionTiming::Auto`] a segment where the positioner moves.
+    /// [`MotionTiming::Auto`] a segment where the positioner moves and the
+    /// moves are not coordinated (`COORD` makes the speed relative to the
+    /// positioner, the planned travel speed over the part).
     pub fn segment_time_based(&self, program: &Program, i: usize) -> bool {
         self.time_based(&program.cell)
-            || (self.timing == MotionTiming::Auto && positioner_moves(program, i))
+            || (self.timing == MotionTiming::Auto
+                && !self.coordinated(&program.cell)
+                && positioner_moves(program, i))
+    }
+
+    /// `true` when linear moves carry the `RTCP` motion option in `cell`:
+    /// the part-carried cell with `common.remote_tcp`.
+    pub fn remote_tcp(&self, cell: &Cell) -> bool {
+        matches!(cell, Cell::PartCarried(_)) && self.common.remote_tcp
+    }
+
+    /// `true` when linear moves carry the `COORD` motion option in `cell`:
+    /// the torch-carried cell (positioner = group 2, the leader) with
+    /// `common.coordinated`.
+    pub fn coordinated(&self, cell: &Cell) -> bool {
+        matches!(cell, Cell::TorchCarried(_)) && self.common.coordinated
     }
 
     /// The tool frame used for Cartesian positions in `cell` (mm).
     pub fn tool_in(&self, cell: &Cell) -> Isometry3 {
         held_tool(cell, self.flange_from_tool)
+    }
+
+    /// The user and tool frames the positions of `cell`'s programs are in
+    /// (module doc, "Frames"): with remote TCP the remote TCP frame at the
+    /// fixed torch, else `user_frame`/`base_from_user`; the tool
+    /// [`FanucOptions::tool_in`].
+    pub fn frames(&self, cell: &Cell) -> FanucFrames {
+        let (user_frame, base_from_user) = match cell {
+            Cell::PartCarried(c) if self.remote_tcp(cell) => (
+                self.remote_tcp_frame,
+                self.base_from_torch
+                    .unwrap_or_else(|| fixed_torch_at(&c.deposition_point_mm)),
+            ),
+            _ => (self.user_frame, self.base_from_user),
+        };
+        FanucFrames {
+            user_frame,
+            base_from_user,
+            tool_frame: self.tool_frame,
+            flange_from_tool: self.tool_in(cell),
+        }
+    }
+
+    /// The instructions starting and stopping a bead.
+    pub fn process_ops(&self) -> (Op, Op) {
+        match (&self.process, self.weld_procedure) {
+            (ProcessControl::Arc { schedule }, None) => {
+                (Op::ArcStart(*schedule), Op::ArcEnd(*schedule))
+            }
+            (ProcessControl::Arc { schedule }, Some(p)) => {
+                (Op::WeldStart(p, *schedule), Op::WeldEnd(p, *schedule))
+            }
+            (ProcessControl::Custom { start, end }, _) => {
+                (Op::Other(start.clone()), Op::Other(end.clone()))
+            }
+        }
+    }
+}
+
+/// `true` when `iso` is the identity within 1e-9 (mm, rad).
+fn is_identity(iso: &Isometry3) -> bool {
+    iso.translation.vector.norm() < 1e-9 && iso.rotation.angle() < 1e-9
+}
+
+/// The frames a set of TP programs assumes (mm): `UFRAME[user_frame]` =
+/// `base_from_user` (robot base = world frame), `UTOOL[tool_frame]` =
+/// `flange_from_tool` (flange = FANUC faceplate frame). Stated in each
+/// program's header remarks ([`frame_remarks`]) and checked by the
+/// validator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FanucFrames {
+    /// `UFRAME_NUM` (0 = world).
+    pub user_frame: u8,
+    /// The user frame in the robot base frame (mm).
+    pub base_from_user: Isometry3,
+    /// `UTOOL_NUM`.
+    pub tool_frame: u8,
+    /// The tool frame on the flange (mm).
+    pub flange_from_tool: Isometry3,
+}
+
+/// Prefix of the remarks stating a frame: `UF` (user frame) or `UT` (tool
+/// frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FrameKind {
+    /// `UFRAME[n]`, remarks `UFn ...`.
+    User,
+    /// `UTOOL[n]`, remarks `UTn ...`.
+    Tool,
+}
+
+impl FrameKind {
+    fn prefix(self) -> &'static str {
+        match self {
+            FrameKind::User => "UF",
+            FrameKind::Tool => "UT",
+        }
+    }
+}
+
+const AXES: [char; 6] = ['X', 'Y', 'Z', 'W', 'P', 'R'];
+
+/// The three remarks stating frame `n` = `pose` in FANUC `X,Y,Z,W,P,R` (mm,
+/// deg, 3 decimals), each at most 32 characters: `UF1 X,Y=1045.747,-630.155`,
+/// `UF1 Z,W=653.167,180.000`, `UF1 P,R=0.000,0.000`.
+pub fn frame_remarks(kind: FrameKind, n: u8, pose: &Isometry3) -> [String; 3] {
+    let v = FanucPose::from_isometry(pose).to_xyzwpr_deg();
+    let line = |a: usize| {
+        format!(
+            "{}{n} {},{}={},{}",
+            kind.prefix(),
+            AXES[a],
+            AXES[a + 1],
+            Fixed::new(v[a], 3),
+            Fixed::new(v[a + 1], 3)
+        )
+    };
+    [line(0), line(2), line(4)]
+}
+
+/// One remark of [`frame_remarks`] read back: the frame, the indices
+/// (0–5 = X..R) of its two values, and the values (mm, deg).
+pub fn parse_frame_remark(s: &str) -> Option<(FrameKind, u8, [usize; 2], [f64; 2])> {
+    let s = s.trim();
+    let (kind, rest) = if let Some(r) = s.strip_prefix("UF") {
+        (FrameKind::User, r)
+    } else {
+        (FrameKind::Tool, s.strip_prefix("UT")?)
+    };
+    let (n, rest) = rest.split_once(' ')?;
+    let n: u8 = n.parse().ok()?;
+    let (names, values) = rest.trim().split_once('=')?;
+    let (a, b) = names.split_once(',')?;
+    let axis = |t: &str| {
+        let mut c = t.trim().chars();
+        let ch = c.next()?;
+        if c.next().is_some() {
+            return None;
+        }
+        AXES.iter().position(|x| *x == ch)
+    };
+    let (va, vb) = values.split_once(',')?;
+    let num = |t: &str| t.trim().parse::<f64>().ok().filter(|x| x.is_finite());
+    Some((kind, n, [axis(a)?, axis(b)?], [num(va)?, num(vb)?]))
+}
+
+/// Motion options written after the termination type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MotionOptions {
+    /// `COORD`: coordinated with the leader group (the positioner): the
+    /// speed is relative to it.
+    pub coord: bool,
+    /// `RTCP`: remote TCP: the speed is the relative speed between the
+    /// workpiece (on the flange) and the fixed tool (the user frame).
+    pub rtcp: bool,
+}
+
+/// A field of a payload schedule `$PLST_GRP1[n]` (FANUC units: kg, cm).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PayloadField {
+    /// `$PAYLOAD`: mass (kg).
+    Mass,
+    /// `$PAYLOAD_X`: centre of gravity X, faceplate frame (cm).
+    X,
+    /// `$PAYLOAD_Y` (cm).
+    Y,
+    /// `$PAYLOAD_Z` (cm).
+    Z,
+}
+
+impl PayloadField {
+    /// Every field, in the order they are written.
+    pub const ALL: [PayloadField; 4] = [Self::Mass, Self::X, Self::Y, Self::Z];
+
+    /// The system variable's field name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Mass => "$PAYLOAD",
+            Self::X => "$PAYLOAD_X",
+            Self::Y => "$PAYLOAD_Y",
+            Self::Z => "$PAYLOAD_Z",
+        }
     }
 }
 
@@ -336,7 +621,7 @@ pub enum MoveKind {
 }
 
 /// One `/MN` instruction.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Op {
     /// `UFRAME_NUM=n`.
     UFrame(u8),
@@ -352,17 +637,50 @@ pub enum Op {
         speed: Speed,
         /// Termination.
         term: Termination,
+        /// Motion options (`COORD`, `RTCP`).
+        options: MotionOptions,
     },
     /// `Arc Start[n]`.
     ArcStart(u32),
     /// `Arc End[n]`.
     ArcEnd(u32),
+    /// `Weld Start[procedure,schedule]`.
+    WeldStart(u32, u32),
+    /// `Weld End[procedure,schedule]`.
+    WeldEnd(u32, u32),
+    /// `WAIT x.xx(sec)`: a dwell (s, 0.01 s steps).
+    WaitTime(f64),
+    /// `WAIT DI[n]=ON`: wait for a digital input.
+    WaitInput(u32),
+    /// `$PLST_GRP1[schedule].<field>=value`: one value of a payload
+    /// schedule (kg or cm, [`PayloadField`]).
+    PayloadValue {
+        /// Payload schedule (1–10).
+        schedule: u8,
+        /// The field.
+        field: PayloadField,
+        /// The value (kg or cm).
+        value: f64,
+    },
+    /// `PAYLOAD[n]`: select payload schedule `n`.
+    Payload(u8),
     /// `CALL NAME`.
     Call(String),
     /// `! remark` (a comment line).
     Remark(String),
     /// Any other instruction, as written (user-given start/end lines).
     Other(String),
+}
+
+/// `t` (s) as a TP `WAIT` time: two decimals, no leading zero below 1 s
+/// (`.50`), right-aligned in 6 characters, as the controller prints it.
+fn wait_seconds(t: f64) -> String {
+    let s = format!("{}", Fixed::new(t, 2));
+    let s = s
+        .strip_prefix('0')
+        .filter(|r| r.starts_with('.'))
+        .map_or(s.clone(), String::from);
+    format!("{s:>6}")
 }
 
 impl std::fmt::Display for Op {
@@ -375,15 +693,38 @@ impl std::fmt::Display for Op {
                 position,
                 speed,
                 term,
+                options,
             } => {
                 let k = match kind {
                     MoveKind::Joint => 'J',
                     MoveKind::Linear => 'L',
                 };
-                write!(f, "{k} P[{position}] {speed} {term}    ;")
+                write!(f, "{k} P[{position}] {speed} {term}")?;
+                if options.coord {
+                    write!(f, " COORD")?;
+                }
+                if options.rtcp {
+                    write!(f, " RTCP")?;
+                }
+                write!(f, "    ;")
             }
             Op::ArcStart(n) => write!(f, "  Arc Start[{n}] ;"),
             Op::ArcEnd(n) => write!(f, "  Arc End[{n}] ;"),
+            Op::WeldStart(p, s) => write!(f, "  Weld Start[{p},{s}] ;"),
+            Op::WeldEnd(p, s) => write!(f, "  Weld End[{p},{s}] ;"),
+            Op::WaitTime(t) => write!(f, "  WAIT {}(sec) ;", wait_seconds(*t)),
+            Op::WaitInput(n) => write!(f, "  WAIT DI[{n}]=ON    ;"),
+            Op::PayloadValue {
+                schedule,
+                field,
+                value,
+            } => write!(
+                f,
+                "  $PLST_GRP1[{schedule}].{}={} ;",
+                field.name(),
+                Fixed::new(*value, 3)
+            ),
+            Op::Payload(n) => write!(f, "  PAYLOAD[{n}] ;"),
             Op::Call(n) => write!(f, "  CALL {n}    ;"),
             Op::Remark(s) => write!(f, "  ! {} ;", ascii_comment(s)),
             Op::Other(s) => write!(f, "  {s} ;"),
@@ -446,8 +787,13 @@ pub struct TpProgram {
     pub comment: String,
     /// Motion groups in use (1 or 2).
     pub groups: usize,
-    /// `/APPL` arc welding section present.
+    /// `/APPL` arc welding section present (`ARC Welding Equipment`).
     pub arc_welding: bool,
+    /// `/APPL` says `ARC : TRUE ;` (an ArcTool arc program).
+    pub arc_enabled: bool,
+    /// `CONTROL_CODE = 00000001 00000000`: a remote TCP program (what a
+    /// controller writes for a program with `RTCP` moves).
+    pub remote_tcp: bool,
     /// `/MN`.
     pub instructions: Vec<Instruction>,
     /// `/POS`, in index order.
@@ -459,29 +805,50 @@ pub struct TpProgram {
 /// `program.name`) and its sub-programs `NAME_001`, `NAME_002`, ... of
 /// whole beads ([`split::chunks`](crate::program::split::chunks)).
 ///
+/// Every program opens with remarks stating its frames ([`frame_remarks`],
+/// [`FanucOptions::frames`]), then `UFRAME_NUM`/`UTOOL_NUM`. With
+/// `program.home`, the first and the last motion (of the main program when
+/// split) are a joint move to the home joints. Before each bead's first
+/// motion come its [`BeadSetup`](crate::program::BeadSetup) instructions:
+/// payload (`$PLST_GRP1[n]` mass and CoG in kg and cm, then `PAYLOAD[n]`),
+/// dwell (`WAIT x.xx(sec)`, rounded up to 0.01 s), interpass wait (`WAIT
+/// DI[n]=ON`).
+///
 /// # Errors
 /// [`ProgramError::InvalidOptions`] for bad options, a name too long for
 /// the sub-program suffix, or a bead longer than the point limit (field
 /// `point_limit`, naming the layer); [`ProgramError::VendorMismatch`] when the
-/// cell's robot is not a FANUC arm.
+/// cell's robot is not a FANUC arm; [`ProgramError::Mismatch`] when
+/// `program.bead_setup` is not one per bead, or a home or set-up value is
+/// not finite.
 pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgram>, ProgramError> {
     check_vendor(&program.cell, Vendor::Fanuc, EMITTER)?;
     program.check_finite()?;
     opts.validate()?;
     check_name(&program.name)?;
+    if opts.remote_tcp(&program.cell) && opts.positions == PositionMode::Cartesian {
+        return Err(ProgramError::InvalidOptions {
+            field: "positions",
+            value: "cartesian".into(),
+            reason: "remote TCP (`remote_tcp`) in the part-carried cell needs joint positions: the Cartesian representation of FANUC RTCP programs (RX..RR) is not documented",
+        });
+    }
     let robot = program.cell.robot();
-    let tool = opts.tool_in(&program.cell);
-    let user_from_base = opts.base_from_user.inverse();
+    let frames = opts.frames(&program.cell);
+    let user_from_base = frames.base_from_user.inverse();
     let groups = if program.points.iter().any(|p| p.positioner.is_some()) {
         2
     } else {
         1
     };
     let arc_welding = matches!(opts.process, ProcessControl::Arc { .. });
-    let (start_op, end_op) = match &opts.process {
-        ProcessControl::Arc { schedule } => (Op::ArcStart(*schedule), Op::ArcEnd(*schedule)),
-        ProcessControl::Custom { start, end } => (Op::Other(start.clone()), Op::Other(end.clone())),
+    let (start_op, end_op) = opts.process_ops();
+    let options = MotionOptions {
+        coord: groups == 2 && opts.coordinated(&program.cell),
+        rtcp: opts.remote_tcp(&program.cell),
     };
+    let bead_of = bead_openings(program)?;
+    let home = home_position(program, groups)?;
     // the segment time of the linear move into point `i` at `v` mm/s,
     // rounded up: never faster than planned (a joint at its maximum speed
     // stays within it)
@@ -500,11 +867,39 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             SpeedUnit::MmPerSec => (floor_to(v, 0), Speed::MmPerSec),
             SpeedUnit::CmPerMin => (floor_to(v * 6.0, 0), Speed::CmPerMin),
         };
-        if n >= 1.0 {
+        let written = speed(n as u32).mm_s().unwrap_or(0.0);
+        // a speed relative to the part (RTCP, COORD) is exact: a joint
+        // planned within JOINT_SPEED_MARGIN of its maximum gets the
+        // segment's time instead, rounded up to the millisecond, so that
+        // the positions' 0.0001 deg rounding cannot push it over
+        let at_limit = (options.rtcp || options.coord)
+            && joint_speed_ratio(program, i, written) > JOINT_SPEED_MARGIN;
+        if n >= 1.0 && !at_limit {
             speed(n as u32)
         } else {
             timed(i, v)
         }
+    };
+    let joint_move = |position: usize| Instruction {
+        line: 0,
+        op: Op::Move {
+            kind: MoveKind::Joint,
+            position,
+            speed: Speed::Percent(opts.approach_percent as u32),
+            term: Termination::Fine,
+            options: MotionOptions::default(),
+        },
+    };
+    let home_record = |index: usize| {
+        home.map(|(j, g)| Position {
+            index,
+            uf_ut: (frames.user_frame, frames.tool_frame),
+            arm: ArmPosition::Joint(j),
+            group2: g,
+            line: 0,
+            value_lines: [0; 6],
+            group2_line: 0,
+        })
     };
     let arcs: Vec<ArcFlag> = program.points.iter().map(|p| p.arc).collect();
     let ranges = chunks(&arcs, opts.point_limit).map_err(|b| ProgramError::InvalidOptions {
@@ -522,32 +917,33 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             .map(|k| sub_name(&program.name, k))
             .collect();
         check_name(names.last().expect("at least two chunks"))?;
+        let mut ins = Vec::new();
+        let mut positions = Vec::new();
+        if let Some(h) = home_record(1) {
+            ins.extend(frame_header(program, opts, &frames));
+            positions.push(h);
+            ins.push(joint_move(1));
+        }
+        ins.extend(names.into_iter().map(|n| Instruction {
+            line: 0,
+            op: Op::Call(n),
+        }));
+        if home.is_some() {
+            ins.push(joint_move(1));
+        }
         out.push(TpProgram {
             name: program.name.clone(),
             comment: attr_comment(&format!("waam: {} parts", ranges.len())),
             groups,
             arc_welding,
-            instructions: names
-                .into_iter()
-                .map(|n| Instruction {
-                    line: 0,
-                    op: Op::Call(n),
-                })
-                .collect(),
-            positions: Vec::new(),
+            arc_enabled: arc_welding,
+            remote_tcp: false,
+            instructions: ins,
+            positions,
         });
     }
     for (k, range) in ranges.iter().enumerate() {
-        let mut ins = vec![
-            Instruction {
-                line: 0,
-                op: Op::UFrame(opts.user_frame),
-            },
-            Instruction {
-                line: 0,
-                op: Op::UTool(opts.tool_frame),
-            },
-        ];
+        let mut ins = frame_header(program, opts, &frames);
         if range
             .clone()
             .any(|i| !joint_move_target(program, i) && opts.segment_time_based(program, i))
@@ -557,14 +953,20 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
                 op: Op::Remark(TIME_BASED_REMARK.into()),
             });
         }
-        let mut positions = Vec::with_capacity(range.len());
+        let mut positions = Vec::with_capacity(range.len() + 1);
+        // the home record follows the points, so that P[n] is point n
+        let home_index = range.len() + 1;
+        if !split && home.is_some() {
+            ins.push(joint_move(home_index));
+        }
         for (local, p) in program.points[range.clone()].iter().enumerate() {
             let index = local + 1;
             let global = range.start + local;
             let prev = global.checked_sub(1).map(|g| &program.points[g]);
             let arm = match opts.positions {
                 PositionMode::Cartesian if !near_turn_edge(&p.joints) => {
-                    let pose = user_from_base * robot.flange_pose(&p.joints) * tool;
+                    let pose =
+                        user_from_base * robot.flange_pose(&p.joints) * frames.flange_from_tool;
                     ArmPosition::Cartesian {
                         xyzwpr: FanucPose::from_isometry(&pose).to_xyzwpr_deg(),
                         config: robot.fanuc_config(&p.joints).to_string(),
@@ -574,53 +976,52 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             };
             positions.push(Position {
                 index,
-                uf_ut: (opts.user_frame, opts.tool_frame),
+                uf_ut: (frames.user_frame, frames.tool_frame),
                 arm,
                 group2: p.positioner.map(|q| q.map(f64::to_degrees)),
                 line: 0,
                 value_lines: [0; 6],
                 group2_line: 0,
             });
-            let mv = |kind, speed, term| Instruction {
+            if let Some(b) = bead_of[global] {
+                if let Some(setup) = program.bead_setup.get(b) {
+                    ins.extend(
+                        setup_ops(setup, opts)
+                            .into_iter()
+                            .map(|op| Instruction { line: 0, op }),
+                    );
+                }
+            }
+            let linear = |speed, term| Instruction {
                 line: 0,
                 op: Op::Move {
-                    kind,
+                    kind: MoveKind::Linear,
                     position: index,
                     speed,
                     term,
+                    options,
                 },
             };
-            let joint_move = || {
-                mv(
-                    MoveKind::Joint,
-                    Speed::Percent(opts.approach_percent as u32),
-                    Termination::Fine,
-                )
-            };
             match p.arc {
-                ArcFlag::Approach => ins.push(joint_move()),
+                ArcFlag::Approach => ins.push(joint_move(index)),
                 ArcFlag::Start => {
                     ins.push(match prev {
-                        Some(a) if a.arc == ArcFlag::Approach => mv(
-                            MoveKind::Linear,
-                            linear_speed(global, a.speed_mm_s),
-                            Termination::Fine,
-                        ),
-                        _ => joint_move(),
+                        Some(a) if a.arc == ArcFlag::Approach => {
+                            linear(linear_speed(global, a.speed_mm_s), Termination::Fine)
+                        }
+                        _ => joint_move(index),
                     });
                     ins.push(Instruction {
                         line: 0,
                         op: start_op.clone(),
                     });
                 }
-                ArcFlag::On => ins.push(mv(
-                    MoveKind::Linear,
+                ArcFlag::On => ins.push(linear(
                     linear_speed(global, p.speed_mm_s),
                     Termination::Cnt(opts.cnt),
                 )),
                 ArcFlag::End => {
-                    ins.push(mv(
-                        MoveKind::Linear,
+                    ins.push(linear(
                         linear_speed(global, p.speed_mm_s),
                         Termination::Fine,
                     ));
@@ -629,11 +1030,16 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
                         op: end_op.clone(),
                     });
                 }
-                ArcFlag::Retract => ins.push(mv(
-                    MoveKind::Linear,
+                ArcFlag::Retract => ins.push(linear(
                     linear_speed(global, p.speed_mm_s),
                     Termination::Fine,
                 )),
+            }
+        }
+        if !split {
+            if let Some(h) = home_record(home_index) {
+                positions.push(h);
+                ins.push(joint_move(home_index));
             }
         }
         out.push(TpProgram {
@@ -649,11 +1055,203 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             }),
             groups,
             arc_welding,
+            arc_enabled: arc_welding,
+            remote_tcp: options.rtcp,
             instructions: ins,
             positions,
         });
     }
     Ok(out)
+}
+
+/// Fraction of a joint's (or positioner axis's) maximum speed above which
+/// a linear move with a speed relative to the part (`RTCP`, `COORD`) is
+/// written as a segment time (rounded up) instead.
+pub const JOINT_SPEED_MARGIN: f64 = 0.98;
+
+/// The largest ratio of joint (and positioner axis) speed to its maximum
+/// on the segment into point `i` of `program` run at `v` mm/s over the part
+/// (0 for a zero-length segment or `i = 0`).
+pub fn joint_speed_ratio(program: &Program, i: usize, v: f64) -> f64 {
+    let d = segment_length_mm(program, i);
+    let Some(prev) = i.checked_sub(1).map(|k| &program.points[k]) else {
+        return 0.0;
+    };
+    if d <= 0.0 || v <= 0.0 {
+        return 0.0;
+    }
+    let dt = d / v;
+    let p = &program.points[i];
+    let robot = program.cell.robot();
+    let mut ratio: f64 = 0.0;
+    for j in 0..6 {
+        ratio = ratio.max((p.joints[j] - prev.joints[j]).abs() / dt / robot.max_speed_rad_s[j]);
+    }
+    if let (Cell::TorchCarried(c), Some(a), Some(b)) =
+        (&program.cell, p.positioner, prev.positioner)
+    {
+        for n in 0..2 {
+            let max = c.positioner.max_speed_rad_s[n];
+            if max.is_finite() && max > 0.0 {
+                ratio = ratio.max((a[n] - b[n]).abs() / dt / max);
+            }
+        }
+    }
+    ratio
+}
+
+/// The remarks stating the frames, then `UFRAME_NUM` and `UTOOL_NUM`.
+fn frame_header(program: &Program, opts: &FanucOptions, frames: &FanucFrames) -> Vec<Instruction> {
+    let what_user = if opts.remote_tcp(&program.cell) {
+        "REMOTE TCP AT TORCH"
+    } else if frames.user_frame == 0 {
+        "WORLD"
+    } else {
+        "WORK"
+    };
+    let what_tool = match &program.cell {
+        Cell::TorchCarried(_) => "TORCH TCP",
+        Cell::PartCarried(_) if is_identity(&frames.flange_from_tool) => "FLANGE",
+        Cell::PartCarried(_) => "PART ON FLANGE",
+    };
+    let mut remarks = vec![
+        "FRAMES: X,Y,Z MM W,P,R DEG".to_string(),
+        format!("UFRAME[{}] = {what_user}", frames.user_frame),
+    ];
+    remarks.extend(frame_remarks(
+        FrameKind::User,
+        frames.user_frame,
+        &frames.base_from_user,
+    ));
+    remarks.push(format!("UTOOL[{}] = {what_tool}", frames.tool_frame));
+    remarks.extend(frame_remarks(
+        FrameKind::Tool,
+        frames.tool_frame,
+        &frames.flange_from_tool,
+    ));
+    let mut ins: Vec<Instruction> = remarks
+        .into_iter()
+        .map(|r| Instruction {
+            line: 0,
+            op: Op::Remark(r),
+        })
+        .collect();
+    ins.push(Instruction {
+        line: 0,
+        op: Op::UFrame(frames.user_frame),
+    });
+    ins.push(Instruction {
+        line: 0,
+        op: Op::UTool(frames.tool_frame),
+    });
+    ins
+}
+
+/// For each point of `program`, the index of the bead it opens (an
+/// approach point, or a bead's first point without one), checking that
+/// `program.bead_setup` is empty or one per bead in layer order with finite
+/// values.
+fn bead_openings(program: &Program) -> Result<Vec<Option<usize>>, ProgramError> {
+    let mut k = 0;
+    let mut out = Vec::with_capacity(program.points.len());
+    for i in 0..program.points.len() {
+        if joint_move_target(program, i) {
+            if let Some(s) = program.bead_setup.get(k) {
+                let p = &program.points[i];
+                let bad = |reason: String| ProgramError::Mismatch { index: i, reason };
+                if s.layer != p.layer {
+                    return Err(bad(format!(
+                        "bead_setup[{k}] is for layer {}, but bead {k} is layer {}",
+                        s.layer, p.layer
+                    )));
+                }
+                let finite_payload = s.payload.is_none_or(|pl| {
+                    pl.mass_kg.is_finite()
+                        && pl.mass_kg >= 0.0
+                        && pl.cog_mm.iter().all(|v| v.is_finite())
+                });
+                if !(finite_payload && s.dwell_s.is_finite() && s.dwell_s >= 0.0) {
+                    return Err(bad(format!(
+                        "bead_setup[{k}] (layer {}): payload or dwell_s not finite and >= 0",
+                        s.layer
+                    )));
+                }
+                if s.wait_input == Some(0) {
+                    return Err(bad(format!(
+                        "bead_setup[{k}] (layer {}): wait_input 0 (DI numbers start at 1)",
+                        s.layer
+                    )));
+                }
+            }
+            out.push(Some(k));
+            k += 1;
+        } else {
+            out.push(None);
+        }
+    }
+    if !program.bead_setup.is_empty() && program.bead_setup.len() != k {
+        return Err(ProgramError::Mismatch {
+            index: program.points.len(),
+            reason: format!(
+                "{} bead_setup entries for {k} beads",
+                program.bead_setup.len()
+            ),
+        });
+    }
+    Ok(out)
+}
+
+/// The home joints (deg) and, in a two-group program, the positioner's
+/// (deg; `[0, 0]` when the home position gives none).
+#[allow(clippy::type_complexity)]
+fn home_position(
+    program: &Program,
+    groups: usize,
+) -> Result<Option<([f64; 6], Option<[f64; 2]>)>, ProgramError> {
+    let Some(h) = program.home else {
+        return Ok(None);
+    };
+    let g = (groups == 2).then(|| h.positioner.unwrap_or([0.0; 2]).map(f64::to_degrees));
+    if !h.joints.iter().all(|v| v.is_finite())
+        || g.is_some_and(|g| !g.iter().all(|v| v.is_finite()))
+    {
+        return Err(ProgramError::Mismatch {
+            index: 0,
+            reason: "home: joints or positioner joints not finite".into(),
+        });
+    }
+    Ok(Some((h.joints.map(f64::to_degrees), g)))
+}
+
+/// The instructions of one bead's set-up: payload (the schedule's mass in
+/// kg and CoG in cm, then `PAYLOAD[n]`), dwell, interpass wait.
+fn setup_ops(setup: &crate::program::BeadSetup, opts: &FanucOptions) -> Vec<Op> {
+    let mut ops = Vec::new();
+    let schedule = opts.payload_schedule;
+    if let Some(p) = setup.payload {
+        for field in PayloadField::ALL {
+            let value = match field {
+                PayloadField::Mass => p.mass_kg,
+                PayloadField::X => p.cog_mm.x / 10.0,
+                PayloadField::Y => p.cog_mm.y / 10.0,
+                PayloadField::Z => p.cog_mm.z / 10.0,
+            };
+            ops.push(Op::PayloadValue {
+                schedule,
+                field,
+                value,
+            });
+        }
+        ops.push(Op::Payload(schedule));
+    }
+    if setup.dwell_s > 0.0 {
+        // never shorter than planned
+        ops.push(Op::WaitTime(ceil_to(setup.dwell_s, 2)));
+    }
+    if let Some(n) = setup.wait_input {
+        ops.push(Op::WaitInput(n));
+    }
+    ops
 }
 
 /// Longest `/ATTR COMMENT` a TP program takes (characters).
@@ -693,10 +1291,20 @@ pub fn write_ls(w: &mut dyn Write, tp: &TpProgram) -> std::io::Result<()> {
         "1,*,*,*,*"
     };
     writeln!(w, "DEFAULT_GROUP\t= {groups};")?;
-    writeln!(w, "CONTROL_CODE\t= 00000000 00000000;")?;
-    if tp.arc_welding {
+    let code = if tp.remote_tcp {
+        "00000001"
+    } else {
+        "00000000"
+    };
+    writeln!(w, "CONTROL_CODE\t= {code} 00000000;")?;
+    if tp.arc_welding || tp.arc_enabled {
         writeln!(w, "/APPL")?;
-        writeln!(w, "  ARC Welding Equipment : 1,*,*,*,*;")?;
+        if tp.arc_enabled {
+            writeln!(w, "  ARC : TRUE ;")?;
+        }
+        if tp.arc_welding {
+            writeln!(w, "  ARC Welding Equipment : 1,*,*,*,*;")?;
+        }
     }
     writeln!(w, "/MN")?;
     for (i, ins) in tp.instructions.iter().enumerate() {

@@ -3,15 +3,18 @@
 //! [SPEC §8]. Errors name the file and line; a file without `/END`
 //! (truncated) is an error.
 //!
-//! KUKA and ABB output are read by [`kuka`] and [`abb`].
+//! KUKA and ABB output are read by [`kuka`] and [`abb`]; [`fanuc`] turns
+//! the TP programs into the validator's steps.
 //!
 //! [`write_ls`]: crate::program::fanuc::write_ls
 
 pub mod abb;
+pub mod fanuc;
 pub mod kuka;
 
 use crate::program::fanuc::{
-    ArmPosition, Instruction, MoveKind, Op, Position, Speed, Termination, TpProgram,
+    ArmPosition, Instruction, MotionOptions, MoveKind, Op, PayloadField, Position, Speed,
+    Termination, TpProgram,
 };
 use crate::program::ProgramError;
 
@@ -56,6 +59,8 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
         comment: String::new(),
         groups: 1,
         arc_welding: false,
+        arc_enabled: false,
+        remote_tcp: false,
         instructions: Vec::new(),
         positions: Vec::new(),
     };
@@ -91,7 +96,6 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
         match l {
             "/ATTR" => continue,
             "/APPL" => {
-                tp.arc_welding = true;
                 section = Section::Appl;
                 continue;
             }
@@ -128,6 +132,11 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
                     tp.comment = v.trim_matches('"').to_string();
                 } else if let Some(v) = attr_value(l, "DEFAULT_GROUP") {
                     tp.groups = v.split(',').filter(|g| g.trim() == "1").count();
+                } else if let Some(v) = attr_value(l, "CONTROL_CODE") {
+                    tp.remote_tcp = v
+                        .split_whitespace()
+                        .next()
+                        .is_some_and(|c| c.ends_with('1'));
                 } else if let Some(v) = attr_value(l, "LINE_COUNT") {
                     let c = v
                         .parse()
@@ -135,7 +144,14 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
                     line_count = Some((c, n));
                 }
             }
-            Section::Appl => {}
+            Section::Appl => {
+                let compact: String = l.chars().filter(|c| !c.is_whitespace()).collect();
+                if compact.eq_ignore_ascii_case("ARC:TRUE;") {
+                    tp.arc_enabled = true;
+                } else if l.starts_with("ARC Welding Equipment") {
+                    tp.arc_welding = true;
+                }
+            }
             Section::Mn => {
                 let (num, body) = l
                     .split_once(':')
@@ -325,10 +341,22 @@ fn parse_op(body: &str) -> Result<Op, String> {
         Some(&"L") => Some(MoveKind::Linear),
         _ => None,
     } {
-        if tokens.len() != 4 {
+        if tokens.len() < 4 {
             return Err(format!(
-                "expected `J|L P[n] <speed> <FINE|CNTn>`, got `{body}`"
+                "expected `J|L P[n] <speed> <FINE|CNTn> [COORD] [RTCP]`, got `{body}`"
             ));
+        }
+        let mut options = MotionOptions::default();
+        for t in &tokens[4..] {
+            let flag = match *t {
+                "COORD" => &mut options.coord,
+                "RTCP" => &mut options.rtcp,
+                t => return Err(format!("unknown motion option `{t}` in `{body}`")),
+            };
+            if *flag {
+                return Err(format!("motion option `{t}` twice in `{body}`"));
+            }
+            *flag = true;
         }
         let position = tokens[1]
             .strip_prefix("P[")
@@ -367,6 +395,7 @@ fn parse_op(body: &str) -> Result<Op, String> {
             position,
             speed,
             term,
+            options,
         });
     }
     let bracket = |prefix: &str| -> Option<Result<u32, String>> {
@@ -382,6 +411,78 @@ fn parse_op(body: &str) -> Result<Op, String> {
     }
     if let Some(r) = bracket("Arc End[") {
         return r.map(Op::ArcEnd);
+    }
+    let pair = |prefix: &str| -> Option<Result<(u32, u32), String>> {
+        let rest = body.strip_prefix(prefix)?;
+        Some(
+            rest.strip_suffix(']')
+                .and_then(|s| s.split_once(','))
+                .and_then(|(a, b)| Some((a.trim().parse().ok()?, b.trim().parse().ok()?)))
+                .ok_or_else(|| format!("bad `{body}` (expected `{prefix}procedure,schedule]`)")),
+        )
+    };
+    if let Some(r) = pair("Weld Start[") {
+        return r.map(|(p, s)| Op::WeldStart(p, s));
+    }
+    if let Some(r) = pair("Weld End[") {
+        return r.map(|(p, s)| Op::WeldEnd(p, s));
+    }
+    if let Some(rest) = body.strip_prefix("WAIT ") {
+        let rest = rest.trim();
+        if let Some(t) = rest.strip_suffix("(sec)") {
+            return t
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|t| t.is_finite() && *t >= 0.0)
+                .map(Op::WaitTime)
+                .ok_or_else(|| format!("bad wait time in `{body}`"));
+        }
+        let compact: String = rest.chars().filter(|c| !c.is_whitespace()).collect();
+        if let Some(n) = compact
+            .strip_prefix("DI[")
+            .and_then(|r| r.strip_suffix("]=ON"))
+        {
+            return n
+                .parse()
+                .map(Op::WaitInput)
+                .map_err(|_| format!("bad input number in `{body}`"));
+        }
+        return Ok(Op::Other(body.to_string()));
+    }
+    if let Some(rest) = body.strip_prefix("$PLST_GRP1[") {
+        let (n, rest) = rest
+            .split_once("].")
+            .ok_or_else(|| format!("bad `{body}`"))?;
+        let schedule: u8 = n
+            .trim()
+            .parse()
+            .map_err(|_| format!("bad schedule in `{body}`"))?;
+        let (name, value) = rest
+            .split_once('=')
+            .ok_or_else(|| format!("expected `=` in `{body}`"))?;
+        let field = PayloadField::ALL
+            .into_iter()
+            .find(|f| f.name() == name.trim())
+            .ok_or_else(|| format!("unknown payload field `{}` in `{body}`", name.trim()))?;
+        let value: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| format!("bad value in `{body}`"))?;
+        return Ok(Op::PayloadValue {
+            schedule,
+            field,
+            value,
+        });
+    }
+    if let Some(r) = bracket("PAYLOAD[") {
+        return r.and_then(|n| {
+            u8::try_from(n)
+                .map(Op::Payload)
+                .map_err(|_| format!("bad `{body}`"))
+        });
     }
     if let Some(v) = body.strip_prefix("UFRAME_NUM=") {
         return v

@@ -163,11 +163,19 @@ fn fanuc_torch_carried_golden_has_group_2() {
     let files = fanuc_files(&prog, &FanucOptions::default()).unwrap();
     assert!(files[0].text.contains("DEFAULT_GROUP\t= 1,1,*,*,*;"));
     assert!(files[0].text.contains("   GP2:"));
-    // layer 0: the positioner is still, TCP speed; layer 1: it turns 45° per
-    // segment under a nearly still torch, time-based moves (34.2 mm / 6 mm/s)
-    assert!(files[0].text.contains("L P[3] 36cm/min CNT100"));
-    assert!(files[0].text.contains("L P[13] 5705msec CNT100"));
+    // coordinated (default): the positioner leads, every linear move is
+    // COORD at the travel speed over the part, also in layer 1 where it
+    // turns 45° per segment under a nearly still torch
+    assert!(files[0].text.contains("L P[3] 36cm/min CNT100 COORD"));
+    assert!(files[0].text.contains("L P[13] 36cm/min CNT100 COORD"));
     check_all("fanuc_torch_", &files);
+    // not coordinated: layer 0 at TCP speed, layer 1 time-based (34.2 mm /
+    // 6 mm/s)
+    let mut opts = FanucOptions::default();
+    opts.common.coordinated = false;
+    let text = &fanuc_files(&prog, &opts).unwrap()[0].text;
+    assert!(text.contains("L P[3] 36cm/min CNT100    ;"), "{text}");
+    assert!(text.contains("L P[13] 5705msec CNT100    ;"), "{text}");
 }
 
 /// Two layers in a KUKA or ABB example cell.

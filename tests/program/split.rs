@@ -25,6 +25,7 @@ fn flatten(files: &[TpProgram]) -> Vec<String> {
                     position,
                     speed,
                     term,
+                    ..
                 } => {
                     let p = tp.positions.iter().find(|p| p.index == *position).unwrap();
                     let arm = match &p.arm {

@@ -182,10 +182,12 @@ fn a_truncated_file_is_named_by_its_last_line() {
 #[test]
 fn tcp_speeds_with_a_still_tcp_are_refused() {
     let cell = part_carried();
-    let opts = FanucOptions {
+    let mut opts = FanucOptions {
         timing: MotionTiming::TcpSpeed,
         ..Default::default()
     };
+    // without remote TCP (with it, RTCP speeds are relative to the torch)
+    opts.common.remote_tcp = false;
     let (text, planned) = emitted(&cell, &opts);
     let r = check(&text, &cell, &opts, &planned);
     let p = r
@@ -195,14 +197,18 @@ fn tcp_speeds_with_a_still_tcp_are_refused() {
         .unwrap_or_else(|| panic!("{r}"));
     let first_bead_move = line_of(&text, ":L P[", line_of(&text, "Arc Start[1]", 0));
     assert_eq!(p.line, first_bead_move, "{r}");
-    let timed = emitted(&cell, &FanucOptions::default());
-    assert!(check(&timed.0, &cell, &FanucOptions::default(), &timed.1).is_ok());
+    let mut no_rtcp = FanucOptions::default();
+    no_rtcp.common.remote_tcp = false;
+    let timed = emitted(&cell, &no_rtcp);
+    assert!(check(&timed.0, &cell, &no_rtcp, &timed.1).is_ok());
 }
 
 #[test]
 fn an_overspeed_is_named_by_its_motion_line() {
     let cell = part_carried();
-    let opts = FanucOptions::default();
+    // time-based moves: the part-carried cell without remote TCP
+    let mut opts = FanucOptions::default();
+    opts.common.remote_tcp = false;
     let (text, planned) = emitted(&cell, &opts);
     // a linear move of the top layer's bead in 1 ms: J6 needs 15° / 1 ms
     let mut lines: Vec<String> = text.lines().map(String::from).collect();
