@@ -462,7 +462,9 @@ pub struct ProgramOptions {
     /// Default on.
     pub coordinated: bool,
     /// FANUC remote TCP (`RTCP`) in the part-carried cell: linear moves are
-    /// about the fixed torch. Default on.
+    /// about the fixed torch (joint positions only; a paid option that
+    /// cannot be loaded with Coordinated Motion, whose Cartesian `RX…RR`
+    /// positions are not publicly specified). Default off.
     pub remote_tcp: bool,
 }
 
@@ -482,7 +484,7 @@ impl Default for ProgramOptions {
             transit_max_clearance_mm: 160.0,
             bead_radius_mm: 2.0,
             coordinated: true,
-            remote_tcp: true,
+            remote_tcp: false,
         }
     }
 }

@@ -4,6 +4,7 @@
 
 mod abb_controller;
 mod api;
+mod cells;
 mod fanuc_controller;
 mod fixture;
 mod formats;

@@ -517,10 +517,8 @@ fn check_transits(
     let mut prev: Option<(Joints, Option<[f64; 2]>)> = None;
     for (i, s) in steps.iter().enumerate() {
         match s {
-            Step::ProcessOff { .. } => {
-                if !current.is_empty() {
-                    beads.push(std::mem::take(&mut current));
-                }
+            Step::ProcessOff { .. } if !current.is_empty() => {
+                beads.push(std::mem::take(&mut current));
             }
             Step::Motion(m) => {
                 let Some(q) = m.joints else {
