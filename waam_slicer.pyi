@@ -196,8 +196,11 @@ class PlannedPart:
 def check_program(path: _PathLike, cell: Cell) -> List[Dict[str, Any]]:
     """Reads a program (FANUC .ls main program and the programs it calls,
     KUKA .src/.dat, ABB .mod) and checks it against `cell`: joint limits,
-    speeds, reachability, configuration, beads. Returns every problem as a
+    speeds, reachability, configuration, beads, and the set-up the cell
+    file's [program] table asks for (home, dwell, interpass wait, payload,
+    arc-off moves clear of the wall). Returns every problem as a
     dict (`file`, `line`, `kind`, `message`; `kind` is one of vendor,
     options, declaration, instruction, call, frame, configuration, reach,
-    joint_limit, joint_speed, timing, deviation, bead, format); [] when clean. Raises WaamError when
+    joint_limit, joint_speed, timing, deviation, bead, format, setup,
+    collision); [] when clean. Raises WaamError when
     the file cannot be read or parsed."""

@@ -96,6 +96,11 @@ def test_check_program_round_trip(feasible, part_carried, tmp_path):
     assert all(f.exists() for f in files)
     assert ws.check_program(files[0], part_carried) == []
     assert ws.check_program(str(files[0]), part_carried) == []
+    # the cell's [program] table is in the files: home first, a 30 s dwell
+    # between layers and payload updates (the check above verified them)
+    main = files[0].read_text()
+    assert "WAIT  30.00(sec)" in main or "WAIT 30.00(sec)" in main, main[:2000]
+    assert "PAYLOAD[" in main
     # Move one joint target of the last program written out of J5's travel.
     target = files[-1]
     text = target.read_text()
