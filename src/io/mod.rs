@@ -2,6 +2,7 @@
 //! joints CSV, the wall STL, atomic writes.
 pub mod atomic;
 pub mod cell_file;
+pub mod decimal;
 pub mod joints_csv;
 pub mod part_file;
 pub mod path_csv;

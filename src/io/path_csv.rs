@@ -4,6 +4,7 @@
 //! `t` tool axis). Also reads such a file back (for distance maps of paths
 //! made elsewhere).
 
+use crate::io::decimal::{push_fixed, push_u64};
 use crate::math::Point3;
 use crate::path::{Layer, PathPoint};
 use crate::toolaxis::LocalFrame;
@@ -22,27 +23,38 @@ pub fn write_path_csv(
     frames: &[Vec<LocalFrame>],
 ) -> std::io::Result<()> {
     writeln!(w, "{HEADER}")?;
+    // one row at a time into a reused buffer, numbers by the fast
+    // fixed-point formatter (`decimal`): the standard float formatting was
+    // most of the time of writing a million-point path
+    let mut row: Vec<u8> = Vec::with_capacity(256);
     for (li, (layer, fr)) in layers.iter().zip(frames).enumerate() {
         for (pi, (p, f)) in layer.points.iter().zip(fr).enumerate() {
-            let delta = p.delta.map(|d| format!("{d:.9}")).unwrap_or_default();
-            writeln!(
-                w,
-                "{li},{pi},{:.12},{:.12},{:.6},{:.6},{:.6},{delta},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9}",
-                p.t,
-                p.v,
-                p.position.x,
-                p.position.y,
-                p.position.z,
-                f.normal.x,
-                f.normal.y,
-                f.normal.z,
-                f.build.x,
-                f.build.y,
-                f.build.z,
-                f.tool.x,
-                f.tool.y,
-                f.tool.z,
-            )?;
+            row.clear();
+            push_u64(&mut row, li as u64);
+            row.push(b',');
+            push_u64(&mut row, pi as u64);
+            for (x, d) in [
+                (p.t, 12),
+                (p.v, 12),
+                (p.position.x, 6),
+                (p.position.y, 6),
+                (p.position.z, 6),
+            ] {
+                row.push(b',');
+                push_fixed(&mut row, x, d);
+            }
+            row.push(b',');
+            if let Some(delta) = p.delta {
+                push_fixed(&mut row, delta, 9);
+            }
+            for v in [f.normal, f.build, f.tool] {
+                for x in v.iter() {
+                    row.push(b',');
+                    push_fixed(&mut row, *x, 9);
+                }
+            }
+            row.push(b'\n');
+            w.write_all(&row)?;
         }
     }
     Ok(())
