@@ -909,57 +909,23 @@ struct Block {
 }
 
 fn blocks(points: &[ProgramPoint]) -> Vec<Block> {
-    let mut out = Vec::new();
+    let arcs: Vec<ArcFlag> = points.iter().map(|p| p.arc).collect();
     let mut bead_points = 0;
-    let mut cur: Option<Block> = None;
-    for (i, p) in points.iter().enumerate() {
-        match p.arc {
-            ArcFlag::Approach => {
-                cur = Some(Block {
-                    first: i,
-                    start: i + 1,
-                    end: i + 1,
-                    last: i + 1,
-                    start_input: bead_points,
-                })
-            }
-            ArcFlag::Start => {
-                let b = cur.get_or_insert(Block {
-                    first: i,
-                    start: i,
-                    end: i,
-                    last: i,
-                    start_input: bead_points,
-                });
-                b.start = i;
-                b.start_input = bead_points;
-            }
-            ArcFlag::End => {
-                if let Some(b) = cur.as_mut() {
-                    b.end = i;
-                    b.last = i;
-                }
-            }
-            ArcFlag::Retract => {
-                if let Some(b) = cur.as_mut() {
-                    b.last = i;
-                }
-            }
-            ArcFlag::On => {}
-        }
-        if p.arc.is_bead() {
-            bead_points += 1;
-        }
-        let closes = match p.arc {
-            ArcFlag::Retract => true,
-            ArcFlag::End => points.get(i + 1).map(|n| n.arc) != Some(ArcFlag::Retract),
-            _ => false,
-        };
-        if closes {
-            out.extend(cur.take());
-        }
-    }
-    out
+    split::beads(&arcs)
+        .into_iter()
+        .map(|r| {
+            let find = |flag| r.clone().find(|&i| arcs[i] == flag).unwrap_or(r.start);
+            let block = Block {
+                first: r.start,
+                start: find(ArcFlag::Start),
+                end: find(ArcFlag::End),
+                last: r.end - 1,
+                start_input: bead_points,
+            };
+            bead_points += arcs[r].iter().filter(|a| a.is_bead()).count();
+            block
+        })
+        .collect()
 }
 
 /// Checks every arc-off joint move between two beads (and the last one, to
