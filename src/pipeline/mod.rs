@@ -4,7 +4,7 @@
 //! cell (slice → tool axes → `R_Z` optimisation → joint trajectory → program
 //! model: [`plan_part`] → [`PlannedPart`]), writes its robot program
 //! ([`PlannedPart::write_programs`]) and checks a program file against a
-//! cell ([`check_program`]). Every function returns the crate's [`Error`],
+//! cell ([`check_program`]). Every function returns the crate's [`Error`](crate::Error),
 //! whose messages name the file, field, layer or point. Lengths in mm,
 //! angles in rad, speeds in mm/s; part-frame geometry; joints in the robot's
 //! controller convention. The stage modules stay public for callers that
@@ -203,7 +203,7 @@ impl Control {
     }
 
     /// Stops the run at the next stage or layer once `flag` is set; the run
-    /// then returns [`Error::Cancelled`].
+    /// then returns [`Error::Cancelled`](crate::Error::Cancelled).
     pub fn with_cancel(mut self, flag: Arc<AtomicBool>) -> Self {
         self.cancel = Some(flag);
         self
@@ -237,10 +237,10 @@ impl Control {
             .is_some_and(|c| c.load(Ordering::Relaxed))
     }
 
-    /// [`Error::Cancelled`] naming `stage` once the host asked to stop.
+    /// [`Error::Cancelled`](crate::Error::Cancelled) naming `stage` once the host asked to stop.
     ///
     /// # Errors
-    /// [`Error::Cancelled`].
+    /// [`Error::Cancelled`](crate::Error::Cancelled).
     pub fn check(&self, stage: &'static str) -> Result<(), crate::Error> {
         if self.is_cancelled() {
             Err(crate::Error::Cancelled { stage })

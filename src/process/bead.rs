@@ -22,7 +22,7 @@ pub fn bead_area_mm2(
 
 /// Xiong's bead height `H_c` (mm), eq. 1.2, in the regression's own units:
 /// WFS in m/min, TS in cm/min, arc voltage `V_a` in V, stick-out `SO` in mm.
-/// Fitted on 2.8–6 m/min, 15–45 cm/min, 16–22 V, 6–18 mm (table 1.1, [72]).
+/// Fitted on 2.8–6 m/min, 15–45 cm/min, 16–22 V, 6–18 mm (table 1.1, \[72\]).
 pub fn xiong_height_mm(wfs_m_min: f64, ts_cm_min: f64, voltage_v: f64, stick_out_mm: f64) -> f64 {
     let (w, t, v, s) = (wfs_m_min, ts_cm_min, voltage_v, stick_out_mm);
     -0.3514 + 0.48318 * w - 0.08477 * t + 0.4028 * v + 0.01431 * s - 0.006146 * w * t
@@ -60,7 +60,7 @@ pub fn xiong_travel_speed_cm_min(
     Some(c / q)
 }
 
-/// Ranges of Xiong's experiments (table 1.1, row [72]).
+/// Ranges of Xiong's experiments (table 1.1, row \[72\]).
 pub const XIONG_RANGE: XiongRange = XiongRange {
     wfs_m_min: (2.8, 6.0),
     ts_cm_min: (15.0, 45.0),

@@ -25,7 +25,7 @@ use bead::{MM_S_PER_CM_MIN, MM_S_PER_M_MIN};
 use serde::{Deserialize, Serialize};
 
 /// Humping limit of CMT steel (ER70S-6, 0.8 and 1.2 mm wire): 60 cm/min
-/// (thesis §1.2.3, Adebayo et al. [61]), in mm/s.
+/// (thesis §1.2.3, Adebayo et al. \[61\]), in mm/s.
 pub const HUMPING_LIMIT_CMT_STEEL_MM_S: f64 = 60.0 * MM_S_PER_CM_MIN;
 
 /// The named parameter sets: the `preset` of a part file's `[process]` table
@@ -140,10 +140,10 @@ impl ProcessParameters {
         }
     }
 
-    /// A CMT steel set from table 1.2 (row [61]): ER70S-6, Ø 1.2 mm, WFS
+    /// A CMT steel set from table 1.2 (row \[61\]): ER70S-6, Ø 1.2 mm, WFS
     /// 4.8 m/min (80 mm/s), TS 50 cm/min (8.33 mm/s); the table gives no
     /// voltage or stick-out for that row: 18 V (middle of Xiong's range) and
-    /// 11 mm (the CMT rows of [73]). Window 15 cm/min (lower end of Xiong's
+    /// 11 mm (the CMT rows of \[73\]). Window 15 cm/min (lower end of Xiong's
     /// fit) to 60 cm/min (humping, §1.2.3). Xiong's bead model; density
     /// 7850 kg/m³.
     pub fn cmt_steel_er70s6() -> Self {
@@ -161,7 +161,7 @@ impl ProcessParameters {
         }
     }
 
-    /// Xiong's own MAG set, middle of its ranges (table 1.1, row [72]):
+    /// Xiong's own MAG set, middle of its ranges (table 1.1, row \[72\]):
     /// ER70S Ø 1.2 mm, WFS 4.4 m/min, TS 30 cm/min, 19 V, stick-out 12 mm;
     /// window 15–45 cm/min (the fitted range).
     pub fn mag_steel_xiong() -> Self {
