@@ -293,7 +293,7 @@ pub(crate) fn slice_positions(
             length_mm,
         });
     }
-    let mut layers = assemble(&vs, &raw, opts, &mut report);
+    let mut layers = assemble(&vs, raw, opts, &mut report);
     align_seams(&mut layers, opts);
     Ok(Path {
         strategy: opts.strategy,
@@ -465,15 +465,16 @@ pub(crate) fn runs<T>(layer: &[Option<T>]) -> Vec<(Vec<usize>, bool)> {
     out
 }
 
-/// Output layers: truncation, splitting into polylines, decimation.
+/// Output layers: truncation, splitting into polylines, decimation. Each
+/// computed layer is freed once assembled (the path is not held twice).
 fn assemble(
     vs: &[f64],
-    raw: &[Vec<Option<(f64, Point3)>>],
+    raw: Vec<Vec<Option<(f64, Point3)>>>,
     opts: &SliceOptions,
     report: &mut SliceReport,
 ) -> Vec<Layer> {
     let mut layers = Vec::new();
-    for (slice, cols) in raw.iter().enumerate() {
+    for (slice, cols) in raw.into_iter().enumerate() {
         let mut pts: Vec<Option<PathPoint>> = cols
             .iter()
             .zip(vs)
