@@ -14,14 +14,14 @@ use std::io::Write;
 pub const HEADER: &str = "layer,point,t,v,x,y,z,delta,nx,ny,nz,bx,by,bz,tx,ty,tz";
 
 /// Rows formatted per piece of a layer (one task of the parallel formatting).
-const PIECE_ROWS: usize = 4096;
+const PIECE_ROWS: usize = 1024;
 /// Pieces formatted at once before they are written (bounds the memory held:
-/// about 64 × 4096 rows of ~190 bytes, 50 MB at most).
-const PIECES_PER_BATCH: usize = 64;
+/// 16 × 1024 rows of at most ~200 bytes, about 3 MB).
+const PIECES_PER_BATCH: usize = 16;
 
 /// Writes the rows of `layers` with their local frames.
 ///
-/// The rows are formatted in parallel, in pieces of a few thousand rows
+/// The rows are formatted in parallel, in pieces of a thousand rows
 /// (a bounded batch at a time), and written in order: the bytes do not
 /// depend on the number of threads.
 ///
@@ -56,6 +56,7 @@ pub fn write_path_csv(
             .zip(batch.par_iter())
             .for_each(|(buf, &(li, a, b))| {
                 buf.clear();
+                buf.reserve(200 * (b - a));
                 push_rows(buf, li, a..b, &layers[li], &frames[li]);
             });
         for buf in &buffers[..batch.len()] {
