@@ -17,6 +17,7 @@ use pipeline::{optimise, path, place, robot};
 criterion_group!(
     benches,
     path::constant_distance,
+    path::at_scale,
     robot::kinematics,
     robot::hemisphere_trajectory,
     optimise::whole_parts,

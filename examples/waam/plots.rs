@@ -85,11 +85,13 @@ fn err<E: std::fmt::Display>(file: &FsPath) -> impl Fn(E) -> String + '_ {
     move |e| format!("{}: {e}", file.display())
 }
 
-/// The path seen from azimuth -50 deg, elevation 25 deg (part frame), each
-/// point coloured by (delta - Delta) / Delta; first layer in grey.
 /// Most points drawn in `path.svg` (about 100 bytes each: the file stays
 /// under 5 MB); above, every k-th point is drawn and the picture says so.
 pub const MAX_PATH_VIEW_POINTS: usize = 40_000;
+/// Most layers drawn one by one in `distance.svg` (a dot each, about 300
+/// bytes a layer); above, each series keeps its extremes per bucket of
+/// layers, without dots, and the title says so.
+pub const MAX_DISTANCE_LAYERS: usize = 4_000;
 /// Most points drawn per joint panel; above, each bucket of consecutive
 /// points keeps its lowest and highest value (peaks and limits stay visible)
 /// and the title says so.
@@ -121,6 +123,28 @@ fn keep_extremes(data: Vec<(f64, f64)>, max: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// `k` as an English ordinal: 1st, 2nd, 3rd, 4th, 11th, 12th, 13th, 21st, …
+pub fn ordinal(k: usize) -> String {
+    let suffix = match (k % 10, k % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{k}{suffix}")
+}
+
+/// Every how many points `path.svg` draws one, for `total` drawable points
+/// (1: all), so that at most [`MAX_PATH_VIEW_POINTS`] are drawn.
+pub fn path_view_every(total: usize) -> usize {
+    total.div_ceil(MAX_PATH_VIEW_POINTS).max(1)
+}
+
+/// The path seen from azimuth -50 deg, elevation 25 deg (part frame), each
+/// point coloured by (delta - Delta) / Delta; first layer in grey. Above
+/// [`MAX_PATH_VIEW_POINTS`] points, every k-th is drawn and the picture
+/// says so under the chart.
 pub fn path_view(path: &Path, title: &str, file: &FsPath) -> Result<(), String> {
     let (az, el) = ((-50.0_f64).to_radians(), 25.0_f64.to_radians());
     let project = |p: &waam_slicer::math::Point3| {
@@ -129,29 +153,27 @@ pub fn path_view(path: &Path, title: &str, file: &FsPath) -> Result<(), String> 
         let y = p.z * el.cos() - depth * el.sin();
         (x, y)
     };
-    let pts: Vec<(f64, f64, Option<f64>)> = path
-        .layers
-        .iter()
-        .flat_map(|l| {
-            l.points.iter().map(|p| {
+    // only points with both view coordinates finite are drawn; a large path
+    // is thinned to every k-th of them (said under the picture), counted
+    // first so that only the drawn points are held
+    let finite = || {
+        path.layers
+            .iter()
+            .flat_map(|l| l.points.iter())
+            .map(|p| {
                 let (x, y) = project(&p.position);
                 (x, y, p.delta)
             })
-        })
-        .collect();
-    // only points with both view coordinates finite are drawn; a large path
-    // is thinned to every k-th point (said under the picture)
-    let pts: Vec<(f64, f64, Option<f64>)> = pts
-        .into_iter()
-        .filter(|p| p.0.is_finite() && p.1.is_finite())
-        .collect();
-    let every = pts.len().div_ceil(MAX_PATH_VIEW_POINTS).max(1);
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+    };
+    let total = finite().count();
+    let every = path_view_every(total);
     let thinned = if every > 1 {
-        format!(" Every {every}th of {} points drawn.", pts.len())
+        format!(" Every {} of {total} points drawn.", ordinal(every))
     } else {
         String::new()
     };
-    let pts: Vec<(f64, f64, Option<f64>)> = pts.into_iter().step_by(every).collect();
+    let pts: Vec<(f64, f64, Option<f64>)> = finite().step_by(every).collect();
     let whole = SVGBackend::new(file, (900, 930)).into_drawing_area();
     whole.fill(&WHITE).map_err(err(file))?;
     let (root, note) = whole.split_vertically(900);
@@ -245,6 +267,17 @@ pub fn distance_plot(
             return root.present().map_err(err(file));
         }
     };
+    // many layers: each series keeps its extremes per bucket of layers
+    // (said in the title), without the per-layer dots
+    let many = rows.len() > MAX_DISTANCE_LAYERS;
+    let title = if many {
+        format!(
+            "{title} [{} layers: per bucket of layers its lowest and highest drawn]",
+            rows.len()
+        )
+    } else {
+        title.to_string()
+    };
     let n = path.layers.len().max(2);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
@@ -275,18 +308,21 @@ pub fn distance_plot(
             .iter()
             .map(|r| (r.0 as f64, [r.1, r.2, r.3][k]))
             .collect();
+        let series = keep_extremes(series, MAX_DISTANCE_LAYERS);
         chart
             .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))
             .map_err(err(file))?
             .label(name)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
-        chart
-            .draw_series(
-                series
-                    .into_iter()
-                    .map(|p| Circle::new(p, 2, colour.filled())),
-            )
-            .map_err(err(file))?;
+        if !many {
+            chart
+                .draw_series(
+                    series
+                        .into_iter()
+                        .map(|p| Circle::new(p, 2, colour.filled())),
+                )
+                .map_err(err(file))?;
+        }
     }
     chart
         .configure_series_labels()
@@ -542,6 +578,116 @@ mod tests {
         assert!(kept.windows(2).all(|w| w[0].0 <= w[1].0));
         let small: Vec<(f64, f64)> = data[..10].to_vec();
         assert_eq!(keep_extremes(small.clone(), MAX_PANEL_POINTS), small);
+    }
+
+    /// Five megabytes: the most a picture may weigh (issue 21: an 80 MB
+    /// `path.svg` of a 0.87 M-point path opened in no viewer).
+    const MAX_PICTURE_BYTES: u64 = 5_000_000;
+
+    /// A path of `layers` closed rings of `per_layer` points (a cylinder of
+    /// radius 50 mm, 0.5 mm a layer), with distances around 0.5 mm.
+    fn big_path(layers: usize, per_layer: usize) -> Path {
+        let layers = (0..layers)
+            .map(|k| Layer {
+                slice: k,
+                points: (0..per_layer)
+                    .map(|i| {
+                        let a = std::f64::consts::TAU * i as f64 / per_layer as f64;
+                        PathPoint {
+                            t: k as f64,
+                            v: a,
+                            position: Point3::new(50.0 * a.cos(), 50.0 * a.sin(), 0.5 * k as f64),
+                            delta: (k > 0).then(|| 0.5 + 0.01 * (3.0 * a).sin()),
+                        }
+                    })
+                    .collect(),
+                closed: true,
+            })
+            .collect();
+        Path {
+            strategy: Strategy::Constant,
+            delta_mm: 0.5,
+            layers,
+            report: SliceReport::default(),
+            spiral: None,
+        }
+    }
+
+    #[test]
+    fn ordinals() {
+        let got: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 17, 21, 22, 23, 101, 111, 112]
+            .into_iter()
+            .map(ordinal)
+            .collect();
+        assert_eq!(
+            got,
+            [
+                "1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "17th", "21st", "22nd", "23rd",
+                "101st", "111th", "112th"
+            ]
+        );
+    }
+
+    #[test]
+    fn a_large_path_view_is_thinned_under_five_megabytes_and_says_so() {
+        // 400 layers of 2000 points: 800 000 points, every 20th drawn
+        let path = big_path(400, 2000);
+        let dir = tempfile::tempdir().expect("temp dir");
+        let file = dir.path().join("path.svg");
+        path_view(&path, "big", &file).expect("drawn");
+        let size = std::fs::metadata(&file).expect("written").len();
+        assert!(size < MAX_PICTURE_BYTES, "path.svg: {size} bytes");
+        let svg = std::fs::read_to_string(&file).expect("text");
+        assert_eq!(path_view_every(800_000), 20);
+        assert!(
+            svg.contains("Every 20th of 800000 points drawn."),
+            "the picture states its thinning"
+        );
+        // the points drawn: one circle each (no other circle in the picture)
+        let circles = svg.matches("<circle").count();
+        assert_eq!(circles, 40_000, "{circles} points drawn");
+        // a small path is drawn whole and says nothing
+        let small = big_path(10, 100);
+        let svg = timed("small", |f| path_view(&small, "small", f));
+        assert!(!svg.contains("points drawn"));
+        assert_eq!(svg.matches("<circle").count(), 1000);
+    }
+
+    #[test]
+    fn a_distance_plot_of_many_layers_stays_under_five_megabytes_and_says_so() {
+        let layers = 50_000;
+        let path = big_path(layers, 3);
+        let stats: Vec<Option<DistanceStats>> = (0..layers)
+            .map(|k| {
+                let d = 0.5 + 0.01 * (k as f64 * 0.01).sin();
+                stats_of(&[d - 0.002, d, d + 0.002])
+            })
+            .collect();
+        let map = DistanceMap {
+            overall: stats[1],
+            per_layer: stats,
+            points: Vec::new(),
+        };
+        let dir = tempfile::tempdir().expect("temp dir");
+        let file = dir.path().join("distance.svg");
+        distance_plot(&path, &map, "many", &file).expect("drawn");
+        let size = std::fs::metadata(&file).expect("written").len();
+        assert!(size < MAX_PICTURE_BYTES, "distance.svg: {size} bytes");
+        let svg = std::fs::read_to_string(&file).expect("text");
+        assert!(
+            svg.contains("[50000 layers: per bucket of layers its lowest and highest drawn]"),
+            "the picture states its thinning"
+        );
+        // below the bound, every layer has its dots and no such note
+        let path = big_path(100, 3);
+        let map = DistanceMap {
+            overall: stats_of(&[0.5]),
+            per_layer: (0..100).map(|_| stats_of(&[0.49, 0.5, 0.51])).collect(),
+            points: Vec::new(),
+        };
+        let svg = timed("few layers", |f| distance_plot(&path, &map, "few", f));
+        assert!(!svg.contains("per bucket"));
+        assert!(svg.matches("<circle").count() >= 300);
     }
 
     #[test]

@@ -58,9 +58,12 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&part.name));
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let t_csv = Instant::now();
     let csv = dir.join("path.csv");
     write_atomic(&csv, |w| sliced.write_path_csv(w))
         .map_err(|e| format!("{}: {e}", csv.display()))?;
+    let t_csv = t_csv.elapsed().as_secs_f64();
+    let t_wall = Instant::now();
     let stl = dir.join("wall.stl");
     let width = more.bead_width.unwrap_or(path.delta_mm);
     if !more.no_wall {
@@ -73,9 +76,12 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             );
         }
     }
+    let t_wall = t_wall.elapsed().as_secs_f64();
+    let t_report = Instant::now();
     sliced
         .write_report(&dir.join("report.html"), Some(&part.substrate), width)
         .map_err(|e| e.to_string())?;
+    let t_report = t_report.elapsed().as_secs_f64();
     // Pictures: written to temporary names, then renamed (no half-written file).
     let t4 = Instant::now();
     for (name, draw) in [
@@ -114,6 +120,9 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
     let t_plots = t4.elapsed().as_secs_f64();
     let mut summary = sliced.summary();
     summary["run_time_s"]["read"] = t_read.into();
+    summary["run_time_s"]["path_csv"] = t_csv.into();
+    summary["run_time_s"]["wall_stl"] = t_wall.into();
+    summary["run_time_s"]["report_html"] = t_report.into();
     summary["run_time_s"]["pictures"] = t_plots.into();
     let summary_file = dir.join("summary.json");
     write_atomic(&summary_file, |w| {

@@ -13,7 +13,17 @@ use std::io::Write;
 /// The header line.
 pub const HEADER: &str = "layer,point,t,v,x,y,z,delta,nx,ny,nz,bx,by,bz,tx,ty,tz";
 
+/// Rows formatted per piece of a layer (one task of the parallel formatting).
+const PIECE_ROWS: usize = 1024;
+/// Pieces formatted at once before they are written (bounds the memory held:
+/// 16 × 1024 rows of at most ~200 bytes, about 3 MB).
+const PIECES_PER_BATCH: usize = 16;
+
 /// Writes the rows of `layers` with their local frames.
+///
+/// The rows are formatted in parallel, in pieces of a thousand rows
+/// (a bounded batch at a time), and written in order: the bytes do not
+/// depend on the number of threads.
 ///
 /// # Errors
 /// I/O errors of `w`.
@@ -22,42 +32,77 @@ pub fn write_path_csv(
     layers: &[Layer],
     frames: &[Vec<LocalFrame>],
 ) -> std::io::Result<()> {
+    use rayon::prelude::*;
     writeln!(w, "{HEADER}")?;
-    // one row at a time into a reused buffer, numbers by the fast
-    // fixed-point formatter (`decimal`): the standard float formatting was
-    // most of the time of writing a million-point path
-    let mut row: Vec<u8> = Vec::with_capacity(256);
-    for (li, (layer, fr)) in layers.iter().zip(frames).enumerate() {
-        for (pi, (p, f)) in layer.points.iter().zip(fr).enumerate() {
-            row.clear();
-            push_u64(&mut row, li as u64);
-            row.push(b',');
-            push_u64(&mut row, pi as u64);
-            for (x, d) in [
-                (p.t, 12),
-                (p.v, 12),
-                (p.position.x, 6),
-                (p.position.y, 6),
-                (p.position.z, 6),
-            ] {
-                row.push(b',');
-                push_fixed(&mut row, x, d);
-            }
-            row.push(b',');
-            if let Some(delta) = p.delta {
-                push_fixed(&mut row, delta, 9);
-            }
-            for v in [f.normal, f.build, f.tool] {
-                for x in v.iter() {
-                    row.push(b',');
-                    push_fixed(&mut row, *x, 9);
-                }
-            }
-            row.push(b'\n');
-            w.write_all(&row)?;
+    // (layer, first point, end point) of each piece, in file order.
+    let pieces = layers
+        .iter()
+        .zip(frames)
+        .enumerate()
+        .flat_map(|(li, (l, f))| {
+            let n = l.points.len().min(f.len());
+            (0..n)
+                .step_by(PIECE_ROWS)
+                .map(move |a| (li, a, (a + PIECE_ROWS).min(n)))
+        });
+    let mut batch: Vec<(usize, usize, usize)> = Vec::with_capacity(PIECES_PER_BATCH);
+    let mut buffers: Vec<Vec<u8>> = vec![Vec::new(); PIECES_PER_BATCH];
+    let mut pieces = pieces.peekable();
+    while pieces.peek().is_some() {
+        batch.clear();
+        batch.extend(pieces.by_ref().take(PIECES_PER_BATCH));
+        buffers
+            .par_iter_mut()
+            .zip(batch.par_iter())
+            .for_each(|(buf, &(li, a, b))| {
+                buf.clear();
+                buf.reserve(200 * (b - a));
+                push_rows(buf, li, a..b, &layers[li], &frames[li]);
+            });
+        for buf in &buffers[..batch.len()] {
+            w.write_all(buf)?;
         }
     }
     Ok(())
+}
+
+/// Appends the rows of points `range` of layer `li` to `out`, numbers by
+/// the fast fixed-point formatter (`decimal`): the standard float
+/// formatting was most of the time of writing a million-point path.
+fn push_rows(
+    out: &mut Vec<u8>,
+    li: usize,
+    range: std::ops::Range<usize>,
+    layer: &Layer,
+    frames: &[LocalFrame],
+) {
+    for pi in range {
+        let (p, f) = (&layer.points[pi], &frames[pi]);
+        push_u64(out, li as u64);
+        out.push(b',');
+        push_u64(out, pi as u64);
+        for (x, d) in [
+            (p.t, 12),
+            (p.v, 12),
+            (p.position.x, 6),
+            (p.position.y, 6),
+            (p.position.z, 6),
+        ] {
+            out.push(b',');
+            push_fixed(out, x, d);
+        }
+        out.push(b',');
+        if let Some(delta) = p.delta {
+            push_fixed(out, delta, 9);
+        }
+        for v in [f.normal, f.build, f.tool] {
+            for x in v.iter() {
+                out.push(b',');
+                push_fixed(out, *x, 9);
+            }
+        }
+        out.push(b'\n');
+    }
 }
 
 /// Error reading a path CSV, naming the line.

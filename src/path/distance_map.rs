@@ -176,11 +176,17 @@ pub fn spiral_distance_map(layer: &Layer, info: super::SpiralInfo, delta_mm: f64
 /// Spiral points keep the distance their root find reached on the ramp turns.
 pub(crate) fn fill_deltas(path: &mut Path) {
     let map = distance_map(path);
+    apply_deltas(path, &map);
+}
+
+/// Writes the distances of `map` (the distance map of `path`) into
+/// `PathPoint::delta`, as [`fill_deltas`] does.
+pub(crate) fn apply_deltas(path: &mut Path, map: &DistanceMap) {
     let spiral = path.spiral.is_some();
-    for (layer, pts) in path.layers.iter_mut().zip(map.points) {
+    for (layer, pts) in path.layers.iter_mut().zip(&map.points) {
         for (p, d) in layer.points.iter_mut().zip(pts) {
             match d {
-                Some((d, _)) => p.delta = Some(d),
+                Some((d, _)) => p.delta = Some(*d),
                 None if spiral => {}
                 None => p.delta = None,
             }

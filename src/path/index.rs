@@ -1,18 +1,26 @@
 //! Nearest-segment queries on polylines (part frame, mm), exact, with a
 //! clamped point-to-segment distance [SPEC §3.2, eq. 2.20].
 //!
-//! The index is a two-level bounding-sphere hierarchy over runs of
-//! [`CHUNK`] consecutive segments. Layers are spatially coherent polylines,
-//! so consecutive segments make tight clusters; the index is built in linear
-//! time with no sorting, and a query visits the spheres then only the chunks
-//! that can beat the best distance so far. (We first used the `rstar` R-tree:
-//! its bulk load and heap-based queries cost about ten times more on
-//! 500-segment layers rebuilt at every layer.)
+//! The index is a bounding-sphere hierarchy over runs of [`CHUNK`]
+//! consecutive segments: chunks, then groups of [`FANOUT`] consecutive
+//! chunks, groups of those, and so on up to one root. Layers are spatially
+//! coherent polylines, so consecutive segments make tight clusters; the
+//! index is built in linear time with no sorting, and a query descends only
+//! into the groups, then chunks, that can beat the best distance so far.
+//! Chunks are visited in index order whatever the grouping (the groups only
+//! skip chunks that cannot win), so a query's answer — ties included — is
+//! that of a scan of every chunk sphere in order. (We first used the `rstar`
+//! R-tree: its bulk load and heap-based queries cost about ten times more on
+//! 500-segment layers rebuilt at every layer; a flat list of chunk spheres
+//! made each query linear in the layer's size, most of the time of a
+//! 4000-point-per-layer slice.)
 
 use crate::math::Point3;
 
 /// Consecutive segments per bounding sphere.
 pub const CHUNK: usize = 8;
+/// Consecutive chunks (or groups) per group sphere.
+pub const FANOUT: usize = 8;
 
 /// Distance from `p` to the segment `[a, b]` with the projection clamped to the
 /// segment; returns `(distance, parameter in [0, 1])`.
@@ -60,13 +68,68 @@ struct Chunk {
     count: usize,
 }
 
+/// A bounding sphere over consecutive nodes of the level below (chunks for
+/// the first level): it contains each of their spheres.
+#[derive(Debug, Clone, Copy)]
+struct Group {
+    centre: Point3,
+    radius: f64,
+}
+
+/// Sphere test of a chunk: whether something inside the sphere `(centre, radius)` may be closer to `p` than `best`
+/// (`|p - c| - r < best  <=>  |p - c|^2 < (r + best)^2`, no square root).
+#[inline]
+fn may_beat(p: &Point3, centre: &Point3, radius: f64, best: f64) -> bool {
+    let reach = radius + best;
+    (p - centre).norm_squared() < reach * reach
+}
+
+/// Groups of [`FANOUT`] consecutive spheres of `below`, each enclosing its
+/// members, inflated by 1e-9 of its size and position so that rounding
+/// never lets a group hide a member that the member's own test would let
+/// through.
+fn group_level(below: &[(Point3, f64)]) -> Vec<Group> {
+    below
+        .chunks(FANOUT)
+        .map(|members| {
+            let (mut lo, mut hi) = (members[0].0.coords, members[0].0.coords);
+            for (c, r) in members {
+                lo = lo.inf(&c.coords.add_scalar(-r));
+                hi = hi.sup(&c.coords.add_scalar(*r));
+            }
+            let centre = Point3::from((lo + hi) * 0.5);
+            let radius = members
+                .iter()
+                .map(|(c, r)| (c - centre).norm() + r)
+                .fold(0.0, f64::max);
+            let scale = radius + centre.coords.amax() + 1.0;
+            Group {
+                centre,
+                radius: radius + 1e-9 * scale,
+            }
+        })
+        .collect()
+}
+
 /// A spatial index over the segments of some polylines.
 #[derive(Debug, Clone)]
 pub struct SegmentIndex {
     chunks: Vec<Chunk>,
+    /// Group levels above the chunks: `levels[0]` groups chunks, `levels[k]`
+    /// groups the groups of `levels[k - 1]`; the last level has one group
+    /// (no level at all for at most [`FANOUT`] chunks).
+    levels: Vec<Vec<Group>>,
     /// Index of the first chunk of each polyline.
     chunk_offset: Vec<usize>,
     polylines: Vec<(Vec<Point3>, bool)>,
+}
+
+/// The first segment of chunk `c`.
+fn first_segment(c: &Chunk) -> SegmentId {
+    SegmentId {
+        polyline: c.polyline,
+        segment: c.first,
+    }
 }
 
 /// Number of segments of a polyline (a single vertex counts as one, degenerate).
@@ -112,8 +175,16 @@ impl SegmentIndex {
                 first += len;
             }
         }
+        let mut levels: Vec<Vec<Group>> = Vec::new();
+        let mut spheres: Vec<(Point3, f64)> = chunks.iter().map(|c| (c.centre, c.radius)).collect();
+        while spheres.len() > FANOUT {
+            let level = group_level(&spheres);
+            spheres = level.iter().map(|g| (g.centre, g.radius)).collect();
+            levels.push(level);
+        }
         Self {
             chunks,
+            levels,
             chunk_offset,
             polylines,
         }
@@ -187,32 +258,88 @@ impl SegmentIndex {
                     .0
             }
         };
-        let mut best = self.scan_chunk(p, &self.chunks[start], None);
-        for (i, c) in self.chunks.iter().enumerate() {
-            // |p - c| - r < best  <=>  |p - c|^2 < (r + best)^2 (no square root).
-            let reach = c.radius + best.distance;
-            if i != start && (p - c.centre).norm_squared() < reach * reach {
-                best = self.scan_chunk(p, c, Some(best));
+        let first = &self.chunks[start];
+        let (mut distance, mut id) = (f64::INFINITY, first_segment(first));
+        self.scan_chunk(p, first, &mut distance, &mut id);
+        // Then every other chunk in index order, descending from the top
+        // level into the groups whose sphere may hold a closer segment.
+        match self.levels.len() {
+            0 => {
+                for i in 0..self.chunks.len() {
+                    self.visit_chunk(p, i, start, &mut distance, &mut id);
+                }
+            }
+            top => {
+                for g in 0..self.levels[top - 1].len() {
+                    self.visit_group(p, top - 1, g, start, &mut distance, &mut id);
+                }
             }
         }
-        Some(best)
+        Some(self.make(p, id))
     }
 
-    fn scan_chunk(&self, p: &Point3, c: &Chunk, best: Option<Nearest>) -> Nearest {
-        let mut best = best;
-        for j in c.first..c.first + c.count {
-            let cand = self.make(
-                p,
-                SegmentId {
-                    polyline: c.polyline,
-                    segment: j,
-                },
-            );
-            if best.is_none_or(|b| cand.distance < b.distance) {
-                best = Some(cand);
+    /// Visits group `g` of level `level` (see [`SegmentIndex::nearest_hinted`]).
+    fn visit_group(
+        &self,
+        p: &Point3,
+        level: usize,
+        g: usize,
+        start: usize,
+        distance: &mut f64,
+        id: &mut SegmentId,
+    ) {
+        let group = &self.levels[level][g];
+        // Widened by a relative 1e-9 over the chunk test: a group is skipped
+        // only when every chunk in it would be, rounding included.
+        let reach = (group.radius + *distance) * (1.0 + 1e-9);
+        if (p - group.centre).norm_squared() >= reach * reach {
+            return;
+        }
+        let members = g * FANOUT..((g + 1) * FANOUT);
+        if level == 0 {
+            for i in members.start..members.end.min(self.chunks.len()) {
+                self.visit_chunk(p, i, start, distance, id);
+            }
+        } else {
+            for m in members.start..members.end.min(self.levels[level - 1].len()) {
+                self.visit_group(p, level - 1, m, start, distance, id);
             }
         }
-        best.expect("chunks hold at least one segment")
+    }
+
+    /// Scans chunk `i` unless it is the start chunk (already scanned) or
+    /// its sphere cannot beat the best distance so far.
+    #[inline]
+    fn visit_chunk(
+        &self,
+        p: &Point3,
+        i: usize,
+        start: usize,
+        distance: &mut f64,
+        id: &mut SegmentId,
+    ) {
+        let c = &self.chunks[i];
+        if i != start && may_beat(p, &c.centre, c.radius, *distance) {
+            self.scan_chunk(p, c, distance, id);
+        }
+    }
+
+    /// Keeps in `(distance, id)` the first segment of chunk `c` strictly
+    /// closer to `p` than `distance`, if any.
+    fn scan_chunk(&self, p: &Point3, c: &Chunk, distance: &mut f64, id: &mut SegmentId) {
+        let (pts, _) = &self.polylines[c.polyline];
+        let n = pts.len();
+        for j in c.first..c.first + c.count {
+            let b = if j + 1 < n { j + 1 } else { (j + 1) % n };
+            let (d, _) = point_segment_distance(p, &pts[j], &pts[b]);
+            if d < *distance {
+                *distance = d;
+                *id = SegmentId {
+                    polyline: c.polyline,
+                    segment: j,
+                };
+            }
+        }
     }
 
     /// The nearest segment of polyline `polyline` among its segments
@@ -284,20 +411,16 @@ impl SegmentIndex {
                 (false, false) => i.checked_sub(1),
             }
         };
-        let mut best = self.make(p, hint);
+        // Distances only while walking; the answer's details at the end.
+        let distance = |j: usize| point_segment_distance(p, &pts[j], &pts[(j + 1) % n]).0;
+        let (mut best, mut best_distance) = (hint.segment, distance(hint.segment));
         for forward in [true, false] {
             let mut i = hint.segment;
             let mut walked = 0;
             while let Some(j) = step(i, forward) {
-                let cand = self.make(
-                    p,
-                    SegmentId {
-                        polyline: hint.polyline,
-                        segment: j,
-                    },
-                );
-                if cand.distance < best.distance {
-                    best = cand;
+                let d = distance(j);
+                if d < best_distance {
+                    (best, best_distance) = (j, d);
                     i = j;
                     walked += 1;
                     if walked > count {
@@ -308,7 +431,13 @@ impl SegmentIndex {
                 }
             }
         }
-        best
+        self.make(
+            p,
+            SegmentId {
+                polyline: hint.polyline,
+                segment: best,
+            },
+        )
     }
 }
 

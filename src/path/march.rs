@@ -19,6 +19,24 @@ use std::f64::consts::TAU;
 /// `Delta` larger than the part, a substrate that misses the tube, a failed
 /// root find, too many points, an end plane beyond the evaluable range.
 pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<Path, PathError> {
+    let mut path = slice_positions(tube, substrate, opts)?;
+    fill_deltas(&mut path);
+    Ok(path)
+}
+
+/// [`slice`] without the last step, the local distances of the points
+/// (`PathPoint::delta` is `None`, or the root find's value on a spiral):
+/// for callers that compute the distance map themselves and fill the
+/// distances from it ([`apply_deltas`](super::distance_map::apply_deltas)),
+/// instead of measuring every point twice.
+///
+/// # Errors
+/// As [`slice`].
+pub(crate) fn slice_positions(
+    tube: &Tube,
+    substrate: &Substrate,
+    opts: &SliceOptions,
+) -> Result<Path, PathError> {
     opts.validate()?;
     let range = tube.range();
     let length_mm = tube.arc_length(range.t_max);
@@ -275,17 +293,15 @@ pub fn slice(tube: &Tube, substrate: &Substrate, opts: &SliceOptions) -> Result<
             length_mm,
         });
     }
-    let mut layers = assemble(&vs, &raw, opts, &mut report);
+    let mut layers = assemble(&vs, raw, opts, &mut report);
     align_seams(&mut layers, opts);
-    let mut path = Path {
+    Ok(Path {
         strategy: opts.strategy,
         delta_mm: opts.delta_mm,
         layers,
         report,
         spiral: None,
-    };
-    fill_deltas(&mut path);
-    Ok(path)
+    })
 }
 
 fn failure_reason(e: RootFailure) -> &'static str {
@@ -356,7 +372,7 @@ fn spiral_path(
         },
         ..SliceReport::default()
     };
-    let mut path = Path {
+    Ok(Path {
         strategy: Strategy::Spiral,
         delta_mm: opts.delta_mm,
         layers: vec![Layer {
@@ -369,9 +385,7 @@ fn spiral_path(
             per_turn: n,
             ramp_down_from,
         }),
-    };
-    fill_deltas(&mut path);
-    Ok(path)
+    })
 }
 
 /// Computation grid: the requested points, or a fine grid for chord / spacing
@@ -451,15 +465,16 @@ pub(crate) fn runs<T>(layer: &[Option<T>]) -> Vec<(Vec<usize>, bool)> {
     out
 }
 
-/// Output layers: truncation, splitting into polylines, decimation.
+/// Output layers: truncation, splitting into polylines, decimation. Each
+/// computed layer is freed once assembled (the path is not held twice).
 fn assemble(
     vs: &[f64],
-    raw: &[Vec<Option<(f64, Point3)>>],
+    raw: Vec<Vec<Option<(f64, Point3)>>>,
     opts: &SliceOptions,
     report: &mut SliceReport,
 ) -> Vec<Layer> {
     let mut layers = Vec::new();
-    for (slice, cols) in raw.iter().enumerate() {
+    for (slice, cols) in raw.into_iter().enumerate() {
         let mut pts: Vec<Option<PathPoint>> = cols
             .iter()
             .zip(vs)

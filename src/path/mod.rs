@@ -17,6 +17,7 @@ pub mod strategy;
 pub use distance_map::{distance_map, spiral_distance_map, DistanceMap, DistanceStats};
 pub use estimate::{estimate_work, WorkEstimate, BYTES_PER_POINT};
 pub use march::slice;
+pub(crate) use march::slice_positions;
 
 use crate::geometry::Plane;
 use crate::math::Point3;

@@ -9,7 +9,7 @@ use serde::Serialize;
 use serde_json::{json, Value};
 
 use super::{Control, Part, SliceOverrides};
-use crate::path::{distance_map, slice, DistanceMap, Path, SliceOptions};
+use crate::path::{distance_map, DistanceMap, Path, SliceOptions};
 use crate::process::{plan_process, ProcessParameters, ProcessPlan};
 use crate::toolaxis::{tool_axes, ToolAxes, ToolAxisOptions};
 use crate::Error;
@@ -101,11 +101,14 @@ pub fn slice_part_with(
     control.check("slicing")?;
     control.report("slicing", 0.0);
     let t = Instant::now();
-    let path = slice(&part.tube, &part.substrate, &options).map_err(|e| in_part(e.into()))?;
+    let mut path = crate::path::slice_positions(&part.tube, &part.substrate, &options)
+        .map_err(|e| in_part(e.into()))?;
     let t_slice = t.elapsed().as_secs_f64();
     control.check("slicing")?;
+    // The distance map, once: it also gives every point its local distance.
     let t = Instant::now();
     let map = distance_map(&path);
+    crate::path::distance_map::apply_deltas(&mut path, &map);
     let t_map = t.elapsed().as_secs_f64();
     control.report("tool axes", 0.5);
     let t = Instant::now();

@@ -50,6 +50,7 @@ pub use rules::{max_angle_rate, max_rate, smooth_angles, smooth_layer, AxisRule}
 use crate::geometry::{Substrate, Tube};
 use crate::math::Vector3;
 use crate::path::Path;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Local frame at one path point (part frame, unit vectors).
@@ -357,7 +358,16 @@ pub fn tool_axes(
     if let Some(p) = opts.project_build {
         rules::project_build(&mut frames, &Vector3::from(p).normalize());
     }
-    // 3. Lead / tilt, constant or by rule.
+    // 3.–5. Per layer, independently (in parallel, results in layer order):
+    // lead / tilt, constant or by rule; smoothing of the angles; bound on
+    // the rate of T; the layer's part of the report.
+    let per_layer: Vec<(Vec<(f64, f64)>, LayerAxisReport)> = path
+        .layers
+        .par_iter()
+        .zip(frames.par_iter_mut())
+        .enumerate()
+        .map(|(li, (layer, layer_frames))| layer_axes(layer, li, layer_frames, opts))
+        .collect();
     let mut report = ToolAxisReport {
         normals: method,
         rule_active_points: 0,
@@ -368,68 +378,91 @@ pub fn tool_axes(
         max_angle_rate_rad_per_mm: 0.0,
         smoothed_points: 0,
     };
-    let mut angles = Vec::with_capacity(frames.len());
-    for (li, layer_frames) in frames.iter_mut().enumerate() {
-        let mut la = Vec::with_capacity(layer_frames.len());
-        for (pi, f) in layer_frames.iter_mut().enumerate() {
-            let out = opts.rule.apply(f, opts.lead_rad, opts.tilt_rad, li, pi);
-            if out.active {
-                report.rule_active_points += 1;
+    let mut angles = Vec::with_capacity(per_layer.len());
+    for (la, r) in per_layer {
+        report.rule_active_points += r.rule_active_points;
+        report.rule_unreachable_count += r.rule_unreachable.len();
+        for &pi in &r.rule_unreachable {
+            if report.rule_unreachable.len() < 100 {
+                report.rule_unreachable.push((angles.len(), pi));
             }
-            if !out.reached {
-                report.rule_unreachable_count += 1;
-                if report.rule_unreachable.len() < 100 {
-                    report.rule_unreachable.push((li, pi));
-                }
-            }
-            f.tool = tool_axis(f, out.lead_rad, out.tilt_rad);
-            la.push((out.lead_rad, out.tilt_rad));
         }
+        report.smoothed_points += r.smoothed_points;
+        report.max_rate_rad_per_mm = report.max_rate_rad_per_mm.max(r.max_rate_rad_per_mm);
+        report.max_angle_from_z_rad = report.max_angle_from_z_rad.max(r.max_angle_from_z_rad);
         angles.push(la);
-    }
-    // 4. Smoothing of the lead/tilt angles along each layer.
-    if let Some(rate) = opts.max_rate_rad_per_mm {
-        for (li, layer) in path.layers.iter().enumerate() {
-            let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
-            let moved = smooth_angles(&positions, &mut angles[li], layer.closed, rate);
-            report.smoothed_points += moved;
-            if moved > 0 {
-                for (f, &(lead, tilt)) in frames[li].iter_mut().zip(&angles[li]) {
-                    f.tool = tool_axis(f, lead, tilt);
-                }
-            }
-        }
-    }
-    // 5. Bound on the rate of T itself.
-    if let Some(rate) = opts.max_axis_rate_rad_per_mm {
-        for (li, layer) in path.layers.iter().enumerate() {
-            let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
-            let mut axes: Vec<Vector3> = frames[li].iter().map(|f| f.tool).collect();
-            let moved = smooth_layer(&positions, &mut axes, layer.closed, rate);
-            report.smoothed_points += moved;
-            if moved > 0 {
-                for ((f, t), a) in frames[li].iter_mut().zip(axes).zip(angles[li].iter_mut()) {
-                    f.tool = t;
-                    *a = lead_tilt_of(f, &t);
-                }
-            }
-        }
-    }
-    for (li, layer) in path.layers.iter().enumerate() {
-        let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
-        let axes: Vec<Vector3> = frames[li].iter().map(|f| f.tool).collect();
-        report.max_rate_rad_per_mm =
-            report
-                .max_rate_rad_per_mm
-                .max(rules::max_rate(&positions, &axes, layer.closed));
-        for a in &axes {
-            report.max_angle_from_z_rad =
-                report.max_angle_from_z_rad.max(a.z.clamp(-1.0, 1.0).acos());
-        }
     }
     Ok(ToolAxes {
         frames,
         angles,
         report,
     })
+}
+
+/// One layer's part of [`ToolAxisReport`].
+struct LayerAxisReport {
+    rule_active_points: usize,
+    /// Points where the rule could not reach its target.
+    rule_unreachable: Vec<usize>,
+    smoothed_points: usize,
+    max_rate_rad_per_mm: f64,
+    max_angle_from_z_rad: f64,
+}
+
+/// Steps 3–5 of [`tool_axes`] on layer `li`: sets the tool axis of each of
+/// its frames and returns its `(theta_n, theta_t)` angles and report.
+fn layer_axes(
+    layer: &crate::path::Layer,
+    li: usize,
+    frames: &mut [LocalFrame],
+    opts: &ToolAxisOptions,
+) -> (Vec<(f64, f64)>, LayerAxisReport) {
+    let mut report = LayerAxisReport {
+        rule_active_points: 0,
+        rule_unreachable: Vec::new(),
+        smoothed_points: 0,
+        max_rate_rad_per_mm: 0.0,
+        max_angle_from_z_rad: 0.0,
+    };
+    // 3. Lead / tilt, constant or by rule.
+    let mut angles = Vec::with_capacity(frames.len());
+    for (pi, f) in frames.iter_mut().enumerate() {
+        let out = opts.rule.apply(f, opts.lead_rad, opts.tilt_rad, li, pi);
+        if out.active {
+            report.rule_active_points += 1;
+        }
+        if !out.reached {
+            report.rule_unreachable.push(pi);
+        }
+        f.tool = tool_axis(f, out.lead_rad, out.tilt_rad);
+        angles.push((out.lead_rad, out.tilt_rad));
+    }
+    let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
+    // 4. Smoothing of the lead/tilt angles along the layer.
+    if let Some(rate) = opts.max_rate_rad_per_mm {
+        let moved = smooth_angles(&positions, &mut angles, layer.closed, rate);
+        report.smoothed_points += moved;
+        if moved > 0 {
+            for (f, &(lead, tilt)) in frames.iter_mut().zip(&angles) {
+                f.tool = tool_axis(f, lead, tilt);
+            }
+        }
+    }
+    // 5. Bound on the rate of T itself.
+    let mut axes: Vec<Vector3> = frames.iter().map(|f| f.tool).collect();
+    if let Some(rate) = opts.max_axis_rate_rad_per_mm {
+        let moved = smooth_layer(&positions, &mut axes, layer.closed, rate);
+        report.smoothed_points += moved;
+        if moved > 0 {
+            for ((f, t), a) in frames.iter_mut().zip(&axes).zip(angles.iter_mut()) {
+                f.tool = *t;
+                *a = lead_tilt_of(f, t);
+            }
+        }
+    }
+    report.max_rate_rad_per_mm = rules::max_rate(&positions, &axes, layer.closed);
+    for a in &axes {
+        report.max_angle_from_z_rad = report.max_angle_from_z_rad.max(a.z.clamp(-1.0, 1.0).acos());
+    }
+    (angles, report)
 }
