@@ -64,8 +64,9 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
             .variables
             .iter()
             .zip(&p.values)
+            .filter(|(v, _)| v.is_free() || v.current != 0.0)
             .map(|(v, x)| {
-                if v.name.ends_with("rotation") {
+                if v.angle {
                     format!("{} = {:.2} deg", v.name, x.to_degrees())
                 } else {
                     format!("{} = {:.3} mm", v.name, x)
@@ -73,11 +74,15 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
             })
             .collect();
         println!(
-            "{}: {} candidates ({:.0} % feasible on the subsample) in {:.2} s",
+            "{}: {} candidates ({:.0} % feasible on the subsample), {} certified on the full path, in {:.2} s (screening {:.2} s, refinement {:.2} s, certification {:.2} s)",
             part.name,
             p.candidates,
             100.0 * p.feasible_fraction,
-            p.time_s
+            p.certified,
+            p.time_s,
+            p.times.screening_s,
+            p.times.refinement_s,
+            p.times.certification_s,
         );
         println!("  {}", values.join(", "));
         if p.feasible {
@@ -93,9 +98,12 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
     if !p.feasible {
         let why = match &p.binding {
             Some((c, share)) if c.ends_with("(on the full path)") => format!(
-                "{c}: feasible on the subsample, it binds {:.0} % of the layers of the best candidate",
+                "{c}: feasible on the subsample, it binds {:.0} % of the layers checked of the best candidate",
                 100.0 * share
             ),
+            Some((c, _)) if c.ends_with("(program check)") => {
+                format!("every candidate feasible on the full path was refused: {c}")
+            }
             Some((c, share)) => format!("{c} bound {:.0} % of the candidates", 100.0 * share),
             None => "no candidate was feasible".into(),
         };

@@ -108,6 +108,11 @@ pub struct CellFile {
 /// fixed = ["z"]                 # variables kept at the file's value: x, y, z, rotation
 /// keep_out_min_mm = [-300, -300, -1000]   # a box the point may not enter
 /// keep_out_max_mm = [300, 300, 500]
+/// # searched only when a range is given (else kept at the file's value):
+/// tilt_x_deg = [-30, 30]        # fixture tilt of the part about X, Y: of its mount on the
+/// tilt_y_deg = [-30, 30]        #   flange (part carried) or on the table (torch carried)
+/// offset_mm = [0, 100]          # part carried: the part's mount along the flange axis
+/// torch_rotation_deg = [-90, 90]  # torch carried: the torch in its clamp, about the flange axis
 /// ```
 #[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -125,6 +130,18 @@ pub struct PlacementSpec {
     pub keep_out_min_mm: Option<[f64; 3]>,
     /// Upper corner of the keep-out box (mm).
     pub keep_out_max_mm: Option<[f64; 3]>,
+    /// Range of the fixture's tilt of the part about X (deg): about the
+    /// flange X axis (part carried) or the table X axis (torch carried),
+    /// within ±90°. Absent: kept at the file's mount.
+    pub tilt_x_deg: Option<[f64; 2]>,
+    /// As `tilt_x_deg`, about Y (deg).
+    pub tilt_y_deg: Option<[f64; 2]>,
+    /// Part carried: range of the part mount's offset along the flange axis
+    /// (mm), within ±1000 mm. Absent: kept.
+    pub offset_mm: Option<[f64; 2]>,
+    /// Torch carried: range of the torch's rotation in its clamp about the
+    /// flange axis (deg), at most a turn wide. Absent: kept.
+    pub torch_rotation_deg: Option<[f64; 2]>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -409,6 +426,40 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
                 "placement.keep_out_min_mm",
                 "give both keep_out_min_mm and keep_out_max_mm",
             ));
+        }
+        let part_carried = matches!(cell, Some(Cell::PartCarried(_)));
+        let ranges = [
+            ("placement.tilt_x_deg", p.tilt_x_deg, 90.0, None),
+            ("placement.tilt_y_deg", p.tilt_y_deg, 90.0, None),
+            ("placement.offset_mm", p.offset_mm, 1000.0, Some(true)),
+            (
+                "placement.torch_rotation_deg",
+                p.torch_rotation_deg,
+                360.0,
+                Some(false),
+            ),
+        ];
+        for (field, range, limit, only_part_carried) in ranges {
+            let Some([lo, hi]) = range else { continue };
+            if only_part_carried.is_some_and(|pc| pc != part_carried) {
+                let kind = if part_carried { "part" } else { "torch" };
+                return Err(invalid(
+                    field,
+                    &format!("not a variable of a {kind}-carried cell"),
+                ));
+            }
+            let ok = lo.is_finite() && hi.is_finite() && lo <= hi;
+            let within = if field.ends_with("torch_rotation_deg") {
+                hi - lo <= limit
+            } else {
+                lo >= -limit && hi <= limit
+            };
+            if !(ok && within) {
+                return Err(invalid(
+                    field,
+                    &format!("[{lo}, {hi}] must be finite, ordered and within {limit}"),
+                ));
+            }
         }
     }
     let program = match doc.program {

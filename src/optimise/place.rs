@@ -1,33 +1,71 @@
 //! **Placement of the part in the cell** (beyond the thesis, which moved the
 //! deposition point by hand, §3.3 "second position"). Takes a cell, the
 //! layers of a path (part frame) and bounds on the cell's placement variables
-//! — part carried: the deposition point `D_R` (robot base frame, mm) and the
-//! rotation of the part's mount about the flange axis (rad); torch carried:
-//! the positioner's position (mm) and its rotation about the vertical (rad) —
 //! and returns the placement that makes every layer feasible with the widest
 //! worst-layer margin (joint-limit distance, speed headroom, dexterity).
 //!
-//! The search is a coarse global sampling of the box (a Halton sequence),
-//! each candidate judged by the `R_Z` optimisation of SPEC §7 on a subsample
-//! of the layers and points, in parallel; then a compass search refines the
-//! best candidates on the same subsample; the winner is certified by the full
-//! optimisation of every point of every layer.
+//! The variables (robot base frame; mm, rad), each searched only where its
+//! bounds differ:
+//!
+//! | | part carried | torch carried |
+//! |---|---|---|
+//! | 0–2 | deposition point `D_R` x, y, z | positioner origin x, y, z |
+//! | 3 | part mount about the flange axis | positioner about the vertical |
+//! | 4, 5 | fixture tilt of the part on the flange about X, Y | fixture tilt of the part on the table about X, Y |
+//! | 6 | part mount offset along the flange axis (mm) | torch in its clamp about the flange axis |
+//!
+//! The search:
+//! 1. **Screening**: a coarse global sampling of the free variables (a
+//!    Halton sequence; the cell as given is the first candidate), each
+//!    candidate judged by the `R_Z` optimisation of SPEC §7 on a subsample
+//!    of the layers and points, candidates in parallel.
+//! 2. **Refinement**: a compass search from the best few, on the subsample.
+//! 3. **Certification**, best first (the cell as given first unless beaten
+//!    by [`KEEP_MARGIN`]), of the candidates feasible on the subsample: every layer at full resolution, in an order that meets the
+//!    layers that failed before first and spreads the others over the part,
+//!    in parallel chunks, stopping at the first chunk with an infeasible
+//!    layer; a feasible plan is then offered to the caller's own check (the
+//!    program stage's transit check, in [`crate::pipeline::place_part`]).
+//! 4. **Feedback**: when certification fails, the failing layers join the
+//!    subsample at full resolution (the subsample misses speed peaks at cusps
+//!    between its points), the best candidates are judged again on it and the
+//!    search goes back to 2, for a bounded number of rounds.
 
+use std::collections::BTreeSet;
 use std::f64::consts::PI;
 use std::time::Instant;
 
 use rayon::prelude::*;
 
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
-use crate::optimise::{optimise, LayerPoints, LayerStatus, OptimiseError, OptimiseOptions, Plan};
+use crate::optimise::{
+    optimise, LayerPlan, LayerPoints, LayerStatus, OptimiseError, OptimiseOptions, Plan, Transition,
+};
 use crate::robot::Cell;
 
-/// One placement variable: its name (as in the cell file), its bounds and
-/// the cell's current value (mm for positions, rad for rotations).
+/// How much better (in the search's score: 1 is comfortable margins, 10° from
+/// a stop and 20 % speed headroom) another candidate must score on the
+/// subsample for the cell as given, when feasible there, not to be
+/// certified first: 0.05 is half a degree from a stop or 1 % of speed
+/// headroom. A placed cell placed again thus stays where it is.
+pub const KEEP_MARGIN: f64 = 0.05;
+
+/// The binding named for a candidate feasible on the subsample that the
+/// caller's check refuses there.
+const SCREEN_REFUSAL: &str = "program check on the subsample (transit or set-up)";
+
+/// Number of placement variables (see the module doc's table).
+pub const VARIABLES: usize = 7;
+
+/// One placement variable: its name, its bounds and the cell's current value
+/// (mm for positions and the offset, rad for rotations and tilts).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlacementVariable {
-    /// Name, e.g. `deposition_point_mm.x`, `flange_rotation`, `positioner.x`.
+    /// Name, e.g. `deposition_point_mm.x`, `flange_rotation`, `positioner.x`,
+    /// `fixture.tilt_x`, `fixture.offset`, `torch_rotation`.
     pub name: &'static str,
+    /// `true` for an angle (rad), `false` for a length (mm).
+    pub angle: bool,
     /// Lower bound (mm or rad).
     pub lower: f64,
     /// Upper bound (mm or rad); equal to `lower` for a fixed variable.
@@ -36,13 +74,19 @@ pub struct PlacementVariable {
     pub current: f64,
 }
 
+impl PlacementVariable {
+    /// `true` when the bounds leave the variable free.
+    pub fn is_free(&self) -> bool {
+        self.upper > self.lower
+    }
+}
+
 /// Bounds of the search and a keep-out box (robot base frame, mm): a
 /// deposition point or positioner origin inside the box is refused (the
 /// robot's base, a wall, the wire feeder).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlacementBounds {
-    /// The variables: part carried `[D_R x, y, z, flange rotation]`, torch
-    /// carried `[positioner x, y, z, rotation about the vertical]`.
+    /// The [`VARIABLES`] variables, in the order of the module doc's table.
     pub variables: Vec<PlacementVariable>,
     /// Keep-out box `(min, max)`, robot base frame (mm).
     pub keep_out: Option<([f64; 3], [f64; 3])>,
@@ -51,37 +95,59 @@ pub struct PlacementBounds {
 impl PlacementBounds {
     /// Default bounds around `cell`'s placement: ±`half_box_mm` on each
     /// coordinate of the deposition point (positioner), the full turn on the
-    /// rotation, and the robot's base keep-out: a vertical cylinder's bounding
-    /// box of half-width 250 mm about the base axis below the shoulder.
+    /// rotation, the fixture and torch mount fixed as given, and the robot's
+    /// base keep-out: a vertical cylinder's bounding box of half-width 250 mm
+    /// about the base axis below the shoulder.
     pub fn around(cell: &Cell, half_box_mm: f64) -> Self {
         let names_pc = [
             "deposition_point_mm.x",
             "deposition_point_mm.y",
             "deposition_point_mm.z",
+            "flange_rotation",
+            "fixture.tilt_x",
+            "fixture.tilt_y",
+            "fixture.offset",
         ];
-        let names_tc = ["positioner.x", "positioner.y", "positioner.z"];
-        let (p, names, rot_name): (Point3, [&'static str; 3], &'static str) = match cell {
-            Cell::PartCarried(c) => (c.deposition_point_mm, names_pc, "flange_rotation"),
+        let names_tc = [
+            "positioner.x",
+            "positioner.y",
+            "positioner.z",
+            "positioner.rotation",
+            "fixture.tilt_x",
+            "fixture.tilt_y",
+            "torch_rotation",
+        ];
+        let (p, names): (Point3, [&'static str; VARIABLES]) = match cell {
+            Cell::PartCarried(c) => (c.deposition_point_mm, names_pc),
             Cell::TorchCarried(c) => (
                 Point3::from(c.base_from_positioner.translation.vector),
                 names_tc,
-                "positioner.rotation",
             ),
+        };
+        let fixed = |name, angle| PlacementVariable {
+            name,
+            angle,
+            lower: 0.0,
+            upper: 0.0,
+            current: 0.0,
         };
         let mut variables: Vec<PlacementVariable> = (0..3)
             .map(|k| PlacementVariable {
                 name: names[k],
+                angle: false,
                 lower: p[k] - half_box_mm,
                 upper: p[k] + half_box_mm,
                 current: p[k],
             })
             .collect();
         variables.push(PlacementVariable {
-            name: rot_name,
             lower: -PI,
             upper: PI,
-            current: 0.0,
+            ..fixed(names[3], true)
         });
+        variables.push(fixed(names[4], true));
+        variables.push(fixed(names[5], true));
+        variables.push(fixed(names[6], matches!(cell, Cell::TorchCarried(_))));
         Self {
             variables,
             keep_out: Some(([-250.0, -250.0, -1e4], [250.0, 250.0, 400.0])),
@@ -93,6 +159,15 @@ impl PlacementBounds {
     /// # Errors
     /// [`OptimiseError::InvalidPlacement`] naming the variable.
     pub fn validate(&self) -> Result<(), OptimiseError> {
+        if self.variables.len() != VARIABLES {
+            return Err(OptimiseError::InvalidPlacement {
+                field: "variables".into(),
+                reason: format!(
+                    "{VARIABLES} variables expected, got {}",
+                    self.variables.len()
+                ),
+            });
+        }
         for v in &self.variables {
             if !(v.lower.is_finite() && v.upper.is_finite() && v.lower <= v.upper) {
                 return Err(OptimiseError::InvalidPlacement {
@@ -103,10 +178,17 @@ impl PlacementBounds {
                     ),
                 });
             }
-            if v.name.ends_with("rotation") && (v.upper - v.lower) > 2.0 * PI + 1e-9 {
+            if v.angle && (v.upper - v.lower) > 2.0 * PI + 1e-9 {
                 return Err(OptimiseError::InvalidPlacement {
                     field: v.name.to_string(),
                     reason: "a rotation range wider than a turn".into(),
+                });
+            }
+            if v.name.contains("tilt") && (v.lower < -PI / 2.0 - 1e-9 || v.upper > PI / 2.0 + 1e-9)
+            {
+                return Err(OptimiseError::InvalidPlacement {
+                    field: v.name.to_string(),
+                    reason: "a fixture tilt beyond ±90°".into(),
                 });
             }
         }
@@ -131,10 +213,15 @@ pub struct PlaceOptions {
     pub layers: usize,
     /// Points per layer of the subsample.
     pub points_per_layer: usize,
-    /// Candidates refined by the compass search.
+    /// Candidates refined by the compass search, and certified, per round.
     pub refined: usize,
     /// Evaluations of each compass search.
     pub refine_evaluations: usize,
+    /// Rounds of refinement and certification (the failing layers of one
+    /// round join the subsample of the next).
+    pub rounds: usize,
+    /// Failing layers added to the subsample after a failed certification.
+    pub feedback_layers: usize,
     /// The optimiser's options (travel speed among them).
     pub optimise: OptimiseOptions,
 }
@@ -147,6 +234,8 @@ impl Default for PlaceOptions {
             points_per_layer: 24,
             refined: 2,
             refine_evaluations: 24,
+            rounds: 4,
+            feedback_layers: 4,
             optimise: OptimiseOptions::default(),
         }
     }
@@ -165,6 +254,17 @@ pub struct Margins {
     pub infeasible_layers: usize,
 }
 
+/// Wall times of the search's phases, summed over the rounds (s).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct PlaceTimes {
+    /// Screening and re-judging candidates on the subsample (s).
+    pub screening_s: f64,
+    /// Compass refinement on the subsample (s).
+    pub refinement_s: f64,
+    /// Full-path certification, the caller's check included (s).
+    pub certification_s: f64,
+}
+
 /// What [`place`] found.
 #[derive(Debug, Clone)]
 pub struct Placement {
@@ -173,71 +273,108 @@ pub struct Placement {
     pub cell: Cell,
     /// The variables' values (mm, rad), in the order of the bounds.
     pub values: Vec<f64>,
-    /// `true` when the full plan in the placed cell is feasible.
+    /// `true` when the full plan in the placed cell is feasible (and passed
+    /// the caller's check).
     pub feasible: bool,
-    /// Margins of the full plan in the placed cell.
+    /// Margins of [`Placement::plan`].
     pub margins: Margins,
-    /// Margins of the full plan in the cell as given.
+    /// Margins of the cell as given, on the final subsample.
     pub margins_before: Margins,
     /// Candidates evaluated on the subsample.
     pub candidates: usize,
-    /// Fraction of them feasible on the subsample.
+    /// Fraction of the coarse global samples feasible on the first subsample.
     pub feasible_fraction: f64,
+    /// Candidates certified on the full path.
+    pub certified: usize,
+    /// Rounds run.
+    pub rounds: usize,
+    /// Layers of the final subsample, and of them at full resolution.
+    pub subsample_layers: (usize, usize),
     /// Why no placement was found: when no candidate was feasible on the
     /// subsample, the constraint that bound most of them (the first
     /// infeasible layer's) with the share of candidates it bound; when the
-    /// best failed on the full path, the full plan's first binding
-    /// constraint with the share of its layers that are infeasible.
+    /// best failed on the full path, that plan's first binding constraint
+    /// (suffix `(on the full path)`) with the share of the layers checked
+    /// that are infeasible; when the caller's check refused every
+    /// candidate feasible on the full path, its reason (suffix
+    /// `(program check)`) and 1.
     pub binding: Option<(String, f64)>,
-    /// The full plan in the placed cell.
+    /// The plan in the placed cell: every layer when feasible; otherwise
+    /// the layers checked before certification stopped, or the subsample's
+    /// plan when no candidate reached certification.
     pub plan: Plan,
+    /// Phase times (s).
+    pub times: PlaceTimes,
     /// Wall time (s).
     pub time_s: f64,
 }
 
-/// The cell with the placement `x` (see [`PlacementBounds::variables`]).
+/// The cell with the placement `x` (see the module doc's table; missing
+/// trailing values are 0).
 pub fn placed_cell(cell: &Cell, x: &[f64]) -> Cell {
+    let at = |k: usize| x.get(k).copied().unwrap_or(0.0);
+    let rot = |axis: &crate::math::UnitVector3, a: f64| UnitQuaternion::from_axis_angle(axis, a);
+    let tilt = rot(&Vector3::x_axis(), at(4)) * rot(&Vector3::y_axis(), at(5));
     let mut out = cell.clone();
     match &mut out {
         Cell::PartCarried(c) => {
-            c.deposition_point_mm = Point3::new(x[0], x[1], x[2]);
-            let turn = Isometry3::from_parts(
-                Translation3::identity(),
-                UnitQuaternion::from_axis_angle(&Vector3::z_axis(), x[3]),
+            c.deposition_point_mm = Point3::new(at(0), at(1), at(2));
+            let mount = Isometry3::from_parts(
+                Translation3::new(0.0, 0.0, at(6)),
+                rot(&Vector3::z_axis(), at(3)) * tilt,
             );
-            c.flange_from_part = turn * c.flange_from_part;
+            c.flange_from_part = mount * c.flange_from_part;
         }
         Cell::TorchCarried(c) => {
-            let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), x[3]);
             c.base_from_positioner = Isometry3::from_parts(
-                Translation3::new(x[0], x[1], x[2]),
-                turn * c.base_from_positioner.rotation,
+                Translation3::new(at(0), at(1), at(2)),
+                rot(&Vector3::z_axis(), at(3)) * c.base_from_positioner.rotation,
             );
+            c.table_from_part =
+                Isometry3::from_parts(Translation3::identity(), tilt) * c.table_from_part;
+            c.flange_from_tcp =
+                Isometry3::from_parts(Translation3::identity(), rot(&Vector3::z_axis(), at(6)))
+                    * c.flange_from_tcp;
         }
     }
     out
 }
 
-/// Every `stride`-th layer (first and last kept), each with every `k`-th point.
-fn subsample(layers: &[LayerPoints], n_layers: usize, n_points: usize) -> Vec<LayerPoints> {
-    let n = layers.len();
-    let picks: Vec<usize> = if n <= n_layers.max(2) {
-        (0..n).collect()
-    } else {
-        let mut v: Vec<usize> = (0..n_layers)
-            .map(|i| (i as f64 * (n - 1) as f64 / (n_layers - 1) as f64).round() as usize)
-            .collect();
-        v.dedup();
-        v
-    };
+/// The layers picked for the subsample: `n_layers` evenly spread (first and
+/// last included), or all when there are fewer.
+fn coarse_picks(n: usize, n_layers: usize) -> BTreeSet<usize> {
+    if n <= n_layers.max(2) {
+        return (0..n).collect();
+    }
+    (0..n_layers)
+        .map(|i| (i as f64 * (n - 1) as f64 / (n_layers - 1) as f64).round() as usize)
+        .collect()
+}
+
+/// The subsample: the picked layers, every `k`-th point, and the layers of
+/// `full` with all their points.
+fn subsample(
+    layers: &[LayerPoints],
+    picks: &BTreeSet<usize>,
+    full: &BTreeSet<usize>,
+    n_points: usize,
+) -> Vec<LayerPoints> {
     picks
-        .into_iter()
-        .map(|i| {
+        .union(full)
+        .map(|&i| {
             let l = &layers[i];
+            if full.contains(&i) {
+                return l.clone();
+            }
             let k = l.points.len().div_ceil(n_points.max(3)).max(1);
+            let mut points: Vec<_> = l.points.iter().step_by(k).copied().collect();
+            // The last point too: the arc-off moves start there.
+            if (l.points.len() - 1) % k != 0 {
+                points.extend(l.points.last().copied());
+            }
             LayerPoints {
                 layer: l.layer,
-                points: l.points.iter().step_by(k).copied().collect(),
+                points,
             }
         })
         .filter(|l| l.points.len() >= 3)
@@ -332,11 +469,126 @@ fn radical_inverse(mut i: usize, base: usize) -> f64 {
     r
 }
 
+/// The order in which certification visits the layers: those that failed
+/// before first, then the others by the base-2 radical inverse of their
+/// index (so that the first few spread over the whole part).
+fn certification_order(n: usize, hot: &[usize]) -> Vec<usize> {
+    let mut seen = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    for &i in hot {
+        if i < n && !seen[i] {
+            seen[i] = true;
+            order.push(i);
+        }
+    }
+    let mut rest: Vec<usize> = (0..n).filter(|i| !seen[*i]).collect();
+    rest.sort_by(|a, b| radical_inverse(*a, 2).total_cmp(&radical_inverse(*b, 2)));
+    order.extend(rest);
+    order
+}
+
+/// Arc-off moves between consecutive planned layers (as the optimiser
+/// reports them).
+fn transitions(cell: &Cell, plans: &[LayerPlan]) -> Vec<Transition> {
+    let robot = cell.robot();
+    plans
+        .windows(2)
+        .filter_map(|w| {
+            let last = w[0].points.last()?.joints?;
+            let first = w[1].points.first()?.joints?;
+            let start = robot
+                .limits
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| !l.is_unlimited())
+                .map(|(j, l)| (first[j] - l.lower_rad).min(l.upper_rad - first[j]))
+                .fold(f64::INFINITY, f64::min);
+            Some(Transition {
+                from_layer: w[0].layer,
+                to_layer: w[1].layer,
+                joint_change_rad: std::array::from_fn(|j| first[j] - last[j]),
+                branch_change: w[0].configuration.chosen != w[1].configuration.chosen,
+                start_limit_distance_rad: start,
+            })
+        })
+        .collect()
+}
+
+/// Every layer of `layers` in `cell`, in `order`, in parallel chunks of
+/// `chunk`, stopping after the first chunk with an infeasible layer.
+/// Returns the layers planned (in path order) and the infeasible ones'
+/// indices.
+fn certify(
+    cell: &Cell,
+    layers: &[LayerPoints],
+    order: &[usize],
+    serial: &OptimiseOptions,
+    chunk: usize,
+) -> Result<(Vec<LayerPlan>, Vec<usize>), OptimiseError> {
+    let mut planned: Vec<(usize, LayerPlan)> = Vec::with_capacity(layers.len());
+    let mut failing = Vec::new();
+    for part in order.chunks(chunk.max(1)) {
+        let results: Vec<Result<(usize, LayerPlan), OptimiseError>> = part
+            .par_iter()
+            .map(|&i| {
+                let mut plan = optimise(cell, std::slice::from_ref(&layers[i]), serial)?;
+                Ok((i, plan.layers.remove(0)))
+            })
+            .collect();
+        for r in results {
+            let (i, l) = r?;
+            if !l.status.is_feasible() {
+                failing.push(i);
+            }
+            planned.push((i, l));
+        }
+        if !failing.is_empty() {
+            break;
+        }
+    }
+    planned.sort_by_key(|(i, _)| *i);
+    Ok((planned.into_iter().map(|(_, l)| l).collect(), failing))
+}
+
+#[derive(Clone)]
 struct Judged {
     x: Vec<f64>,
     score: f64,
     binding: Option<String>,
 }
+
+/// The most frequent binding constraint among `judged`, with its share.
+fn most_frequent_binding(judged: &[Judged]) -> Option<(String, f64)> {
+    let mut counts: Vec<(String, usize)> = Vec::new();
+    for j in judged {
+        if let Some(b) = &j.binding {
+            match counts.iter_mut().find(|(n, _)| n == b) {
+                Some((_, c)) => *c += 1,
+                None => counts.push((b.clone(), 1)),
+            }
+        }
+    }
+    counts.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+    counts
+        .first()
+        .map(|(n, c)| (n.clone(), *c as f64 / judged.len().max(1) as f64))
+}
+
+/// A caller's refusal of a candidate: why, and the layers it implicates
+/// (their [`LayerPoints::layer`] numbers, e.g. the two ends of an arc-off
+/// move), which join the subsample at full resolution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refusal {
+    /// Why (names the layer and point).
+    pub reason: String,
+    /// Layers implicated (may be empty).
+    pub layers: Vec<usize>,
+}
+
+/// A caller's check of a plan feasible on every layer it has (e.g. the
+/// program stage's), given the layers the plan is of (the subsample's while
+/// screening, every layer at certification).
+pub type Accept<'a> = &'a (dyn Fn(&Cell, &[LayerPoints], &Plan) -> Result<(), Refusal> + Sync);
 
 /// Searches the placement of `layers` in `cell` within `bounds` [module doc].
 ///
@@ -351,33 +603,46 @@ pub fn place(
     bounds: &PlacementBounds,
     opts: &PlaceOptions,
 ) -> Result<Placement, OptimiseError> {
+    place_with(cell, layers, bounds, opts, &|_, _, _| Ok(()))
+}
+
+/// [`place`] with the caller's check of each plan feasible on every layer:
+/// a candidate it refuses is passed over for the next (its reason becomes
+/// the binding constraint when every candidate is refused).
+///
+/// # Errors
+/// As [`place`].
+pub fn place_with(
+    cell: &Cell,
+    layers: &[LayerPoints],
+    bounds: &PlacementBounds,
+    opts: &PlaceOptions,
+    accept: Accept<'_>,
+) -> Result<Placement, OptimiseError> {
     let t0 = Instant::now();
     bounds.validate()?;
-    if bounds.variables.len() != 4 {
-        return Err(OptimiseError::InvalidPlacement {
-            field: "variables".into(),
-            reason: format!("4 variables expected, got {}", bounds.variables.len()),
-        });
-    }
-    if opts.samples == 0 || opts.layers < 2 || opts.points_per_layer < 3 {
+    if opts.samples == 0 || opts.layers < 2 || opts.points_per_layer < 3 || opts.rounds == 0 {
         return Err(OptimiseError::InvalidPlacement {
             field: "options".into(),
-            reason: "samples >= 1, layers >= 2 and points_per_layer >= 3".into(),
+            reason: "samples >= 1, layers >= 2, points_per_layer >= 3 and rounds >= 1".into(),
         });
     }
     opts.optimise.validate()?;
-    let sub = subsample(layers, opts.layers, opts.points_per_layer);
+    cell.validate()?;
+    let mut times = PlaceTimes::default();
     let serial = OptimiseOptions {
         parallel: false,
         ..opts.optimise
     };
     let vars = &bounds.variables;
+    let free: Vec<usize> = (0..vars.len()).filter(|k| vars[*k].is_free()).collect();
     let inside_keep_out = |x: &[f64]| {
         bounds
             .keep_out
             .is_some_and(|(lo, hi)| (0..3).all(|k| x[k] >= lo[k] && x[k] <= hi[k]))
     };
-    let judge = |x: Vec<f64>| -> Judged {
+    let screen_refusal: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+    let judge = |x: Vec<f64>, sub: &[LayerPoints]| -> Judged {
         if inside_keep_out(&x) {
             return Judged {
                 x,
@@ -386,12 +651,30 @@ pub fn place(
             };
         }
         let c = placed_cell(cell, &x);
-        match optimise(&c, &sub, &serial) {
-            Ok(plan) => Judged {
-                score: score(&plan, &c),
-                binding: binding_of(&plan),
-                x,
-            },
+        match optimise(&c, sub, &serial) {
+            Ok(plan) => {
+                let s = score(&plan, &c);
+                // Feasible on the subsample: the caller's check on it too (a
+                // screen: the subsample's wall is sparse and its transits
+                // join layers far apart).
+                if s >= 0.0 {
+                    if let Err(reason) = accept(&c, sub, &plan) {
+                        if let Ok(mut first) = screen_refusal.lock() {
+                            first.get_or_insert(reason.reason);
+                        }
+                        return Judged {
+                            x,
+                            score: -0.05,
+                            binding: Some(SCREEN_REFUSAL.into()),
+                        };
+                    }
+                }
+                Judged {
+                    score: s,
+                    binding: binding_of(&plan),
+                    x,
+                }
+            }
             Err(e) => Judged {
                 x,
                 score: -3.0,
@@ -404,120 +687,287 @@ pub fn place(
             *v = v.clamp(b.lower, b.upper);
         }
     };
-    // Coarse global sampling: the cell as given first, then a Halton set.
+    let picks = coarse_picks(layers.len(), opts.layers);
+    let mut full: BTreeSet<usize> = BTreeSet::new();
+    let mut sub = subsample(layers, &picks, &full, opts.points_per_layer);
+
+    // 1. Screening: the cell as given first, then a Halton set on the free
+    // variables.
+    let t = Instant::now();
     let current: Vec<f64> = vars
         .iter()
         .map(|v| v.current.clamp(v.lower, v.upper))
         .collect();
-    let mut starts = vec![current];
+    let mut starts = vec![current.clone()];
+    const BASES: [usize; VARIABLES] = [2, 3, 5, 7, 11, 13, 17];
     for i in 1..opts.samples {
-        starts.push(
-            vars.iter()
-                .zip([2, 3, 5, 7])
-                .map(|(v, base)| v.lower + radical_inverse(i, base) * (v.upper - v.lower))
-                .collect(),
-        );
+        let mut x = current.clone();
+        for (d, &k) in free.iter().enumerate() {
+            let v = &vars[k];
+            x[k] = v.lower + radical_inverse(i, BASES[d]) * (v.upper - v.lower);
+        }
+        starts.push(x);
     }
-    let mut judged: Vec<Judged> = starts.into_par_iter().map(judge).collect();
-    let mut candidates = judged.len();
-    let feasible_count = judged.iter().filter(|j| j.score >= 0.0).count();
-    judged.sort_by(|a, b| b.score.total_cmp(&a.score));
-    // Binding constraint over the candidates (most frequent).
-    let binding = if feasible_count == 0 {
-        let mut counts: Vec<(String, usize)> = Vec::new();
-        for j in &judged {
-            if let Some(b) = &j.binding {
-                match counts.iter_mut().find(|(n, _)| n == b) {
-                    Some((_, c)) => *c += 1,
-                    None => counts.push((b.clone(), 1)),
+    let screened: Vec<Judged> = starts.into_par_iter().map(|x| judge(x, &sub)).collect();
+    let mut candidates = screened.len();
+    let feasible_fraction =
+        screened.iter().filter(|j| j.score >= 0.0).count() as f64 / screened.len() as f64;
+    let mut pool = screened.clone();
+    pool.sort_by(|a, b| b.score.total_cmp(&a.score));
+    times.screening_s += t.elapsed().as_secs_f64();
+
+    let chunk = (2 * rayon::current_num_threads()).max(4);
+    let mut hot: Vec<usize> = Vec::new();
+    let mut refused: Vec<Vec<f64>> = Vec::new();
+    let mut certified = 0;
+    let mut rounds = 0;
+    let mut chosen: Option<(Vec<f64>, Cell, Plan)> = None;
+    // The best candidate that failed certification: x, cell, partial plan,
+    // share of the checked layers infeasible.
+    let mut failed: Option<(Vec<f64>, Cell, Plan, f64)> = None;
+    let mut refusal: Option<String> = None;
+    'rounds: for _ in 0..opts.rounds {
+        rounds += 1;
+        // 2. Compass search from the best few not refused.
+        let t = Instant::now();
+        let starts: Vec<Judged> = pool
+            .iter()
+            .filter(|j| !refused.contains(&j.x))
+            .take(opts.refined.max(1))
+            .cloned()
+            .collect();
+        for start in starts {
+            let mut best = start;
+            let mut step: Vec<f64> = vars.iter().map(|v| (v.upper - v.lower) / 8.0).collect();
+            let mut evaluations = 0;
+            while evaluations < opts.refine_evaluations && step.iter().any(|s| *s > 1e-3) {
+                let trials: Vec<Vec<f64>> = free
+                    .iter()
+                    .filter(|k| step[**k] > 1e-3)
+                    .flat_map(|&k| {
+                        [-1.0, 1.0].into_iter().map({
+                            let (best, step) = (&best, &step);
+                            move |sign| {
+                                let mut x = best.x.clone();
+                                x[k] += sign * step[k];
+                                x
+                            }
+                        })
+                    })
+                    .map(|mut x| {
+                        clamp(&mut x);
+                        x
+                    })
+                    .collect();
+                if trials.is_empty() {
+                    break;
+                }
+                evaluations += trials.len();
+                candidates += trials.len();
+                let results: Vec<Judged> = trials.into_par_iter().map(|x| judge(x, &sub)).collect();
+                let top = results.into_iter().max_by(|a, b| {
+                    a.score
+                        .total_cmp(&b.score)
+                        .then(std::cmp::Ordering::Greater)
+                });
+                match top {
+                    Some(t) if t.score > best.score + 1e-9 && !refused.contains(&t.x) => best = t,
+                    _ => step.iter_mut().for_each(|s| *s *= 0.5),
                 }
             }
-        }
-        counts.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
-        counts
-            .first()
-            .map(|(n, c)| (n.clone(), *c as f64 / judged.len() as f64))
-    } else {
-        None
-    };
-    // Compass search from the best few.
-    let mut refined: Vec<Judged> = Vec::new();
-    for start in judged.into_iter().take(opts.refined.max(1)) {
-        let mut best = start;
-        let mut step: Vec<f64> = vars.iter().map(|v| (v.upper - v.lower) / 8.0).collect();
-        let mut evaluations = 0;
-        while evaluations < opts.refine_evaluations && step.iter().any(|s| *s > 1e-3) {
-            let trials: Vec<Vec<f64>> = (0..vars.len())
-                .filter(|k| step[*k] > 0.0)
-                .flat_map(|k| {
-                    [-1.0, 1.0].into_iter().map({
-                        let (best, step) = (&best, &step);
-                        move |sign| {
-                            let mut x = best.x.clone();
-                            x[k] += sign * step[k];
-                            x
-                        }
-                    })
-                })
-                .map(|mut x| {
-                    clamp(&mut x);
-                    x
-                })
-                .collect();
-            evaluations += trials.len();
-            candidates += trials.len();
-            let results: Vec<Judged> = trials.into_par_iter().map(judge).collect();
-            let top = results.into_iter().max_by(|a, b| {
-                a.score
-                    .total_cmp(&b.score)
-                    .then(std::cmp::Ordering::Greater)
-            });
-            match top {
-                Some(t) if t.score > best.score + 1e-9 => best = t,
-                _ => step.iter_mut().for_each(|s| *s *= 0.5),
+            if !pool.iter().any(|j| j.x == best.x) {
+                pool.push(best);
             }
         }
-        refined.push(best);
-    }
-    refined.sort_by(|a, b| b.score.total_cmp(&a.score));
-    // Certify on every point; fall back to the next candidate.
-    let before_plan = optimise(cell, layers, &opts.optimise)?;
-    let margins_before = margins(&before_plan, cell);
-    let mut chosen: Option<(Vec<f64>, Cell, Plan)> = None;
-    for r in &refined {
-        let c = placed_cell(cell, &r.x);
-        let plan = optimise(&c, layers, &opts.optimise)?;
-        let ok = plan.is_feasible();
-        if chosen.is_none() || ok {
-            chosen = Some((r.x.clone(), c, plan));
+        pool.sort_by(|a, b| b.score.total_cmp(&a.score));
+        times.refinement_s += t.elapsed().as_secs_f64();
+
+        // 3. Certification of the best feasible on the subsample, the cell
+        // as given last among them (a part that plans where it stands keeps
+        // a feasible placement).
+        let t = Instant::now();
+        let mut to_certify: Vec<Vec<f64>> = pool
+            .iter()
+            .filter(|j| j.score >= 0.0 && !refused.contains(&j.x))
+            .take(opts.refined.max(1))
+            .map(|j| j.x.clone())
+            .collect();
+        let current_score = pool
+            .iter()
+            .find(|j| j.x == current && !refused.contains(&j.x))
+            .map(|j| j.score)
+            .filter(|s| *s >= 0.0);
+        if let Some(s) = current_score {
+            to_certify.retain(|x| *x != current);
+            // Kept unless clearly beaten: placing a placed cell again finds it.
+            let best = pool
+                .iter()
+                .find(|j| !refused.contains(&j.x))
+                .map_or(s, |j| j.score);
+            if s >= best - KEEP_MARGIN {
+                to_certify.insert(0, current.clone());
+            } else {
+                to_certify.push(current.clone());
+            }
         }
-        if ok {
+        if to_certify.is_empty() {
+            times.certification_s += t.elapsed().as_secs_f64();
             break;
         }
+        let mut new_failures: Vec<usize> = Vec::new();
+        for x in to_certify {
+            certified += 1;
+            let c = placed_cell(cell, &x);
+            let order = certification_order(layers.len(), &hot);
+            let (planned, failing) = certify(&c, layers, &order, &serial, chunk)?;
+            let checked = planned.len().max(1);
+            let plan = Plan {
+                transitions: transitions(&c, &planned),
+                layers: planned,
+                time_s: 0.0,
+            };
+            refused.push(x.clone());
+            if failing.is_empty() {
+                match accept(&c, layers, &plan) {
+                    Ok(()) => {
+                        chosen = Some((x, c, plan));
+                        times.certification_s += t.elapsed().as_secs_f64();
+                        break 'rounds;
+                    }
+                    Err(r) => {
+                        refusal.get_or_insert(r.reason);
+                        let named: Vec<usize> = r
+                            .layers
+                            .iter()
+                            .filter_map(|n| layers.iter().position(|l| l.layer == *n))
+                            .collect();
+                        if named.is_empty() {
+                            continue;
+                        }
+                        // Those layers join the subsample: its screen then
+                        // sees the move refused.
+                        new_failures = named;
+                        break;
+                    }
+                }
+            }
+            let share = failing.len() as f64 / checked as f64;
+            if failed.is_none() {
+                failed = Some((x, c, plan, share));
+            }
+            new_failures = failing;
+            break;
+        }
+        times.certification_s += t.elapsed().as_secs_f64();
+        if new_failures.is_empty() {
+            continue;
+        }
+        // 4. Feedback: the failing layers (spread, at most
+        // `feedback_layers`) join the subsample at full resolution; the
+        // best candidates are judged again on it.
+        let t = Instant::now();
+        new_failures.sort_unstable();
+        let step = new_failures
+            .len()
+            .div_ceil(opts.feedback_layers.max(1))
+            .max(1);
+        for &i in new_failures.iter().step_by(step) {
+            full.insert(i);
+        }
+        for &i in &new_failures {
+            if !hot.contains(&i) {
+                hot.push(i);
+            }
+        }
+        sub = subsample(layers, &picks, &full, opts.points_per_layer);
+        let keep = (4 * opts.refined).max(8);
+        let mut again: Vec<Vec<f64>> = pool
+            .iter()
+            .filter(|j| !refused.contains(&j.x))
+            .take(keep)
+            .map(|j| j.x.clone())
+            .collect();
+        if !again.contains(&current) {
+            again.push(current.clone());
+        }
+        candidates += again.len();
+        pool = again.into_par_iter().map(|x| judge(x, &sub)).collect();
+        pool.sort_by(|a, b| b.score.total_cmp(&a.score));
+        times.screening_s += t.elapsed().as_secs_f64();
     }
-    let (values, placed, plan) = chosen.unwrap_or_else(|| {
-        let x: Vec<f64> = vars.iter().map(|v| v.current).collect();
-        (x, cell.clone(), before_plan.clone())
-    });
-    let m = margins(&plan, &placed);
-    // Not feasible on every point: name what binds the full plan.
-    let binding = match (plan.is_feasible(), binding) {
-        (false, None) => binding_of(&plan).map(|b| {
-            let share = plan.infeasible_layers().count() as f64 / plan.layers.len().max(1) as f64;
-            (format!("{b} (on the full path)"), share)
-        }),
-        (_, b) => b,
+
+    // Last resort: the cell as given, when feasible on the subsample and not
+    // yet certified (a part that plans where it stands keeps a placement).
+    if chosen.is_none() && !refused.contains(&current) {
+        let c = placed_cell(cell, &current);
+        if optimise(&c, &sub, &serial).is_ok_and(|p| p.is_feasible()) {
+            let t = Instant::now();
+            certified += 1;
+            let order = certification_order(layers.len(), &hot);
+            let (planned, failing) = certify(&c, layers, &order, &serial, chunk)?;
+            let plan = Plan {
+                transitions: transitions(&c, &planned),
+                layers: planned,
+                time_s: 0.0,
+            };
+            if failing.is_empty() {
+                match accept(&c, layers, &plan) {
+                    Ok(()) => chosen = Some((current.clone(), c, plan)),
+                    Err(r) => {
+                        refusal.get_or_insert(r.reason);
+                    }
+                }
+            }
+            times.certification_s += t.elapsed().as_secs_f64();
+        }
+    }
+    let before_cell = placed_cell(cell, &current);
+    let margins_before = match optimise(&before_cell, &sub, &serial) {
+        Ok(p) => margins(&p, &before_cell),
+        Err(_) => Margins::default(),
+    };
+    let (values, placed, plan, feasible, binding) = match (chosen, failed) {
+        (Some((x, c, plan)), _) => (x, c, plan, true, None),
+        (None, Some((x, c, plan, share))) => {
+            let b = binding_of(&plan).map(|b| (format!("{b} (on the full path)"), share));
+            (x, c, plan, false, b)
+        }
+        (None, None) => {
+            let best = pool
+                .iter()
+                .find(|j| !refused.contains(&j.x))
+                .or(pool.first())
+                .map(|j| j.x.clone())
+                .unwrap_or(current);
+            let c = placed_cell(cell, &best);
+            let plan = optimise(&c, &sub, &serial)?;
+            let b = match refusal {
+                Some(r) => Some((format!("{r} (program check)"), 1.0)),
+                None => most_frequent_binding(&screened).map(|(b, share)| {
+                    let first = screen_refusal.lock().ok().and_then(|f| f.clone());
+                    match first {
+                        Some(r) if b == SCREEN_REFUSAL => (format!("{b}, e.g. {r}"), share),
+                        _ => (b, share),
+                    }
+                }),
+            };
+            (best, c, plan, false, b)
+        }
     };
     Ok(Placement {
-        feasible: plan.is_feasible(),
-        margins: m,
+        feasible,
+        margins: margins(&plan, &placed),
         margins_before,
         values,
         cell: placed,
         candidates,
-        feasible_fraction: feasible_count as f64 / opts.samples as f64,
+        feasible_fraction,
+        certified,
+        rounds,
+        subsample_layers: (sub.len(), full.len()),
         binding,
         plan,
+        times,
         time_s: t0.elapsed().as_secs_f64(),
     })
 }

@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 use serde_json::{json, Value};
 
 use super::{slice_part_with, Cell, Part, SliceOverrides};
-use crate::optimise::place::{place, PlaceOptions, Placement, PlacementBounds};
+use crate::optimise::place::{place_with, PlaceOptions, Placement, PlacementBounds, Refusal};
 use crate::optimise::{layer_points, ConfigurationChoice, OptimiseError};
 use crate::robot::orientation::FanucPose;
 use crate::Error;
@@ -47,7 +47,7 @@ pub struct PlacedCell {
 ///
 /// # Errors
 /// [`OptimiseError::InvalidPlacement`] naming the variable.
-pub fn bounds_of(cell: &Cell, half_box_mm: f64) -> Result<PlacementBounds, OptimiseError> {
+pub fn placement_bounds(cell: &Cell, half_box_mm: f64) -> Result<PlacementBounds, OptimiseError> {
     let mut b = PlacementBounds::around(&cell.layout, half_box_mm);
     let Some(spec) = &cell.placement else {
         b.validate()?;
@@ -77,6 +77,23 @@ pub fn bounds_of(cell: &Cell, half_box_mm: f64) -> Result<PlacementBounds, Optim
     if let (Some(lo), Some(hi)) = (spec.keep_out_min_mm, spec.keep_out_max_mm) {
         b.keep_out = Some((lo, hi));
     }
+    // Fixture and torch mount: searched only when the table gives a range
+    // (the cell file reader has checked them and their cell kind).
+    let part_carried = matches!(cell.layout, crate::robot::Cell::PartCarried(_));
+    let extra = [
+        (4, spec.tilt_x_deg, true),
+        (5, spec.tilt_y_deg, true),
+        (6, spec.offset_mm.filter(|_| part_carried), false),
+        (6, spec.torch_rotation_deg.filter(|_| !part_carried), true),
+    ];
+    for (k, range, degrees) in extra {
+        if let Some([lo, hi]) = range {
+            let f = if degrees { lo.to_radians() } else { lo };
+            let g = if degrees { hi.to_radians() } else { hi };
+            b.variables[k].lower = f;
+            b.variables[k].upper = g;
+        }
+    }
     b.validate()?;
     Ok(b)
 }
@@ -94,13 +111,34 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
     } else {
         400.0
     };
-    let bounds = bounds_of(cell, half)?;
+    let bounds = placement_bounds(cell, half)?;
     let sliced = slice_part_with(part, &req.slice, &Default::default())?;
     let layers = layer_points(&sliced.path, &sliced.axes.frames);
     let mut search = req.search.clone();
     search.optimise.travel_speed_mm_s = sliced.process.travel_speed_mm_s;
     search.optimise.configuration = ConfigurationChoice::Cell;
-    let placement = place(&cell.layout, &layers, &bounds, &search)?;
+    // A candidate feasible on every layer must also pass the program stage
+    // (the arc-off transits against the deposited wall, the set-up), as
+    // `plan` will check it.
+    let name = super::program_name(&part.name);
+    let accept = |layout: &crate::robot::Cell,
+                  layers: &[crate::optimise::LayerPoints],
+                  plan: &crate::optimise::Plan| {
+        let c = Cell {
+            layout: layout.clone(),
+            ..cell.clone()
+        };
+        super::planned::build(&name, &c, &sliced, layers, plan, &search.optimise)
+            .map(|_| ())
+            .map_err(|e| {
+                let reason = e.to_string();
+                Refusal {
+                    layers: layers_named(&reason),
+                    reason,
+                }
+            })
+    };
+    let placement = place_with(&cell.layout, &layers, &bounds, &search, &accept)?;
     let toml = placed_toml(cell, &placement, &bounds)?;
     let mut placed = Cell::from_toml_str(&toml, &cell.file)?;
     placed.file = cell.file.clone();
@@ -110,6 +148,24 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
         cell: placed,
         toml,
     })
+}
+
+/// The layer numbers a program-stage message names (`layer 80: … to layer
+/// 81's approach`): every `layer N` in it.
+fn layers_named(message: &str) -> Vec<usize> {
+    let mut out = Vec::new();
+    for (i, _) in message.match_indices("layer ") {
+        let digits: String = message[i + 6..]
+            .chars()
+            .take_while(char::is_ascii_digit)
+            .collect();
+        if let Ok(n) = digits.parse() {
+            if !out.contains(&n) {
+                out.push(n);
+            }
+        }
+    }
+    out
 }
 
 fn toml_error(cell: &Cell, message: String) -> Error {
@@ -138,7 +194,8 @@ fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<S
                 "deposition_point_mm".into(),
                 arr(c.deposition_point_mm.coords.as_slice()),
             );
-            if p.values[3] != 0.0 || t.contains_key("flange_from_part_xyzwpr") {
+            if p.values[3..].iter().any(|v| *v != 0.0) || t.contains_key("flange_from_part_xyzwpr")
+            {
                 let pose = FanucPose::from_isometry(&c.flange_from_part).to_xyzwpr_deg();
                 t.insert("flange_from_part_xyzwpr".into(), arr(&pose));
             }
@@ -150,6 +207,15 @@ fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<S
                 .ok_or_else(|| toml_error(cell, "no [torch_carried] table".into()))?;
             let pose = FanucPose::from_isometry(&c.base_from_positioner).to_xyzwpr_deg();
             t.insert("positioner_pose_xyzwpr".into(), arr(&pose));
+            if p.values[4..6].iter().any(|v| *v != 0.0) || t.contains_key("table_from_part_xyzwpr")
+            {
+                let pose = FanucPose::from_isometry(&c.table_from_part).to_xyzwpr_deg();
+                t.insert("table_from_part_xyzwpr".into(), arr(&pose));
+            }
+            if p.values[6] != 0.0 {
+                let pose = FanucPose::from_isometry(&c.flange_from_tcp).to_xyzwpr_deg();
+                t.insert("tool_xyzwpr".into(), arr(&pose));
+            }
         }
     }
     // The bounds searched, around the original placement, so that placing
@@ -165,6 +231,34 @@ fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<S
         "rotation_deg".into(),
         arr(&[lo.to_degrees(), (lo + span).to_degrees()]),
     );
+    // Fixture and torch mount ranges, relative to the mount written above
+    // (exact for one free tilt axis; with both, placing again searches a
+    // slightly different box about the found mount).
+    let part_carried = matches!(p.cell, crate::robot::Cell::PartCarried(_));
+    let extra = [
+        (4, "tilt_x_deg", true),
+        (5, "tilt_y_deg", true),
+        (
+            6,
+            if part_carried {
+                "offset_mm"
+            } else {
+                "torch_rotation_deg"
+            },
+            !part_carried,
+        ),
+    ];
+    for (k, key, degrees) in extra {
+        if v[k].is_free() {
+            let (lo, hi) = (v[k].lower - p.values[k], v[k].upper - p.values[k]);
+            let r = if degrees {
+                [lo.to_degrees(), hi.to_degrees()]
+            } else {
+                [lo, hi]
+            };
+            spec.insert(key.into(), arr(&r));
+        }
+    }
     let fixed: Vec<toml::Value> = ["x", "y", "z", "rotation"]
         .iter()
         .zip(v)
@@ -185,8 +279,8 @@ fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<S
     Ok(format!(
         "# Placed by waam place from {} ({}).\n\
          # Worst-layer margins after: {:.2} deg from a joint stop, speed headroom {:.1} %, dexterity {:.4}, {} infeasible layer(s).\n\
-         # Before: {:.2} deg, {:.1} %, {:.4}, {} infeasible layer(s).\n\
-         # Candidates {}, feasible on the subsample {:.0} %.\n{body}",
+         # Before (on the search's subsample of layers and points): {:.2} deg, {:.1} %, {:.4}, {} infeasible layer(s).\n\
+         # Candidates {}, feasible on the subsample {:.0} %, certified on the full path {}, {:.1} s.\n{body}",
         cell.file,
         if p.feasible { "feasible" } else { "NOT feasible" },
         m.joint_limit_deg,
@@ -199,6 +293,8 @@ fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<S
         b.infeasible_layers,
         p.candidates,
         100.0 * p.feasible_fraction,
+        p.certified,
+        p.time_s,
     ))
 }
 
@@ -220,7 +316,7 @@ impl PlacedCell {
         json!({
             "feasible": p.feasible,
             "variables": self.bounds.variables.iter().zip(&p.values).map(|(v, x)| {
-                let deg = v.name.ends_with("rotation");
+                let deg = v.angle;
                 let k = if deg { 180.0 / PI } else { 1.0 };
                 json!({
                     "name": v.name,
@@ -235,10 +331,32 @@ impl PlacedCell {
             "margins": p.margins,
             "margins_before": p.margins_before,
             "candidates": p.candidates,
+            "certified": p.certified,
+            "rounds": p.rounds,
+            "subsample_layers": p.subsample_layers.0,
+            "subsample_layers_full": p.subsample_layers.1,
+            "times": p.times,
             "feasible_fraction": p.feasible_fraction,
             "binding": p.binding.as_ref().map(|(c, share)| json!({"constraint": c, "share": share})),
             "infeasible_layers": p.plan.infeasible_layers().map(|l| json!({"layer": l.layer, "status": l.status.to_string()})).collect::<Vec<_>>(),
             "time_s": p.time_s,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::layers_named;
+
+    #[test]
+    fn layers_named_reads_every_layer_number_of_a_program_message() {
+        let m = "refusing to write a program for an infeasible plan: 1 violation(s), first: \
+                 layer 80: the arc-off joint move to layer 81's approach passes 2.0 mm into the wall";
+        assert_eq!(layers_named(m), vec![80, 81]);
+        assert_eq!(
+            layers_named("layer 85: the arc-off joint move to home"),
+            vec![85]
+        );
+        assert!(layers_named("no layers here, layer x").is_empty());
     }
 }

@@ -173,7 +173,7 @@ pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<Planned
 }
 
 /// The program model of a plan, refused when a layer is infeasible or lost.
-fn build(
+pub(super) fn build(
     name: &str,
     cell: &Cell,
     sliced: &SlicedPart,

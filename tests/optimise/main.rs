@@ -10,5 +10,6 @@ mod hose;
 mod objectives;
 mod parts;
 mod place;
+mod place_cells;
 mod spiral;
 mod support;

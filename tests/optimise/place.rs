@@ -51,6 +51,52 @@ fn spec_fk_reproduces_the_spec_check_values() {
     assert!((r.column(2) - Vector3::new(0.0, 0.0, -1.0)).norm() < 1e-9);
 }
 
+/// Checks every planned point of `planned` with the SPEC §6.1 forward
+/// kinematics against the placed cell file `toml`: the part point carried by
+/// the flange pose of its planned joints through the file's
+/// `flange_from_part_xyzwpr` lands on the file's `deposition_point_mm`
+/// (within 1 µm) with its tool axis vertical (within 1e-6). Returns the
+/// number of points checked. Reads the file's numbers itself (not the
+/// library's cell model).
+fn fk_check(toml: &str, planned: &waam_slicer::pipeline::PlannedPart) -> usize {
+    let doc: toml::Table = toml.parse().unwrap();
+    let pc = doc["part_carried"].as_table().unwrap();
+    let floats = |v: &toml::Value| -> Vec<f64> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_float().or(x.as_integer().map(|i| i as f64)).unwrap())
+            .collect()
+    };
+    let d = floats(&pc["deposition_point_mm"]);
+    let d_r = Vector3::new(d[0], d[1], d[2]);
+    let (fp_rot, fp_t) = match pc.get("flange_from_part_xyzwpr") {
+        Some(v) => {
+            let v = floats(v);
+            // FANUC W P R: Rz(R) Ry(P) Rx(W) (SPEC §6.3).
+            let r = rz(v[5].to_radians()) * ry(v[4].to_radians()) * rx(v[3].to_radians());
+            (r, Vector3::new(v[0], v[1], v[2]))
+        }
+        None => (Matrix3::identity(), Vector3::zeros()),
+    };
+    let mut checked = 0;
+    for (lp, pl) in planned.layers.iter().zip(&planned.plan.layers) {
+        for (cp, pp) in lp.points.iter().zip(&pl.points) {
+            let (r, p) = spec_fk(&pp.joints.unwrap());
+            let m = r * (fp_rot * cp.position_mm.coords + fp_t) + p;
+            assert!(
+                (m - d_r).norm() < 1e-3,
+                "layer {}: {m} vs D_R {d_r}",
+                lp.layer
+            );
+            let t = r * fp_rot * cp.tool_axis.into_inner();
+            assert!((t - Vector3::z()).norm() < 1e-6, "tool axis {t}");
+            checked += 1;
+        }
+    }
+    checked
+}
+
 /// The ROBOWAM part-carried cell with its deposition point moved to
 /// `[700, -300, 400]`, where the hemisphere is refused, and a search box.
 fn misplaced_cell() -> Cell {
@@ -100,45 +146,7 @@ fn a_refused_hemisphere_plans_after_placement_checked_by_spec_kinematics() {
     // Independent check: every planned point, carried by the SPEC's forward
     // kinematics of the planned joints, is at the placed D_R with its tool
     // axis vertical.
-    let doc: toml::Table = placed.toml.parse().unwrap();
-    let pc = doc["part_carried"].as_table().unwrap();
-    let d: Vec<f64> = pc["deposition_point_mm"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_float().unwrap())
-        .collect();
-    let d_r = Vector3::new(d[0], d[1], d[2]);
-    let (fp_rot, fp_t) = match pc.get("flange_from_part_xyzwpr") {
-        Some(v) => {
-            let v: Vec<f64> = v
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|x| x.as_float().unwrap())
-                .collect();
-            // FANUC W P R: Rz(R) Ry(P) Rx(W) (SPEC §6.3).
-            let r = rz(v[5].to_radians()) * ry(v[4].to_radians()) * rx(v[3].to_radians());
-            (r, Vector3::new(v[0], v[1], v[2]))
-        }
-        None => (Matrix3::identity(), Vector3::zeros()),
-    };
-    let mut checked = 0;
-    for (lp, pl) in planned.layers.iter().zip(&planned.plan.layers) {
-        for (cp, pp) in lp.points.iter().zip(&pl.points) {
-            let (r, p) = spec_fk(&pp.joints.unwrap());
-            let m = r * (fp_rot * cp.position_mm.coords + fp_t) + p;
-            assert!(
-                (m - d_r).norm() < 1e-3,
-                "layer {}: {m} vs D_R {d_r}",
-                lp.layer
-            );
-            let t = r * fp_rot * cp.tool_axis.into_inner();
-            assert!((t - Vector3::z()).norm() < 1e-6, "tool axis {t}");
-            checked += 1;
-        }
-    }
-    assert!(checked > 300);
+    assert!(fk_check(&placed.toml, &planned) > 300);
 
     // Placing again from the placed cell keeps it feasible with margins at
     // least as wide (the search starts from the cell as given).
@@ -153,6 +161,52 @@ fn a_refused_hemisphere_plans_after_placement_checked_by_spec_kinematics() {
     );
 }
 
+/// Issue 19's "done when": the S-bent tube of `parts/s-bend.toml` (a pipe
+/// of straight legs and two opposite 90° bends, as a new user writes one)
+/// is refused where `parts/cells/robowam_part_carried.toml` puts it, at
+/// J5's ±135° travel, and plans after `place_part` in that cell with its
+/// own `[placement]`-less default box; every planned point is checked by
+/// the SPEC §6.1 forward kinematics with the placed file's `D_R`.
+/// Coarse grid for test time: Delta 5 mm, 48 points a layer (86 layers;
+/// refused at J5's travel on that grid too, as on the part file's own
+/// Delta 2 / 400 points, checked with `waam plan` on 2026-12-02).
+#[test]
+fn the_s_bent_tube_refused_in_the_robowam_part_carried_cell_plans_after_placement() {
+    let part = Part::read(part_path("s-bend.toml")).unwrap();
+    let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
+    let coarse = SliceOverrides {
+        delta_mm: Some(5.0),
+        discretisation: Some(waam_slicer::path::Discretisation::Points(48)),
+        ..SliceOverrides::default()
+    };
+    let opts = PlanOptions {
+        slice: coarse.clone(),
+        ..PlanOptions::default()
+    };
+    let before = plan_part(&part, &cell, &opts).unwrap();
+    assert!(
+        !before.is_feasible(),
+        "the cell as given must refuse the S-bend"
+    );
+    let j5 = before
+        .plan
+        .infeasible_layers()
+        .filter(|l| l.status.to_string().contains("J5 travel"))
+        .count();
+    assert!(j5 > 0, "refused at J5's travel: {:?}", before.refusal);
+
+    let req = PlaceRequest {
+        slice: coarse,
+        ..PlaceRequest::default()
+    };
+    let placed = place_part(&part, &cell, &req).unwrap();
+    assert!(placed.placement.feasible, "{:#}", placed.summary());
+    let again = Cell::from_toml_str(&placed.toml, "placed.toml").unwrap();
+    let planned = plan_part(&part, &again, &opts).unwrap();
+    assert!(planned.is_feasible(), "{:?}", planned.refusal);
+    assert_eq!(fk_check(&placed.toml, &planned), 86 * 48);
+}
+
 #[test]
 fn bad_placement_bounds_name_their_field() {
     let text = std::fs::read_to_string(part_path("cells/robowam_part_carried.toml")).unwrap();
@@ -164,7 +218,45 @@ fn bad_placement_bounds_name_their_field() {
     let bad = text.clone() + "\n[placement]\nfixed = [\"w\"]\n";
     let e = Cell::from_toml_str(&bad, "bad.toml").unwrap_err();
     assert!(e.to_string().contains("placement.fixed"), "{e}");
-    let bad = text + "\n[placement]\nmin_mm = [900, 0, 0]\n";
+    let bad = text.clone() + "\n[placement]\nmin_mm = [900, 0, 0]\n";
     let e = Cell::from_toml_str(&bad, "bad.toml").unwrap_err();
     assert!(e.to_string().contains("placement.min_mm"), "{e}");
+    // The fixture and torch-mount ranges: beyond ±90°, unordered, not
+    // finite, or a variable the cell kind does not have.
+    let torch = std::fs::read_to_string(part_path("cells/kuka_kr16_2_torch_carried.toml")).unwrap();
+    for (base, table, field) in [
+        (&text, "tilt_x_deg = [-100, 0]", "placement.tilt_x_deg"),
+        (&text, "tilt_y_deg = [10, -10]", "placement.tilt_y_deg"),
+        (&text, "offset_mm = [0, inf]", "placement.offset_mm"),
+        (
+            &text,
+            "torch_rotation_deg = [-90, 90]",
+            "placement.torch_rotation_deg",
+        ),
+        (&torch, "offset_mm = [0, 50]", "placement.offset_mm"),
+        (
+            &torch,
+            "torch_rotation_deg = [-200, 200]",
+            "placement.torch_rotation_deg",
+        ),
+        (&torch, "tilt_x_deg = [nan, 10]", "placement.tilt_x_deg"),
+    ] {
+        let bad = format!("{base}\n[placement]\n{table}\n");
+        let e = Cell::from_toml_str(&bad, "bad.toml").unwrap_err();
+        assert!(e.to_string().contains(field), "{table}: {e}");
+        assert!(e.to_string().contains("bad.toml"), "{table}: {e}");
+    }
+    // Good ranges read and become free variables of the search, in radians.
+    let good =
+        format!("{torch}\n[placement]\ntilt_x_deg = [-30, 30]\ntorch_rotation_deg = [-90, 90]\n");
+    let cell = Cell::from_toml_str(&good, "good.toml").unwrap();
+    let b = waam_slicer::pipeline::placement_bounds(&cell, 400.0).unwrap();
+    let v = &b.variables;
+    assert_eq!(
+        (v[4].name, v[5].name, v[6].name),
+        ("fixture.tilt_x", "fixture.tilt_y", "torch_rotation")
+    );
+    assert!((v[4].upper - 30f64.to_radians()).abs() < 1e-12 && v[4].is_free());
+    assert!(!v[5].is_free());
+    assert!((v[6].lower + 90f64.to_radians()).abs() < 1e-12);
 }
