@@ -152,7 +152,8 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             );
         }
         println!(
-            "  wrote path.csv, summary.json, path.svg, distance.svg, wall.stl, report.html in {}",
+            "  wrote path.csv, summary.json, path.svg, distance.svg, {}report.html in {}",
+            if more.no_wall { "" } else { "wall.stl, " },
             dir.display()
         );
     }

@@ -459,6 +459,95 @@ mod tests {
         );
     }
 
+    /// The query as it was before the groups: the start chunk, then every
+    /// other chunk sphere in order (each segment a `make`).
+    fn flat_query(idx: &SegmentIndex, p: &Point3, start: usize) -> Nearest {
+        let scan = |c: &Chunk, best: Option<Nearest>| {
+            let mut best = best;
+            for j in c.first..c.first + c.count {
+                let cand = idx.make(
+                    p,
+                    SegmentId {
+                        polyline: c.polyline,
+                        segment: j,
+                    },
+                );
+                if best.is_none_or(|b| cand.distance < b.distance) {
+                    best = Some(cand);
+                }
+            }
+            best.unwrap()
+        };
+        let mut best = scan(&idx.chunks[start], None);
+        for (i, c) in idx.chunks.iter().enumerate() {
+            let reach = c.radius + best.distance;
+            if i != start && (p - c.centre).norm_squared() < reach * reach {
+                best = scan(c, Some(best));
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn groups_give_the_flat_scans_answers_ties_included() {
+        // three polylines, 12 000 segments (three levels of groups): a
+        // wavy ring, an open helix turn and a closed line with every vertex
+        // twice (exact ties), queried near, on, between and far off; a
+        // group sphere half its size fails this test
+        let ring: Vec<Point3> = (0..4000)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / 4000.0;
+                let r = 40.0 + 0.3 * (17.0 * a).sin();
+                Point3::new(r * a.cos(), r * a.sin(), 0.2 * (5.0 * a).cos())
+            })
+            .collect();
+        let helix: Vec<Point3> = (0..4001)
+            .map(|k| {
+                let a = k as f64 * 0.0016;
+                Point3::new(40.5 * a.cos(), 40.5 * a.sin(), 0.5 + 0.08 * a)
+            })
+            .collect();
+        let doubled: Vec<Point3> = (0..4000)
+            .map(|k| {
+                let s = (k / 2) as f64 * 0.05; // each vertex twice
+                Point3::new(-50.0 + s, 0.0, 1.0)
+            })
+            .collect();
+        let idx = SegmentIndex::new(vec![(ring, true), (helix, false), (doubled, true)]);
+        assert!(idx.levels.len() >= 3, "{} levels", idx.levels.len());
+        let mut x = 0.123_f64;
+        let mut next = || {
+            x = (x * 7.13 + 0.291).fract();
+            x
+        };
+        for q in 0..3000 {
+            let a = next() * std::f64::consts::TAU;
+            let r = [40.0, 40.3, 39.5, 0.0, 90.0][q % 5] + next();
+            let p = match q % 7 {
+                // on a vertex of the doubled polyline: ties between segments
+                6 => Point3::new(-50.0 + (q % 97) as f64 * 0.05, 0.0, 1.0),
+                _ => Point3::new(r * a.cos(), r * a.sin(), 2.0 * next() - 0.5),
+            };
+            let hint = SegmentId {
+                polyline: q % 3,
+                segment: (q * 37) % 3999,
+            };
+            let got = idx.nearest_hinted(&p, Some(hint)).unwrap();
+            let start = idx.chunk_offset[hint.polyline] + hint.segment / CHUNK;
+            assert_eq!(got, flat_query(&idx, &p, start), "query {q} at {p:?}");
+            let got = idx.nearest(&p).unwrap();
+            let start = idx
+                .chunks
+                .iter()
+                .enumerate()
+                .map(|(i, c)| (i, (p - c.centre).norm() - c.radius))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap()
+                .0;
+            assert_eq!(got, flat_query(&idx, &p, start), "query {q} at {p:?}");
+        }
+    }
+
     #[test]
     fn index_agrees_with_brute_force() {
         let circle: Vec<Point3> = (0..100)

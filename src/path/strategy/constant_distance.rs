@@ -41,10 +41,18 @@ pub fn next_t(
     // function is deterministic (a bracket found stays a bracket); the exact
     // query (any segment) confirms the root, and is used throughout if the
     // local descent stopped at a local minimum.
-    let local = |p: &Point3| below.nearest_from(p, hint).distance;
+    // The foot segment of the last local query: where the exact query
+    // starts (near the answer, it prunes most of the layer at once; the
+    // start only orders the search, the answer is the nearest segment).
+    let foot = std::cell::Cell::new(hint);
+    let local = |p: &Point3| {
+        let n = below.nearest_from(p, hint);
+        foot.set(n.id);
+        n.distance
+    };
     let exact = |p: &Point3| {
         below
-            .nearest_hinted(p, Some(hint))
+            .nearest_hinted(p, Some(foot.get()))
             .map_or(f64::INFINITY, |n| n.distance)
     };
     let x_tol = 1e-12 * (1.0 + t_below.abs());
