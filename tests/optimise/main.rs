@@ -11,4 +11,5 @@ mod objectives;
 mod parts;
 mod place;
 mod spiral;
+mod subsample;
 mod support;
