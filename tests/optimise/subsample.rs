@@ -69,6 +69,9 @@ struct Compared {
     worst_gap: f64,
     /// The (common) verdict.
     feasible: bool,
+    /// Layers whose objective is more than [`OBJECTIVE_REL_TOL`] above the
+    /// whole layer's (when not asserted).
+    worse: Vec<String>,
 }
 
 /// Compares the two plans of `layers` in `cell`.
@@ -78,6 +81,7 @@ fn compare(
     layers: &[LayerPoints],
     speed: f64,
     samples: usize,
+    strict_objective: bool,
 ) -> Compared {
     let opts = OptimiseOptions {
         travel_speed_mm_s: speed,
@@ -95,6 +99,7 @@ fn compare(
     assert_eq!(sub.is_feasible(), whole.is_feasible(), "{what}: verdict");
     let mut worst: f64 = 0.0;
     let mut certified = 0;
+    let mut worse = Vec::new();
     for (a, b) in sub.layers.iter().zip(&whole.layers) {
         let at = format!("{what}, layer {}", a.layer);
         assert_eq!(
@@ -112,13 +117,16 @@ fn compare(
             let (fa, fb) = (objective(a, &opts), objective(b, &opts));
             let gap = (fa - fb) / fb.abs().max(1e-12);
             worst = worst.max(gap.abs());
-            assert!(
-                gap <= OBJECTIVE_REL_TOL,
-                "{at}: objective {fa:.6e} subsampled, {fb:.6e} whole ({:+.2} %); laws {:?} and {:?}",
-                100.0 * gap,
-                a.law,
-                b.law
-            );
+            if gap > OBJECTIVE_REL_TOL {
+                let why = format!(
+                    "{at}: objective {fa:.6e} subsampled, {fb:.6e} whole ({:+.2} %); laws {:?} and {:?}",
+                    100.0 * gap,
+                    a.law,
+                    b.law
+                );
+                assert!(!strict_objective, "{why}");
+                worse.push(why);
+            }
         }
     }
     Compared {
@@ -126,6 +134,7 @@ fn compare(
         certified,
         worst_gap: worst,
         feasible: sub.is_feasible(),
+        worse,
     }
 }
 
@@ -176,7 +185,14 @@ fn subsampled_and_whole_layer_optimisation_agree_on_every_part_and_cell() {
         let every = all.len().div_ceil(5).max(1);
         let picked: Vec<LayerPoints> = all.into_iter().step_by(every).collect();
         for (name, c) in &cells {
-            let r = compare(&format!("{part} in {name}"), c, &picked, speed, samples);
+            let r = compare(
+                &format!("{part} in {name}"),
+                c,
+                &picked,
+                speed,
+                samples,
+                true,
+            );
             layers_seen += r.layers;
             certified += r.certified;
             worst = worst.max(r.worst_gap);
@@ -193,8 +209,9 @@ fn subsampled_and_whole_layer_optimisation_agree_on_every_part_and_cell() {
 }
 
 /// The same comparison at the part files' own settings (what `waam plan
-/// PART --cell CELL` optimises), every layer; prints one line per part and
-/// cell. Minutes in release: `cargo test --release --test optimise --
+/// PART --cell CELL` optimises), every layer; the verdicts and every
+/// point's bounds are asserted, the objective gaps printed (one line per
+/// part and cell, and each layer above the tolerance). Minutes in release: `cargo test --release --test optimise --
 /// --ignored --nocapture full_size`.
 #[test]
 #[ignore = "minutes: run in release by hand"]
@@ -209,15 +226,18 @@ fn full_size_subsampled_and_whole_layer_verdicts_agree() {
         for (name, c) in &cells {
             let what = format!("{part} in {name}");
             let t = std::time::Instant::now();
-            let r = compare(&what, c, &layers, speed, samples);
+            let r = compare(&what, c, &layers, speed, samples, false);
             println!(
-                "{what}: {} ({} layers, {} certified on a subsample, objective within {:.3} %; {:.1} s)",
+                "{what}: {} ({} layers, {} certified on a subsample, largest objective gap {:.3} %; {:.1} s)",
                 if r.feasible { "feasible" } else { "infeasible" },
                 r.layers,
                 r.certified,
                 100.0 * r.worst_gap,
                 t.elapsed().as_secs_f64()
             );
+            for w in &r.worse {
+                println!("  {w}");
+            }
         }
     }
 }
