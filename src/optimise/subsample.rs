@@ -224,9 +224,20 @@ fn certify(
             return None;
         }
         let feasible_on_samples = res.violation <= 0.0;
-        let worst = worst_points(problem, &e);
+        let mut worst = worst_points(problem, &e);
+        let objective = problem.objective(&e, 0.0);
+        if worst.is_empty() && feasible_on_samples && round < MAX_ROUNDS {
+            // the samples' estimate of the objective must hold too: where
+            // the joints move fast between two samples (a corner of the
+            // path) the estimate misses it, and the law would be tuned to
+            // the wrong objective
+            worst = poorly_estimated(problem, &e, &samples.idx, objective);
+            if !worst.is_empty() && samples.add(setup.points, &worst) {
+                continue;
+            }
+            worst.clear();
+        }
         if worst.is_empty() || !feasible_on_samples {
-            let objective = problem.objective(&e, 0.0);
             let violation = if worst.is_empty() {
                 0.0
             } else {
@@ -252,6 +263,58 @@ fn certify(
         }
     }
     None
+}
+
+/// Share of the layer's objective by which the joint displacement of one
+/// gap between samples may exceed its estimate `(Δq)² / L` before the
+/// gap's fastest step joins the samples.
+const GAP_ESTIMATE_TOLERANCE: f64 = 2e-3;
+
+/// Gaps between samples held at most this many at a time.
+const GAPS_PER_ROUND: usize = 16;
+
+/// The points to add where the samples misjudge the joint displacement
+/// (eq. 4.3) of the whole layer's evaluation `e` (objective `f`): in each
+/// gap whose displacement exceeds its estimate by more than
+/// [`GAP_ESTIMATE_TOLERANCE`]` · f` (the worst [`GAPS_PER_ROUND`]), the
+/// step that moves the joints most (both its points).
+fn poorly_estimated(
+    problem: &LayerProblem,
+    e: &super::problem::Evaluation,
+    idx: &[usize],
+    f: f64,
+) -> Vec<usize> {
+    if problem.objective != super::Objective::JointDisplacement || !(f > 0.0) {
+        return Vec::new();
+    }
+    let step = |a: usize, b: usize| -> f64 {
+        (0..6)
+            .map(|j| problem.gamma[j] * (e.q[b][j] - e.q[a][j]).powi(2))
+            .sum()
+    };
+    let mut bad: Vec<(f64, usize)> = Vec::new();
+    for w in idx.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b - a < 2 {
+            continue;
+        }
+        let mut exact = 0.0;
+        let mut fastest = (f64::NEG_INFINITY, b);
+        for m in a + 1..=b {
+            let d = step(m - 1, m);
+            exact += d;
+            if d > fastest.0 {
+                fastest = (d, m);
+            }
+        }
+        let excess = exact - step(a, b) / (b - a) as f64;
+        if excess > GAP_ESTIMATE_TOLERANCE * f {
+            bad.push((excess, fastest.1));
+        }
+    }
+    bad.sort_by(|x, y| y.0.total_cmp(&x.0));
+    bad.truncate(GAPS_PER_ROUND);
+    bad.into_iter().flat_map(|(_, m)| [m - 1, m]).collect()
 }
 
 /// The points of `points` at `idx`.
