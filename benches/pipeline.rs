@@ -21,6 +21,7 @@ criterion_group!(
     robot::kinematics,
     robot::hemisphere_trajectory,
     optimise::whole_parts,
+    optimise::plan_at_scale,
     place::hemisphere_in_kuka_part_carried
 );
 criterion_main!(benches);

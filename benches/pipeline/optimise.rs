@@ -60,3 +60,48 @@ pub fn whole_parts(c: &mut Criterion) {
     }
     g.finish();
 }
+
+/// Planning at scale [issue 21]: the quarter torus R = 80, r = 20 at
+/// Delta = 1 mm, 1000 points a layer (130 layers, 108 591 points;
+/// `tests/optimise/data/quarter-torus-r80.toml`) in the ROBOWAM
+/// part-carried cell: the optimiser alone (as `plan_part` runs it: the
+/// cell's branch, the process's travel speed, layers subsampled and
+/// certified on every point) and the library's whole
+/// `plan_part` (slice, tool axes, optimisation, program model).
+pub fn plan_at_scale(c: &mut Criterion) {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let file = root.join("tests/optimise/data/quarter-torus-r80.toml");
+    let cell_file = parts_dir().join("cells/robowam_part_carried.toml");
+    let part = waam_slicer::Part::read(&file).unwrap();
+    let cell = waam_slicer::Cell::read(&cell_file).unwrap();
+    // the layers, travel speed and branch rule `plan_part` optimises with
+    let sliced = waam_slicer::slice_part(&part).unwrap();
+    let l = layer_points(&sliced.path, &sliced.axes.frames);
+    let points: usize = l.iter().map(|x| x.points.len()).sum();
+    assert!(points > 100_000, "{points} points");
+    let opts = OptimiseOptions {
+        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
+        configuration: waam_slicer::optimise::ConfigurationChoice::Cell,
+        ..OptimiseOptions::default()
+    };
+    let mut g = c.benchmark_group("plan_at_scale");
+    g.sample_size(10)
+        .warm_up_time(std::time::Duration::from_secs(1))
+        .measurement_time(std::time::Duration::from_secs(5));
+    g.bench_function("optimise_quarter_torus_r80_110k", |b| {
+        b.iter(|| {
+            let plan = optimise(black_box(&cell.layout), black_box(&l), &opts).unwrap();
+            assert!(plan.is_feasible());
+            plan
+        })
+    });
+    let plan_opts = waam_slicer::PlanOptions::default();
+    g.bench_function("plan_part_quarter_torus_r80_110k", |b| {
+        b.iter(|| {
+            let planned = waam_slicer::plan_part(black_box(&part), &cell, &plan_opts).unwrap();
+            assert!(planned.plan.is_feasible());
+            planned
+        })
+    });
+    g.finish();
+}

@@ -30,6 +30,8 @@ pub(super) struct BranchOutcome {
     pub(super) qp_solves: usize,
     pub(super) qp_failures: usize,
     pub(super) problem_psi: Vec<f64>,
+    /// Points the law was optimised on, when subsampled and certified.
+    pub(super) samples: Option<usize>,
 }
 
 /// One layer (or spiral turn, `anchor` given); also returns the dexterity
@@ -114,6 +116,7 @@ pub(super) fn optimise_layer(
         .unwrap_or(0);
     let out = outcomes.swap_remove(pick);
     let chosen = out.cfg;
+    let samples = out.samples;
     let reason = match anchor {
         Some(_) => format!("{chosen}: the previous spiral turn's branch (the arc does not stop)"),
         None => choice_reason(&ranking, chosen, own, branches_tried, fixed, opts),
@@ -128,6 +131,7 @@ pub(super) fn optimise_layer(
         qp_solves,
         qp_failures,
         branches_tried,
+        samples,
         time_s,
     };
     let end_floor = out.problem_psi.last().copied().unwrap_or(0.0);
@@ -249,6 +253,7 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
         qp_solves: 0,
         qp_failures: 0,
         problem_psi: psi,
+        samples: None,
     };
     match opts.parameterisation {
         Parameterisation::Fixed { r_z_rad } => {

@@ -5,10 +5,10 @@
 
 use super::branch::BranchOutcome;
 use super::parameterisation::Basis;
-use super::problem::{Evaluation, LayerProblem};
+use super::problem::{Evaluation, LayerProblem, PointFailure};
 use super::seed::Seed;
 use super::setup::LayerSetup;
-use super::{sqp, RzLaw};
+use super::{sqp, subsample, RzLaw, SqpOptions};
 
 /// Raises the degree of the polynomial `R_Z` law of `setup`'s layer from
 /// `seed`'s up to `max_degree` while the relative objective gain is at least
@@ -23,14 +23,13 @@ pub(super) fn raise_degrees(
     stop_relative_gain: f64,
     outcome: &mut BranchOutcome,
 ) {
-    let opts = setup.opts;
     let p = setup.points.len();
     let x: Vec<f64> = if setup.cylindrical {
         setup.theta.clone()
     } else {
         (0..p).map(|m| m as f64).collect()
     };
-    let (start, mut basis) = match setup.anchor {
+    let (start, basis) = match setup.anchor {
         // continuity: R_Z held on the shared point, degree ≥ 1
         Some(a) => {
             let d = seed.degree.min(max_degree).max(1);
@@ -41,90 +40,193 @@ pub(super) fn raise_degrees(
             (d, Basis::polynomial(&x, d + 1))
         }
     };
-    let mut c = basis.fit(&seed.r);
+    let c = basis.fit(&seed.r);
+    let degrees = Degrees {
+        start,
+        max: max_degree,
+        stop_relative_gain,
+    };
+    if subsample::solve(setup, problem, &basis, &c, &degrees, outcome) {
+        return;
+    }
+    match degree_loop(problem, basis, c, &degrees, &setup.opts.sqp, outcome) {
+        Ok((best, history)) => record(setup, best, history, outcome),
+        Err(f) => outcome.eval = Err(f),
+    }
+}
+
+/// The degrees a polynomial law goes through: from `start` up to `max`,
+/// while the relative objective gain is at least `stop_relative_gain`.
+pub(super) struct Degrees {
+    pub(super) start: usize,
+    pub(super) max: usize,
+    pub(super) stop_relative_gain: f64,
+}
+
+/// The degree kept by [`degree_loop`]: its coefficients, basis and SQP result.
+pub(super) struct Best {
+    pub(super) degree: usize,
+    pub(super) c: Vec<f64>,
+    pub(super) basis: Basis,
+    pub(super) res: sqp::SqpResult,
+}
+
+/// Records `best` (with the objective of every degree solved, `history`)
+/// as `outcome`'s law and evaluation.
+pub(super) fn record(
+    setup: &LayerSetup,
+    best: Best,
+    history: Vec<(usize, f64)>,
+    outcome: &mut BranchOutcome,
+) {
+    outcome.converged = best.res.converged;
+    outcome.law = RzLaw::Polynomial {
+        degree: best.degree,
+        cylindrical: setup.cylindrical,
+        coefficients_deg: best
+            .basis
+            .thesis_coefficients_deg(&best.c, !setup.cylindrical)
+            .unwrap_or_default(),
+        objective_per_degree: history,
+    };
+    outcome.eval = Ok(best.res.eval);
+}
+
+/// The degree loop on `problem` (a whole layer or a subsample of it) from
+/// coefficients `c` over `basis` (of degree `degrees.start`): the best
+/// degree and the objective of every degree solved; the SQP's counts are
+/// added to `counts`. `Err` when the start has no joint solution.
+pub(super) fn degree_loop(
+    problem: &LayerProblem,
+    mut basis: Basis,
+    mut c: Vec<f64>,
+    degrees: &Degrees,
+    sqp_opts: &SqpOptions,
+    counts: &mut BranchOutcome,
+) -> Result<(Best, Vec<(usize, f64)>), PointFailure> {
     let e0 = problem.evaluate(&basis.eval(&c)).ok();
     let scale = match &e0 {
         Some(e) => problem.objective(e, 0.0).max(1e-6),
         None => 1.0,
     };
     let mut history = Vec::new();
-    let mut best: Option<(usize, Vec<f64>, Basis, sqp::SqpResult)> = None;
+    let mut best: Option<Best> = None;
     let mut at_c: Option<Evaluation> = e0;
-    for degree in start..=max_degree.max(start) {
-        match sqp::solve(
+    for degree in degrees.start..=degrees.max.max(degrees.start) {
+        let gain = match sqp::solve(
             problem,
             &basis,
             c.clone(),
             at_c.take(),
             0.0,
             scale,
-            &opts.sqp,
+            sqp_opts,
         ) {
             Ok(res) => {
                 at_c = Some(res.eval.clone());
-                outcome.iterations += res.iterations;
-                outcome.qp_solves += res.qp_solves;
-                outcome.qp_failures += res.qp_failures;
+                counts.iterations += res.iterations;
+                counts.qp_solves += res.qp_solves;
+                counts.qp_failures += res.qp_failures;
                 history.push((degree, res.objective));
                 c = res.c.clone();
-                let improved = match &best {
-                    None => true,
-                    Some((_, _, _, b)) => {
-                        res.violation < b.violation
-                            || (res.violation <= b.violation && res.objective < b.objective)
-                    }
-                };
-                let gain = match &best {
-                    Some((_, _, _, b)) if b.violation <= 0.0 && res.violation <= 0.0 => {
-                        (b.objective - res.objective) / b.objective.abs().max(1e-300)
-                    }
-                    _ => f64::INFINITY,
-                };
-                if improved {
-                    best = Some((degree, c.clone(), basis.clone(), res));
+                let last = best.as_ref().map(|b| (b.res.violation, b.res.objective));
+                let new = (res.violation, res.objective);
+                if improves(new, last) {
+                    best = Some(Best {
+                        degree,
+                        c: c.clone(),
+                        basis: basis.clone(),
+                        res,
+                    });
                 }
-                if gain < stop_relative_gain {
-                    break;
-                }
+                relative_gain(new, last)
             }
-            Err(f) => {
-                if best.is_none() {
-                    outcome.eval = Err(f);
-                    return;
-                }
-                break;
-            }
-        }
-        match basis.raised() {
-            Some(b) => {
-                // The Gauss–Newton model at this optimum bounds what
-                // the next degree can gain while no constraint is in
-                // reach of its step: far below the stop criterion,
-                // solving it is not worth its evaluations.
-                if let (Some(e), Some((_, _, _, bst))) = (&at_c, &best) {
-                    if bst.violation <= 0.0
-                        && skip_raise(problem, e, &b, stop_relative_gain * bst.objective)
-                    {
-                        break;
-                    }
-                }
-                basis = b;
-                c.push(0.0);
-            }
-            None => break,
-        }
-    }
-    if let Some((degree, c, basis, res)) = best {
-        outcome.converged = res.converged;
-        outcome.law = RzLaw::Polynomial {
-            degree,
-            cylindrical: setup.cylindrical,
-            coefficients_deg: basis
-                .thesis_coefficients_deg(&c, !setup.cylindrical)
-                .unwrap_or_default(),
-            objective_per_degree: history,
+            Err(f) => match best {
+                None => return Err(f),
+                Some(_) => break,
+            },
         };
-        outcome.eval = Ok(res.eval);
+        let Some(raised) = basis.raised() else {
+            break;
+        };
+        let last = best.as_ref().map(|b| (b.res.violation, b.res.objective));
+        if !raise_again(
+            problem,
+            at_c.as_ref(),
+            &raised,
+            degree + 1,
+            gain,
+            degrees,
+            last,
+        ) {
+            break;
+        }
+        basis = raised;
+        c.push(0.0);
+    }
+    // the first degree either failed (returned above) or set `best`
+    best.map(|b| (b, history)).ok_or(PointFailure {
+        point: 0,
+        error: crate::robot::RobotError::NonFinite { what: "not solved" },
+    })
+}
+
+/// Whether to solve degree `next` (basis `raised`) after one whose relative
+/// gain over the best before it was `gain` (`best`: the best `(violation,
+/// objective)` now; `e`: the evaluation at the degree just solved).
+///
+/// A gain below the stop criterion [§4.2.1] ends the loop unless the
+/// Gauss–Newton model at this optimum predicts that the next two degrees
+/// gain at least the criterion; a gain above it goes on unless
+/// [`skip_raise`] shows that they cannot pay. The look-ahead is two degrees
+/// because one is myopic: the odd term of a layer whose best law is nearly
+/// even adds nothing where the even term after it does, and whether such a
+/// degree is solved at all then hangs on residues (a 1e-9 rad violation
+/// of the degree before, the model's 1e-8 gain on a subsample against
+/// 1e-6 on every point).
+pub(super) fn raise_again(
+    problem: &LayerProblem,
+    e: Option<&Evaluation>,
+    raised: &Basis,
+    next: usize,
+    gain: f64,
+    degrees: &Degrees,
+    best: Option<(f64, f64)>,
+) -> bool {
+    let Some((violation, objective)) = best else {
+        return true;
+    };
+    let stop = degrees.stop_relative_gain;
+    let threshold = stop * objective;
+    let Some(e) = e else {
+        return gain >= stop;
+    };
+    if violation > 0.0 {
+        return true;
+    }
+    let twice = (next < degrees.max).then(|| raised.raised()).flatten();
+    let raised = twice.as_ref().unwrap_or(raised);
+    if gain < stop {
+        return sqp::predicted_gain(problem, e, 0.0, raised).is_some_and(|(g, _)| g >= threshold);
+    }
+    !skip_raise(problem, e, raised, threshold)
+}
+
+/// `true` when a degree's `(violation, objective)` is better than the best
+/// so far (less violation, or as little and a lower objective).
+pub(super) fn improves(new: (f64, f64), best: Option<(f64, f64)>) -> bool {
+    match best {
+        None => true,
+        Some((bv, bf)) => new.0 < bv || (new.0 <= bv && new.1 < bf),
+    }
+}
+
+/// Relative objective gain of a degree over the best so far when both are
+/// feasible; infinite otherwise (keep raising).
+pub(super) fn relative_gain(new: (f64, f64), best: Option<(f64, f64)>) -> f64 {
+    match best {
+        Some((bv, bf)) if bv <= 0.0 && new.0 <= 0.0 => (bf - new.1) / bf.abs().max(1e-300),
+        _ => f64::INFINITY,
     }
 }
 
@@ -137,7 +239,12 @@ const RAISE_MODEL_FRACTION: f64 = 1e-2;
 /// decrease below `RAISE_MODEL_FRACTION × threshold` (objective units), and
 /// no constraint is within reach of that model step (with one, the model
 /// would not bound the gain).
-fn skip_raise(problem: &LayerProblem, e: &Evaluation, raised: &Basis, threshold: f64) -> bool {
+pub(super) fn skip_raise(
+    problem: &LayerProblem,
+    e: &Evaluation,
+    raised: &Basis,
+    threshold: f64,
+) -> bool {
     let Some((gain, step)) = sqp::predicted_gain(problem, e, 0.0, raised) else {
         return false;
     };

@@ -22,6 +22,7 @@
 //! | seeds scored in every branch | `seed` | — |
 //! | branch choice and the per-branch solve | `branch` | — |
 //! | the polynomial degree loop | `degree` | — |
+//! | a long layer's law on a subsample, certified on every point | `subsample` | [`OptimiseOptions::subsample_points`] |
 //! | the point-by-point baseline [§4.1.4] | `point_by_point` | — |
 //! | a layer's status, objective figures and quality | `report` | — |
 //! | spiral paths, turn by turn | `spiral` | [`optimise_spiral`] |
@@ -48,7 +49,21 @@
 //!    at the least violation with the binding constraint named. The
 //!    dexterity's SVD runs only where a cheap bound cannot show the point
 //!    well above its floor, warm-started along the layer.
-//! 4. **Transitions**: every layer starts from the joint representation inside
+//! 4. **Subsample, then every point.** On a layer of more than twice
+//!    [`OptimiseOptions::subsample_points`] points, steps 2–3 run on about
+//!    that many points (spread along the layer, denser where the tool axis
+//!    turns; the objective weighted as the whole layer's estimate, the
+//!    speed bound on the mean speed between samples). The law found is
+//!    evaluated on every point (one IK pass) and every constraint checked
+//!    there; where one is violated or within half the solver's margin of
+//!    its bound the worst point (and the one before it) joins the samples
+//!    and the law is re-solved at the same degree. A layer the subsample
+//!    cannot certify is solved on every point, so the verdict is the whole
+//!    layer's; the plan's joints, status and quality always are. The SQP's
+//!    cost is then bounded per layer and the planning time grows linearly
+//!    with the points (the passes over every point: the floor, the
+//!    certification, the trajectory re-check and the report).
+//! 5. **Transitions**: every layer starts from the joint representation inside
 //!    the travel (J4/J6 rewound with the arc off), and the centring term of
 //!    [`OptimiseOptions::centring_weight`] keeps each layer well inside the
 //!    ranges; [`Transition`] reports the arc-off moves.
@@ -102,6 +117,7 @@ mod seed;
 mod setup;
 mod spiral;
 mod sqp;
+mod subsample;
 #[cfg(test)]
 mod tests;
 

@@ -196,6 +196,17 @@ pub struct OptimiseOptions {
     pub trajectory: TrajectoryOptions,
     /// Solve the layers in parallel (rayon, order preserved; same result).
     pub parallel: bool,
+    /// Points of a layer the polynomial law's SQP works on (0: every
+    /// point). A layer of more than twice this many points is optimised on
+    /// a subsample of about this many (spread along the layer and denser
+    /// where the tool axis turns), then the law is certified on every point
+    /// with one IK pass; points where a constraint is violated or within the
+    /// solver's margin of its bound are added to the subsample and the law
+    /// re-solved, and a layer that the subsample cannot certify is solved
+    /// on every point as without it. Joints, constraints, status and quality
+    /// are always those of every point. Ignored by the fixed law, the
+    /// smoothing spline and the point-by-point baseline.
+    pub subsample_points: usize,
 }
 
 impl Default for OptimiseOptions {
@@ -213,6 +224,7 @@ impl Default for OptimiseOptions {
             sqp: SqpOptions::default(),
             trajectory: TrajectoryOptions::default(),
             parallel: true,
+            subsample_points: 64,
         }
     }
 }
@@ -299,6 +311,13 @@ impl OptimiseOptions {
         }
         if self.seeds == 0 {
             return bad("seeds", 0.0, "must be at least 1");
+        }
+        if self.subsample_points != 0 && self.subsample_points < 8 {
+            return bad(
+                "subsample_points",
+                self.subsample_points as f64,
+                "must be 0 (off) or at least 8",
+            );
         }
         if self.seed_points < 2 {
             return bad("seed_points", self.seed_points as f64, "must be at least 2");

@@ -270,6 +270,11 @@ pub struct SolverReport {
     pub qp_failures: usize,
     /// Branches optimised (more than one when the first was infeasible).
     pub branches_tried: usize,
+    /// `Some(n)`: the law kept was optimised on `n` points of the layer and
+    /// certified on every point
+    /// ([`OptimiseOptions::subsample_points`](super::OptimiseOptions::subsample_points));
+    /// `None`: optimised on every point.
+    pub samples: Option<usize>,
     /// Wall time (s).
     pub time_s: f64,
 }

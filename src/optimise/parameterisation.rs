@@ -168,6 +168,49 @@ impl Basis {
         }
     }
 
+    /// The same law on the points `idx` only (a polynomial keeps its
+    /// abscissa scaling, so equal coefficients give equal `R_Z` there);
+    /// `None` for the per-point basis.
+    pub fn restricted(&self, idx: &[usize]) -> Option<Self> {
+        match self {
+            Self::Polynomial {
+                s,
+                x_min,
+                x_max,
+                coefficients,
+                anchor,
+            } => Some(Self::Polynomial {
+                s: idx.iter().map(|&m| s[m]).collect(),
+                x_min: *x_min,
+                x_max: *x_max,
+                coefficients: *coefficients,
+                anchor: *anchor,
+            }),
+            Self::PerPoint { .. } => None,
+        }
+    }
+
+    /// The same polynomial with `coefficients` terms (`None` for the
+    /// per-point basis).
+    pub fn with_coefficients(&self, coefficients: usize) -> Option<Self> {
+        match self {
+            Self::Polynomial {
+                s,
+                x_min,
+                x_max,
+                anchor,
+                ..
+            } => Some(Self::Polynomial {
+                s: s.clone(),
+                x_min: *x_min,
+                x_max: *x_max,
+                coefficients,
+                anchor: *anchor,
+            }),
+            Self::PerPoint { .. } => None,
+        }
+    }
+
     /// Same polynomial, one more coefficient (zero): warm start of the next degree.
     pub fn raised(&self) -> Option<Self> {
         match self {

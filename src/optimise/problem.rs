@@ -77,6 +77,24 @@ pub(crate) struct LayerProblem<'a> {
     /// Joints the first point is unwrapped towards (a spiral turn continuing
     /// the one before); `None`: the representation inside the travel.
     pub start_near: Option<Joints>,
+    /// Quadrature weights when `points` is a subsample of the layer
+    /// (`None`: every point of the layer, each of weight 1).
+    pub weights: Option<SampleWeights>,
+}
+
+/// How a subsample of a layer stands for the whole layer in the objective:
+/// the displacement between two successive samples `L` points apart counts
+/// as `L` equal steps (`(Δq)² / L`, exact where the joints move linearly
+/// between them), and each sample's own terms (centring, uncertainty) count
+/// for the points around it (half the index gap on either side).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SampleWeights {
+    /// Per sample `m ≥ 1`: `1 / L`, `L` the index gap from sample `m − 1`;
+    /// entry 0 unused.
+    pub step: Vec<f64>,
+    /// Per sample: the number of layer points it stands for (they sum to
+    /// the layer's points).
+    pub point: Vec<f64>,
 }
 
 /// Joints and derivatives at every point for given `R_Z`.
@@ -112,6 +130,53 @@ pub(crate) struct Row {
 }
 
 impl<'a> LayerProblem<'a> {
+    /// This whole-layer problem on the samples `idx` (increasing point
+    /// indices) of its layer, `points` being those points: the time of a
+    /// step between samples is the layer's time between them (so the joint
+    /// speed bound there is on the mean speed over the gap, which every
+    /// step obeying its own bound implies), the floors are the samples' own,
+    /// and [`SampleWeights`] make the objective the layer's estimate.
+    pub fn restricted<'b>(&self, idx: &[usize], points: &'b [CellPoint]) -> LayerProblem<'b>
+    where
+        'a: 'b,
+    {
+        debug_assert_eq!(idx.len(), points.len());
+        let n = idx.len();
+        let mut dt = vec![0.0; n];
+        let mut step = vec![0.0; n];
+        let mut point = vec![0.0; n];
+        for k in 1..n {
+            dt[k] = self.dt[idx[k - 1] + 1..=idx[k]].iter().sum();
+            let gap = (idx[k] - idx[k - 1]) as f64;
+            step[k] = 1.0 / gap;
+            point[k - 1] += 0.5 * gap;
+            point[k] += 0.5 * gap;
+        }
+        if n > 0 {
+            point[0] += 0.5;
+            point[n - 1] += 0.5;
+        }
+        LayerProblem {
+            cell: self.cell,
+            configuration: self.configuration,
+            points,
+            dt,
+            psi: idx.iter().map(|&m| self.psi[m]).collect(),
+            gamma: self.gamma,
+            lower: self.lower,
+            upper: self.upper,
+            wrist_margin: self.wrist_margin,
+            hose: self.hose,
+            max_speed: self.max_speed,
+            centring: self.centring,
+            objective: self.objective,
+            sigma: self.sigma,
+            dex_scale: self.dex_scale,
+            start_near: self.start_near,
+            weights: Some(SampleWeights { step, point }),
+        }
+    }
+
     /// Joints at one point for `r_z`, unwrapped towards `near`.
     pub fn joints_at(
         &self,
@@ -273,15 +338,26 @@ impl<'a> LayerProblem<'a> {
         f
     }
 
-    /// Weighted joint displacement of eq. 4.3 (rad).
+    /// Weighted joint displacement of eq. 4.3 (rad; over a subsample, its
+    /// estimate with the sample weights).
     pub fn displacement(&self, e: &Evaluation) -> f64 {
         let mut f = 0.0;
         for m in 1..e.q.len() {
             for j in 0..6 {
-                f += self.gamma[j] * (e.q[m][j] - e.q[m - 1][j]).powi(2);
+                f += self.gamma[j] * self.step_weight(m) * (e.q[m][j] - e.q[m - 1][j]).powi(2);
             }
         }
         f
+    }
+
+    /// `1 / L` for the step into point `m` (1 on a whole layer).
+    fn step_weight(&self, m: usize) -> f64 {
+        self.weights.as_ref().map_or(1.0, |w| w.step[m])
+    }
+
+    /// The number of layer points that point `m` stands for (1 on a whole layer).
+    fn point_weight(&self, m: usize) -> f64 {
+        self.weights.as_ref().map_or(1.0, |w| w.point[m])
     }
 
     /// Calls `sink(value, row)` for every residual; rows (through `basis`)
@@ -341,7 +417,7 @@ impl<'a> LayerProblem<'a> {
                         if self.gamma[j] == 0.0 {
                             continue;
                         }
-                        let w = self.gamma[j].sqrt();
+                        let w = (self.gamma[j] * self.step_weight(m)).sqrt();
                         let r = w * (e.q[m][j] - e.q[m - 1][j]);
                         combine(&mut a, w * e.g[m][j], &row_m, -w * e.g[m - 1][j], &row_p);
                         sink(r, &a);
@@ -356,14 +432,15 @@ impl<'a> LayerProblem<'a> {
                     } else {
                         0.0
                     };
-                    combine(&mut a, d, &row_m, 0.0, &[]);
-                    sink(e.unc[m], &a);
+                    let w = self.point_weight(m).sqrt();
+                    combine(&mut a, w * d, &row_m, 0.0, &[]);
+                    sink(w * e.unc[m], &a);
                 }
             }
         }
         if self.centring > 0.0 {
-            let w = self.centring.sqrt();
             for m in 0..p {
+                let w = (self.centring * self.point_weight(m)).sqrt();
                 rows(m, &mut row_m);
                 for j in 0..6 {
                     if self.gamma[j] == 0.0 {

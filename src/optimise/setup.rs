@@ -95,6 +95,7 @@ impl<'a> LayerSetup<'a> {
             sigma: sigma_rad.map(|s| s * 1e6),
             dex_scale: self.opts.trajectory.dexterity_length_scale_mm,
             start_near: self.anchor.map(|a| a.joints),
+            weights: None,
         }
     }
 

@@ -12,4 +12,5 @@ mod parts;
 mod place;
 mod place_cells;
 mod spiral;
+mod subsample;
 mod support;
