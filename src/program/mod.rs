@@ -947,15 +947,15 @@ fn safe_transits(
         }
     })?;
     let blocks = blocks(&program.points);
-    let beads: Vec<Vec<Point3>> = blocks
-        .iter()
-        .map(|b| {
-            program.points[b.start..=b.end]
-                .iter()
-                .map(|p| p.position_mm)
-                .collect()
-        })
-        .collect();
+    // Each bead decimated once; the wall after bead k is built from them.
+    let mut decimated = transit::WallBeads::default();
+    for b in &blocks {
+        let bead: Vec<Point3> = program.points[b.start..=b.end]
+            .iter()
+            .map(|p| p.position_mm)
+            .collect();
+        decimated.push(&bead);
+    }
     let n = blocks.len();
     let target = |program: &Program, k: usize| -> Option<(Joints, Option<PositionerJoints>)> {
         if k + 1 < n {
@@ -974,7 +974,7 @@ fn safe_transits(
         let Some((qb, pb)) = target(program, k) else {
             return Ok(inf);
         };
-        let wall = transit::wall_of(beads[..=k].iter().map(Vec::as_slice), opts.bead_radius_mm);
+        let wall = decimated.wall(k + 1, opts.bead_radius_mm);
         let from = &program.points[blocks[k].last];
         transit::joint_move_clearance(
             &program.cell,

@@ -135,27 +135,68 @@ pub fn joint_move_clearance(
 /// `bead_radius_mm` grown by the largest distance of a dropped point from
 /// its chord.
 pub fn wall_of<'b>(beads: impl IntoIterator<Item = &'b [Point3]>, bead_radius_mm: f64) -> Wall {
-    let mut kept: Vec<Vec<Point3>> = Vec::new();
-    let mut grow: f64 = 0.0;
+    let mut decimated = WallBeads::default();
     for b in beads {
-        if b.len() <= WALL_POINTS_PER_BEAD {
-            kept.push(b.to_vec());
-            continue;
-        }
-        let step = b.len().div_ceil(WALL_POINTS_PER_BEAD - 1);
-        let mut idx: Vec<usize> = (0..b.len()).step_by(step).collect();
-        if idx.last() != Some(&(b.len() - 1)) {
-            idx.push(b.len() - 1);
-        }
-        for w in idx.windows(2) {
-            let (a, c) = (b[w[0]], b[w[1]]);
-            for p in &b[w[0] + 1..w[1]] {
-                grow = grow.max(point_segment_distance(p, &a, &c));
-            }
-        }
-        kept.push(idx.iter().map(|&i| b[i]).collect());
+        decimated.push(b);
     }
-    Wall::new(kept.iter().map(Vec::as_slice), bead_radius_mm + grow)
+    decimated.wall(decimated.len(), bead_radius_mm)
+}
+
+/// Beads decimated once for the transit check, in deposition order (part
+/// frame, mm), from which the wall after any number of beads is built
+/// without decimating the earlier beads again: `wall(k, r)` is
+/// [`wall_of`] of the first `k` beads.
+#[derive(Debug, Clone, Default)]
+pub struct WallBeads {
+    kept: Vec<Vec<Point3>>,
+    /// Largest chord distance of a dropped point over beads `..=i` (mm).
+    grow: Vec<f64>,
+}
+
+impl WallBeads {
+    /// Adds the next bead (part frame, mm), decimated to at most
+    /// [`WALL_POINTS_PER_BEAD`] points.
+    pub fn push(&mut self, b: &[Point3]) {
+        let mut grow = self.grow.last().copied().unwrap_or(0.0);
+        if b.len() <= WALL_POINTS_PER_BEAD {
+            self.kept.push(b.to_vec());
+        } else {
+            let step = b.len().div_ceil(WALL_POINTS_PER_BEAD - 1);
+            let mut idx: Vec<usize> = (0..b.len()).step_by(step).collect();
+            if idx.last() != Some(&(b.len() - 1)) {
+                idx.push(b.len() - 1);
+            }
+            for w in idx.windows(2) {
+                let (a, c) = (b[w[0]], b[w[1]]);
+                for p in &b[w[0] + 1..w[1]] {
+                    grow = grow.max(point_segment_distance(p, &a, &c));
+                }
+            }
+            self.kept.push(idx.iter().map(|&i| b[i]).collect());
+        }
+        self.grow.push(grow);
+    }
+
+    /// Beads added so far.
+    pub fn len(&self) -> usize {
+        self.kept.len()
+    }
+
+    /// Whether no bead was added.
+    pub fn is_empty(&self) -> bool {
+        self.kept.is_empty()
+    }
+
+    /// The wall of the first `n` beads (at most [`Self::len`]), capsules of
+    /// `bead_radius_mm` grown by their decimation's largest chord distance.
+    pub fn wall(&self, n: usize, bead_radius_mm: f64) -> Wall {
+        let n = n.min(self.kept.len());
+        let grow = if n == 0 { 0.0 } else { self.grow[n - 1] };
+        Wall::new(
+            self.kept[..n].iter().map(Vec::as_slice),
+            bead_radius_mm + grow,
+        )
+    }
 }
 
 fn point_segment_distance(p: &Point3, a: &Point3, b: &Point3) -> f64 {

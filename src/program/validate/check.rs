@@ -6,10 +6,11 @@ use std::f64::consts::PI;
 
 use crate::math::Point3;
 use crate::program::fanuc::MoveKind;
-use crate::program::transit::{joint_move_clearance, wall_of};
+use crate::program::transit::{joint_move_clearance, WallBeads};
 use crate::program::ProgramOptions;
 use crate::robot::{Cell, Joints};
 use crate::toolaxis::collision::Torch;
+use crate::toolaxis::collision::Wall;
 
 use super::ProblemKind;
 use super::{
@@ -512,13 +513,14 @@ fn check_transits(
     let Ok(torch) = Torch::new(&Default::default()) else {
         return;
     };
-    let mut beads: Vec<Vec<Point3>> = Vec::new();
+    let mut beads = WallBeads::default();
+    let mut wall: Option<(usize, Wall)> = None;
     let mut current: Vec<Point3> = Vec::new();
     let mut prev: Option<(Joints, Option<[f64; 2]>)> = None;
     for (i, s) in steps.iter().enumerate() {
         match s {
             Step::ProcessOff { .. } if !current.is_empty() => {
-                beads.push(std::mem::take(&mut current));
+                beads.push(&std::mem::take(&mut current));
             }
             Step::Motion(m) => {
                 let Some(q) = m.joints else {
@@ -532,8 +534,13 @@ fn check_transits(
                 }
                 if let (Some((pq, pp)), MoveKind::Joint) = (prev, m.kind) {
                     if !beads.is_empty() {
-                        let wall = wall_of(beads.iter().map(Vec::as_slice), common.bead_radius_mm);
-                        match joint_move_clearance(cell, &wall, &torch, (&pq, pp), (&q, m.positioner)) {
+                        // The wall is rebuilt only when a bead was added.
+                        if wall.as_ref().is_none_or(|(n, _)| *n != beads.len()) {
+                            wall =
+                                Some((beads.len(), beads.wall(beads.len(), common.bead_radius_mm)));
+                        }
+                        let (_, wall) = wall.as_ref().expect("built above");
+                        match joint_move_clearance(cell, wall, &torch, (&pq, pp), (&q, m.positioner)) {
                             Ok(c) if c.min_clearance_mm <= 0.0 => push(
                                 report,
                                 ProblemKind::Collision,
