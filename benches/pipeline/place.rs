@@ -1,7 +1,7 @@
 //! Placement of the part in the cell (`pipeline::place_part`) with the
 //! default search (64 Halton candidates on an 8-layer × 24-point subsample,
 //! two compass refinements, certification with early exit on every point,
-//! up to 4 rounds feeding the failing layers back into the subsample):
+//! up to 6 rounds feeding the failing layers back into the subsample):
 //!
 //! * the hemisphere (Delta 5, 500 points a layer) in the KUKA KR 16-2
 //!   part-carried example cell, where it is refused where the cell file

@@ -19,7 +19,8 @@
 //!    Halton sequence; the cell as given is the first candidate), each
 //!    candidate judged by the `R_Z` optimisation of SPEC §7 on a subsample
 //!    of the layers and points, candidates in parallel.
-//! 2. **Refinement**: a compass search from the best few, on the subsample.
+//! 2. **Refinement**: a compass search from the best few, on the subsample
+//!    (after a feedback, from the best one with half the evaluations).
 //! 3. **Certification**, best first (the cell as given first unless beaten
 //!    by [`KEEP_MARGIN`]), of the candidates feasible on the subsample: every layer at full resolution, in an order that meets the
 //!    layers that failed before first and spreads the others over the part,
@@ -234,7 +235,7 @@ impl Default for PlaceOptions {
             points_per_layer: 24,
             refined: 2,
             refine_evaluations: 24,
-            rounds: 4,
+            rounds: 6,
             feedback_layers: 4,
             optimise: OptimiseOptions::default(),
         }
@@ -716,7 +717,7 @@ pub fn place_with(
     pool.sort_by(|a, b| b.score.total_cmp(&a.score));
     times.screening_s += t.elapsed().as_secs_f64();
 
-    let chunk = (2 * rayon::current_num_threads()).max(4);
+    let chunk = (4 * rayon::current_num_threads()).max(8);
     let mut hot: Vec<usize> = Vec::new();
     let mut refused: Vec<Vec<f64>> = Vec::new();
     let mut certified = 0;
@@ -726,21 +727,28 @@ pub fn place_with(
     // share of the checked layers infeasible.
     let mut failed: Option<(Vec<f64>, Cell, Plan, f64)> = None;
     let mut refusal: Option<String> = None;
-    'rounds: for _ in 0..opts.rounds {
+    'rounds: for round in 0..opts.rounds {
         rounds += 1;
-        // 2. Compass search from the best few not refused.
+        // 2. Compass search from the best few not refused; after a
+        // feedback (a heavier subsample) from the best one only, with half
+        // the evaluations.
         let t = Instant::now();
+        let (n_starts, n_evaluations) = if round == 0 {
+            (opts.refined.max(1), opts.refine_evaluations)
+        } else {
+            (1, opts.refine_evaluations / 2)
+        };
         let starts: Vec<Judged> = pool
             .iter()
             .filter(|j| !refused.contains(&j.x))
-            .take(opts.refined.max(1))
+            .take(n_starts)
             .cloned()
             .collect();
         for start in starts {
             let mut best = start;
             let mut step: Vec<f64> = vars.iter().map(|v| (v.upper - v.lower) / 8.0).collect();
             let mut evaluations = 0;
-            while evaluations < opts.refine_evaluations && step.iter().any(|s| *s > 1e-3) {
+            while evaluations < n_evaluations && step.iter().any(|s| *s > 1e-3) {
                 let trials: Vec<Vec<f64>> = free
                     .iter()
                     .filter(|k| step[**k] > 1e-3)

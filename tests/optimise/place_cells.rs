@@ -153,3 +153,83 @@ fn a_placed_cell_placed_again_finds_itself() {
         .to_degrees();
     assert!(angle < 0.01, "mount turned by {angle} deg");
 }
+
+/// `waam place`: exit 0 with a `cell.toml` that `waam plan` takes, exit 1
+/// naming a bad range's field, exit 2 naming the binding constraint (the
+/// general tube in the KUKA torch-carried cell: the positioner's J8 speed,
+/// as the README's table gives it). Coarse grids for test time.
+#[test]
+fn the_place_command_exits_0_1_or_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("placed");
+    let grid = ["--delta", "8", "--points", "16", "--samples", "8"];
+    let run = |args: &[&str]| crate::common::waam().args(args).output().unwrap();
+    let hemi = part_path("hemisphere.toml");
+    let cell = part_path("cells/robowam_part_carried.toml");
+    let mut args = vec![
+        "place",
+        hemi.to_str().unwrap(),
+        "--cell",
+        cell.to_str().unwrap(),
+    ];
+    args.extend(grid);
+    args.extend(["--out", out.to_str().unwrap()]);
+    let o = run(&args);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let placed = out.join("cell.toml");
+    assert!(out.join("placement.json").exists());
+    let plan_out = dir.path().join("plan");
+    let mut args = vec![
+        "plan",
+        hemi.to_str().unwrap(),
+        "--cell",
+        placed.to_str().unwrap(),
+    ];
+    args.extend([
+        "--delta",
+        "8",
+        "--points",
+        "16",
+        "--out",
+        plan_out.to_str().unwrap(),
+    ]);
+    let o = run(&args);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+
+    let bad = dir.path().join("bad.toml");
+    let text = std::fs::read_to_string(&cell).unwrap() + "\n[placement]\ntilt_x_deg = [-100, 0]\n";
+    std::fs::write(&bad, text).unwrap();
+    let o = run(&[
+        "place",
+        hemi.to_str().unwrap(),
+        "--cell",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("placement.tilt_x_deg"));
+
+    let tube = part_path("general-tube.toml");
+    let torch = part_path("cells/kuka_kr16_2_torch_carried.toml");
+    let mut args = vec![
+        "place",
+        tube.to_str().unwrap(),
+        "--cell",
+        torch.to_str().unwrap(),
+    ];
+    args.extend(grid);
+    args.extend(["--out", out.to_str().unwrap()]);
+    let o = run(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("J8 speed"), "{err}");
+}
