@@ -300,7 +300,8 @@ fn validate_input(
     Ok(())
 }
 
-fn transitions(cell: &Cell, plans: &[LayerPlan]) -> Vec<Transition> {
+/// Arc-off moves between consecutive planned layers.
+pub(super) fn transitions(cell: &Cell, plans: &[LayerPlan]) -> Vec<Transition> {
     let robot = cell.robot();
     plans
         .windows(2)

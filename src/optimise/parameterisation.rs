@@ -213,22 +213,7 @@ impl Basis {
 
     /// Same polynomial, one more coefficient (zero): warm start of the next degree.
     pub fn raised(&self) -> Option<Self> {
-        match self {
-            Self::Polynomial {
-                s,
-                x_min,
-                x_max,
-                coefficients,
-                anchor,
-            } => Some(Self::Polynomial {
-                s: s.clone(),
-                x_min: *x_min,
-                x_max: *x_max,
-                coefficients: coefficients + 1,
-                anchor: *anchor,
-            }),
-            Self::PerPoint { .. } => None,
-        }
+        self.with_coefficients(self.len() + 1)
     }
 
     /// Least-squares coefficients reproducing the values `r` (rad) per point

@@ -40,7 +40,8 @@ use rayon::prelude::*;
 
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use crate::optimise::{
-    optimise, LayerPlan, LayerPoints, LayerStatus, OptimiseError, OptimiseOptions, Plan, Transition,
+    optimise, transitions, LayerPlan, LayerPoints, LayerStatus, OptimiseError, OptimiseOptions,
+    Plan,
 };
 use crate::robot::Cell;
 
@@ -486,33 +487,6 @@ fn certification_order(n: usize, hot: &[usize]) -> Vec<usize> {
     rest.sort_by(|a, b| radical_inverse(*a, 2).total_cmp(&radical_inverse(*b, 2)));
     order.extend(rest);
     order
-}
-
-/// Arc-off moves between consecutive planned layers (as the optimiser
-/// reports them).
-fn transitions(cell: &Cell, plans: &[LayerPlan]) -> Vec<Transition> {
-    let robot = cell.robot();
-    plans
-        .windows(2)
-        .filter_map(|w| {
-            let last = w[0].points.last()?.joints?;
-            let first = w[1].points.first()?.joints?;
-            let start = robot
-                .limits
-                .iter()
-                .enumerate()
-                .filter(|(_, l)| !l.is_unlimited())
-                .map(|(j, l)| (first[j] - l.lower_rad).min(l.upper_rad - first[j]))
-                .fold(f64::INFINITY, f64::min);
-            Some(Transition {
-                from_layer: w[0].layer,
-                to_layer: w[1].layer,
-                joint_change_rad: std::array::from_fn(|j| first[j] - last[j]),
-                branch_change: w[0].configuration.chosen != w[1].configuration.chosen,
-                start_limit_distance_rad: start,
-            })
-        })
-        .collect()
 }
 
 /// Every layer of `layers` in `cell`, in `order`, in parallel chunks of
