@@ -71,6 +71,36 @@ pub(super) struct Best {
     pub(super) res: sqp::SqpResult,
 }
 
+impl Best {
+    /// `(violation, objective)` of `best`, `None` before the first degree.
+    pub(super) fn key(best: &Option<Best>) -> Option<(f64, f64)> {
+        best.as_ref().map(|b| (b.res.violation, b.res.objective))
+    }
+
+    /// Offers degree `degree`'s solution `res` (coefficients `c` over
+    /// `basis`) to the best so far: it replaces it when it [`improves`] on
+    /// it. Returns its [`relative_gain`] over the best before it.
+    pub(super) fn offer(
+        best: &mut Option<Best>,
+        degree: usize,
+        c: &[f64],
+        basis: &Basis,
+        res: sqp::SqpResult,
+    ) -> f64 {
+        let last = Best::key(best);
+        let new = (res.violation, res.objective);
+        if improves(new, last) {
+            *best = Some(Best {
+                degree,
+                c: c.to_vec(),
+                basis: basis.clone(),
+                res,
+            });
+        }
+        relative_gain(new, last)
+    }
+}
+
 /// Records `best` (with the objective of every degree solved, `history`)
 /// as `outcome`'s law and evaluation.
 pub(super) fn record(
@@ -129,17 +159,7 @@ pub(super) fn degree_loop(
                 counts.qp_failures += res.qp_failures;
                 history.push((degree, res.objective));
                 c = res.c.clone();
-                let last = best.as_ref().map(|b| (b.res.violation, b.res.objective));
-                let new = (res.violation, res.objective);
-                if improves(new, last) {
-                    best = Some(Best {
-                        degree,
-                        c: c.clone(),
-                        basis: basis.clone(),
-                        res,
-                    });
-                }
-                relative_gain(new, last)
+                Best::offer(&mut best, degree, &c, &basis, res)
             }
             Err(f) => match best {
                 None => return Err(f),
@@ -149,7 +169,7 @@ pub(super) fn degree_loop(
         let Some(raised) = basis.raised() else {
             break;
         };
-        let last = best.as_ref().map(|b| (b.res.violation, b.res.objective));
+        let last = Best::key(&best);
         if !raise_again(
             problem,
             at_c.as_ref(),
@@ -214,7 +234,7 @@ pub(super) fn raise_again(
 
 /// `true` when a degree's `(violation, objective)` is better than the best
 /// so far (less violation, or as little and a lower objective).
-pub(super) fn improves(new: (f64, f64), best: Option<(f64, f64)>) -> bool {
+fn improves(new: (f64, f64), best: Option<(f64, f64)>) -> bool {
     match best {
         None => true,
         Some((bv, bf)) => new.0 < bv || (new.0 <= bv && new.1 < bf),
@@ -223,7 +243,7 @@ pub(super) fn improves(new: (f64, f64), best: Option<(f64, f64)>) -> bool {
 
 /// Relative objective gain of a degree over the best so far when both are
 /// feasible; infinite otherwise (keep raising).
-pub(super) fn relative_gain(new: (f64, f64), best: Option<(f64, f64)>) -> f64 {
+fn relative_gain(new: (f64, f64), best: Option<(f64, f64)>) -> f64 {
     match best {
         Some((bv, bf)) if bv <= 0.0 && new.0 <= 0.0 => (bf - new.1) / bf.abs().max(1e-300),
         _ => f64::INFINITY,

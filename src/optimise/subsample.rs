@@ -24,7 +24,7 @@
 //! computed on every point by the caller.
 
 use super::branch::BranchOutcome;
-use super::degree::{improves, raise_again, record, relative_gain, Best, Degrees};
+use super::degree::{raise_again, record, Best, Degrees};
 use super::parameterisation::Basis;
 use super::problem::{LayerProblem, SOLVER_MARGIN};
 use super::setup::LayerSetup;
@@ -142,22 +142,12 @@ fn degree_loop(
         } = done;
         c = sub_c;
         history.push((degree, res.objective));
-        let last = best.as_ref().map(|b| (b.res.violation, b.res.objective));
-        let new = (res.violation, res.objective);
-        let gain = relative_gain(new, last);
-        if improves(new, last) {
-            best = Some(Best {
-                degree,
-                c: c.clone(),
-                basis: full_basis.clone(),
-                res,
-            });
-        }
+        let gain = Best::offer(&mut best, degree, &c, &full_basis, res);
         let Some(raised) = full_basis.raised() else {
             break;
         };
         let sub = problem.restricted(&samples.idx, &samples.points);
-        let last = best.as_ref().map(|b| (b.res.violation, b.res.objective));
+        let last = Best::key(&best);
         let sub_raised = raised.restricted(&samples.idx)?;
         if !raise_again(
             &sub,

@@ -28,6 +28,18 @@ pub const SAMPLE_PARTS: [&str; 8] = [
     "helix.toml",
 ];
 
+/// Every sample cell file in `parts/cells/` with a robot and a layout (the
+/// robot-only files `abb_irb2600_12_185` and `kuka_kr16_2` cannot plan).
+pub const SAMPLE_CELLS: [&str; 7] = [
+    "robowam_part_carried.toml",
+    "robowam_part_carried_second_position.toml",
+    "robowam_torch_carried.toml",
+    "kuka_kr16_2_part_carried.toml",
+    "kuka_kr16_2_torch_carried.toml",
+    "abb_irb2600_part_carried.toml",
+    "abb_irb2600_torch_carried.toml",
+];
+
 /// A straight cylinder of the given radius and height on a plate, as part-file
 /// text: the smallest valid part, for tests that edit one field.
 pub fn cylinder_part_text(name: &str, radius: f64, height: f64, delta: f64) -> String {

@@ -19,19 +19,7 @@ use waam_slicer::path::Discretisation;
 use waam_slicer::robot::Cell;
 use waam_slicer::{slice_part_with, Control, SliceOverrides};
 
-use crate::common::{load_part, part_path, SAMPLE_PARTS};
-
-/// The sample cells with a robot and a layout (the robot-only files
-/// `abb_irb2600_12_185` and `kuka_kr16_2` cannot plan).
-const CELLS: [&str; 7] = [
-    "robowam_part_carried.toml",
-    "robowam_part_carried_second_position.toml",
-    "robowam_torch_carried.toml",
-    "kuka_kr16_2_part_carried.toml",
-    "kuka_kr16_2_torch_carried.toml",
-    "abb_irb2600_part_carried.toml",
-    "abb_irb2600_torch_carried.toml",
-];
+use crate::common::{load_part, part_path, SAMPLE_CELLS, SAMPLE_PARTS};
 
 /// Relative tolerance on a feasible layer's objective (joint displacement
 /// plus the centring term, as the optimiser weighs them): the subsample's
@@ -177,7 +165,7 @@ fn cell(name: &str) -> Cell {
 /// layers of each part.
 #[test]
 fn subsampled_and_whole_layer_optimisation_agree_on_every_part_and_cell() {
-    let cells: Vec<(&str, Cell)> = CELLS.iter().map(|c| (*c, cell(c))).collect();
+    let cells: Vec<(&str, Cell)> = SAMPLE_CELLS.iter().map(|c| (*c, cell(c))).collect();
     let samples = OptimiseOptions::default().subsample_points;
     let (mut layers_seen, mut certified, mut worst) = (0, 0, 0.0f64);
     for part in SAMPLE_PARTS {
@@ -216,7 +204,7 @@ fn subsampled_and_whole_layer_optimisation_agree_on_every_part_and_cell() {
 #[test]
 #[ignore = "minutes: run in release by hand"]
 fn full_size_subsampled_and_whole_layer_verdicts_agree() {
-    let cells: Vec<(&str, Cell)> = CELLS.iter().map(|c| (*c, cell(c))).collect();
+    let cells: Vec<(&str, Cell)> = SAMPLE_CELLS.iter().map(|c| (*c, cell(c))).collect();
     let samples = OptimiseOptions::default().subsample_points;
     // `SUBSAMPLE_PARTS=quarter-torus.toml,elbow.toml`: those parts only
     let only = std::env::var("SUBSAMPLE_PARTS").ok();

@@ -10,15 +10,7 @@
 use waam_slicer::program::validate::ProblemKind;
 use waam_slicer::{check_program, plan_part, Cell, Part, PlanOptions};
 
-const CELLS: [&str; 7] = [
-    "robowam_part_carried.toml",
-    "robowam_part_carried_second_position.toml",
-    "robowam_torch_carried.toml",
-    "kuka_kr16_2_part_carried.toml",
-    "kuka_kr16_2_torch_carried.toml",
-    "abb_irb2600_part_carried.toml",
-    "abb_irb2600_torch_carried.toml",
-];
+use crate::shared::SAMPLE_CELLS;
 
 fn root() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -31,7 +23,7 @@ fn every_sample_cell_writes_programs_with_home_dwell_transit_and_payload_that_ch
     opts.slice.max_layers = Some(4);
     opts.slice.discretisation = Some(waam_slicer::path::Discretisation::Points(40));
     let tmp = std::env::temp_dir().join(format!("waam-cells-{}", std::process::id()));
-    for file in CELLS {
+    for file in SAMPLE_CELLS {
         let cell = Cell::read(root().join("parts/cells").join(file)).unwrap();
         let common = cell.program.common;
         assert!(
