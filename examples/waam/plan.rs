@@ -61,23 +61,22 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&part.name));
     std::fs::create_dir_all(&dir).map_err(|e| input(format!("{}: {e}", dir.display())))?;
+    let t = Instant::now();
     let csv = dir.join("joints.csv");
     write_atomic(&csv, |w| planned.write_joints_csv(w))
         .map_err(|e| input(format!("{}: {e}", csv.display())))?;
+    let t_csv = t.elapsed().as_secs_f64();
+    let t = Instant::now();
     draw_joint_plots(&dir, &part.name, &planned).map_err(input)?;
+    let t_plots = t.elapsed().as_secs_f64();
+    let t = Instant::now();
     planned
         .write_report(&dir.join("report.html"), Some(&part.substrate))
         .map_err(|e| input(e.to_string()))?;
-    let mut summary = planned.summary();
-    summary["run_time_s"]["read"] = t_read.into();
-    let sj = dir.join("summary.json");
-    write_atomic(&sj, |w| {
-        serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
-        writeln!(w)
-    })
-    .map_err(|e| input(format!("{}: {e}", sj.display())))?;
+    let t_report = t.elapsed().as_secs_f64();
     // The robot program, only for a feasible plan; the program stage checks
     // again and refuses (exit 2) if the trajectory it rebuilds breaks a limit.
+    let t = Instant::now();
     let feasible = if planned.plan.is_feasible() {
         match planned.write_programs(&dir, planned.format) {
             Ok(files) => {
@@ -98,6 +97,21 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     } else {
         false
     };
+    let t_programs = t.elapsed().as_secs_f64();
+    // Last, with every writer's time.
+    let mut summary = planned.summary();
+    let times = &mut summary["run_time_s"];
+    times["read"] = t_read.into();
+    times["joints_csv"] = t_csv.into();
+    times["pictures"] = t_plots.into();
+    times["report_html"] = t_report.into();
+    times["program_files"] = t_programs.into();
+    let sj = dir.join("summary.json");
+    write_atomic(&sj, |w| {
+        serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
+        writeln!(w)
+    })
+    .map_err(|e| input(format!("{}: {e}", sj.display())))?;
     if !quiet {
         let result = &planned.plan;
         println!(

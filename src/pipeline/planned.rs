@@ -437,6 +437,7 @@ impl PlannedPart {
                 "slice": self.times.slice,
                 "tool_axes": self.times.tool_axes,
                 "optimise": self.times.optimise,
+                "program": self.times.program,
             },
         });
         merge(&mut s, self.sliced.path_summary());
