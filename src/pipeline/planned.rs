@@ -409,6 +409,9 @@ impl PlannedPart {
                         "qp_solves": l.solver.qp_solves,
                         "qp_failures": l.solver.qp_failures,
                         "branches_tried": l.solver.branches_tried,
+                        // points the law was optimised on (null: every
+                        // point); it is certified on every point either way
+                        "samples": l.solver.samples,
                         "time_s": l.solver.time_s,
                     },
                 })

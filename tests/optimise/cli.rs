@@ -3,12 +3,16 @@
 use crate::common::{part_path, waam};
 
 fn plan(rz: &str, out: &std::path::Path) -> std::process::ExitStatus {
+    plan_at(rz, 120, out)
+}
+
+fn plan_at(rz: &str, points: usize, out: &std::path::Path) -> std::process::ExitStatus {
     waam()
         .args(["--quiet", "plan"])
         .arg(part_path("hemisphere.toml"))
         .arg("--cell")
         .arg(part_path("cells/robowam_part_carried.toml"))
-        .args(["--points", "120", "--rz", rz, "--out"])
+        .args(["--points", &points.to_string(), "--rz", rz, "--out"])
         .arg(out)
         .status()
         .unwrap()
@@ -44,6 +48,36 @@ fn plan_refuses_fixed_zero_and_succeeds_with_a_linear_law() {
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(good.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["feasible"], true);
+    // 120 points a layer: every layer optimised on every point.
+    let layers = summary["layer_plans"].as_array().unwrap();
+    assert!(layers.iter().all(|l| l["solver"]["samples"].is_null()));
+    // Every stage and writer timed.
+    for stage in [
+        "read",
+        "slice",
+        "tool_axes",
+        "optimise",
+        "program",
+        "joints_csv",
+        "pictures",
+        "report_html",
+        "program_files",
+    ] {
+        let t = summary["run_time_s"][stage].as_f64();
+        assert!(t.is_some_and(|t| t >= 0.0), "run_time_s.{stage}: {t:?}");
+    }
+
+    // 400 points a layer: subsampled (more than 128), fewer samples than
+    // points on every layer, certified: feasible with a program.
+    let many = dir.path().join("many");
+    assert_eq!(plan_at("poly:1", 400, &many).code(), Some(0));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(many.join("summary.json")).unwrap()).unwrap();
+    let layers = summary["layer_plans"].as_array().unwrap();
+    for l in layers {
+        let n = l["solver"]["samples"].as_u64().expect("subsampled layer");
+        assert!((3..400).contains(&n), "{l}");
+    }
 }
 
 #[test]
