@@ -87,6 +87,32 @@ class Part:
             "spline" or "point". Other keywords as in `slice`. Progress is
             reported at stage boundaries (slicing, optimising, program).
         """
+    def place(
+        self,
+        cell: "Cell",
+        *,
+        delta_mm: Optional[float] = None,
+        points: Optional[int] = None,
+        chord_mm: Optional[float] = None,
+        travel_speed_mm_s: Optional[float] = None,
+        samples: Optional[int] = None,
+        half_box_mm: Optional[float] = None,
+    ) -> "PlacedCell":
+        """Searches where the part should sit in `cell` (as `waam place`):
+        the deposition point and the part's mount when the arm carries the
+        part, the positioner's pose when it carries the torch; the fixture
+        tilt, part offset and torch clamp rotation when the cell file's
+        [placement] table gives their ranges; so that every layer is
+        feasible and the program stage accepts the plan, with the widest
+        worst-layer margins. The cell as given is kept when it is as good.
+
+        samples: candidates of the global screening (default 64).
+        half_box_mm: half-width (mm) of the box searched around the cell's
+            placement when its file has no [placement] bounds (default 400).
+        A part no placement makes feasible gives a PlacedCell whose
+        `feasible` is False and whose `binding` says why; bad bounds raise
+        WaamError naming the field.
+        """
 
 class Cell:
     """A robot cell: the robot and its layout (part carried under a fixed
@@ -192,6 +218,37 @@ class PlannedPart:
         is infeasible."""
     def __len__(self) -> int:
         """Number of planned points."""
+
+class PlacedCell:
+    """A part placed in a cell by `Part.place`, or the search's account of
+    why it cannot be."""
+
+    @property
+    def feasible(self) -> bool:
+        """True when a placement makes every layer feasible and the program
+        stage accepts the plan."""
+    @property
+    def cell(self) -> Cell:
+        """The placed cell (the best candidate when none was found); pass it
+        to `Part.plan`."""
+    @property
+    def toml(self) -> str:
+        """The placed cell as a complete cell file (TOML), the margins
+        achieved in its header comment; `waam plan` takes it unchanged."""
+    @property
+    def binding(self) -> Optional[str]:
+        """The constraint that bound every candidate when none was found
+        (with its share), None when found."""
+    @property
+    def values(self) -> Dict[str, float]:
+        """Placement variable name -> value found (mm or degrees, the unit
+        in summary()["variables"])."""
+    def summary(self) -> Dict[str, Any]:
+        """The content of placement.json as `waam place` writes it."""
+    def write(self, dir: _PathLike) -> List[Path]:
+        """Writes placement.json and, when a placement was found, cell.toml
+        into `dir` (created if missing), each atomically; returns the
+        paths."""
 
 def check_program(path: _PathLike, cell: Cell) -> List[Dict[str, Any]]:
     """Reads a program (FANUC .ls main program and the programs it calls,

@@ -6,7 +6,6 @@
 use crate::args::PlaceArgs;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use waam_slicer::io::atomic::write_atomic;
 use waam_slicer::pipeline::{place_part, PlaceRequest};
 use waam_slicer::{Cell, Part};
 
@@ -45,19 +44,9 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-placed", part.name)));
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    placed.write(&dir).map_err(|e| e.to_string())?;
     let p = &placed.placement;
-    let json = dir.join("placement.json");
-    write_atomic(&json, |w| {
-        serde_json::to_writer_pretty(&mut *w, &placed.summary()).map_err(std::io::Error::other)?;
-        writeln!(w)
-    })
-    .map_err(|e| format!("{}: {e}", json.display()))?;
     let toml = dir.join("cell.toml");
-    if p.feasible {
-        write_atomic(&toml, |w| w.write_all(placed.toml.as_bytes()))
-            .map_err(|e| format!("{}: {e}", toml.display()))?;
-    }
     if !quiet {
         let values: Vec<String> = placed
             .bounds

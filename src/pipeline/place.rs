@@ -344,6 +344,37 @@ impl PlacedCell {
     }
 }
 
+impl PlacedCell {
+    /// Writes `placement.json` ([`PlacedCell::summary`]) and, when a
+    /// placement was found, `cell.toml` ([`PlacedCell::toml`]) into `dir`
+    /// (created if missing), each atomically; returns the paths written.
+    ///
+    /// # Errors
+    /// The I/O error, its message naming the file.
+    pub fn write(&self, dir: &std::path::Path) -> std::io::Result<Vec<std::path::PathBuf>> {
+        let named = |path: &std::path::Path| {
+            let path = path.display().to_string();
+            move |e: std::io::Error| std::io::Error::new(e.kind(), format!("{path}: {e}"))
+        };
+        std::fs::create_dir_all(dir).map_err(named(dir))?;
+        let json = dir.join("placement.json");
+        crate::io::atomic::write_atomic(&json, |w| {
+            serde_json::to_writer_pretty(&mut *w, &self.summary())
+                .map_err(std::io::Error::other)?;
+            writeln!(w)
+        })
+        .map_err(named(&json))?;
+        let mut written = vec![json];
+        if self.placement.feasible {
+            let toml = dir.join("cell.toml");
+            crate::io::atomic::write_atomic(&toml, |w| w.write_all(self.toml.as_bytes()))
+                .map_err(named(&toml))?;
+            written.push(toml);
+        }
+        Ok(written)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::layers_named;

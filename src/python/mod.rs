@@ -1,7 +1,8 @@
 //! **The Python extension module `waam_slicer`** (feature `python`, built by
 //! maturin from `pyproject.toml`). Wraps the front door ([`crate::pipeline`])
 //! for Python hosts: `Part.read` / `Cell.read`, `Part.slice` → `SlicedPart`,
-//! `Part.plan` → `PlannedPart` (`write_program`), `check_program`. Per-point
+//! `Part.plan` → `PlannedPart` (`write_program`), `Part.place` →
+//! `PlacedCell` (`cell`, `write`), `check_program`. Per-point
 //! data are numpy arrays built from one Rust buffer each (no per-point Python
 //! object): positions in the part frame (mm), joints in degrees, controller
 //! convention. Slicing, planning, writing and checking run with the GIL
@@ -13,6 +14,7 @@
 mod arrays;
 mod control;
 mod part;
+mod placed;
 mod planned;
 mod sliced;
 
@@ -89,6 +91,7 @@ fn waam_slicer(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<part::PyCell>()?;
     m.add_class::<sliced::PySlicedPart>()?;
     m.add_class::<planned::PyPlannedPart>()?;
+    m.add_class::<placed::PyPlacedCell>()?;
     m.add_function(wrap_pyfunction!(check_program, m)?)?;
     Ok(())
 }

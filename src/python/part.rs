@@ -6,10 +6,11 @@ use std::path::PathBuf;
 use pyo3::prelude::*;
 
 use super::control::{HostControl, SliceKeywords};
+use super::placed::PyPlacedCell;
 use super::planned::PyPlannedPart;
 use super::sliced::PySlicedPart;
 use super::waam_error;
-use crate::pipeline::{Cell, Part, PlanOptions, RzLaw};
+use crate::pipeline::{Cell, Part, PlaceRequest, PlanOptions, RzLaw};
 
 /// A tube to build: geometry, substrate and the part file's slicing,
 /// tool-axis and process settings. Part frame, mm.
@@ -129,6 +130,62 @@ impl PyPart {
         };
         let result = py.detach(|| crate::pipeline::plan_part(&self.part, &cell.cell, &opts));
         PyPlannedPart::new(py, host.finish(result)?)
+    }
+
+    /// Searches where the part should sit in `cell` (the deposition point
+    /// and the part's mount when the arm carries it, the positioner's pose
+    /// when it carries the torch; fixture tilt, offset and torch clamp when
+    /// the cell file's `[placement]` table gives their ranges) so that every
+    /// layer is feasible with the widest margins; the cell as given is kept
+    /// when it is as good. `samples`: candidates of the global screening
+    /// (default 64); `half_box_mm`: half-width of the box searched around
+    /// the cell's placement when its file has no `[placement]` bounds
+    /// (default 400). A part no placement makes feasible is a `PlacedCell`
+    /// with `feasible` False and `binding` naming why, not an exception.
+    /// Releases the GIL.
+    #[pyo3(signature = (cell, *, delta_mm = None, points = None, chord_mm = None,
+        travel_speed_mm_s = None, samples = None, half_box_mm = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn place(
+        &self,
+        py: Python<'_>,
+        cell: &PyCell,
+        delta_mm: Option<f64>,
+        points: Option<i64>,
+        chord_mm: Option<f64>,
+        travel_speed_mm_s: Option<f64>,
+        samples: Option<i64>,
+        half_box_mm: Option<f64>,
+    ) -> PyResult<PyPlacedCell> {
+        let slice = SliceKeywords {
+            strategy: None,
+            delta_mm,
+            points,
+            chord_mm,
+            max_layers: None,
+            travel_speed_mm_s,
+        }
+        .overrides()?;
+        let mut req = PlaceRequest {
+            slice,
+            ..PlaceRequest::default()
+        };
+        if let Some(n) = samples {
+            req.search.samples = usize::try_from(n)
+                .ok()
+                .filter(|n| *n >= 1)
+                .ok_or_else(|| waam_error(format!("samples = {n}: must be at least 1")))?;
+        }
+        if let Some(h) = half_box_mm {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(waam_error(format!(
+                    "half_box_mm = {h}: must be positive and finite"
+                )));
+            }
+            req.half_box_mm = h;
+        }
+        let result = py.detach(|| crate::pipeline::place_part(&self.part, &cell.cell, &req));
+        PyPlacedCell::new(py, result.map_err(waam_error)?)
     }
 }
 
