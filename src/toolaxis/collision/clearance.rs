@@ -142,6 +142,19 @@ impl<'a> Obstacles<'a> {
         tool: &Vector3,
         margin: f64,
     ) -> Result<bool, ToolAxisError> {
+        self.is_clear_with_radius(torch, point, tool, margin, self.bead_radius)
+    }
+
+    /// [`Obstacles::is_clear`] with beads of `bead_radius` (mm) in place of
+    /// the obstacles' own.
+    fn is_clear_with_radius(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin: f64,
+        bead_radius: f64,
+    ) -> Result<bool, ToolAxisError> {
         let torch_pose = part_from_torch(point, tool);
         for (local, part) in &torch.parts {
             let pose = torch_pose * local;
@@ -152,7 +165,7 @@ impl<'a> Obstacles<'a> {
                     part,
                     &Isometry3::identity(),
                     built,
-                    margin + self.bead_radius,
+                    margin + bead_radius,
                 )
                 .map_err(|_| ToolAxisError::UnsupportedQuery {
                     what: "the built part",
@@ -182,6 +195,18 @@ impl<'a> Obstacles<'a> {
         point: &Point3,
         tool: &Vector3,
     ) -> Result<f64, ToolAxisError> {
+        self.clearance_with_radius(torch, point, tool, self.bead_radius)
+    }
+
+    /// [`Obstacles::clearance`] with beads of `bead_radius` (mm) in place
+    /// of the obstacles' own.
+    fn clearance_with_radius(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        bead_radius: f64,
+    ) -> Result<f64, ToolAxisError> {
         let torch_pose = part_from_torch(point, tool);
         let mut best = f64::INFINITY;
         for (local, part) in &torch.parts {
@@ -194,7 +219,7 @@ impl<'a> Obstacles<'a> {
                             what: "the built part",
                         }
                     })?;
-                best = best.min(d - self.bead_radius);
+                best = best.min(d - bead_radius);
             }
             if let Some((iso, shape)) = self.substrate {
                 let d = query::distance(&pose, part, iso, shape.as_ref()).map_err(|_| {
@@ -284,6 +309,39 @@ impl Wall {
         margin_mm: f64,
     ) -> Result<bool, ToolAxisError> {
         self.obstacles.is_clear(torch, point, tool, margin_mm)
+    }
+
+    /// [`Wall::clearance`] with capsules of `bead_radius_mm` (≥ 0) in place
+    /// of the wall's own: one segment tree serves any radius.
+    ///
+    /// # Errors
+    /// [`ToolAxisError::UnsupportedQuery`] if parry cannot answer.
+    pub fn clearance_with_radius(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        bead_radius_mm: f64,
+    ) -> Result<f64, ToolAxisError> {
+        self.obstacles
+            .clearance_with_radius(torch, point, tool, bead_radius_mm.max(0.0))
+    }
+
+    /// [`Wall::is_clear`] with capsules of `bead_radius_mm` (≥ 0) in place
+    /// of the wall's own.
+    ///
+    /// # Errors
+    /// [`ToolAxisError::UnsupportedQuery`] if parry cannot answer.
+    pub fn is_clear_with_radius(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin_mm: f64,
+        bead_radius_mm: f64,
+    ) -> Result<bool, ToolAxisError> {
+        self.obstacles
+            .is_clear_with_radius(torch, point, tool, margin_mm, bead_radius_mm.max(0.0))
     }
 }
 
