@@ -222,12 +222,20 @@ impl TransitWall for Wall {
 /// walls of a program's `L` transits build `O(L log L)` beads' segments
 /// instead of `O(L²)`.
 ///
-/// The queries equal those of [`wall_of`] on the first `n` beads: a torch
-/// clears the union of the blocks exactly when it clears each block (parry
-/// reports a leaf within the margin whatever the tree), and the union's
-/// clearance is the smallest of the blocks', every segment's distance
-/// computed from the same points and pose (`tests/program/transit_wall.rs`
-/// compares them on sample-part beads).
+/// The queries answer as [`wall_of`] of the first `n` beads (one tree):
+/// * `is_clear`: parry reports a segment within the margin when one is,
+///   whatever the tree (a node's box holds its segments' boxes, so it is
+///   never cut off before such a segment is found), and the blocks are
+///   clear exactly when each is;
+/// * `clearance`: parry's distance query gives the smallest distance over
+///   the segments it visits, and it leaves out only those whose box is no
+///   closer than a distance already found; each block's search here starts
+///   from the smallest distance of the blocks before it
+///   ([`Wall::axis_distance_below`]). Both are the smallest segment
+///   distance over all the beads as long as no computed segment distance
+///   falls below its box's bound by rounding; the radius is taken off
+///   once, as in [`Wall::clearance`]. `tests/program/transit_wall.rs`
+///   finds them equal to the bit on sample-part beads and program moves.
 #[derive(Debug, Default)]
 pub struct WallBeads {
     kept: Vec<Vec<Point3>>,
@@ -351,11 +359,19 @@ impl TransitWall for WallPrefix<'_> {
         point: &Point3,
         tool: &Vector3,
     ) -> Result<f64, ToolAxisError> {
-        let mut best = f64::INFINITY;
+        // the smallest distance to a segment of any block, each block's
+        // search bounded by the smallest found so far; the radius taken off
+        // once (`d - r` is monotone in `d`, so this is the smallest `d - r`)
+        let mut axis = f64::MAX;
         for b in self.blocks() {
-            best = best.min(b.clearance_with_radius(torch, point, tool, self.bead_radius_mm)?);
+            if let Some(d) = b.axis_distance_below(torch, point, tool, axis) {
+                axis = d;
+            }
         }
-        Ok(best)
+        if axis == f64::MAX {
+            return Ok(f64::INFINITY);
+        }
+        Ok(axis - self.bead_radius_mm.max(0.0))
     }
 }
 
