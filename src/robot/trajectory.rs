@@ -493,7 +493,10 @@ pub fn joint_trajectory(
         let jac = robot.jacobian(&q);
         let dex = dexterity_warm(&jac, opts.dexterity_length_scale_mm, &mut warm);
         let dq_drz = if opts.with_derivatives {
-            cell.dq_drz(&pose, &q).ok()
+            // the Jacobian above, and its dexterity as a bound for the
+            // singularity test (same answers as `cell.dq_drz(&pose, &q)`)
+            cell.dq_drz_from(&pose, &jac, Some((dex, opts.dexterity_length_scale_mm)))
+                .ok()
         } else {
             None
         };
