@@ -18,7 +18,7 @@ use crate::optimise::{
 use crate::program::{
     build_program_with, check_vendor, write_files, Program, ProgramError, TravelSpeed,
 };
-use crate::robot::trajectory::{joint_trajectory, TrajectoryOptions};
+use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
 use crate::Error;
 
 /// Wall-clock time of each planning stage (s).
@@ -184,11 +184,18 @@ pub(super) fn build(
     check_every_layer(layers, plan)?;
     let inputs = trajectory_inputs(layers, plan);
     let speed = opts.travel_speed_mm_s;
-    let traj = joint_trajectory(&cell.layout, &inputs, speed, &TrajectoryOptions::default())
-        .map_err(|e| ProgramError::Mismatch {
-            index: 0,
-            reason: format!("joint trajectory: {e}"),
-        })?;
+    // the program reads the joints, speeds and violations only: no
+    // dexterity (an SVD a point) nor dq/dR_Z
+    let traj = joint_trajectory_without_measures(
+        &cell.layout,
+        &inputs,
+        speed,
+        &TrajectoryOptions::default(),
+    )
+    .map_err(|e| ProgramError::Mismatch {
+        index: 0,
+        reason: format!("joint trajectory: {e}"),
+    })?;
     let common = &cell.program.common;
     let mut program = build_program_with(
         name,

@@ -43,8 +43,62 @@ impl fmt::Display for Fixed {
         if (v * scale).round() == 0.0 {
             v = 0.0;
         }
-        write!(f, "{:>w$.d$}", v, w = self.width, d = self.decimals)
+        let mut buf = [0u8; 40];
+        match fixed_digits(v, self.decimals, &mut buf) {
+            Some(text) => write!(f, "{text:>w$}", w = self.width),
+            None => write!(f, "{:>w$.d$}", v, w = self.width, d = self.decimals),
+        }
     }
+}
+
+/// `v` with `decimals` decimals as `format!("{v:.decimals$}")` writes it,
+/// from integers, or `None` where that cannot be decided cheaply (then the
+/// standard formatter runs): the exact `|v|·10^decimals` lies within half an
+/// ulp of its rounded product `x`, so rounding `x` to the nearest integer
+/// gives the correctly rounded digits unless `x` is within an ulp of a
+/// half-integer (ties and near-ties go to the standard formatter).
+fn fixed_digits(v: f64, decimals: usize, buf: &mut [u8; 40]) -> Option<&str> {
+    if decimals > 9 || !v.is_finite() {
+        return None;
+    }
+    let scale = 10f64.powi(decimals as i32); // exact up to 10^22
+    let x = v.abs() * scale;
+    if !(x < 1e15) {
+        return None;
+    }
+    let whole = x.floor();
+    let frac = x - whole; // exact: the bits of x below the units
+    if (frac - 0.5).abs() <= f64::EPSILON * x.max(1.0) {
+        return None;
+    }
+    let n = whole as u64 + u64::from(frac > 0.5);
+    let unit = 10u64.pow(decimals as u32);
+    let (int, mut dec) = (n / unit, n % unit);
+    // right to left: decimals, point, integer digits, sign
+    let mut i = buf.len();
+    for _ in 0..decimals {
+        i -= 1;
+        buf[i] = b'0' + (dec % 10) as u8;
+        dec /= 10;
+    }
+    if decimals > 0 {
+        i -= 1;
+        buf[i] = b'.';
+    }
+    let mut int = int;
+    loop {
+        i -= 1;
+        buf[i] = b'0' + (int % 10) as u8;
+        int /= 10;
+        if int == 0 {
+            break;
+        }
+    }
+    if v.is_sign_negative() {
+        i -= 1;
+        buf[i] = b'-';
+    }
+    std::str::from_utf8(&buf[i..]).ok()
 }
 
 /// FANUC position lengths: mm, 3 decimals, width 9 (`X =  1045.747  mm`).
@@ -178,6 +232,43 @@ mod tests {
             "45 deg * 2 - Staubli ?"
         );
         assert!(ascii_comment("dépôt porté ✓").is_ascii());
+    }
+
+    #[test]
+    fn integer_digits_are_the_standard_formatters() {
+        // random magnitudes and signs, values on the 10^-d grid and half
+        // way between (ties and near-ties), every decimal count used
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut checked = 0;
+        for k in 0..400_000u64 {
+            let r = next();
+            let mantissa = (r >> 11) as f64 / (1u64 << 53) as f64;
+            let exponent = (next() % 24) as i32 - 8;
+            let mut v = mantissa * 10f64.powi(exponent);
+            let d = (k % 6) as usize;
+            match k % 4 {
+                1 => v = (v * 10f64.powi(d as i32)).round() / 10f64.powi(d as i32),
+                2 => v = ((v * 10f64.powi(d as i32)).floor() + 0.5) / 10f64.powi(d as i32),
+                _ => {}
+            }
+            if next() % 2 == 0 {
+                v = -v;
+            }
+            let mut buf = [0u8; 40];
+            if let Some(t) = fixed_digits(v, d, &mut buf) {
+                assert_eq!(t, format!("{v:.d$}"), "{v:e}, {d} decimals");
+                checked += 1;
+            }
+        }
+        // exact ties such as 1.03125 at 4 decimals are left to the standard formatter
+        assert!(fixed_digits(1.03125, 4, &mut [0u8; 40]).is_none());
+        assert!(checked > 200_000, "{checked}");
     }
 
     #[test]

@@ -947,7 +947,8 @@ fn safe_transits(
         }
     })?;
     let blocks = blocks(&program.points);
-    // Each bead decimated once; the wall after bead k is built from them.
+    // Each bead decimated once; the wall after bead k is the union of at
+    // most log2(k + 1) + 1 blocks of them, each block's tree built once.
     let mut decimated = transit::WallBeads::default();
     for b in &blocks {
         let bead: Vec<Point3> = program.points[b.start..=b.end]

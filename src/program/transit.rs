@@ -8,9 +8,12 @@
 //! approach points of a transition that collides; the validator checks the
 //! joint moves it reads back. Part frame, mm, rad.
 
+use std::sync::OnceLock;
+
 use crate::math::{Point3, Vector3};
 use crate::robot::{Cell, Joints};
 use crate::toolaxis::collision::{Torch, Wall};
+use crate::toolaxis::ToolAxisError;
 
 /// Largest change of any joint between two samples of a joint move (rad,
 /// 0.5°): at 1.5 m from the axis a sample every ~13 mm, well under the
@@ -78,7 +81,7 @@ pub struct TransitClearance {
 /// positioner joints) or parry cannot answer.
 pub fn joint_move_clearance(
     cell: &Cell,
-    wall: &Wall,
+    wall: &(impl TransitWall + ?Sized),
     torch: &Torch,
     (qa, pa): (&Joints, Option<[f64; 2]>),
     (qb, pb): (&Joints, Option<[f64; 2]>),
@@ -130,27 +133,120 @@ pub fn joint_move_clearance(
     Ok(best)
 }
 
-/// The wall of `beads` (part frame, mm) for a transit check: each bead
-/// decimated to at most [`WALL_POINTS_PER_BEAD`] points, capsules of
-/// `bead_radius_mm` grown by the largest distance of a dropped point from
-/// its chord.
+/// The wall of `beads` (part frame, mm) for a transit check, as one
+/// segment tree: each bead decimated to at most [`WALL_POINTS_PER_BEAD`]
+/// points, capsules of `bead_radius_mm` grown by the largest distance of a
+/// dropped point from its chord. [`WallBeads::wall`] answers the same
+/// queries for any number of first beads without building a tree each time.
 pub fn wall_of<'b>(beads: impl IntoIterator<Item = &'b [Point3]>, bead_radius_mm: f64) -> Wall {
     let mut decimated = WallBeads::default();
     for b in beads {
         decimated.push(b);
     }
-    decimated.wall(decimated.len(), bead_radius_mm)
+    let grow = decimated.grow.last().copied().unwrap_or(0.0);
+    Wall::new(
+        decimated.kept.iter().map(Vec::as_slice),
+        bead_radius_mm + grow,
+    )
+}
+
+/// An obstacle a joint move is checked against (part frame, mm): one
+/// [`Wall`], or the first beads of [`WallBeads`] ([`WallPrefix`]).
+pub trait TransitWall {
+    /// `true` when there is no bead to hit.
+    fn is_empty(&self) -> bool;
+
+    /// Whether the clearance of `torch` with its tip at `point` and its
+    /// axis along `tool` (towards the torch, part frame) exceeds
+    /// `margin_mm` (≥ 0); see [`Wall::is_clear`].
+    ///
+    /// # Errors
+    /// [`ToolAxisError::UnsupportedQuery`] if parry cannot answer.
+    fn is_clear(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin_mm: f64,
+    ) -> Result<bool, ToolAxisError>;
+
+    /// Smallest distance from `torch` (tip at `point`, axis along `tool`) to
+    /// the beads' capsules (mm; `<= 0` a collision, `+inf` without beads);
+    /// see [`Wall::clearance`].
+    ///
+    /// # Errors
+    /// [`ToolAxisError::UnsupportedQuery`] if parry cannot answer.
+    fn clearance(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+    ) -> Result<f64, ToolAxisError>;
+}
+
+impl TransitWall for Wall {
+    fn is_empty(&self) -> bool {
+        Wall::is_empty(self)
+    }
+
+    fn is_clear(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin_mm: f64,
+    ) -> Result<bool, ToolAxisError> {
+        Wall::is_clear(self, torch, point, tool, margin_mm)
+    }
+
+    fn clearance(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+    ) -> Result<f64, ToolAxisError> {
+        Wall::clearance(self, torch, point, tool)
+    }
 }
 
 /// Beads decimated once for the transit check, in deposition order (part
-/// frame, mm), from which the wall after any number of beads is built
-/// without decimating the earlier beads again: `wall(k, r)` is
-/// [`wall_of`] of the first `k` beads.
-#[derive(Debug, Clone, Default)]
+/// frame, mm), from which the wall after any number of beads is queried
+/// without decimating or building the earlier beads' segment trees again.
+///
+/// The beads are grouped in blocks as in a Fenwick tree: block `m` (1-based)
+/// holds beads `m - low(m) .. m`, where `low(m)` is the largest power of two
+/// dividing `m`, and its segment tree is built once, at its first query
+/// (capsule radius left to the query). The first `n` beads are the disjoint
+/// union of the blocks `n`, `n - low(n)`, … (at most `log2(n) + 1` of them),
+/// so [`WallBeads::wall`] costs no tree build after the first, and all the
+/// walls of a program's `L` transits build `O(L log L)` beads' segments
+/// instead of `O(L²)`.
+///
+/// The queries answer as [`wall_of`] of the first `n` beads (one tree):
+/// * `is_clear`: parry reports a segment within the margin when one is,
+///   whatever the tree (a node's box holds its segments' boxes, so it is
+///   never cut off before such a segment is found), and the blocks are
+///   clear exactly when each is;
+/// * `clearance`: parry's distance query gives the smallest distance over
+///   the segments it visits, and it leaves out only those whose box is no
+///   closer than a distance already found; each block's search here starts
+///   from the smallest distance of the blocks before it
+///   ([`Wall::axis_distance_below`]). Both are the smallest segment
+///   distance over all the beads as long as no computed segment distance
+///   falls below its box's bound by rounding; the radius is taken off
+///   once, as in [`Wall::clearance`]. `tests/program/transit_wall.rs`
+///   finds them equal to the bit on sample-part beads and program moves.
+#[derive(Debug, Default)]
 pub struct WallBeads {
     kept: Vec<Vec<Point3>>,
     /// Largest chord distance of a dropped point over beads `..=i` (mm).
     grow: Vec<f64>,
+    /// Beads of at least two kept points (the wall's segments) among
+    /// beads `..=i`.
+    solid: Vec<usize>,
+    /// `blocks[m - 1]`: the wall of beads `m - low(m) .. m`, built on first
+    /// use (capsule radius 0: queries give theirs).
+    blocks: Vec<OnceLock<Wall>>,
 }
 
 impl WallBeads {
@@ -175,6 +271,10 @@ impl WallBeads {
             self.kept.push(idx.iter().map(|&i| b[i]).collect());
         }
         self.grow.push(grow);
+        let solid = self.solid.last().copied().unwrap_or(0);
+        self.solid
+            .push(solid + usize::from(self.kept.last().is_some_and(|k| k.len() >= 2)));
+        self.blocks.push(OnceLock::new());
     }
 
     /// Beads added so far.
@@ -188,14 +288,90 @@ impl WallBeads {
     }
 
     /// The wall of the first `n` beads (at most [`Self::len`]), capsules of
-    /// `bead_radius_mm` grown by their decimation's largest chord distance.
-    pub fn wall(&self, n: usize, bead_radius_mm: f64) -> Wall {
+    /// `bead_radius_mm` grown by the largest chord distance of their
+    /// decimation: the queries of [`wall_of`] on those beads, answered by
+    /// the blocks' segment trees.
+    pub fn wall(&self, n: usize, bead_radius_mm: f64) -> WallPrefix<'_> {
         let n = n.min(self.kept.len());
         let grow = if n == 0 { 0.0 } else { self.grow[n - 1] };
-        Wall::new(
-            self.kept[..n].iter().map(Vec::as_slice),
-            bead_radius_mm + grow,
-        )
+        WallPrefix {
+            beads: self,
+            n,
+            // the radius `wall_of` gives its `Wall`
+            bead_radius_mm: bead_radius_mm + grow,
+        }
+    }
+
+    /// Block `m` (1-based): the wall of beads `m - low(m) .. m`.
+    fn block(&self, m: usize) -> &Wall {
+        self.blocks[m - 1]
+            .get_or_init(|| Wall::new(self.kept[m - low(m)..m].iter().map(Vec::as_slice), 0.0))
+    }
+}
+
+/// The largest power of two dividing `m` (> 0).
+fn low(m: usize) -> usize {
+    m & m.wrapping_neg()
+}
+
+/// The wall of the first beads of a [`WallBeads`] ([`WallBeads::wall`]).
+#[derive(Debug, Clone, Copy)]
+pub struct WallPrefix<'a> {
+    beads: &'a WallBeads,
+    n: usize,
+    /// Capsule radius (mm): the bead radius grown by the decimation.
+    bead_radius_mm: f64,
+}
+
+impl WallPrefix<'_> {
+    /// The blocks whose union is the wall, latest beads first.
+    fn blocks(&self) -> impl Iterator<Item = &Wall> + '_ {
+        std::iter::successors((self.n > 0).then_some(self.n), |&m| {
+            (m > low(m)).then(|| m - low(m))
+        })
+        .map(|m| self.beads.block(m))
+    }
+}
+
+impl TransitWall for WallPrefix<'_> {
+    fn is_empty(&self) -> bool {
+        self.n == 0 || self.beads.solid[self.n - 1] == 0
+    }
+
+    fn is_clear(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin_mm: f64,
+    ) -> Result<bool, ToolAxisError> {
+        for b in self.blocks() {
+            if !b.is_clear_with_radius(torch, point, tool, margin_mm, self.bead_radius_mm)? {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
+    fn clearance(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+    ) -> Result<f64, ToolAxisError> {
+        // the smallest distance to a segment of any block, each block's
+        // search bounded by the smallest found so far; the radius taken off
+        // once (`d - r` is monotone in `d`, so this is the smallest `d - r`)
+        let mut axis = f64::MAX;
+        for b in self.blocks() {
+            if let Some(d) = b.axis_distance_below(torch, point, tool, axis) {
+                axis = d;
+            }
+        }
+        if axis == f64::MAX {
+            return Ok(f64::INFINITY);
+        }
+        Ok(axis - self.bead_radius_mm.max(0.0))
     }
 }
 

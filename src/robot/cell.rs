@@ -556,12 +556,36 @@ impl Cell {
     /// # Errors
     /// [`RobotError::SingularJacobian`] at a singularity; as [`Cell::pose`].
     pub fn dq_drz(&self, pose: &CellPose, q: &Joints) -> Result<Joints, RobotError> {
-        let robot = self.robot();
-        let j = robot.jacobian(q);
+        self.dq_drz_from(pose, &self.robot().jacobian(q), None)
+    }
+
+    /// [`Cell::dq_drz`] from the robot's Jacobian `j` at the joints
+    /// (already computed by the caller) and, when known, a lower bound of
+    /// its dexterity at the length scale `length_scale_mm` (`(bound,
+    /// scale)`), which can spare the singularity test's SVD.
+    ///
+    /// # Errors
+    /// As [`Cell::dq_drz`].
+    pub(crate) fn dq_drz_from(
+        &self,
+        pose: &CellPose,
+        j: &crate::robot::jacobian::Jacobian,
+        dexterity_at: Option<(f64, f64)>,
+    ) -> Result<Joints, RobotError> {
+        // Rescaling the Jacobian's position rows from `s` to 1000 mm
+        // multiplies them by `k = s/1000`: the smallest singular value is
+        // at least min(k, 1)·σ_min, the largest at most max(k, 1)·σ_max, so
+        // the dexterity at 1000 mm is at least min(k, 1/k) times the one at
+        // `s`. A bound 100 times above the test's 10⁻¹² leaves the SVDs'
+        // rounding (~10⁻¹⁵ in dexterity) far behind: the test would pass.
+        let regular = dexterity_at.is_some_and(|(dex, s)| {
+            let k = s / 1000.0;
+            dex * k.min(1.0 / k) > 1e-10
+        });
         // a near-exact singularity can leave a finite but meaningless LU solution
-        if crate::robot::indices::dexterity(&j, 1000.0) < 1e-12 {
+        if !regular && crate::robot::indices::dexterity(j, 1000.0) < 1e-12 {
             return Err(RobotError::SingularJacobian {
-                manipulability: crate::robot::indices::manipulability(&j),
+                manipulability: crate::robot::indices::manipulability(j),
             });
         }
         let lu = j.lu();
@@ -569,7 +593,7 @@ impl Cell {
         match sol {
             Some(x) if x.iter().all(|v| v.is_finite()) => Ok([x[0], x[1], x[2], x[3], x[4], x[5]]),
             _ => Err(RobotError::SingularJacobian {
-                manipulability: crate::robot::indices::manipulability(&j),
+                manipulability: crate::robot::indices::manipulability(j),
             }),
         }
     }

@@ -322,6 +322,31 @@ pub fn joint_trajectory(
     travel_speed_mm_s: f64,
     opts: &TrajectoryOptions,
 ) -> Result<JointTrajectory, RobotError> {
+    trajectory(cell, points, travel_speed_mm_s, opts, true)
+}
+
+/// [`joint_trajectory`] without the dexterity (0 at every point) and
+/// `dq/dR_Z` (`None`): the same joints, speeds and violations, for a
+/// program model, which reads nothing else.
+///
+/// # Errors
+/// As [`joint_trajectory`].
+pub(crate) fn joint_trajectory_without_measures(
+    cell: &Cell,
+    points: &[PathPointInput],
+    travel_speed_mm_s: f64,
+    opts: &TrajectoryOptions,
+) -> Result<JointTrajectory, RobotError> {
+    trajectory(cell, points, travel_speed_mm_s, opts, false)
+}
+
+fn trajectory(
+    cell: &Cell,
+    points: &[PathPointInput],
+    travel_speed_mm_s: f64,
+    opts: &TrajectoryOptions,
+    measures: bool,
+) -> Result<JointTrajectory, RobotError> {
     opts.validate()?;
     if !(travel_speed_mm_s > 0.0 && travel_speed_mm_s.is_finite()) {
         return Err(RobotError::InvalidOptions {
@@ -490,12 +515,20 @@ pub fn joint_trajectory(
                 });
             }
         }
-        let jac = robot.jacobian(&q);
-        let dex = dexterity_warm(&jac, opts.dexterity_length_scale_mm, &mut warm);
-        let dq_drz = if opts.with_derivatives {
-            cell.dq_drz(&pose, &q).ok()
+        let (dex, dq_drz) = if measures {
+            let jac = robot.jacobian(&q);
+            let dex = dexterity_warm(&jac, opts.dexterity_length_scale_mm, &mut warm);
+            let dq_drz = if opts.with_derivatives {
+                // the Jacobian above, and its dexterity as a bound for the
+                // singularity test (same answers as `cell.dq_drz(&pose, &q)`)
+                cell.dq_drz_from(&pose, &jac, Some((dex, opts.dexterity_length_scale_mm)))
+                    .ok()
+            } else {
+                None
+            };
+            (dex, dq_drz)
         } else {
-            None
+            (0.0, None)
         };
         out.push(JointPoint {
             layer: p.layer,

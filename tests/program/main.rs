@@ -16,4 +16,5 @@ mod setup;
 #[path = "../common/mod.rs"]
 mod shared;
 mod split;
+mod transit_wall;
 mod validate;

@@ -4,6 +4,7 @@
 use waam_slicer::math::{Isometry3, Point3, UnitVector3, Vector3};
 use waam_slicer::robot::cell::{part_carried_angles, torch_carried_angles};
 use waam_slicer::robot::orientation::FanucPose;
+use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
 use waam_slicer::robot::{
     Cell, CellPoint, Configuration, Positioner, RobotModel, TorchCarriedCell,
 };
@@ -186,6 +187,77 @@ fn dq_drz_matches_finite_differences_torch_carried() {
         })
         .collect();
     check_dq_drz(&cell, &pts);
+}
+
+/// The trajectory's `dq/dR_Z` (from its own Jacobian, the singularity test
+/// spared where its dexterity bounds the test's) against [`Cell::dq_drz`]
+/// at the same joints and pose, for several dexterity length scales.
+fn check_trajectory_dq_drz(cell: &Cell, points: &[PathPointInput]) {
+    // 1e-9 mm: the bound is too weak, the singularity test runs every time
+    for scale in [1.0, 1000.0, 1e5, 1e-9] {
+        let opts = TrajectoryOptions {
+            dexterity_length_scale_mm: scale,
+            ..TrajectoryOptions::default()
+        };
+        let tr = joint_trajectory(cell, points, 6.0, &opts).unwrap();
+        let mut q8 = 0.0;
+        let mut some = 0;
+        for (p, jp) in points.iter().zip(&tr.points) {
+            let Some(q) = jp.joints else {
+                continue;
+            };
+            let cp = CellPoint {
+                position_mm: p.position_mm,
+                tool_axis: p.tool_axis,
+                build_direction: p.build_direction,
+            };
+            let pose = cell.pose(&cp, p.r_z, q8).unwrap();
+            if let Some(qp) = jp.positioner {
+                q8 = qp[1];
+            }
+            assert_eq!(pose.positioner, jp.positioner);
+            let expected = cell.dq_drz(&pose, &q).ok();
+            assert_eq!(jp.dq_drz, expected, "layer {} point {}", p.layer, p.point);
+            some += usize::from(expected.is_some());
+        }
+        assert!(some > points.len() / 2, "{some} of {}", points.len());
+    }
+}
+
+#[test]
+fn trajectory_dq_drz_is_the_cells() {
+    // a quarter of the hemisphere's equator and a higher ring, in both cells
+    let points: Vec<PathPointInput> = (0..2)
+        .flat_map(|layer| {
+            (0..60).map(move |i| {
+                let v = i as f64 / 60.0 * std::f64::consts::FRAC_PI_2;
+                let phi: f64 = [0.1, 0.9][layer];
+                let n = Vector3::new(phi.cos() * v.cos(), phi.cos() * v.sin(), phi.sin());
+                PathPointInput {
+                    layer,
+                    point: i,
+                    position_mm: Point3::from(n * 45.0),
+                    tool_axis: UnitVector3::new_normalize(Vector3::z() + n * 0.3),
+                    build_direction: None,
+                    r_z: -v,
+                }
+            })
+        })
+        .collect();
+    check_trajectory_dq_drz(&robowam_part_carried(thesis_configuration()), &points);
+    let torch: Vec<PathPointInput> = points
+        .iter()
+        .map(|p| PathPointInput {
+            position_mm: Point3::new(
+                p.position_mm.x * 3.0,
+                p.position_mm.y * 3.0,
+                p.position_mm.z,
+            ),
+            r_z: 0.0,
+            ..*p
+        })
+        .collect();
+    check_trajectory_dq_drz(&robowam_torch_carried(), &torch);
 }
 
 #[test]

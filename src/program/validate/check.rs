@@ -10,7 +10,6 @@ use crate::program::transit::{joint_move_clearance, WallBeads};
 use crate::program::ProgramOptions;
 use crate::robot::{Cell, Joints};
 use crate::toolaxis::collision::Torch;
-use crate::toolaxis::collision::Wall;
 
 use super::ProblemKind;
 use super::{
@@ -514,7 +513,6 @@ fn check_transits(
         return;
     };
     let mut beads = WallBeads::default();
-    let mut wall: Option<(usize, Wall)> = None;
     let mut current: Vec<Point3> = Vec::new();
     let mut prev: Option<(Joints, Option<[f64; 2]>)> = None;
     for (i, s) in steps.iter().enumerate() {
@@ -534,13 +532,9 @@ fn check_transits(
                 }
                 if let (Some((pq, pp)), MoveKind::Joint) = (prev, m.kind) {
                     if !beads.is_empty() {
-                        // The wall is rebuilt only when a bead was added.
-                        if wall.as_ref().is_none_or(|(n, _)| *n != beads.len()) {
-                            wall =
-                                Some((beads.len(), beads.wall(beads.len(), common.bead_radius_mm)));
-                        }
-                        let (_, wall) = wall.as_ref().expect("built above");
-                        match joint_move_clearance(cell, wall, &torch, (&pq, pp), (&q, m.positioner)) {
+                        // the blocks' trees are built once, at their first use
+                        let wall = beads.wall(beads.len(), common.bead_radius_mm);
+                        match joint_move_clearance(cell, &wall, &torch, (&pq, pp), (&q, m.positioner)) {
                             Ok(c) if c.min_clearance_mm <= 0.0 => push(
                                 report,
                                 ProblemKind::Collision,

@@ -6,7 +6,9 @@ use crate::geometry::Substrate;
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, UnitVector3, Vector3};
 use crate::path::Path;
 use crate::toolaxis::{LocalFrame, ToolAxisError};
-use parry3d_f64::query;
+use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::partitioning::BvhNode;
+use parry3d_f64::query::{self, DefaultQueryDispatcher, QueryDispatcher};
 use parry3d_f64::shape::{Cylinder, HalfSpace, Polyline, Shape};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -142,6 +144,19 @@ impl<'a> Obstacles<'a> {
         tool: &Vector3,
         margin: f64,
     ) -> Result<bool, ToolAxisError> {
+        self.is_clear_with_radius(torch, point, tool, margin, self.bead_radius)
+    }
+
+    /// [`Obstacles::is_clear`] with beads of `bead_radius` (mm) in place of
+    /// the obstacles' own.
+    fn is_clear_with_radius(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin: f64,
+        bead_radius: f64,
+    ) -> Result<bool, ToolAxisError> {
         let torch_pose = part_from_torch(point, tool);
         for (local, part) in &torch.parts {
             let pose = torch_pose * local;
@@ -152,7 +167,7 @@ impl<'a> Obstacles<'a> {
                     part,
                     &Isometry3::identity(),
                     built,
-                    margin + self.bead_radius,
+                    margin + bead_radius,
                 )
                 .map_err(|_| ToolAxisError::UnsupportedQuery {
                     what: "the built part",
@@ -284,6 +299,78 @@ impl Wall {
         margin_mm: f64,
     ) -> Result<bool, ToolAxisError> {
         self.obstacles.is_clear(torch, point, tool, margin_mm)
+    }
+
+    /// Smallest distance (mm) from `torch` with its tip at `point` and its
+    /// axis along `tool` (towards the torch, part frame) to the beads'
+    /// polylines — the capsules' axes, radius not taken off — when it is
+    /// below `below_mm`; `None` when no segment is that close (or without
+    /// beads). Subtracting the capsule radius from the smallest of these
+    /// over several walls gives the clearance of their union.
+    ///
+    /// Each torch part runs parry's own composite distance query
+    /// (`query::distance`, as [`Wall::clearance`] does: the same relative
+    /// pose, box bounds and segment distances), started from the bound
+    /// instead of `f64::MAX`: a segment tree whose box is no closer than
+    /// the bound is left at its root.
+    pub fn axis_distance_below(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        below_mm: f64,
+    ) -> Option<f64> {
+        let built = self.obstacles.built.as_ref()?;
+        let torch_pose = part_from_torch(point, tool);
+        let mut best: Option<f64> = None;
+        for (local, part) in &torch.parts {
+            let pose = torch_pose * local;
+            let part = part.shape();
+            // as `query::distance(&pose, part, &identity, built)` →
+            // `distance_shape_composite_shape` → `distance_to_shape`
+            let pos12 = pose.inv_mul(&Isometry3::identity());
+            let pose12 = pos12.inverse();
+            let aabb = part.compute_aabb(&pose12);
+            let shift = -aabb.center().coords;
+            let half = aabb.half_extents();
+            let bound = best.unwrap_or(below_mm);
+            let found = built.bvh().find_best(
+                bound,
+                |node: &BvhNode, _| {
+                    Aabb {
+                        mins: node.mins() + shift - half,
+                        maxs: node.maxs() + shift + half,
+                    }
+                    .distance_to_origin()
+                },
+                |i, _| {
+                    DefaultQueryDispatcher
+                        .distance(&pose12, &built.segment(i), part)
+                        .ok()
+                },
+            );
+            if let Some((_, d)) = found {
+                best = Some(d);
+            }
+        }
+        best
+    }
+
+    /// [`Wall::is_clear`] with capsules of `bead_radius_mm` (≥ 0) in place
+    /// of the wall's own.
+    ///
+    /// # Errors
+    /// [`ToolAxisError::UnsupportedQuery`] if parry cannot answer.
+    pub fn is_clear_with_radius(
+        &self,
+        torch: &Torch,
+        point: &Point3,
+        tool: &Vector3,
+        margin_mm: f64,
+        bead_radius_mm: f64,
+    ) -> Result<bool, ToolAxisError> {
+        self.obstacles
+            .is_clear_with_radius(torch, point, tool, margin_mm, bead_radius_mm.max(0.0))
     }
 }
 
