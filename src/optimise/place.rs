@@ -29,8 +29,18 @@
 //!    program stage's transit check, in [`crate::pipeline::place_part`]).
 //! 4. **Feedback**: when certification fails, the failing layers join the
 //!    subsample at full resolution (the subsample misses speed peaks at cusps
-//!    between its points), the best candidates are judged again on it and the
-//!    search goes back to 2, for a bounded number of rounds.
+//!    between its points), and so do the layers of the certified plan that
+//!    bind its joint-stop, speed or reach margin below the score's
+//!    comfortable values (the subsample missed them); the best candidates
+//!    are judged again on it, and when fewer than two of them stay feasible
+//!    a fresh batch of the Halton sequence (half the screening's) is judged
+//!    on it too; the search goes back to 2, for a bounded number of rounds.
+//!
+//! The score of a candidate feasible on the subsample is its worst margin:
+//! joint stops, speed headroom and the wrist centre's distance inside the
+//! arm's reach ([`REACH_COMFORT_MM`]), so that a candidate at the edge of
+//! the reach ranks below one with room (points between the subsample's may
+//! be out of reach). Certification still plans every point.
 
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -43,7 +53,7 @@ use crate::optimise::{
     optimise, transitions, LayerPlan, LayerPoints, LayerStatus, OptimiseError, OptimiseOptions,
     Plan,
 };
-use crate::robot::Cell;
+use crate::robot::{Cell, Joints, RobotModel};
 
 /// How much better (in the search's score: 1 is comfortable margins, 10° from
 /// a stop and 20 % speed headroom) another candidate must score on the
@@ -252,6 +262,11 @@ pub struct Margins {
     pub speed_headroom: f64,
     /// Smallest dexterity over every layer (0 singular, 1 isotropic).
     pub dexterity: f64,
+    /// Smallest distance (mm) of the robot's wrist centre inside the arm's
+    /// reach over every planned point: from the J2 axis, in the arm plane,
+    /// to the stretched arm's reach or the folded arm's (the annulus of
+    /// [`RobotError::Unreachable`](crate::robot::RobotError::Unreachable)).
+    pub reach_mm: f64,
     /// Layers infeasible.
     pub infeasible_layers: usize,
 }
@@ -390,11 +405,15 @@ pub fn margins(plan: &Plan, cell: &Cell) -> Margins {
         joint_limit_deg: f64::INFINITY,
         speed_headroom: f64::INFINITY,
         dexterity: f64::INFINITY,
+        reach_mm: f64::INFINITY,
         infeasible_layers: 0,
     };
     for l in &plan.layers {
         if !l.status.is_feasible() {
             m.infeasible_layers += 1;
+        }
+        for q in l.points.iter().filter_map(|p| p.joints.as_ref()) {
+            m.reach_mm = m.reach_mm.min(reach_margin_mm(robot, q));
         }
         let q = &l.quality;
         m.joint_limit_deg = m.joint_limit_deg.min(q.min_limit_distance_rad.to_degrees());
@@ -410,6 +429,7 @@ pub fn margins(plan: &Plan, cell: &Cell) -> Margins {
         &mut m.joint_limit_deg,
         &mut m.speed_headroom,
         &mut m.dexterity,
+        &mut m.reach_mm,
     ] {
         if !v.is_finite() {
             *v = 0.0;
@@ -418,9 +438,30 @@ pub fn margins(plan: &Plan, cell: &Cell) -> Margins {
     m
 }
 
-/// One scalar to maximise: for a feasible plan the worse of the joint-limit
-/// and speed margins, each scaled to 1 at a comfortable value (10° from a
-/// stop, 20 % speed headroom) and capped at 1, plus a small reward for
+/// Distance (mm) of the wrist centre at joints `q` (rad) inside the arm's
+/// reach annulus `[|c2 − k|, c2 + k]` about the J2 axis (`c2` the upper arm,
+/// `k` the J3 → wrist-centre distance), as the inverse kinematics tests it;
+/// negative outside.
+fn reach_margin_mm(robot: &RobotModel, q: &Joints) -> f64 {
+    let s = robot.chain_state(q);
+    let d = (s.wrist_centre - s.axis_points[1]).norm();
+    let g = &robot.geometry;
+    let k = g.forearm_mm.hypot(g.elbow_offset_mm);
+    (d - (g.upper_arm_mm - k).abs()).min(g.upper_arm_mm + k - d)
+}
+
+/// The reach margin (mm) the score calls comfortable. The full path's
+/// layers and laws (each layer re-optimised on every point) take the wrist
+/// centre further out than the subsample's: the S-bend at Delta 2 mm, 400
+/// points a layer, had a candidate 51 mm inside the reach on the subsample
+/// and 6.7 mm beyond it at layer 192 on the full path, between two layers
+/// of the subsample.
+pub const REACH_COMFORT_MM: f64 = 50.0;
+
+/// One scalar to maximise: for a feasible plan the worst of the joint-limit,
+/// speed and reach margins, each scaled to 1 at a comfortable value (10°
+/// from a stop, 20 % speed headroom, [`REACH_COMFORT_MM`] inside the arm's
+/// reach) and capped at 1, plus a small reward for
 /// dexterity (the floor itself is a constraint of every layer; dexterity
 /// mixes mm and rad, its values are ~1e-3 on our arms, so it only breaks
 /// ties); for an infeasible plan minus the share of infeasible layers minus
@@ -430,8 +471,9 @@ fn score(plan: &Plan, cell: &Cell) -> f64 {
     if m.infeasible_layers == 0 {
         let a = (m.joint_limit_deg / 10.0).min(1.0);
         let b = (m.speed_headroom / 0.2).min(1.0);
+        let r = (m.reach_mm / REACH_COMFORT_MM).min(1.0);
         let c = (m.dexterity / 2e-3).min(1.0);
-        return a.min(b).max(0.0) + 0.01 * c.max(0.0);
+        return a.min(b).min(r).max(0.0) + 0.01 * c.max(0.0);
     }
     let n = plan.layers.len().max(1) as f64;
     let violation: f64 = plan
@@ -489,17 +531,20 @@ fn certification_order(n: usize, hot: &[usize]) -> Vec<usize> {
     order
 }
 
+/// Layers planned at certification, with their indices in the path.
+type Certified = Vec<(usize, LayerPlan)>;
+
 /// Every layer of `layers` in `cell`, in `order`, in parallel chunks of
 /// `chunk`, stopping after the first chunk with an infeasible layer.
-/// Returns the layers planned (in path order) and the infeasible ones'
-/// indices.
+/// Returns the layers planned (in path order, with their indices in
+/// `layers`) and the infeasible ones' indices.
 fn certify(
     cell: &Cell,
     layers: &[LayerPoints],
     order: &[usize],
     serial: &OptimiseOptions,
     chunk: usize,
-) -> Result<(Vec<LayerPlan>, Vec<usize>), OptimiseError> {
+) -> Result<(Certified, Vec<usize>), OptimiseError> {
     let mut planned: Vec<(usize, LayerPlan)> = Vec::with_capacity(layers.len());
     let mut failing = Vec::new();
     for part in order.chunks(chunk.max(1)) {
@@ -522,7 +567,50 @@ fn certify(
         }
     }
     planned.sort_by_key(|(i, _)| *i);
-    Ok((planned.into_iter().map(|(_, l)| l).collect(), failing))
+    Ok((planned, failing))
+}
+
+/// The layers of a certified (possibly partial) plan that bind its margins
+/// below the score's comfortable values (the smallest joint-stop distance,
+/// speed headroom and reach margin, each over the layers planned), by their
+/// index in the path, excluding those in `known`. The subsample's points
+/// may miss a layer's worst point and its layers may miss the worst layer
+/// (the S-bend at Delta 2 mm: 11° from a stop on the subsample, 0.5° on the
+/// full path, in layers between the subsample's); these layers joining the
+/// subsample make its score the full path's.
+fn weakest_layers(
+    planned: &[(usize, LayerPlan)],
+    cell: &Cell,
+    known: &BTreeSet<usize>,
+) -> Vec<usize> {
+    let mut worst: [(f64, Option<usize>); 3] = [(f64::INFINITY, None); 3];
+    for (i, l) in planned {
+        if known.contains(i) {
+            continue;
+        }
+        let m = margins(
+            &Plan {
+                layers: vec![l.clone()],
+                transitions: Vec::new(),
+                time_s: 0.0,
+            },
+            cell,
+        );
+        let scaled = [
+            m.joint_limit_deg / 10.0,
+            m.speed_headroom / 0.2,
+            m.reach_mm / REACH_COMFORT_MM,
+        ];
+        for (w, v) in worst.iter_mut().zip(scaled) {
+            if v < 1.0 && v < w.0 {
+                *w = (v, Some(*i));
+            }
+        }
+    }
+    let mut out: Vec<usize> = worst.iter().filter_map(|w| w.1).collect();
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 #[derive(Clone)]
@@ -673,16 +761,18 @@ pub fn place_with(
         .iter()
         .map(|v| v.current.clamp(v.lower, v.upper))
         .collect();
-    let mut starts = vec![current.clone()];
     const BASES: [usize; VARIABLES] = [2, 3, 5, 7, 11, 13, 17];
-    for i in 1..opts.samples {
+    let halton = |i: usize| {
         let mut x = current.clone();
         for (d, &k) in free.iter().enumerate() {
             let v = &vars[k];
             x[k] = v.lower + radical_inverse(i, BASES[d]) * (v.upper - v.lower);
         }
-        starts.push(x);
-    }
+        x
+    };
+    let mut starts = vec![current.clone()];
+    starts.extend((1..opts.samples).map(halton));
+    let mut halton_next = opts.samples.max(1);
     let screened: Vec<Judged> = starts.into_par_iter().map(|x| judge(x, &sub)).collect();
     let mut candidates = screened.len();
     let feasible_fraction =
@@ -797,12 +887,16 @@ pub fn place_with(
             break;
         }
         let mut new_failures: Vec<usize> = Vec::new();
+        let mut new_weakest: Vec<usize> = Vec::new();
         for x in to_certify {
             certified += 1;
             let c = placed_cell(cell, &x);
             let order = certification_order(layers.len(), &hot);
             let (planned, failing) = certify(&c, layers, &order, &serial, chunk)?;
             let checked = planned.len().max(1);
+            let known: BTreeSet<usize> = picks.union(&full).copied().collect();
+            let weakest = weakest_layers(&planned, &c, &known);
+            let planned: Vec<LayerPlan> = planned.into_iter().map(|(_, l)| l).collect();
             let plan = Plan {
                 transitions: transitions(&c, &planned),
                 layers: planned,
@@ -823,12 +917,16 @@ pub fn place_with(
                             .iter()
                             .filter_map(|n| layers.iter().position(|l| l.layer == *n))
                             .collect();
-                        if named.is_empty() {
+                        if named.is_empty() && weakest.is_empty() {
                             continue;
                         }
                         // Those layers join the subsample: its screen then
-                        // sees the move refused.
+                        // sees the move refused; and the layers that bind
+                        // the margins, which the subsample missed (a
+                        // refused transit follows a law pressed against a
+                        // stop).
                         new_failures = named;
+                        new_weakest = weakest;
                         break;
                     }
                 }
@@ -838,10 +936,11 @@ pub fn place_with(
                 failed = Some((x, c, plan, share));
             }
             new_failures = failing;
+            new_weakest = weakest;
             break;
         }
         times.certification_s += t.elapsed().as_secs_f64();
-        if new_failures.is_empty() {
+        if new_failures.is_empty() && new_weakest.is_empty() {
             continue;
         }
         // 4. Feedback: the failing layers (spread, at most
@@ -853,10 +952,10 @@ pub fn place_with(
             .len()
             .div_ceil(opts.feedback_layers.max(1))
             .max(1);
-        for &i in new_failures.iter().step_by(step) {
+        for &i in new_failures.iter().step_by(step).chain(&new_weakest) {
             full.insert(i);
         }
-        for &i in &new_failures {
+        for &i in new_failures.iter().chain(&new_weakest) {
             if !hot.contains(&i) {
                 hot.push(i);
             }
@@ -874,6 +973,22 @@ pub fn place_with(
         }
         candidates += again.len();
         pool = again.into_par_iter().map(|x| judge(x, &sub)).collect();
+        // Few of the best left feasible on the heavier subsample: screen a
+        // fresh batch of the Halton sequence on it (the subsample now holds
+        // what made the certified ones fail, so the batch is judged on it).
+        let feasible = pool.iter().filter(|j| j.score >= 0.0).count();
+        if feasible < opts.refined.max(2) && !free.is_empty() {
+            let batch = (opts.samples / 2).max(1);
+            let fresh: Vec<Vec<f64>> = (halton_next..halton_next + batch).map(halton).collect();
+            halton_next += batch;
+            candidates += fresh.len();
+            pool.extend(
+                fresh
+                    .into_par_iter()
+                    .map(|x| judge(x, &sub))
+                    .collect::<Vec<_>>(),
+            );
+        }
         pool.sort_by(|a, b| b.score.total_cmp(&a.score));
         times.screening_s += t.elapsed().as_secs_f64();
     }
@@ -887,6 +1002,7 @@ pub fn place_with(
             certified += 1;
             let order = certification_order(layers.len(), &hot);
             let (planned, failing) = certify(&c, layers, &order, &serial, chunk)?;
+            let planned: Vec<LayerPlan> = planned.into_iter().map(|(_, l)| l).collect();
             let plan = Plan {
                 transitions: transitions(&c, &planned),
                 layers: planned,
