@@ -305,6 +305,10 @@ pub struct Placement {
     pub certified: usize,
     /// Rounds run.
     pub rounds: usize,
+    /// The binding constraint the rounds stopped on, when they stopped
+    /// before [`PlaceOptions::rounds`] because every candidate judged again
+    /// after a feedback was infeasible on the subsample, bound by it.
+    pub stopped_on: Option<String>,
     /// Layers of the final subsample, and of them at full resolution.
     pub subsample_layers: (usize, usize),
     /// Why no placement was found: when no candidate was feasible on the
@@ -791,6 +795,9 @@ pub fn place_with(
     // share of the checked layers infeasible.
     let mut failed: Option<(Vec<f64>, Cell, Plan, f64)> = None;
     let mut refusal: Option<String> = None;
+    // The binding constraint every re-judged candidate shared, when the
+    // rounds stopped on it.
+    let mut stopped: Option<String> = None;
     'rounds: for round in 0..opts.rounds {
         rounds += 1;
         // 2. Compass search from the best few not refused; after a
@@ -973,6 +980,20 @@ pub fn place_with(
         }
         candidates += again.len();
         pool = again.into_par_iter().map(|x| judge(x, &sub)).collect();
+        // None of the best is feasible on the heavier subsample and one
+        // constraint binds them all (e.g. a joint speed at the cusps of the
+        // layers that joined it): the search stops there; more candidates
+        // and refinement would meet the same wall.
+        let first = pool.first().and_then(|j| j.binding.clone());
+        if first.is_some()
+            && pool
+                .iter()
+                .all(|j| j.score < 0.0 && j.binding == first && j.score > -2.0)
+        {
+            times.screening_s += t.elapsed().as_secs_f64();
+            stopped = first;
+            break;
+        }
         // Few of the best left feasible on the heavier subsample: screen a
         // fresh batch of the Halton sequence on it (the subsample now holds
         // what made the certified ones fail, so the batch is judged on it).
@@ -1062,6 +1083,7 @@ pub fn place_with(
         feasible_fraction,
         certified,
         rounds,
+        stopped_on: stopped,
         subsample_layers: (sub.len(), full.len()),
         binding,
         plan,

@@ -335,6 +335,7 @@ impl PlacedCell {
             "candidates": p.candidates,
             "certified": p.certified,
             "rounds": p.rounds,
+            "stopped_on": p.stopped_on,
             "subsample_layers": p.subsample_layers.0,
             "subsample_layers_full": p.subsample_layers.1,
             "times": p.times,
