@@ -265,11 +265,9 @@ fn bad_placement_bounds_name_their_field() {
 /// layer, 213 layers, 85 200 points), the default search: placed, the
 /// written cell plans, and every one of the 85 200 planned points is checked
 /// by the SPEC §6.1 forward kinematics at the placed file's `D_R`.
-/// Ignored in CI: about 35 s of CPU in release (50 s wall on the loaded
-/// 2-core box), several minutes in the test profile. Run by hand:
-/// `cargo test --release --locked --test optimise -- --ignored own_grid`.
+/// Measured alone (2026-12-03, 2-core box, load average 3): 53 s in the
+/// test profile, 33 s of CPU in release for the search itself.
 #[test]
-#[ignore = "minutes in the test profile; run by hand in release (see the doc comment)"]
 fn the_s_bent_tube_at_its_own_grid_plans_after_placement() {
     let part = Part::read(part_path("s-bend.toml")).unwrap();
     let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
