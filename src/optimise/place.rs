@@ -219,7 +219,9 @@ impl PlacementBounds {
 /// Settings of [`place`]. Plain data.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlaceOptions {
-    /// Coarse candidates sampled in the box.
+    /// Coarse candidates sampled in the box (and half as many more, further
+    /// along the Halton sequence, after a feedback that leaves fewer than two
+    /// of the best feasible on the subsample).
     pub samples: usize,
     /// Layers of the subsample (evenly spread, first and last included).
     pub layers: usize,
@@ -232,7 +234,9 @@ pub struct PlaceOptions {
     /// Rounds of refinement and certification (the failing layers of one
     /// round join the subsample of the next).
     pub rounds: usize,
-    /// Failing layers added to the subsample after a failed certification.
+    /// Failing layers added to the subsample after a failed certification
+    /// (besides at most three that bind the certified layers' joint-stop,
+    /// speed and reach margins).
     pub feedback_layers: usize,
     /// The optimiser's options (travel speed among them).
     pub optimise: OptimiseOptions,
