@@ -542,10 +542,17 @@ fn certification_order(n: usize, hot: &[usize]) -> Vec<usize> {
 /// Layers planned at certification, with their indices in the path.
 type Certified = Vec<(usize, LayerPlan)>;
 
+/// Layers certified together: certification stops after the first group
+/// of this many (in certification order) with an infeasible layer, whatever
+/// the number of threads (the chunks computed in parallel are whole
+/// groups), so that the search's path does not depend on the machine.
+const CERTIFY_GROUP: usize = 8;
+
 /// Every layer of `layers` in `cell`, in `order`, in parallel chunks of
-/// `chunk`, stopping after the first chunk with an infeasible layer.
-/// Returns the layers planned (in path order, with their indices in
-/// `layers`) and the infeasible ones' indices.
+/// about `chunk` (rounded up to whole [`CERTIFY_GROUP`]s), stopping after
+/// the first group with an infeasible layer. Returns the layers planned (in
+/// path order, with their indices in `layers`) and the infeasible ones'
+/// indices.
 fn certify(
     cell: &Cell,
     layers: &[LayerPoints],
@@ -553,9 +560,10 @@ fn certify(
     serial: &OptimiseOptions,
     chunk: usize,
 ) -> Result<(Certified, Vec<usize>), OptimiseError> {
+    let chunk = chunk.max(1).div_ceil(CERTIFY_GROUP) * CERTIFY_GROUP;
     let mut planned: Vec<(usize, LayerPlan)> = Vec::with_capacity(layers.len());
     let mut failing = Vec::new();
-    for part in order.chunks(chunk.max(1)) {
+    for part in order.chunks(chunk) {
         let results: Vec<Result<(usize, LayerPlan), OptimiseError>> = part
             .par_iter()
             .map(|&i| {
@@ -563,12 +571,16 @@ fn certify(
                 Ok((i, plan.layers.remove(0)))
             })
             .collect();
-        for r in results {
+        for (k, r) in results.into_iter().enumerate() {
             let (i, l) = r?;
             if !l.status.is_feasible() {
                 failing.push(i);
             }
             planned.push((i, l));
+            // the end of a group with a failure: the rest is not used
+            if (k + 1) % CERTIFY_GROUP == 0 && !failing.is_empty() {
+                break;
+            }
         }
         if !failing.is_empty() {
             break;
