@@ -29,8 +29,18 @@
 //!    program stage's transit check, in [`crate::pipeline::place_part`]).
 //! 4. **Feedback**: when certification fails, the failing layers join the
 //!    subsample at full resolution (the subsample misses speed peaks at cusps
-//!    between its points), the best candidates are judged again on it and the
-//!    search goes back to 2, for a bounded number of rounds.
+//!    between its points), and so do the layers of the certified plan that
+//!    bind its joint-stop, speed or reach margin below the score's
+//!    comfortable values (the subsample missed them); the best candidates
+//!    are judged again on it, and when fewer than two of them stay feasible
+//!    a fresh batch of the Halton sequence (half the screening's) is judged
+//!    on it too; the search goes back to 2, for a bounded number of rounds.
+//!
+//! The score of a candidate feasible on the subsample is its worst margin:
+//! joint stops, speed headroom and the wrist centre's distance inside the
+//! arm's reach ([`REACH_COMFORT_MM`]), so that a candidate at the edge of
+//! the reach ranks below one with room (points between the subsample's may
+//! be out of reach). Certification still plans every point.
 
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -43,7 +53,7 @@ use crate::optimise::{
     optimise, transitions, LayerPlan, LayerPoints, LayerStatus, OptimiseError, OptimiseOptions,
     Plan,
 };
-use crate::robot::Cell;
+use crate::robot::{Cell, Joints, RobotModel};
 
 /// How much better (in the search's score: 1 is comfortable margins, 10° from
 /// a stop and 20 % speed headroom) another candidate must score on the
@@ -209,7 +219,9 @@ impl PlacementBounds {
 /// Settings of [`place`]. Plain data.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlaceOptions {
-    /// Coarse candidates sampled in the box.
+    /// Coarse candidates sampled in the box (and half as many more, further
+    /// along the Halton sequence, after a feedback that leaves fewer than two
+    /// of the best feasible on the subsample).
     pub samples: usize,
     /// Layers of the subsample (evenly spread, first and last included).
     pub layers: usize,
@@ -222,7 +234,9 @@ pub struct PlaceOptions {
     /// Rounds of refinement and certification (the failing layers of one
     /// round join the subsample of the next).
     pub rounds: usize,
-    /// Failing layers added to the subsample after a failed certification.
+    /// Failing layers added to the subsample after a failed certification
+    /// (besides at most three that bind the certified layers' joint-stop,
+    /// speed and reach margins).
     pub feedback_layers: usize,
     /// The optimiser's options (travel speed among them).
     pub optimise: OptimiseOptions,
@@ -252,6 +266,11 @@ pub struct Margins {
     pub speed_headroom: f64,
     /// Smallest dexterity over every layer (0 singular, 1 isotropic).
     pub dexterity: f64,
+    /// Smallest distance (mm) of the robot's wrist centre inside the arm's
+    /// reach over every planned point: from the J2 axis, in the arm plane,
+    /// to the stretched arm's reach or the folded arm's (the annulus of
+    /// [`RobotError::Unreachable`](crate::robot::RobotError::Unreachable)).
+    pub reach_mm: f64,
     /// Layers infeasible.
     pub infeasible_layers: usize,
 }
@@ -290,6 +309,10 @@ pub struct Placement {
     pub certified: usize,
     /// Rounds run.
     pub rounds: usize,
+    /// The binding constraint the rounds stopped on, when they stopped
+    /// before [`PlaceOptions::rounds`] because every candidate judged again
+    /// after a feedback was infeasible on the subsample, bound by it.
+    pub stopped_on: Option<String>,
     /// Layers of the final subsample, and of them at full resolution.
     pub subsample_layers: (usize, usize),
     /// Why no placement was found: when no candidate was feasible on the
@@ -390,11 +413,15 @@ pub fn margins(plan: &Plan, cell: &Cell) -> Margins {
         joint_limit_deg: f64::INFINITY,
         speed_headroom: f64::INFINITY,
         dexterity: f64::INFINITY,
+        reach_mm: f64::INFINITY,
         infeasible_layers: 0,
     };
     for l in &plan.layers {
         if !l.status.is_feasible() {
             m.infeasible_layers += 1;
+        }
+        for q in l.points.iter().filter_map(|p| p.joints.as_ref()) {
+            m.reach_mm = m.reach_mm.min(reach_margin_mm(robot, q));
         }
         let q = &l.quality;
         m.joint_limit_deg = m.joint_limit_deg.min(q.min_limit_distance_rad.to_degrees());
@@ -410,6 +437,7 @@ pub fn margins(plan: &Plan, cell: &Cell) -> Margins {
         &mut m.joint_limit_deg,
         &mut m.speed_headroom,
         &mut m.dexterity,
+        &mut m.reach_mm,
     ] {
         if !v.is_finite() {
             *v = 0.0;
@@ -418,9 +446,30 @@ pub fn margins(plan: &Plan, cell: &Cell) -> Margins {
     m
 }
 
-/// One scalar to maximise: for a feasible plan the worse of the joint-limit
-/// and speed margins, each scaled to 1 at a comfortable value (10° from a
-/// stop, 20 % speed headroom) and capped at 1, plus a small reward for
+/// Distance (mm) of the wrist centre at joints `q` (rad) inside the arm's
+/// reach annulus `[|c2 − k|, c2 + k]` about the J2 axis (`c2` the upper arm,
+/// `k` the J3 → wrist-centre distance), as the inverse kinematics tests it;
+/// negative outside.
+fn reach_margin_mm(robot: &RobotModel, q: &Joints) -> f64 {
+    let s = robot.chain_state(q);
+    let d = (s.wrist_centre - s.axis_points[1]).norm();
+    let g = &robot.geometry;
+    let k = g.forearm_mm.hypot(g.elbow_offset_mm);
+    (d - (g.upper_arm_mm - k).abs()).min(g.upper_arm_mm + k - d)
+}
+
+/// The reach margin (mm) the score calls comfortable. The full path's
+/// layers and laws (each layer re-optimised on every point) take the wrist
+/// centre further out than the subsample's: the S-bend at Delta 2 mm, 400
+/// points a layer, had a candidate 51 mm inside the reach on the subsample
+/// and 6.7 mm beyond it at layer 192 on the full path, between two layers
+/// of the subsample.
+pub const REACH_COMFORT_MM: f64 = 50.0;
+
+/// One scalar to maximise: for a feasible plan the worst of the joint-limit,
+/// speed and reach margins, each scaled to 1 at a comfortable value (10°
+/// from a stop, 20 % speed headroom, [`REACH_COMFORT_MM`] inside the arm's
+/// reach) and capped at 1, plus a small reward for
 /// dexterity (the floor itself is a constraint of every layer; dexterity
 /// mixes mm and rad, its values are ~1e-3 on our arms, so it only breaks
 /// ties); for an infeasible plan minus the share of infeasible layers minus
@@ -430,8 +479,9 @@ fn score(plan: &Plan, cell: &Cell) -> f64 {
     if m.infeasible_layers == 0 {
         let a = (m.joint_limit_deg / 10.0).min(1.0);
         let b = (m.speed_headroom / 0.2).min(1.0);
+        let r = (m.reach_mm / REACH_COMFORT_MM).min(1.0);
         let c = (m.dexterity / 2e-3).min(1.0);
-        return a.min(b).max(0.0) + 0.01 * c.max(0.0);
+        return a.min(b).min(r).max(0.0) + 0.01 * c.max(0.0);
     }
     let n = plan.layers.len().max(1) as f64;
     let violation: f64 = plan
@@ -489,9 +539,19 @@ fn certification_order(n: usize, hot: &[usize]) -> Vec<usize> {
     order
 }
 
+/// Layers planned at certification, with their indices in the path.
+type Certified = Vec<(usize, LayerPlan)>;
+
+/// Layers certified together: certification stops after the first group
+/// of this many (in certification order) with an infeasible layer, whatever
+/// the number of threads (the chunks computed in parallel are whole
+/// groups), so that the search's path does not depend on the machine.
+const CERTIFY_GROUP: usize = 8;
+
 /// Every layer of `layers` in `cell`, in `order`, in parallel chunks of
-/// `chunk`, stopping after the first chunk with an infeasible layer.
-/// Returns the layers planned (in path order) and the infeasible ones'
+/// about `chunk` (rounded up to whole [`CERTIFY_GROUP`]s), stopping after
+/// the first group with an infeasible layer. Returns the layers planned (in
+/// path order, with their indices in `layers`) and the infeasible ones'
 /// indices.
 fn certify(
     cell: &Cell,
@@ -499,10 +559,11 @@ fn certify(
     order: &[usize],
     serial: &OptimiseOptions,
     chunk: usize,
-) -> Result<(Vec<LayerPlan>, Vec<usize>), OptimiseError> {
+) -> Result<(Certified, Vec<usize>), OptimiseError> {
+    let chunk = chunk.max(1).div_ceil(CERTIFY_GROUP) * CERTIFY_GROUP;
     let mut planned: Vec<(usize, LayerPlan)> = Vec::with_capacity(layers.len());
     let mut failing = Vec::new();
-    for part in order.chunks(chunk.max(1)) {
+    for part in order.chunks(chunk) {
         let results: Vec<Result<(usize, LayerPlan), OptimiseError>> = part
             .par_iter()
             .map(|&i| {
@@ -510,19 +571,66 @@ fn certify(
                 Ok((i, plan.layers.remove(0)))
             })
             .collect();
-        for r in results {
+        for (k, r) in results.into_iter().enumerate() {
             let (i, l) = r?;
             if !l.status.is_feasible() {
                 failing.push(i);
             }
             planned.push((i, l));
+            // the end of a group with a failure: the rest is not used
+            if (k + 1) % CERTIFY_GROUP == 0 && !failing.is_empty() {
+                break;
+            }
         }
         if !failing.is_empty() {
             break;
         }
     }
     planned.sort_by_key(|(i, _)| *i);
-    Ok((planned.into_iter().map(|(_, l)| l).collect(), failing))
+    Ok((planned, failing))
+}
+
+/// The layers of a certified (possibly partial) plan that bind its margins
+/// below the score's comfortable values (the smallest joint-stop distance,
+/// speed headroom and reach margin, each over the layers planned), by their
+/// index in the path, excluding those in `known`. The subsample's points
+/// may miss a layer's worst point and its layers may miss the worst layer
+/// (the S-bend at Delta 2 mm: 11° from a stop on the subsample, 0.5° on the
+/// full path, in layers between the subsample's); these layers joining the
+/// subsample make its score the full path's.
+fn weakest_layers(
+    planned: &[(usize, LayerPlan)],
+    cell: &Cell,
+    known: &BTreeSet<usize>,
+) -> Vec<usize> {
+    let mut worst: [(f64, Option<usize>); 3] = [(f64::INFINITY, None); 3];
+    for (i, l) in planned {
+        if known.contains(i) {
+            continue;
+        }
+        let m = margins(
+            &Plan {
+                layers: vec![l.clone()],
+                transitions: Vec::new(),
+                time_s: 0.0,
+            },
+            cell,
+        );
+        let scaled = [
+            m.joint_limit_deg / 10.0,
+            m.speed_headroom / 0.2,
+            m.reach_mm / REACH_COMFORT_MM,
+        ];
+        for (w, v) in worst.iter_mut().zip(scaled) {
+            if v < 1.0 && v < w.0 {
+                *w = (v, Some(*i));
+            }
+        }
+    }
+    let mut out: Vec<usize> = worst.iter().filter_map(|w| w.1).collect();
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 #[derive(Clone)]
@@ -673,16 +781,18 @@ pub fn place_with(
         .iter()
         .map(|v| v.current.clamp(v.lower, v.upper))
         .collect();
-    let mut starts = vec![current.clone()];
     const BASES: [usize; VARIABLES] = [2, 3, 5, 7, 11, 13, 17];
-    for i in 1..opts.samples {
+    let halton = |i: usize| {
         let mut x = current.clone();
         for (d, &k) in free.iter().enumerate() {
             let v = &vars[k];
             x[k] = v.lower + radical_inverse(i, BASES[d]) * (v.upper - v.lower);
         }
-        starts.push(x);
-    }
+        x
+    };
+    let mut starts = vec![current.clone()];
+    starts.extend((1..opts.samples).map(halton));
+    let mut halton_next = opts.samples.max(1);
     let screened: Vec<Judged> = starts.into_par_iter().map(|x| judge(x, &sub)).collect();
     let mut candidates = screened.len();
     let feasible_fraction =
@@ -701,6 +811,9 @@ pub fn place_with(
     // share of the checked layers infeasible.
     let mut failed: Option<(Vec<f64>, Cell, Plan, f64)> = None;
     let mut refusal: Option<String> = None;
+    // The binding constraint every re-judged candidate shared, when the
+    // rounds stopped on it.
+    let mut stopped: Option<String> = None;
     'rounds: for round in 0..opts.rounds {
         rounds += 1;
         // 2. Compass search from the best few not refused; after a
@@ -797,12 +910,16 @@ pub fn place_with(
             break;
         }
         let mut new_failures: Vec<usize> = Vec::new();
+        let mut new_weakest: Vec<usize> = Vec::new();
         for x in to_certify {
             certified += 1;
             let c = placed_cell(cell, &x);
             let order = certification_order(layers.len(), &hot);
             let (planned, failing) = certify(&c, layers, &order, &serial, chunk)?;
             let checked = planned.len().max(1);
+            let known: BTreeSet<usize> = picks.union(&full).copied().collect();
+            let weakest = weakest_layers(&planned, &c, &known);
+            let planned: Vec<LayerPlan> = planned.into_iter().map(|(_, l)| l).collect();
             let plan = Plan {
                 transitions: transitions(&c, &planned),
                 layers: planned,
@@ -823,12 +940,16 @@ pub fn place_with(
                             .iter()
                             .filter_map(|n| layers.iter().position(|l| l.layer == *n))
                             .collect();
-                        if named.is_empty() {
+                        if named.is_empty() && weakest.is_empty() {
                             continue;
                         }
                         // Those layers join the subsample: its screen then
-                        // sees the move refused.
+                        // sees the move refused; and the layers that bind
+                        // the margins, which the subsample missed (a
+                        // refused transit follows a law pressed against a
+                        // stop).
                         new_failures = named;
+                        new_weakest = weakest;
                         break;
                     }
                 }
@@ -838,10 +959,11 @@ pub fn place_with(
                 failed = Some((x, c, plan, share));
             }
             new_failures = failing;
+            new_weakest = weakest;
             break;
         }
         times.certification_s += t.elapsed().as_secs_f64();
-        if new_failures.is_empty() {
+        if new_failures.is_empty() && new_weakest.is_empty() {
             continue;
         }
         // 4. Feedback: the failing layers (spread, at most
@@ -853,10 +975,10 @@ pub fn place_with(
             .len()
             .div_ceil(opts.feedback_layers.max(1))
             .max(1);
-        for &i in new_failures.iter().step_by(step) {
+        for &i in new_failures.iter().step_by(step).chain(&new_weakest) {
             full.insert(i);
         }
-        for &i in &new_failures {
+        for &i in new_failures.iter().chain(&new_weakest) {
             if !hot.contains(&i) {
                 hot.push(i);
             }
@@ -874,6 +996,36 @@ pub fn place_with(
         }
         candidates += again.len();
         pool = again.into_par_iter().map(|x| judge(x, &sub)).collect();
+        // None of the best is feasible on the heavier subsample and one
+        // constraint binds them all (e.g. a joint speed at the cusps of the
+        // layers that joined it): the search stops there; more candidates
+        // and refinement would meet the same wall.
+        let first = pool.first().and_then(|j| j.binding.clone());
+        if first.is_some()
+            && pool
+                .iter()
+                .all(|j| j.score < 0.0 && j.binding == first && j.score > -2.0)
+        {
+            times.screening_s += t.elapsed().as_secs_f64();
+            stopped = first;
+            break;
+        }
+        // Few of the best left feasible on the heavier subsample: screen a
+        // fresh batch of the Halton sequence on it (the subsample now holds
+        // what made the certified ones fail, so the batch is judged on it).
+        let feasible = pool.iter().filter(|j| j.score >= 0.0).count();
+        if feasible < opts.refined.max(2) && !free.is_empty() {
+            let batch = (opts.samples / 2).max(1);
+            let fresh: Vec<Vec<f64>> = (halton_next..halton_next + batch).map(halton).collect();
+            halton_next += batch;
+            candidates += fresh.len();
+            pool.extend(
+                fresh
+                    .into_par_iter()
+                    .map(|x| judge(x, &sub))
+                    .collect::<Vec<_>>(),
+            );
+        }
         pool.sort_by(|a, b| b.score.total_cmp(&a.score));
         times.screening_s += t.elapsed().as_secs_f64();
     }
@@ -887,6 +1039,7 @@ pub fn place_with(
             certified += 1;
             let order = certification_order(layers.len(), &hot);
             let (planned, failing) = certify(&c, layers, &order, &serial, chunk)?;
+            let planned: Vec<LayerPlan> = planned.into_iter().map(|(_, l)| l).collect();
             let plan = Plan {
                 transitions: transitions(&c, &planned),
                 layers: planned,
@@ -946,10 +1099,62 @@ pub fn place_with(
         feasible_fraction,
         certified,
         rounds,
+        stopped_on: stopped,
         subsample_layers: (sub.len(), full.len()),
         binding,
         plan,
         times,
         time_s: t0.elapsed().as_secs_f64(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::reach_margin_mm;
+    use crate::math::{Isometry3, Translation3, Vector3};
+    use crate::robot::ik::Configuration;
+    use crate::robot::RobotModel;
+
+    /// At zero joints the SPEC §6.1 chain puts the flange at (1085, 0, 1040)
+    /// mm with the approach along +X, so the wrist centre at (985, 0, 1040),
+    /// 1333.7 mm from the J2 axis at (150, 0, 0); the arm spans
+    /// |790 − 871.6| .. 790 + 871.6 mm (871.6 = hypot(835, 250)).
+    #[test]
+    fn the_reach_margin_at_zero_joints_is_the_specs_closed_form() {
+        let robot = RobotModel::arcmate_120ic_nominal();
+        let k = 835f64.hypot(250.0);
+        let d = 835f64.hypot(1040.0);
+        let expected = (d - (790.0 - k).abs()).min(790.0 + k - d);
+        let got = reach_margin_mm(&robot, &[0.0; 6]);
+        assert!((got - expected).abs() < 1e-9, "{got} vs {expected}");
+        assert!((expected - 327.9).abs() < 0.1);
+    }
+
+    /// A wrist centre placed `m` mm inside the stretched arm's reach (the
+    /// flange pose of zero joints moved along X) comes back from the inverse
+    /// kinematics with a margin of `m`; 1 mm beyond, the inverse refuses it.
+    #[test]
+    fn the_reach_margin_agrees_with_the_inverse_kinematics_reach() {
+        let robot = RobotModel::arcmate_120ic_nominal();
+        let home = robot.flange_pose(&[0.0; 6]);
+        let arm_max = 790.0 + 835f64.hypot(250.0);
+        for m in [100.0, 10.0, 1.0] {
+            // the wrist centre at (150 + x, 0, 1040): distance hypot(x, 1040)
+            let x = ((arm_max - m).powi(2) - 1040f64.powi(2)).sqrt();
+            let shift = Vector3::new(x - 835.0, 0.0, 0.0);
+            let pose = Isometry3::from_parts(
+                Translation3::from(home.translation.vector + shift),
+                home.rotation,
+            );
+            let q = robot.inverse(&pose, Configuration::NUT).unwrap();
+            let got = reach_margin_mm(&robot, &q);
+            assert!((got - m).abs() < 1e-6, "{got} vs {m}");
+        }
+        let x = ((arm_max + 1.0).powi(2) - 1040f64.powi(2)).sqrt();
+        let pose = Isometry3::from_parts(
+            Translation3::from(home.translation.vector + Vector3::new(x - 835.0, 0.0, 0.0)),
+            home.rotation,
+        );
+        assert!(robot.inverse(&pose, Configuration::NUT).is_err());
+    }
 }

@@ -278,18 +278,20 @@ fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<S
     let b = &p.margins_before;
     Ok(format!(
         "# Placed by waam place from {} ({}).\n\
-         # Worst-layer margins after: {:.2} deg from a joint stop, speed headroom {:.1} %, dexterity {:.4}, {} infeasible layer(s).\n\
-         # Before (on the search's subsample of layers and points): {:.2} deg, {:.1} %, {:.4}, {} infeasible layer(s).\n\
+         # Worst-layer margins after: {:.2} deg from a joint stop, speed headroom {:.1} %, dexterity {:.4}, {:.1} mm inside the arm's reach, {} infeasible layer(s).\n\
+         # Before (on the search's subsample of layers and points): {:.2} deg, {:.1} %, {:.4}, {:.1} mm, {} infeasible layer(s).\n\
          # Candidates {}, feasible on the subsample {:.0} %, certified on the full path {}, {:.1} s.\n{body}",
         cell.file,
         if p.feasible { "feasible" } else { "NOT feasible" },
         m.joint_limit_deg,
         100.0 * m.speed_headroom,
         m.dexterity,
+        m.reach_mm,
         m.infeasible_layers,
         b.joint_limit_deg,
         100.0 * b.speed_headroom,
         b.dexterity,
+        b.reach_mm,
         b.infeasible_layers,
         p.candidates,
         100.0 * p.feasible_fraction,
@@ -333,6 +335,7 @@ impl PlacedCell {
             "candidates": p.candidates,
             "certified": p.certified,
             "rounds": p.rounds,
+            "stopped_on": p.stopped_on,
             "subsample_layers": p.subsample_layers.0,
             "subsample_layers_full": p.subsample_layers.1,
             "times": p.times,
