@@ -76,9 +76,10 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
         println!("  {}", values.join(", "));
         if p.feasible {
             println!(
-                "  feasible: worst layer {:.2} deg from a joint stop, speed headroom {:.1} %, dexterity {:.4} -> {}",
+                "  feasible: worst layer {:.2} deg from a joint stop, speed headroom {:.1} %, {:.1} mm inside the arm's reach, dexterity {:.4} -> {}",
                 p.margins.joint_limit_deg,
                 100.0 * p.margins.speed_headroom,
+                p.margins.reach_mm,
                 p.margins.dexterity,
                 toml.display()
             );

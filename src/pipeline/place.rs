@@ -36,9 +36,9 @@ pub struct PlacedCell {
     pub bounds: PlacementBounds,
     /// The placed cell, as [`Cell::from_toml_str`] reads `toml`.
     pub cell: Cell,
-    /// A complete cell file: the original's keys with the placement's
-    /// values, the bounds searched as its `[placement]` table, and a comment
-    /// giving the margins achieved.
+    /// A complete cell file: the original's text (comments, key order and
+    /// layout kept) with the placement's values, the bounds searched as its
+    /// `[placement]` table, and a header comment giving the margins achieved.
     pub toml: String,
 }
 
@@ -176,61 +176,69 @@ fn toml_error(cell: &Cell, message: String) -> Error {
     .into()
 }
 
-/// The cell file's text with the placement's values and the bounds searched.
+/// The cell file's text with the placement's values and the bounds searched:
+/// the original's comments, key order and layout kept (toml_edit), only the
+/// placement keys rewritten and the `[placement]` table's keys replaced.
 fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<String, Error> {
-    let mut doc: toml::Table = cell
+    use toml_edit::{value, Array, DocumentMut, Item, Table};
+    let mut doc: DocumentMut = cell
         .text
         .parse()
-        .map_err(|e: toml::de::Error| toml_error(cell, e.to_string()))?;
-    let arr =
-        |v: &[f64]| toml::Value::Array(v.iter().map(|x| toml::Value::Float(round6(*x))).collect());
+        .map_err(|e: toml_edit::TomlError| toml_error(cell, e.to_string()))?;
+    let arr = |v: &[f64]| {
+        let mut a: Array = v.iter().map(|x| round6(*x)).collect();
+        a.fmt();
+        value(a)
+    };
+    let table = |doc: &mut DocumentMut, name: &str| -> Result<Table, Error> {
+        match doc.get(name).and_then(Item::as_table) {
+            Some(t) => Ok(t.clone()),
+            None => Err(toml_error(cell, format!("no [{name}] table"))),
+        }
+    };
     match &p.cell {
         crate::robot::Cell::PartCarried(c) => {
-            let t = doc
-                .get_mut("part_carried")
-                .and_then(toml::Value::as_table_mut)
-                .ok_or_else(|| toml_error(cell, "no [part_carried] table".into()))?;
-            t.insert(
-                "deposition_point_mm".into(),
-                arr(c.deposition_point_mm.coords.as_slice()),
-            );
+            let mut t = table(&mut doc, "part_carried")?;
+            t["deposition_point_mm"] = arr(c.deposition_point_mm.coords.as_slice());
             if p.values[3..].iter().any(|v| *v != 0.0) || t.contains_key("flange_from_part_xyzwpr")
             {
                 let pose = FanucPose::from_isometry(&c.flange_from_part).to_xyzwpr_deg();
-                t.insert("flange_from_part_xyzwpr".into(), arr(&pose));
+                t["flange_from_part_xyzwpr"] = arr(&pose);
             }
+            doc["part_carried"] = Item::Table(t);
         }
         crate::robot::Cell::TorchCarried(c) => {
-            let t = doc
-                .get_mut("torch_carried")
-                .and_then(toml::Value::as_table_mut)
-                .ok_or_else(|| toml_error(cell, "no [torch_carried] table".into()))?;
+            let mut t = table(&mut doc, "torch_carried")?;
             let pose = FanucPose::from_isometry(&c.base_from_positioner).to_xyzwpr_deg();
-            t.insert("positioner_pose_xyzwpr".into(), arr(&pose));
+            t["positioner_pose_xyzwpr"] = arr(&pose);
             if p.values[4..6].iter().any(|v| *v != 0.0) || t.contains_key("table_from_part_xyzwpr")
             {
                 let pose = FanucPose::from_isometry(&c.table_from_part).to_xyzwpr_deg();
-                t.insert("table_from_part_xyzwpr".into(), arr(&pose));
+                t["table_from_part_xyzwpr"] = arr(&pose);
             }
             if p.values[6] != 0.0 {
                 let pose = FanucPose::from_isometry(&c.flange_from_tcp).to_xyzwpr_deg();
-                t.insert("tool_xyzwpr".into(), arr(&pose));
+                t["tool_xyzwpr"] = arr(&pose);
             }
+            doc["torch_carried"] = Item::Table(t);
         }
     }
     // The bounds searched, around the original placement, so that placing
-    // again from this file searches the same box.
+    // again from this file searches the same box. An existing [placement]
+    // table keeps its place and comments; its keys are replaced.
     let v = &bounds.variables;
-    let mut spec = toml::Table::new();
-    spec.insert("min_mm".into(), arr(&[v[0].lower, v[1].lower, v[2].lower]));
-    spec.insert("max_mm".into(), arr(&[v[0].upper, v[1].upper, v[2].upper]));
+    let mut spec = doc
+        .get("placement")
+        .and_then(Item::as_table)
+        .cloned()
+        .unwrap_or_default();
+    spec.clear();
+    spec["min_mm"] = arr(&[v[0].lower, v[1].lower, v[2].lower]);
+    spec["max_mm"] = arr(&[v[0].upper, v[1].upper, v[2].upper]);
     let (lo, hi) = (v[3].lower - p.values[3], v[3].upper - p.values[3]);
     // The rotation is relative to the mount written above.
     let span = (hi - lo).min(2.0 * PI);
-    spec.insert(
-        "rotation_deg".into(),
-        arr(&[lo.to_degrees(), (lo + span).to_degrees()]),
-    );
+    spec["rotation_deg"] = arr(&[lo.to_degrees(), (lo + span).to_degrees()]);
     // Fixture and torch mount ranges, relative to the mount written above
     // (exact for one free tilt axis; with both, placing again searches a
     // slightly different box about the found mount).
@@ -256,24 +264,26 @@ fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<S
             } else {
                 [lo, hi]
             };
-            spec.insert(key.into(), arr(&r));
+            spec[key] = arr(&r);
         }
     }
-    let fixed: Vec<toml::Value> = ["x", "y", "z", "rotation"]
+    let fixed: Array = ["x", "y", "z", "rotation"]
         .iter()
         .zip(v)
         .filter(|(_, var)| var.lower == var.upper)
-        .map(|(n, _)| toml::Value::String((*n).into()))
+        .map(|(n, _)| *n)
         .collect();
     if !fixed.is_empty() {
-        spec.insert("fixed".into(), toml::Value::Array(fixed));
+        spec["fixed"] = value(fixed);
     }
     if let Some((lo, hi)) = bounds.keep_out {
-        spec.insert("keep_out_min_mm".into(), arr(&lo));
-        spec.insert("keep_out_max_mm".into(), arr(&hi));
+        spec["keep_out_min_mm"] = arr(&lo);
+        spec["keep_out_max_mm"] = arr(&hi);
     }
-    doc.insert("placement".into(), toml::Value::Table(spec));
-    let body = toml::to_string(&doc).map_err(|e| toml_error(cell, e.to_string()))?;
+    doc["placement"] = Item::Table(spec);
+    let body = doc.to_string();
+    // A file placed before starts with our header: not repeated.
+    let body = strip_placed_header(&body);
     let m = &p.margins;
     let b = &p.margins_before;
     Ok(format!(
@@ -298,6 +308,24 @@ fn placed_toml(cell: &Cell, p: &Placement, bounds: &PlacementBounds) -> Result<S
         p.certified,
         p.time_s,
     ))
+}
+
+/// The first lines of the comment [`placed_toml`] puts at the top.
+const PLACED_HEADER: [&str; 4] = [
+    "# Placed by waam place ",
+    "# Worst-layer margins after: ",
+    "# Before (on the search's subsample",
+    "# Candidates ",
+];
+
+/// `text` without the header [`placed_toml`] puts first (a cell file placed
+/// again keeps one header, the new one, and the original's own comments).
+fn strip_placed_header(text: &str) -> &str {
+    let mut rest = text;
+    while PLACED_HEADER.iter().any(|h| rest.starts_with(h)) {
+        rest = rest.split_once('\n').map_or("", |(_, r)| r);
+    }
+    rest
 }
 
 fn round6(x: f64) -> f64 {

@@ -137,6 +137,19 @@ fn a_refused_hemisphere_plans_after_placement_checked_by_spec_kinematics() {
     assert!(placed.placement.feasible, "{:?}", placed.summary());
     assert!(placed.placement.margins.joint_limit_deg > 0.0);
     assert!(placed.toml.starts_with("# Placed by waam place"));
+    // The user's file survives: every comment line of the original (the
+    // cell file's notes on J5, J6 and the configuration) and every key
+    // outside the placement, as written.
+    let original = &cell.text;
+    for line in original.lines().filter(|l| l.trim_start().starts_with('#')) {
+        assert!(placed.toml.contains(line), "comment lost: {line}");
+    }
+    let before_placement = original.split("\n[placement]").next().unwrap();
+    for line in before_placement.lines() {
+        if !line.starts_with("deposition_point_mm") {
+            assert!(placed.toml.contains(line), "line lost: {line:?}");
+        }
+    }
 
     // The written cell file reads back and plans (as `plan` would take it).
     let again = Cell::from_toml_str(&placed.toml, "placed.toml").unwrap();
@@ -152,6 +165,11 @@ fn a_refused_hemisphere_plans_after_placement_checked_by_spec_kinematics() {
     // least as wide (the search starts from the cell as given).
     let replaced = place_part(&part, &again, &req).unwrap();
     assert!(replaced.placement.feasible);
+    // One header, the new one, on a file placed twice; the comments kept.
+    assert_eq!(replaced.toml.matches("# Placed by waam place").count(), 1);
+    for line in original.lines().filter(|l| l.trim_start().starts_with('#')) {
+        assert!(replaced.toml.contains(line), "comment lost: {line}");
+    }
     assert!(
         replaced.placement.margins.joint_limit_deg
             >= placed.placement.margins.joint_limit_deg.min(10.0) - 0.5,
