@@ -87,10 +87,13 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
     }
     if !p.feasible {
         let why = match &p.binding {
-            Some((c, share)) if c.ends_with("(on the full path)") => format!(
-                "{c}: feasible on the subsample, it binds {:.0} % of the layers checked of the best candidate",
-                100.0 * share
-            ),
+            Some((c, share)) if c.contains("(on the full path)") => {
+                let (head, tail) = c.split_once("(on the full path)").unwrap_or((c, ""));
+                format!(
+                    "{head}(on the full path): feasible on the subsample, it binds {:.0} % of the layers checked of the best candidate{tail}",
+                    100.0 * share
+                )
+            }
             Some((c, _)) if c.ends_with("(program check)") => {
                 format!("every candidate feasible on the full path was refused: {c}")
             }

@@ -319,8 +319,9 @@ pub struct Placement {
     /// subsample, the constraint that bound most of them (the first
     /// infeasible layer's) with the share of candidates it bound; when the
     /// best failed on the full path, that plan's first binding constraint
-    /// (suffix `(on the full path)`) with the share of the layers checked
-    /// that are infeasible; when the caller's check refused every
+    /// (marked `(on the full path)`, followed by the caller's check's
+    /// reason when it refused another candidate) with the share of the
+    /// layers checked that are infeasible; when the caller's check refused every
     /// candidate feasible on the full path, its reason (suffix
     /// `(program check)`) and 1.
     pub binding: Option<(String, f64)>,
@@ -1064,7 +1065,16 @@ pub fn place_with(
     let (values, placed, plan, feasible, binding) = match (chosen, failed) {
         (Some((x, c, plan)), _) => (x, c, plan, true, None),
         (None, Some((x, c, plan, share))) => {
-            let b = binding_of(&plan).map(|b| (format!("{b} (on the full path)"), share));
+            // The best candidate's failure on the full path; and, when
+            // others were refused by the caller's check, that reason too
+            // (it may be what bound the rest of the search).
+            let b = binding_of(&plan).map(|b| {
+                let also = refusal
+                    .as_ref()
+                    .map(|r| format!("; another candidate was refused by the program check: {r}"))
+                    .unwrap_or_default();
+                (format!("{b} (on the full path){also}"), share)
+            });
             (x, c, plan, false, b)
         }
         (None, None) => {
