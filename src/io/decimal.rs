@@ -38,21 +38,36 @@ pub fn push_fixed(out: &mut Vec<u8>, x: f64, decimals: usize) {
         return;
     }
     let n = scaled as u64;
-    if x.is_sign_negative() && n != 0 {
-        out.push(b'-');
-    }
-    // The digits of n, right to left, two at a time; at least d + 1 of them
-    // (leading zeros), the point before the last d.
-    let mut buf = [b'0'; 24];
+    let mut buf = [0u8; 24];
+    let first = scaled_digits(&mut buf, n, x.is_sign_negative() && n != 0, d);
+    out.extend_from_slice(&buf[first..]);
+}
+
+/// Writes `n / 10^d` with `d` (≤ 15) digits after the point, `-` first when
+/// `negative`, right-aligned at the end of `buf`; returns where it starts.
+/// The one digit writer of the CSV writers ([`push_fixed`]) and the program
+/// emitters' exact fixed-point numbers (`program::fmt`).
+pub(crate) fn scaled_digits(buf: &mut [u8; 24], n: u64, negative: bool, d: usize) -> usize {
+    let d = d.min(15);
+    // The digits of n, right to left, two at a time, one slot left for the
+    // point; at least d + 1 of them (leading zeros).
+    let mut digits = [b'0'; 24];
+    let count = write_digits(&mut digits, n).max(d + 1);
     let end = buf.len();
-    let digits = write_digits(&mut buf, n);
-    let count = digits.max(d + 1);
-    let first = end - count;
-    out.extend_from_slice(&buf[first..end - d]);
+    let mut i = end;
     if d > 0 {
-        out.push(b'.');
-        out.extend_from_slice(&buf[end - d..]);
+        buf[end - d..].copy_from_slice(&digits[digits.len() - d..]);
+        buf[end - d - 1] = b'.';
+        i = end - d - 1;
     }
+    let int = count - d;
+    buf[i - int..i].copy_from_slice(&digits[digits.len() - count..digits.len() - d]);
+    i -= int;
+    if negative {
+        i -= 1;
+        buf[i] = b'-';
+    }
+    i
 }
 
 /// "00" to "99".

@@ -43,7 +43,7 @@ impl fmt::Display for Fixed {
         if (v * scale).round() == 0.0 {
             v = 0.0;
         }
-        let mut buf = [0u8; 40];
+        let mut buf = [0u8; 24];
         match fixed_digits(v, self.decimals, &mut buf) {
             Some(text) => write!(f, "{text:>w$}", w = self.width),
             None => write!(f, "{:>w$.d$}", v, w = self.width, d = self.decimals),
@@ -57,7 +57,7 @@ impl fmt::Display for Fixed {
 /// ulp of its rounded product `x`, so rounding `x` to the nearest integer
 /// gives the correctly rounded digits unless `x` is within an ulp of a
 /// half-integer (ties and near-ties go to the standard formatter).
-fn fixed_digits(v: f64, decimals: usize, buf: &mut [u8; 40]) -> Option<&str> {
+fn fixed_digits(v: f64, decimals: usize, buf: &mut [u8; 24]) -> Option<&str> {
     if decimals > 9 || !v.is_finite() {
         return None;
     }
@@ -72,33 +72,8 @@ fn fixed_digits(v: f64, decimals: usize, buf: &mut [u8; 40]) -> Option<&str> {
         return None;
     }
     let n = whole as u64 + u64::from(frac > 0.5);
-    let unit = 10u64.pow(decimals as u32);
-    let (int, mut dec) = (n / unit, n % unit);
-    // right to left: decimals, point, integer digits, sign
-    let mut i = buf.len();
-    for _ in 0..decimals {
-        i -= 1;
-        buf[i] = b'0' + (dec % 10) as u8;
-        dec /= 10;
-    }
-    if decimals > 0 {
-        i -= 1;
-        buf[i] = b'.';
-    }
-    let mut int = int;
-    loop {
-        i -= 1;
-        buf[i] = b'0' + (int % 10) as u8;
-        int /= 10;
-        if int == 0 {
-            break;
-        }
-    }
-    if v.is_sign_negative() {
-        i -= 1;
-        buf[i] = b'-';
-    }
-    std::str::from_utf8(&buf[i..]).ok()
+    let first = crate::io::decimal::scaled_digits(buf, n, v.is_sign_negative(), decimals);
+    std::str::from_utf8(&buf[first..]).ok()
 }
 
 /// FANUC position lengths: mm, 3 decimals, width 9 (`X =  1045.747  mm`).
@@ -260,14 +235,14 @@ mod tests {
             if next() % 2 == 0 {
                 v = -v;
             }
-            let mut buf = [0u8; 40];
+            let mut buf = [0u8; 24];
             if let Some(t) = fixed_digits(v, d, &mut buf) {
                 assert_eq!(t, format!("{v:.d$}"), "{v:e}, {d} decimals");
                 checked += 1;
             }
         }
         // exact ties such as 1.03125 at 4 decimals are left to the standard formatter
-        assert!(fixed_digits(1.03125, 4, &mut [0u8; 40]).is_none());
+        assert!(fixed_digits(1.03125, 4, &mut [0u8; 24]).is_none());
         assert!(checked > 200_000, "{checked}");
     }
 

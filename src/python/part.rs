@@ -158,12 +158,11 @@ impl PyPart {
         half_box_mm: Option<f64>,
     ) -> PyResult<PyPlacedCell> {
         let slice = SliceKeywords {
-            strategy: None,
             delta_mm,
             points,
             chord_mm,
-            max_layers: None,
             travel_speed_mm_s,
+            ..SliceKeywords::default()
         }
         .overrides()?;
         let mut req = PlaceRequest {

@@ -98,3 +98,16 @@ fn the_test_layers_are_feasible_in_every_cell() {
         assert!(tr.report.is_clean(), "{file}: {}", tr.report);
     }
 }
+
+/// The positions of the beads of layers `0..layers` of `prog` (part frame,
+/// mm), one list per layer.
+pub fn bead_positions(prog: &Program, layers: usize) -> Vec<Vec<waam_slicer::math::Point3>> {
+    (0..layers)
+        .map(|l| {
+            prog.bead_points()
+                .filter(|p| p.layer == l)
+                .map(|p| p.position_mm)
+                .collect()
+        })
+        .collect()
+}

@@ -24,8 +24,8 @@ use waam_slicer::robot::Cell;
 use waam_slicer::toolaxis::collision::Torch;
 
 use crate::fixture::{
-    cell, hemisphere, law, part_carried, program, trajectory, ABB_CELLS, FANUC_CELLS, KUKA_CELLS,
-    TS_MM_S,
+    bead_positions, cell, hemisphere, law, part_carried, program, trajectory, ABB_CELLS,
+    FANUC_CELLS, KUKA_CELLS, TS_MM_S,
 };
 
 #[test]
@@ -237,14 +237,7 @@ fn a_move_into_the_wall_is_found_and_the_program_refused() {
     // and the move itself, checked alone
     let (prog, _) = program(&cell, 0..7, 12);
     let last = prog.points.last().unwrap();
-    let beads: Vec<Vec<Point3>> = (0..7)
-        .map(|l| {
-            prog.bead_points()
-                .filter(|p| p.layer == l)
-                .map(|p| p.position_mm)
-                .collect()
-        })
-        .collect();
+    let beads = bead_positions(&prog, 7);
     let wall = wall_of(beads.iter().map(Vec::as_slice), 2.0);
     let torch = Torch::new(&Default::default()).unwrap();
     let c = joint_move_clearance(&cell, &wall, &torch, (&last.joints, None), (&q0, None)).unwrap();

@@ -12,7 +12,7 @@ use waam_slicer::path::slice;
 use waam_slicer::program::transit::{joint_move_clearance, wall_of, TransitWall, WallBeads};
 use waam_slicer::toolaxis::collision::Torch;
 
-use crate::fixture::{part_carried, program};
+use crate::fixture::{bead_positions, part_carried, program};
 
 /// The layers of a sample part in `parts/` at `delta_mm`, one bead each
 /// (part frame, mm).
@@ -177,14 +177,7 @@ fn the_arc_off_moves_of_a_program_meet_the_wall_alike() {
     // next layers, see `setup.rs`) and to the next bead's first point
     let cell = part_carried();
     let (prog, _) = program(&cell, 0..7, 12);
-    let beads: Vec<Vec<Point3>> = (0..7)
-        .map(|l| {
-            prog.bead_points()
-                .filter(|p| p.layer == l)
-                .map(|p| p.position_mm)
-                .collect()
-        })
-        .collect();
+    let beads = bead_positions(&prog, 7);
     let torch = Torch::new(&Default::default()).unwrap();
     let q0 = prog.bead_points().next().unwrap().joints;
     let mut blocks = WallBeads::default();
