@@ -97,6 +97,7 @@ pub fn hemisphere_trajectory(c: &mut Criterion) {
                     phi.cos(),
                 )),
                 build_direction: None,
+                positioner: None,
                 r_z: -v,
             });
         }

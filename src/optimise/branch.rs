@@ -14,7 +14,7 @@ use super::spiral::Anchor;
 use super::{degree, sqp, LayerPoints};
 use super::{
     ConfigurationChoice, ConfigurationChoiceReport, LayerPlan, LayerQuality, LayerStatus,
-    ObjectiveReport, OptimiseOptions, Parameterisation, RzLaw, SolverReport,
+    ObjectiveReport, OptimiseOptions, Parameterisation, PlannedPoint, RzLaw, SolverReport,
 };
 use crate::robot::cell::Cell;
 use crate::robot::ik::Configuration;
@@ -146,7 +146,19 @@ pub(super) fn optimise_layer(
                 },
                 configuration,
                 law: out.law,
-                points: Vec::new(),
+                // one point per input point, without joints, so that every
+                // writer and the report see the layer's shape
+                points: lp
+                    .points
+                    .iter()
+                    .map(|cp| PlannedPoint {
+                        r_z: 0.0,
+                        joints: None,
+                        positioner: cp.positioner,
+                        dexterity: 0.0,
+                    })
+                    .collect(),
+                positioner: None,
                 objective: ObjectiveReport::default(),
                 quality: LayerQuality::default(),
                 solver: solver(t0.elapsed().as_secs_f64()),

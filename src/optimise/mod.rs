@@ -97,6 +97,7 @@
 //!             position_mm: Point3::new(40.0 * v.cos(), 40.0 * v.sin(), 10.0),
 //!             tool_axis: UnitVector3::new_normalize(Vector3::z()),
 //!             build_direction: None,
+//!             positioner: None,
 //!         }
 //!     })
 //!     .collect();
@@ -111,6 +112,7 @@ pub mod outcome;
 pub mod parameterisation;
 pub mod place;
 mod point_by_point;
+pub mod positioner;
 mod problem;
 mod report;
 mod seed;
@@ -171,6 +173,7 @@ pub fn layer_points(path: &Path, frames: &[Vec<LocalFrame>]) -> Vec<LayerPoints>
                     position_mm: p.position,
                     tool_axis: UnitVector3::new_normalize(f.tool),
                     build_direction: Some(UnitVector3::new_normalize(f.build)),
+                    positioner: None,
                 })
                 .collect(),
         })
@@ -189,7 +192,12 @@ pub fn trajectory_inputs(layers: &[LayerPoints], plan: &Plan) -> Vec<PathPointIn
                 .iter()
                 .zip(&pl.points)
                 .enumerate()
-                .map(move |(m, (cp, pp))| path_point(lp.layer, m, cp, pp.r_z))
+                .map(move |(m, (cp, pp))| {
+                    let mut p = path_point(lp.layer, m, cp, pp.r_z);
+                    // the positioner as planned (its laws live in the plan)
+                    p.positioner = pp.positioner.or(p.positioner);
+                    p
+                })
         })
         .collect()
 }
@@ -203,6 +211,7 @@ fn path_point(layer: usize, point: usize, cp: &CellPoint, r_z: f64) -> PathPoint
         tool_axis: cp.tool_axis,
         build_direction: cp.build_direction,
         r_z,
+        positioner: cp.positioner,
     }
 }
 
@@ -237,22 +246,39 @@ pub fn optimise_with(
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     validate_input(cell, layers, opts)?;
     let t0 = Instant::now();
+    let (scheduled, laws) = schedule_positioner(cell, layers, opts);
+    let given = layers;
+    let layers: &[LayerPoints] = scheduled.as_deref().unwrap_or(layers);
     let (done, stop) = (AtomicUsize::new(0), AtomicBool::new(false));
     let total = layers.len();
-    let solve = |l: &LayerPoints| -> Option<LayerPlan> {
+    let solve = |(i, l): (usize, &LayerPoints)| -> Option<LayerPlan> {
         if stop.load(Ordering::Relaxed) {
             return None;
         }
-        let plan = optimise_layer(cell, l, opts, None).0;
+        let mut plan = optimise_layer(cell, l, opts, None).0;
+        if let (Cell::TorchCarried(c), Some(laws)) = (cell, &laws) {
+            plan.positioner = Some(laws[i].clone());
+            // the positioner's laws see the arm only through a proxy: where
+            // the arm cannot follow them, the thesis's exact vertical (inside
+            // any cone) is tried, and kept when it builds the layer
+            if !plan.status.is_feasible() && laws[i].seed != positioner::PositionerSeed::Vertical {
+                if let Some((alt_plan, law)) =
+                    vertical_alternative(c, cell, &given[i], &laws[i], opts)
+                {
+                    plan = alt_plan;
+                    plan.positioner = Some(law);
+                }
+            }
+        }
         if !on_layer(done.fetch_add(1, Ordering::Relaxed) + 1, total) {
             stop.store(true, Ordering::Relaxed);
         }
         Some(plan)
     };
     let plans: Vec<Option<LayerPlan>> = if opts.parallel {
-        layers.par_iter().map(solve).collect()
+        layers.par_iter().enumerate().map(solve).collect()
     } else {
-        layers.iter().map(solve).collect()
+        layers.iter().enumerate().map(solve).collect()
     };
     if stop.load(Ordering::Relaxed) {
         return Err(OptimiseError::Cancelled {
@@ -267,6 +293,124 @@ pub fn optimise_with(
         transitions,
         time_s: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// The layer planned with the thesis's exact-vertical positioner (the turn
+/// starting near the law's), when that is feasible for the positioner and
+/// the arm; with its law.
+fn vertical_alternative(
+    c: &crate::robot::cell::TorchCarriedCell,
+    cell: &Cell,
+    layer: &LayerPoints,
+    law: &positioner::PositionerLaw,
+    opts: &OptimiseOptions,
+) -> Option<(LayerPlan, positioner::PositionerLaw)> {
+    let vertical = positioner::PositionerOptions {
+        mode: positioner::PositionerMode::Vertical,
+        ..opts.positioner
+    };
+    let hint = law.joints.first().map_or(0.0, |q| q[1]);
+    let alt = positioner::positioner_law(
+        c,
+        &layer.points,
+        opts.travel_speed_mm_s,
+        opts.joint_limit_margin_rad,
+        hint,
+        &vertical,
+    );
+    if !alt.feasible {
+        return None;
+    }
+    let points = LayerPoints {
+        layer: layer.layer,
+        points: layer
+            .points
+            .iter()
+            .zip(&alt.joints)
+            .map(|(p, q)| CellPoint {
+                positioner: Some(*q),
+                ..*p
+            })
+            .collect(),
+    };
+    let plan = optimise_layer(cell, &points, opts, None).0;
+    plan.status.is_feasible().then_some((plan, alt))
+}
+
+/// The positioner's laws of every layer (torch-carried cell, points without
+/// planned positioner joints): solved per layer (in parallel with
+/// `opts.parallel`), then each layer's turn shifted by whole turns to start
+/// nearest the previous layer's last, within the turn's travel. Returns the
+/// layers with the joints filled in and the laws; `(None, None)` when there
+/// is nothing to plan.
+fn schedule_positioner(
+    cell: &Cell,
+    layers: &[LayerPoints],
+    opts: &OptimiseOptions,
+) -> (
+    Option<Vec<LayerPoints>>,
+    Option<Vec<positioner::PositionerLaw>>,
+) {
+    let Cell::TorchCarried(c) = cell else {
+        return (None, None);
+    };
+    if layers
+        .iter()
+        .any(|l| l.points.iter().any(|p| p.positioner.is_some()))
+    {
+        return (None, None);
+    }
+    let solve = |l: &LayerPoints| {
+        positioner::positioner_law(
+            c,
+            &l.points,
+            opts.travel_speed_mm_s,
+            opts.joint_limit_margin_rad,
+            0.0,
+            &opts.positioner,
+        )
+    };
+    let mut laws: Vec<positioner::PositionerLaw> = if opts.parallel {
+        layers.par_iter().map(solve).collect()
+    } else {
+        layers.iter().map(solve).collect()
+    };
+    let turn = c.positioner.limits[1];
+    let mut last: Option<f64> = None;
+    for law in &mut laws {
+        if let (Some(prev), Some(first)) = (last, law.joints.first()) {
+            let k = ((prev - first[1]) / std::f64::consts::TAU).round();
+            let fits = |k: f64| {
+                law.joints
+                    .iter()
+                    .all(|q| turn.contains(q[1] + k * std::f64::consts::TAU))
+            };
+            let shift = [k, k - 1.0, k + 1.0, 0.0].into_iter().find(|&k| fits(k));
+            if let Some(k) = shift.filter(|k| *k != 0.0) {
+                for q in &mut law.joints {
+                    q[1] += k * std::f64::consts::TAU;
+                }
+            }
+        }
+        last = law.joints.last().map(|q| q[1]);
+    }
+    let scheduled = layers
+        .iter()
+        .zip(&laws)
+        .map(|(l, law)| LayerPoints {
+            layer: l.layer,
+            points: l
+                .points
+                .iter()
+                .zip(&law.joints)
+                .map(|(p, q)| CellPoint {
+                    positioner: Some(*q),
+                    ..*p
+                })
+                .collect(),
+        })
+        .collect();
+    (Some(scheduled), Some(laws))
 }
 
 fn validate_input(

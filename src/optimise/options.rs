@@ -207,6 +207,9 @@ pub struct OptimiseOptions {
     /// are always those of every point. Ignored by the fixed law, the
     /// smoothing spline and the point-by-point baseline.
     pub subsample_points: usize,
+    /// The torch-carried cell's positioner: optimised laws within the cone
+    /// of the vertical (default) or the thesis's exact vertical.
+    pub positioner: crate::optimise::positioner::PositionerOptions,
 }
 
 impl Default for OptimiseOptions {
@@ -225,6 +228,7 @@ impl Default for OptimiseOptions {
             trajectory: TrajectoryOptions::default(),
             parallel: true,
             subsample_points: 64,
+            positioner: Default::default(),
         }
     }
 }
@@ -242,6 +246,9 @@ impl OptimiseOptions {
                 reason,
             })
         };
+        if let Some((field, value, reason)) = self.positioner.invalid() {
+            return bad(field, value, reason);
+        }
         match self.parameterisation {
             Parameterisation::Fixed { r_z_rad } if !r_z_rad.is_finite() => {
                 return bad("parameterisation.r_z_rad", r_z_rad, "must be finite")

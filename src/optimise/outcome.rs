@@ -84,6 +84,9 @@ pub enum Constraint {
         /// Joint number, 1-based.
         joint: usize,
     },
+    /// The build direction outside the cell's cone of the vertical
+    /// (torch-carried cell; the violation in rad).
+    BuildTilt,
 }
 
 impl fmt::Display for Constraint {
@@ -93,6 +96,7 @@ impl fmt::Display for Constraint {
             Constraint::Dexterity => write!(f, "dexterity floor"),
             Constraint::HoseTorsion => write!(f, "hose torsion |J4 + J6|"),
             Constraint::JointSpeed { joint } => write!(f, "J{joint} speed"),
+            Constraint::BuildTilt => write!(f, "build direction outside the cone of the vertical"),
         }
     }
 }
@@ -301,6 +305,9 @@ pub struct LayerPlan {
     /// Every violation of the final trajectory (trajectory stage's check,
     /// layer and point named), empty when feasible.
     pub violations: Vec<Violation>,
+    /// The positioner's laws (torch-carried cell): seed, largest tilt of
+    /// `b` from the vertical and where, binding constraint.
+    pub positioner: Option<crate::optimise::positioner::PositionerLaw>,
 }
 
 /// The arc-off move from the last point of a layer to the first of the next.

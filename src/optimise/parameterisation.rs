@@ -59,6 +59,29 @@ pub enum Basis {
         /// Number of points.
         points: usize,
     },
+    /// Uniform cubic B-spline in the abscissa: `segments` equal spans over
+    /// its range, `segments + 3` coefficients (control values, rad); it
+    /// reproduces constant and linear laws exactly (the positioner's laws,
+    /// [`crate::optimise::positioner`]).
+    Spline {
+        /// Abscissa per point scaled to `u ∈ [0, segments]`.
+        u: Vec<f64>,
+        /// Number of spans.
+        segments: usize,
+    },
+}
+
+/// The four uniform cubic B-spline weights at `t ∈ [0, 1]` within a span.
+fn cubic_bspline_weights(t: f64) -> [f64; 4] {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    let s = 1.0 - t;
+    [
+        s * s * s / 6.0,
+        (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0,
+        (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0,
+        t3 / 6.0,
+    ]
 }
 
 impl Basis {
@@ -98,11 +121,32 @@ impl Basis {
         }
     }
 
+    /// Uniform cubic B-spline basis of `segments` (≥ 1) spans on abscissa
+    /// `x` (one per point), see [`Basis::Spline`].
+    pub fn spline(x: &[f64], segments: usize) -> Self {
+        let segments = segments.max(1);
+        let x_min = x.iter().copied().fold(f64::INFINITY, f64::min);
+        let x_max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let h = x_max - x_min;
+        let u = x
+            .iter()
+            .map(|v| {
+                if h > 0.0 {
+                    ((v - x_min) / h * segments as f64).clamp(0.0, segments as f64)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        Self::Spline { u, segments }
+    }
+
     /// Number of coefficients.
     pub fn len(&self) -> usize {
         match self {
             Self::Polynomial { coefficients, .. } => *coefficients,
             Self::PerPoint { points } => *points,
+            Self::Spline { segments, .. } => segments + 3,
         }
     }
 
@@ -116,6 +160,7 @@ impl Basis {
         match self {
             Self::Polynomial { s, .. } => s.len(),
             Self::PerPoint { points } => *points,
+            Self::Spline { u, .. } => u.len(),
         }
     }
 
@@ -136,6 +181,11 @@ impl Basis {
                 }
             }
             Self::PerPoint { .. } => out.push((m, 1.0)),
+            Self::Spline { u, segments } => {
+                let span = (u[m].floor() as usize).min(segments - 1);
+                let w = cubic_bspline_weights(u[m] - span as f64);
+                out.extend(w.iter().enumerate().map(|(i, v)| (span + i, *v)));
+            }
         }
     }
 
@@ -143,7 +193,8 @@ impl Basis {
     pub fn row_l1_bound(&self) -> f64 {
         match self {
             Self::Polynomial { coefficients, .. } => *coefficients as f64,
-            Self::PerPoint { .. } => 1.0,
+            // non-negative weights summing to 1
+            Self::PerPoint { .. } | Self::Spline { .. } => 1.0,
         }
     }
 
@@ -165,6 +216,15 @@ impl Basis {
                 .map(|x| r0 + x * c.iter().rev().fold(0.0, |acc, ci| acc * x + ci))
                 .collect(),
             Self::PerPoint { .. } => c.to_vec(),
+            Self::Spline { .. } => {
+                let mut row = Vec::with_capacity(4);
+                (0..self.points())
+                    .map(|m| {
+                        self.row(m, &mut row);
+                        row.iter().map(|&(i, v)| v * c[i]).sum()
+                    })
+                    .collect()
+            }
         }
     }
 
@@ -185,6 +245,10 @@ impl Basis {
                 x_max: *x_max,
                 coefficients: *coefficients,
                 anchor: *anchor,
+            }),
+            Self::Spline { u, segments } => Some(Self::Spline {
+                u: idx.iter().map(|&m| u[m]).collect(),
+                segments: *segments,
             }),
             Self::PerPoint { .. } => None,
         }
@@ -207,7 +271,7 @@ impl Basis {
                 coefficients,
                 anchor: *anchor,
             }),
-            Self::PerPoint { .. } => None,
+            Self::PerPoint { .. } | Self::Spline { .. } => None,
         }
     }
 
@@ -221,6 +285,31 @@ impl Basis {
     pub fn fit(&self, r: &[f64]) -> Vec<f64> {
         match self {
             Self::PerPoint { .. } => r.to_vec(),
+            Self::Spline { .. } => {
+                // normal equations with a tiny ridge (a span without points
+                // leaves its coefficient to its neighbours)
+                let k = self.len();
+                let mut ata = nalgebra::DMatrix::<f64>::zeros(k, k);
+                let mut atb = nalgebra::DVector::<f64>::zeros(k);
+                let mut row = Vec::new();
+                for (m, rm) in r.iter().enumerate() {
+                    self.row(m, &mut row);
+                    for &(i, a) in &row {
+                        atb[i] += a * rm;
+                        for &(j, b) in &row {
+                            ata[(i, j)] += a * b;
+                        }
+                    }
+                }
+                let ridge = 1e-14 * (ata.trace() / k as f64).max(1e-300);
+                for i in 0..k {
+                    ata[(i, i)] += ridge;
+                }
+                match ata.cholesky() {
+                    Some(ch) => ch.solve(&atb).iter().copied().collect(),
+                    None => vec![r.iter().sum::<f64>() / r.len().max(1) as f64; k],
+                }
+            }
             Self::Polynomial {
                 coefficients,
                 anchor,
@@ -320,6 +409,43 @@ mod tests {
         let mut c2 = c.clone();
         c2.push(0.0);
         assert_eq!(raised.eval(&c2), b.eval(&c));
+    }
+
+    /// The spline reproduces a linear law exactly (uniform cubic B-splines
+    /// reproduce degree-1 polynomials), its rows are a partition of unity, and
+    /// it follows a three-lobed law a degree-6 polynomial cannot.
+    #[test]
+    fn spline_basis_reproduces_lines_and_follows_lobes() {
+        let x: Vec<f64> = (0..400).map(|m| m as f64).collect();
+        let b = Basis::spline(&x, 16);
+        assert_eq!(b.len(), 19);
+        let line: Vec<f64> = x.iter().map(|m| 0.3 - 0.0157 * m).collect();
+        for (a, e) in b.eval(&b.fit(&line)).iter().zip(&line) {
+            assert!((a - e).abs() < 1e-9, "{a} {e}");
+        }
+        let mut row = Vec::new();
+        for m in [0, 17, 200, 399] {
+            b.row(m, &mut row);
+            let s: f64 = row.iter().map(|(_, v)| v).sum();
+            assert!((s - 1.0).abs() < 1e-14 && row.iter().all(|(_, v)| *v >= 0.0));
+        }
+        let lobes: Vec<f64> = x.iter().map(|m| (3.0 * TAU * m / 400.0).sin()).collect();
+        let err = |basis: &Basis| {
+            basis
+                .eval(&basis.fit(&lobes))
+                .iter()
+                .zip(&lobes)
+                .map(|(a, e)| (a - e).abs())
+                .fold(0.0, f64::max)
+        };
+        assert!(err(&b) < 0.01, "spline {}", err(&b));
+        assert!(err(&Basis::polynomial(&x, 7)) > 0.1);
+        let sub = b.restricted(&[0, 100, 399]).unwrap();
+        let c = b.fit(&lobes);
+        assert_eq!(
+            sub.eval(&c),
+            vec![b.eval(&c)[0], b.eval(&c)[100], b.eval(&c)[399]]
+        );
     }
 
     #[test]

@@ -108,6 +108,9 @@ pub(super) fn finish(
                     torsion_rad,
                     max_rad,
                 } => (Constraint::HoseTorsion, torsion_rad - max_rad),
+                ViolationKind::BuildTilt { tilt_rad, max_rad } => {
+                    (Constraint::BuildTilt, tilt_rad - max_rad)
+                }
                 _ => (Constraint::Dexterity, 0.0),
             };
             Binding {
@@ -159,6 +162,7 @@ pub(super) fn finish(
         quality,
         solver: solver(t0.elapsed().as_secs_f64()),
         violations,
+        positioner: None,
     }
 }
 

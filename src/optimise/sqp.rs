@@ -39,9 +39,9 @@ pub(crate) struct SqpResult {
     pub converged: bool,
 }
 
-struct Qp {
-    x: Vec<f64>,
-    t: f64,
+pub(crate) struct Qp {
+    pub x: Vec<f64>,
+    pub t: f64,
 }
 
 /// Solves `min ½ δᵀPδ + gᵀδ + ρ t` s.t. `a·δ − t ≤ b`, `t ≥ 0`, `|δ_i| ≤ box`.
@@ -52,7 +52,7 @@ struct Qp {
 /// solves the QP on a working set (the rows that minimiser violates, and
 /// the currently violated ones), grown with the rows its solution violates
 /// until none is (constraint generation: the same optimum as with all rows).
-fn solve_qp(
+pub(crate) fn solve_qp(
     k: usize,
     p_dense: &[f64],
     g: &[f64],

@@ -411,6 +411,7 @@ impl PlannedPart {
                         "min_limit_distance_joint": q.min_limit_distance_joint,
                         "max_hose_torsion_deg": q.max_hose_torsion_rad.to_degrees(),
                     },
+                    "positioner": l.positioner.as_ref().map(positioner_summary),
                     "solver": {
                         "iterations": l.solver.iterations,
                         "qp_solves": l.solver.qp_solves,
@@ -433,6 +434,17 @@ impl PlannedPart {
             "travel_speed_mm_s": self.optimise.travel_speed_mm_s,
             "feasible": plan.is_feasible(),
             "infeasible_layers": plan.infeasible_layers().map(|l| l.layer).collect::<Vec<_>>(),
+            // layers that no motion of arm and positioner within the cone
+            // can build, by a bound from the geometry alone
+            "unbuildable_layers": plan.layers.iter().filter_map(|l| {
+                let law = l.positioner.as_ref()?;
+                law.proven_infeasible.then(|| json!({
+                    "layer": l.layer,
+                    "required_rate_deg_s": finite_or_null(law.required_rate_rad_s.to_degrees()),
+                    "available_rate_deg_s": finite_or_null(law.available_rate_rad_s.to_degrees()),
+                    "between_points": [law.required_between.0, law.required_between.1],
+                }))
+            }).collect::<Vec<_>>(),
             "violations": violations,
             "layer_plans": layers,
             "transitions": plan.transitions.iter().map(|t| json!({
@@ -492,4 +504,31 @@ impl Serialize for PlannedPart {
         m.serialize_entry("points", &points)?;
         m.end()
     }
+}
+
+/// A number for JSON, `null` when not finite (an unbounded rate).
+fn finite_or_null(v: f64) -> Value {
+    if v.is_finite() {
+        json!(v)
+    } else {
+        Value::Null
+    }
+}
+
+/// One layer's positioner laws in `summary.json` (angles in degrees, rates
+/// in deg/s; `null` for an unbounded rate).
+fn positioner_summary(law: &crate::optimise::positioner::PositionerLaw) -> Value {
+    json!({
+        "seed": law.seed,
+        "feasible": law.feasible,
+        "binding": law.binding.map(|b| b.to_string()),
+        "max_tilt_deg": law.max_tilt_rad.to_degrees(),
+        "max_tilt_point": law.max_tilt_point,
+        "required_rate_deg_s": finite_or_null(law.required_rate_rad_s.to_degrees()),
+        "available_rate_deg_s": finite_or_null(law.available_rate_rad_s.to_degrees()),
+        "required_between_points": [law.required_between.0, law.required_between.1],
+        "proven_infeasible": law.proven_infeasible,
+        "iterations": law.iterations,
+        "samples": law.samples,
+    })
 }

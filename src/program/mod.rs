@@ -1133,6 +1133,7 @@ fn clearance_point(
         position_mm,
         tool_axis: p.tool_axis,
         build_direction: input.build_direction,
+        positioner: input.positioner,
     };
     let q8 = p.positioner.map_or(0.0, |q| q[1]);
     let (q, pose) = cell

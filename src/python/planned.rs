@@ -96,6 +96,12 @@ fn what_and_amount(
             Some((torsion_rad - max_rad).to_degrees()),
             "deg",
         ),
+        ViolationKind::BuildTilt { tilt_rad, max_rad } => (
+            "build_tilt",
+            None,
+            Some((tilt_rad - max_rad).to_degrees()),
+            "deg",
+        ),
         ViolationKind::NoSolution(_) => ("no_solution", None, None, ""),
     }
 }

@@ -141,6 +141,7 @@ fn the_drawn_cell_puts_the_torch_tip_on_the_path_point() {
         position_mm: Point3::new(30.0, 10.0, 20.0),
         tool_axis: UnitVector3::new_normalize(Vector3::new(0.2, 0.1, 1.0)),
         build_direction: Some(UnitVector3::new_normalize(Vector3::new(0.2, 0.1, 1.0))),
+        positioner: None,
     };
     for name in [
         "robowam_part_carried.toml",

@@ -29,6 +29,10 @@ pub struct CellPoint {
     /// Build direction `b`, part frame: what the positioner turns vertical in
     /// the torch-carried cell. `None`: the tool axis is used.
     pub build_direction: Option<UnitVector3>,
+    /// Positioner joints `[q7, q8]` (rad) planned for this point (torch-carried
+    /// cell, [`crate::optimise::positioner`]); `None`: the positioner turns
+    /// `b` exactly vertical ([`TorchCarriedCell::positioner_angles`]).
+    pub positioner: Option<PositionerJoints>,
 }
 
 /// Where one path point puts the cell.
@@ -333,9 +337,12 @@ pub struct TorchCarriedCell {
     pub configuration: Configuration,
     /// Largest admissible hose torsion `|q4 + q6|` (rad) [eq. 4.8: 120°].
     pub max_hose_torsion_rad: f64,
-    /// Largest accepted angle between the build direction and the vertical
-    /// when the positioner cannot make it exact (rad); see
-    /// [`Positioner::angles_for_vertical`]. 1° in the thesis cell files.
+    /// Half angle of the cone about the vertical within which the build
+    /// direction `b` must stay, seen in the robot base frame (rad): the
+    /// positioner's laws ([`crate::optimise::positioner`]) move within it, and
+    /// the thesis's exact-vertical mode accepts this much error where the
+    /// positioner cannot make `b` exactly vertical. Set from the process
+    /// qualification; 15° in the sample cells.
     pub max_vertical_error_rad: f64,
 }
 
@@ -410,6 +417,14 @@ impl TorchCarriedCell {
         )
     }
 
+    /// Angle (rad) between the point's build direction, seen in the robot
+    /// base frame at positioner joints `q`, and the vertical.
+    pub fn build_tilt(&self, p: &CellPoint, q: &PositionerJoints) -> f64 {
+        let b_part = p.build_direction.unwrap_or(p.tool_axis);
+        let b = self.base_from_part(q).rotation * b_part.into_inner();
+        b.xy().norm().atan2(b.z)
+    }
+
     /// Positioner angles that turn the point's build direction vertical,
     /// `q8_hint` (rad) used when `q8` is free.
     ///
@@ -439,7 +454,10 @@ impl TorchCarriedCell {
     /// # Errors
     /// [`RobotError::PositionerUnreachable`].
     pub fn pose(&self, p: &CellPoint, r_z: f64, q8_hint: f64) -> Result<CellPose, RobotError> {
-        let qp = self.positioner_angles(p, q8_hint)?;
+        let qp = match p.positioner {
+            Some(q) => q,
+            None => self.positioner_angles(p, q8_hint)?,
+        };
         let base_from_part = self.base_from_part(&qp);
         let m = base_from_part * p.position_mm;
         let t = base_from_part.rotation * p.tool_axis;

@@ -185,6 +185,31 @@ impl Positioner {
         best.ok_or_else(unreachable)
     }
 
+    /// `positioner_from_table` at `q` and its derivatives with respect to
+    /// `q7` and `q8` [eq. C.5–C.6 differentiated], as `(R, t)` pairs: the
+    /// rotation matrix (unitless, per rad) and the translation (mm, mm/rad).
+    /// `R = Ry(q7)·Rz(q8)`, `t = Ry(q7)·(0, 0, |C7C8|)`.
+    pub fn positioner_from_table_derivatives(
+        &self,
+        q: &PositionerJoints,
+    ) -> [(crate::math::Matrix3, Vector3); 3] {
+        let (s7, c7) = q[0].sin_cos();
+        let (s8, c8) = q[1].sin_cos();
+        let ry = rot_y(s7, c7);
+        let rz = rot_z(s8, c8);
+        // d/dq Ry(q) = Ry(q + π/2) with the middle row zeroed; likewise Rz
+        let mut dry = rot_y(c7, -s7);
+        dry[(1, 1)] = 0.0;
+        let mut drz = rot_z(c8, -s8);
+        drz[(2, 2)] = 0.0;
+        let l = self.tilt_to_table_mm;
+        [
+            (ry * rz, Vector3::new(l * s7, 0.0, l * c7)),
+            (dry * rz, Vector3::new(l * c7, 0.0, -l * s7)),
+            (ry * drz, Vector3::zeros()),
+        ]
+    }
+
     /// Table-frame build direction seen in the positioner frame at `q` (helper for checks).
     pub fn direction_in_positioner(&self, q: &PositionerJoints, v_table: &Vector3) -> Vector3 {
         self.positioner_from_table(q).rotation * v_table

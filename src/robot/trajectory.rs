@@ -37,6 +37,10 @@ pub struct PathPointInput {
     pub build_direction: Option<UnitVector3>,
     /// The free angle about the tool axis `R_Z` (rad).
     pub r_z: f64,
+    /// Positioner joints `[q7, q8]` (rad) planned for this point
+    /// (torch-carried cell); `None`: `b` turned exactly vertical.
+    #[serde(default)]
+    pub positioner: Option<PositionerJoints>,
 }
 
 /// Options of [`joint_trajectory`]. Plain data.
@@ -172,6 +176,14 @@ pub enum ViolationKind {
         /// Limit (rad).
         max_rad: f64,
     },
+    /// The build direction `b`, seen in the robot base frame, outside the
+    /// torch-carried cell's cone of the vertical (`max_vertical_error_deg`).
+    BuildTilt {
+        /// Angle of `b` from the vertical (rad).
+        tilt_rad: f64,
+        /// The cone's half angle (rad).
+        max_rad: f64,
+    },
     /// No joints for this point.
     NoSolution(RobotError),
 }
@@ -223,6 +235,12 @@ impl fmt::Display for Violation {
                 f,
                 "hose torsion |J4 + J6| = {:.2}° over {:.1}°",
                 torsion_rad.to_degrees(),
+                max_rad.to_degrees()
+            ),
+            ViolationKind::BuildTilt { tilt_rad, max_rad } => write!(
+                f,
+                "build direction {:.2}° from the vertical, cone {:.1}°",
+                tilt_rad.to_degrees(),
                 max_rad.to_degrees()
             ),
             ViolationKind::NoSolution(e) => write!(f, "no joint solution: {e}"),
@@ -389,6 +407,7 @@ fn trajectory(
             position_mm: p.position_mm,
             tool_axis: p.tool_axis,
             build_direction: p.build_direction,
+            positioner: p.positioner,
         };
         let mut violation = |kind| {
             report.violations.push(Violation {
@@ -474,6 +493,14 @@ fn trajectory(
             }
         }
         if let (Cell::TorchCarried(c), Some(qp)) = (cell, pose.positioner) {
+            let tilt = c.build_tilt(&cp, &qp);
+            // rounding of the chain of rotations: 1e-9 rad
+            if tilt > c.max_vertical_error_rad + 1e-9 {
+                violation(ViolationKind::BuildTilt {
+                    tilt_rad: tilt,
+                    max_rad: c.max_vertical_error_rad,
+                });
+            }
             for (k, (l, v)) in c.positioner.limits.iter().zip(qp).enumerate() {
                 if !l.contains(v) {
                     violation(ViolationKind::JointLimit {

@@ -108,6 +108,7 @@ pub fn hemisphere_cell_points(
                 position_mm: Point3::new(a * v.cos(), a * v.sin(), z),
                 tool_axis: UnitVector3::new_normalize(t),
                 build_direction: None,
+                positioner: None,
                 r_z: r_z(layer, v),
             });
         }

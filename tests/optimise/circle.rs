@@ -17,6 +17,7 @@ fn circle() -> Vec<CellPoint> {
                 position_mm: Point3::new(300.0 * v.cos(), 300.0 * v.sin(), 0.0),
                 tool_axis: UnitVector3::new_normalize(Vector3::z()),
                 build_direction: Some(UnitVector3::new_normalize(Vector3::z())),
+                positioner: None,
             }
         })
         .collect()
@@ -61,6 +62,7 @@ fn circle_is_feasible_within_the_hose_limit_and_beats_the_thesis_cubic() {
                 position_mm: p.position_mm,
                 tool_axis: p.tool_axis,
                 build_direction: p.build_direction,
+                positioner: None,
                 r_z: rz.to_radians(),
             }
         })

@@ -190,13 +190,15 @@ fn the_validator_accepts_our_programs_for_every_feasible_part_and_cell() {
         ),
         (
             "kuka_kr16_2_torch_carried.toml",
-            // quarter torus, general tube: the positioner's turn axis (J8)
-            // at its 180°/s near the pole of the build direction; helix: J3
-            // speed
+            // the quarter torus and the general tube plan since the
+            // positioner's laws (before them its turn J8 passed 180°/s at the
+            // pole of b); helix: J4 speed at layer 1
             &[
                 "hemisphere.toml",
                 "nozzle.toml",
                 "half-catenoid.toml",
+                "quarter-torus.toml",
+                "general-tube.toml",
                 "torus-on-cylinder.toml",
                 "elbow.toml",
             ][..],
@@ -205,11 +207,14 @@ fn the_validator_accepts_our_programs_for_every_feasible_part_and_cell() {
         ("abb_irb2600_part_carried.toml", &SAMPLE_PARTS[..7]),
         (
             "abb_irb2600_torch_carried.toml",
-            // as the KUKA torch-carried cell (same positioner); helix: J8
+            // as the KUKA torch-carried cell (same positioner); helix: J6
+            // speed at layer 1
             &[
                 "hemisphere.toml",
                 "nozzle.toml",
                 "half-catenoid.toml",
+                "quarter-torus.toml",
+                "general-tube.toml",
                 "torus-on-cylinder.toml",
                 "elbow.toml",
             ][..],

@@ -98,6 +98,7 @@ fn torch_carried_pose_puts_the_torch_on_the_point_with_b_vertical() {
             position_mm: m,
             tool_axis: t,
             build_direction: Some(b),
+            positioner: None,
         };
         let pose = cell.pose(&p, rng.range(-3.0, 3.0), 0.0).unwrap();
         let qp = pose.positioner.unwrap();
@@ -156,6 +157,7 @@ fn dq_drz_matches_finite_differences_part_carried() {
                     position_mm: m,
                     tool_axis: t,
                     build_direction: None,
+                    positioner: None,
                 },
                 rng.range(-3.0, 3.0),
             )
@@ -181,6 +183,7 @@ fn dq_drz_matches_finite_differences_torch_carried() {
                     position_mm: m,
                     tool_axis: t,
                     build_direction: Some(t),
+                    positioner: None,
                 },
                 rng.range(-3.0, 3.0),
             )
@@ -210,6 +213,7 @@ fn check_trajectory_dq_drz(cell: &Cell, points: &[PathPointInput]) {
                 position_mm: p.position_mm,
                 tool_axis: p.tool_axis,
                 build_direction: p.build_direction,
+                positioner: None,
             };
             let pose = cell.pose(&cp, p.r_z, q8).unwrap();
             if let Some(qp) = jp.positioner {
@@ -239,6 +243,7 @@ fn trajectory_dq_drz_is_the_cells() {
                     position_mm: Point3::from(n * 45.0),
                     tool_axis: UnitVector3::new_normalize(Vector3::z() + n * 0.3),
                     build_direction: None,
+                    positioner: None,
                     r_z: -v,
                 }
             })
@@ -270,6 +275,7 @@ fn part_carried_rz_rate_is_not_one_for_tilted_tool_axes() {
         position_mm: Point3::new(10.0, 0.0, 5.0),
         tool_axis: t,
         build_direction: None,
+        positioner: None,
     };
     let w = cell.pose(&p, 0.0, 0.0).unwrap().flange_twist_per_rz;
     assert!((w[5] - 0.6 / (0.36 + 0.64)).abs() < 1e-12 && w[3] == 0.0 && w[4] == 0.0);
@@ -296,6 +302,7 @@ fn torch_carried_circle_is_reachable_and_reports_hose_torsion() {
                 position_mm: Point3::new(300.0 * v.cos(), 300.0 * v.sin(), 0.0),
                 tool_axis: Vector3::z_axis(),
                 build_direction: None,
+                positioner: None,
                 r_z: 0.0,
             }
         })
@@ -343,6 +350,7 @@ fn torch_carried_circle_uncertainty_matches_thesis() {
                 position_mm: Point3::new(300.0 * v.cos(), 300.0 * v.sin(), 0.0),
                 tool_axis: Vector3::z_axis(),
                 build_direction: None,
+                positioner: None,
                 r_z: 0.0,
             }
         })

@@ -13,6 +13,7 @@ fn point(layer: usize, point: usize, x: f64) -> PathPointInput {
         position_mm: Point3::new(x, 0.0, 0.0),
         tool_axis: Vector3::z_axis(),
         build_direction: None,
+        positioner: None,
         r_z: 0.0,
     }
 }
@@ -55,6 +56,7 @@ fn degenerate_tool_axis_is_reported() {
         position_mm: Point3::origin(),
         tool_axis: Vector3::y_axis(),
         build_direction: None,
+        positioner: None,
     };
     let e = cell.pose(&p, 0.0, 0.0).unwrap_err();
     assert!(matches!(e, RobotError::DegenerateToolAxis { .. }), "{e}");
@@ -86,6 +88,7 @@ fn singular_jacobian_is_reported_by_dq_drz() {
         position_mm: Point3::origin(),
         tool_axis: Vector3::z_axis(),
         build_direction: None,
+        positioner: None,
     };
     let pose = pc.pose(&p, 0.0).unwrap();
     let e = cell.dq_drz(&pose, &q).unwrap_err();

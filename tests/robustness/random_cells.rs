@@ -226,7 +226,7 @@ fn extreme_speeds_and_limits_end_cleanly() {
             "max_speed_deg_s = [1e-300, 1e-300]",
         ),
         (
-            "max_vertical_error_deg = 1.0",
+            "max_vertical_error_deg = 15.0",
             "max_vertical_error_deg = 1e300",
         ),
     ] {

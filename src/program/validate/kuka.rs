@@ -826,6 +826,7 @@ mod tests {
                         phi.cos(),
                     )),
                     build_direction: None,
+                    positioner: None,
                     r_z: 0.0,
                 });
             }
