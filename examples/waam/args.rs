@@ -208,6 +208,11 @@ pub struct PlanArgs {
     /// R_Z law: fixed:DEG, poly:N (max degree), spline, point.
     #[arg(long, default_value = "poly:4")]
     pub rz: String,
+    /// Torch-carried cells: the positioner's tilt and turn optimised within
+    /// the cell's cone of the vertical (`optimised`), or turning the build
+    /// direction exactly vertical at every point as in the thesis (`vertical`).
+    #[arg(long, default_value = "optimised", value_parser = ["optimised", "vertical"])]
+    pub positioner: String,
     /// Tool axis and process.
     #[command(flatten)]
     pub axes: AxisArgs,

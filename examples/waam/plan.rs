@@ -41,6 +41,9 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
         format,
         ..PlanOptions::default()
     };
+    if a.positioner == "vertical" {
+        opts.positioner.mode = waam_slicer::optimise::positioner::PositionerMode::Vertical;
+    }
     a.grid.apply(&mut opts.slice);
     a.axes.apply(&mut opts.slice);
     let t_read = t0.elapsed().as_secs_f64();

@@ -35,9 +35,11 @@
 //! violation with the binding constraint named. Where `b` stays within the
 //! cone of the turn axis the turn is free and is held still (the pole).
 //!
-//! Two seeds are solved and the better kept: the positioner held at the pose
-//! that turns the layer's mean `b` vertical, and the thesis's pose that turns
-//! every point's `b` exactly vertical (fitted by the law). A law is solved on
+//! Three seeds are solved and the best kept: the positioner held at the pose
+//! that turns the layer's mean `b` vertical; a lazy follower that holds its
+//! pose while `b` stays within 70 % of the cone and moves just enough where
+//! it would leave it; and the thesis's pose that turns every point's `b`
+//! exactly vertical (each fitted by the law). A law is solved on
 //! at most [`PositionerOptions::sample_points`] points, then checked on every
 //! point; the worst violated points join the samples and it is solved again.
 
@@ -210,6 +212,9 @@ pub enum PositionerSeed {
     Hold,
     /// Every point's `b` exactly vertical (the thesis), fitted by the law.
     Follow,
+    /// The pose held while `b` stays well inside the cone, moved just
+    /// enough where it would leave it, fitted by the law.
+    Lazy,
     /// Every point's `b` exactly vertical, not fitted: with
     /// [`PositionerMode::Vertical`], or where no smooth law keeps the cone
     /// (a corner of `b`) and the positioner's speeds allow it.
@@ -683,6 +688,40 @@ pub fn vertical_joints(
         .collect()
 }
 
+/// The lazy follower's joints: the positioner holds its pose while `b`
+/// stays within `hold_rad` of the vertical, and otherwise moves just enough to
+/// bring it back to `hold_rad`, leaning the way it leans (the pose turning
+/// `b` onto that leaning direction, the turn nearest the last). Smooth
+/// through the pole, where the exact vertical spins. `None` where no pose
+/// is found.
+fn lazy_joints(
+    pb: &LawProblem,
+    start: PositionerJoints,
+    hold_rad: f64,
+) -> Option<Vec<PositionerJoints>> {
+    let r0t = pb.r0.transpose();
+    let mut q = start;
+    let mut out = Vec::with_capacity(pb.b.len());
+    for m in 0..pb.b.len() {
+        let b_w = pb.world(m, &q).b[0];
+        let tilt = b_w.xy().norm().atan2(b_w.z);
+        if tilt > hold_rad {
+            // the world direction at hold_rad from the vertical, towards b_w
+            let h = b_w.xy().normalize();
+            let target = Vector3::new(h.x * hold_rad.sin(), h.y * hold_rad.sin(), hold_rad.cos());
+            let up = UnitVector3::new_normalize(r0t * target);
+            let b = UnitVector3::try_new(pb.b[m], 1e-12)?;
+            q = pb
+                .cell
+                .positioner
+                .angles_for_vertical(&b, &up, q[1], 0.5 * hold_rad)
+                .ok()?;
+        }
+        out.push(q);
+    }
+    Some(out)
+}
+
 /// Positioner laws of one layer [module doc]. `travel_speed_mm_s`: the
 /// programmed speed of the torch over the part (mm/s); `margin_rad`: how far
 /// inside its travel each axis stays (rad); `q8_hint`: the turn the layer
@@ -769,6 +808,15 @@ pub fn positioner_law(
     x_hold[0] = hold[0];
     x_hold[k] = hold[1];
     seeds.push((PositionerSeed::Hold, x_hold));
+    let start = follow
+        .as_ref()
+        .and_then(|f| f.first().copied())
+        .unwrap_or(hold);
+    if let Some(l) = lazy_joints(&pb, start, 0.7 * pb.cone) {
+        let c7 = basis.fit(&l.iter().map(|q| q[0]).collect::<Vec<_>>());
+        let c8 = basis.fit(&l.iter().map(|q| q[1]).collect::<Vec<_>>());
+        seeds.push((PositionerSeed::Lazy, [c7, c8].concat()));
+    }
     if let Some(f) = &follow {
         let c7 = basis.fit(&f.iter().map(|q| q[0]).collect::<Vec<_>>());
         let c8 = basis.fit(&f.iter().map(|q| q[1]).collect::<Vec<_>>());

@@ -294,6 +294,9 @@ pub struct PlanOptions {
     pub rz: RzLaw,
     /// Program format; `None`: the cell robot's vendor's.
     pub format: Option<ProgramFormat>,
+    /// The torch-carried cell's positioner: optimised laws within the cell's
+    /// cone of the vertical (default) or the thesis's exact vertical.
+    pub positioner: crate::optimise::positioner::PositionerOptions,
     /// Progress reports and cancellation for a host program.
     pub control: super::Control,
 }

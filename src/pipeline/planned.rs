@@ -128,6 +128,7 @@ pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<Planned
         parameterisation: opts.rz.0,
         travel_speed_mm_s: sliced.process.travel_speed_mm_s,
         configuration: ConfigurationChoice::Cell,
+        positioner: opts.positioner,
         ..OptimiseOptions::default()
     };
     optimise_opts.validate()?;

@@ -168,3 +168,75 @@ fn every_sample_part_plans_in_the_part_carried_cell() {
     let v = summary["violations"].to_string();
     assert!(v.contains("J4 needs") || v.contains("J6 needs"), "{v}");
 }
+
+/// A layer without any joint solution is an answer, not an error (issue 33):
+/// the elbow at its own grid in the KUKA torch-carried cell with the thesis's
+/// exact-vertical positioner reaches layers whose points the arm cannot
+/// reach (before: exit 1, "report: plan has 0 points where the path has
+/// 400 (layer 52)", no summary). Now exit 2 with summary.json naming the
+/// layer, the point and why, the report and joints written, and no program;
+/// with the optimised positioner summary.json names every refused layer with
+/// its binding constraint or the geometric bound that proves it unbuildable.
+#[test]
+fn a_layer_without_joints_exits_2_with_its_summary_and_report() {
+    let dir = tempfile::tempdir().unwrap();
+    for (mode, out) in [("vertical", "v"), ("optimised", "o")] {
+        let out = dir.path().join(out);
+        let o = waam()
+            .args(["--quiet", "plan"])
+            .arg(part_path("elbow.toml"))
+            .arg("--cell")
+            .arg(part_path("cells/kuka_kr16_2_torch_carried.toml"))
+            .args(["--positioner", mode, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{mode}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        for f in ["summary.json", "joints.csv", "report.html"] {
+            assert!(out.join(f).exists(), "{mode}: {f} missing");
+        }
+        assert!(!std::fs::read_dir(&out).unwrap().any(|e| {
+            let p = e.unwrap().path();
+            p.extension().is_some_and(|x| x == "src" || x == "dat")
+        }));
+        let s: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let infeasible = s["infeasible_layers"].as_array().unwrap();
+        assert!(!infeasible.is_empty());
+        let plans = s["layer_plans"].as_array().unwrap();
+        for l in infeasible {
+            let plan = &plans[l.as_u64().unwrap() as usize];
+            let status = plan["status"].as_str().unwrap();
+            assert!(
+                status.starts_with("infeasible: ")
+                    || status.starts_with("no joint solution at point"),
+                "{mode}: {status}"
+            );
+        }
+        if mode == "vertical" {
+            let status = plans[52]["status"].as_str().unwrap();
+            assert!(
+                status.starts_with("no joint solution at point") && status.contains("out of reach"),
+                "{status}"
+            );
+            assert_eq!(plans[52]["points"], 400);
+        } else {
+            // every refused layer of the optimised plan here is a corner of
+            // b that the positioner's 90 + 180 °/s cannot turn within the cone
+            let unbuildable = s["unbuildable_layers"].as_array().unwrap();
+            assert!(!unbuildable.is_empty());
+            for u in unbuildable {
+                let need = u["required_rate_deg_s"].as_f64().unwrap_or(f64::INFINITY);
+                assert!(need > u["available_rate_deg_s"].as_f64().unwrap());
+            }
+            let tilt = plans[10]["positioner"]["max_tilt_deg"].as_f64().unwrap();
+            assert!(tilt <= 15.0 + 1e-6, "{tilt}");
+        }
+    }
+}

@@ -14,3 +14,4 @@ mod place_cells;
 mod spiral;
 mod subsample;
 mod support;
+mod torch_carried;
