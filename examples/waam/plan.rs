@@ -180,20 +180,28 @@ fn draw_joint_plots(
     let (layers, plan) = (&planned.layers, &planned.plan);
     let speed_mm_s = planned.travel_speed_mm_s();
     let robot = planned.cell.robot();
-    let mut angles: [Vec<(f64, f64)>; 6] = Default::default();
-    let mut speeds: [Vec<(f64, f64)>; 6] = Default::default();
+    // J1-J6, then the positioner's J7 (tilt) and J8 (turn) when there is one
+    let positioner = match &planned.cell.layout {
+        waam_slicer::robot::Cell::TorchCarried(c) => Some(&c.positioner),
+        _ => None,
+    };
+    let axes = if positioner.is_some() { 8 } else { 6 };
+    let mut angles: Vec<Vec<(f64, f64)>> = vec![Vec::new(); axes];
+    let mut speeds: Vec<Vec<(f64, f64)>> = vec![Vec::new(); axes];
     let mut k = 0usize;
     for (lp, pl) in layers.iter().zip(&plan.layers) {
-        let mut prev: Option<(waam_slicer::math::Point3, [f64; 6])> = None;
+        let mut prev: Option<(waam_slicer::math::Point3, [f64; 8])> = None;
         for (cp, pp) in lp.points.iter().zip(&pl.points) {
-            if let Some(q) = pp.joints {
-                for j in 0..6 {
+            if let Some(q6) = pp.joints {
+                let e = pp.positioner.unwrap_or([0.0; 2]);
+                let q = [q6[0], q6[1], q6[2], q6[3], q6[4], q6[5], e[0], e[1]];
+                for j in 0..axes {
                     angles[j].push((k as f64, q[j].to_degrees()));
                 }
                 if let Some((p0, q0)) = prev {
                     let dt = (cp.position_mm - p0).norm() / speed_mm_s;
                     if dt > 0.0 {
-                        for j in 0..6 {
+                        for j in 0..axes {
                             speeds[j].push((k as f64, ((q[j] - q0[j]) / dt).abs().to_degrees()));
                         }
                     }
@@ -203,26 +211,42 @@ fn draw_joint_plots(
             k += 1;
         }
     }
-    let limits = robot
+    let mut limits: Vec<(f64, f64)> = robot
         .limits
-        .map(|l| (l.lower_rad.to_degrees(), l.upper_rad.to_degrees()));
-    let max_speed = robot
+        .iter()
+        .map(|l| (l.lower_rad.to_degrees(), l.upper_rad.to_degrees()))
+        .collect();
+    let mut max_speed: Vec<(f64, f64)> = robot
         .max_speed_rad_s
-        .map(|v| (f64::NEG_INFINITY, v.to_degrees()));
+        .iter()
+        .map(|v| (f64::NEG_INFINITY, v.to_degrees()))
+        .collect();
+    if let Some(p) = positioner {
+        limits.extend(
+            p.limits
+                .iter()
+                .map(|l| (l.lower_rad.to_degrees(), l.upper_rad.to_degrees())),
+        );
+        max_speed.extend(
+            p.max_speed_rad_s
+                .iter()
+                .map(|v| (f64::NEG_INFINITY, v.to_degrees())),
+        );
+    }
     for (file, title, unit, series, bounds) in [
         (
             "joints.svg",
             format!("{name}: joint angles (limits in red)"),
             "deg",
             &angles,
-            limits,
+            &limits,
         ),
         (
             "speeds.svg",
             format!("{name}: joint speeds at the travel speed (maxima in red)"),
             "deg/s",
             &speeds,
-            max_speed,
+            &max_speed,
         ),
     ] {
         let tmp = dir.join(format!(".{file}.tmp"));

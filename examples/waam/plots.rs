@@ -340,8 +340,8 @@ pub fn distance_plot(
 pub fn joint_panels(
     title: &str,
     y_unit: &str,
-    series: &[Vec<(f64, f64)>; 6],
-    bounds: [(f64, f64); 6],
+    series: &[Vec<(f64, f64)>],
+    bounds: &[(f64, f64)],
     file: &FsPath,
 ) -> Result<(), String> {
     let longest = series.iter().map(Vec::len).max().unwrap_or(0);
@@ -350,13 +350,15 @@ pub fn joint_panels(
     } else {
         title.to_string()
     };
-    let whole = SVGBackend::new(file, (1200, 900)).into_drawing_area();
+    // two panels a row: J1-J6, and J7, J8 (the positioner) when given
+    let rows = series.len().div_ceil(2);
+    let whole = SVGBackend::new(file, (1200, 300 * rows as u32)).into_drawing_area();
     whole.fill(&WHITE).map_err(err(file))?;
     let whole = whole
         .titled(&title, ("sans-serif", 22))
         .map_err(err(file))?;
-    let panels = whole.split_evenly((3, 2));
-    for (j, area) in panels.iter().enumerate() {
+    let panels = whole.split_evenly((rows, 2));
+    for (j, area) in panels.iter().enumerate().take(series.len()) {
         let caption = format!("J{}", j + 1);
         // only finite points are drawn; the bounds widen the axis only
         // when there is something to draw
@@ -549,7 +551,7 @@ mod tests {
             let series: [Vec<(f64, f64)>; 6] = std::array::from_fn(|_| s.clone());
             // the case: no joint values, unlimited J6
             let bounds = [limited, limited, limited, limited, limited, unlimited];
-            let svg = timed(name, |f| joint_panels(name, "rad", &series, bounds, f));
+            let svg = timed(name, |f| joint_panels(name, "rad", &series, &bounds, f));
             let panels = svg.matches("no data").count();
             assert_eq!(
                 panels,
@@ -560,7 +562,7 @@ mod tests {
         // huge x (point index) and a huge bound
         let series: [Vec<(f64, f64)>; 6] = std::array::from_fn(|_| vec![(1e308, 1.0), (0.0, 2.0)]);
         let svg = timed("huge x", |f| {
-            joint_panels("huge x", "rad", &series, [(-1e308, 1e308); 6], f)
+            joint_panels("huge x", "rad", &series, &[(-1e308, 1e308); 6], f)
         });
         assert_eq!(svg.matches("no data").count(), 6);
     }

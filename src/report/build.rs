@@ -151,6 +151,12 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
     let mut speed = vec![];
     let mut rz = vec![];
     let mut margin = vec![];
+    // the build direction's tilt from the vertical in the world (torch carried)
+    let mut tilt = vec![];
+    let torch_carried = match input.plan.as_ref().map(|pv| pv.cell) {
+        Some(Cell::TorchCarried(c)) => Some(c),
+        _ => None,
+    };
     let robot = input.plan.as_ref().map(|pv| pv.cell.robot());
     for (l, layer) in path.layers.iter().enumerate() {
         layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
@@ -186,6 +192,13 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
                     Some(q) => limit_margin_rad(robot, &q).to_degrees() as f32,
                     None => f32::NAN,
                 });
+                if let Some(c) = torch_carried {
+                    let cp = &pv.layers[l].points[i];
+                    tilt.push(match pp.positioner.or(cp.positioner) {
+                        Some(e) => c.build_tilt(cp, &e).to_degrees() as f32,
+                        None => f32::NAN,
+                    });
+                }
             }
         }
     }
@@ -238,6 +251,16 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             min_half_range: 0.0,
             values: margin,
         });
+        if torch_carried.is_some() {
+            fields.push(Field {
+                key: "tilt",
+                name: "build direction from the vertical (positioner)",
+                unit: "deg",
+                diverging: false,
+                min_half_range: 0.0,
+                values: tilt,
+            });
+        }
     }
 
     let mut marks: Vec<Mark> = vec![];

@@ -200,6 +200,12 @@ fn a_layer_without_joints_exits_2_with_its_summary_and_report() {
         for f in ["summary.json", "joints.csv", "report.html"] {
             assert!(out.join(f).exists(), "{mode}: {f} missing");
         }
+        // joints.svg draws the positioner's tilt (J7) and turn (J8) too
+        let svg = std::fs::read_to_string(out.join("joints.svg")).unwrap();
+        assert!(
+            svg.contains("\nJ7\n") && svg.contains("\nJ8\n"),
+            "{mode}: no positioner panels"
+        );
         assert!(!std::fs::read_dir(&out).unwrap().any(|e| {
             let p = e.unwrap().path();
             p.extension().is_some_and(|x| x == "src" || x == "dat")

@@ -248,17 +248,24 @@ fn sliced_report_draws_in_chromium() {
     assert_eq!(keys, ["deviation", "lean", "speed", "layer"]);
 }
 
-#[test]
-fn planned_report_animates_the_robot_in_chromium() {
-    let Some(browser) = chromium() else { return };
+/// Plans `part` (its first `layers` layers, `points` a layer) in `cell`,
+/// writes its report and opens it in Chromium: the page's check object.
+fn planned_report(
+    browser: &std::path::Path,
+    part: &str,
+    cell: &str,
+    points: usize,
+    layers: Option<usize>,
+) -> serde_json::Value {
     let (dir, _keep) = out_dir();
-    let part = read_part_file(&repo("parts/hemisphere.toml")).unwrap();
-    let cell = read_cell_file(repo("parts/cells/robowam_part_carried.toml"))
+    let part = read_part_file(&repo(&format!("parts/{part}"))).unwrap();
+    let cell = read_cell_file(repo(&format!("parts/cells/{cell}")))
         .unwrap()
         .cell
         .unwrap();
     let mut so = part.slice_options();
-    so.discretisation = Discretisation::Points(36);
+    so.discretisation = Discretisation::Points(points);
+    so.max_layers = layers;
     let path = slice(&part.tube, &part.substrate, &so).unwrap();
     let axes = tool_axes(
         &path,
@@ -287,7 +294,28 @@ fn planned_report_animates_the_robot_in_chromium() {
     };
     let html = dir.join("planned.html");
     write_report(&html, &input).unwrap();
-    let r = open_and_check(&browser, &html);
+    open_and_check(browser, &html)
+}
+
+fn field_keys(r: &serde_json::Value) -> Vec<&str> {
+    r["fields"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f[0].as_str().unwrap())
+        .collect()
+}
+
+#[test]
+fn planned_report_animates_the_robot_in_chromium() {
+    let Some(browser) = chromium() else { return };
+    let r = planned_report(
+        &browser,
+        "hemisphere.toml",
+        "robowam_part_carried.toml",
+        36,
+        None,
+    );
     check_drawing(&r);
     // the robot alone covers a good part of the cell view
     let of = r["first"]["of"].as_u64().unwrap();
@@ -295,13 +323,29 @@ fn planned_report_animates_the_robot_in_chromium() {
     // playing moves the animation on, and the joint table has a row per joint
     assert!(r["played_to_frame"].as_u64().unwrap() > 0, "{r}");
     assert!(r["joint_rows"].as_u64().unwrap() >= 8, "{r}");
-    let keys: Vec<&str> = r["fields"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| f[0].as_str().unwrap())
-        .collect();
-    assert_eq!(keys, ["deviation", "lean", "rz", "margin", "layer"]);
+    assert_eq!(
+        field_keys(&r),
+        ["deviation", "lean", "rz", "margin", "layer"]
+    );
+}
+
+/// A torch-carried plan offers the build direction's tilt from the
+/// vertical as a colour (issue 33), and it varies over the elbow's layers.
+#[test]
+fn a_torch_carried_report_colours_the_tilt_of_the_build_direction() {
+    let Some(browser) = chromium() else { return };
+    let r = planned_report(
+        &browser,
+        "elbow.toml",
+        "kuka_kr16_2_torch_carried.toml",
+        60,
+        Some(20),
+    );
+    check_drawing(&r);
+    let keys = field_keys(&r);
+    assert_eq!(keys, ["deviation", "lean", "rz", "margin", "tilt", "layer"]);
+    let colours = r["fields"][4][1].as_u64().unwrap();
+    assert!(colours > 2, "tilt drawn in {colours} colours: {r}");
 }
 
 #[test]
