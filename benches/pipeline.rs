@@ -22,6 +22,7 @@ criterion_group!(
     robot::hemisphere_trajectory,
     optimise::whole_parts,
     optimise::plan_at_scale,
+    optimise::torch_vs_part_carried,
     place::hemisphere_in_kuka_part_carried
 );
 criterion_main!(benches);

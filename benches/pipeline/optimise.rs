@@ -105,3 +105,55 @@ pub fn plan_at_scale(c: &mut Criterion) {
     });
     g.finish();
 }
+
+/// The torch-carried cell against the part-carried cell for the same part
+/// [issue 33]: the whole optimisation (the positioner's laws, then `R_Z`)
+/// of the hemisphere (Delta 5 mm) and of the elbow (its own grid: Delta 2 mm,
+/// 400 points a layer) in the ROBOWAM and KUKA KR 16-2 cells. Goal: the
+/// torch-carried planning time per layer within 2× of the part-carried one.
+/// The layers are the same in both cells, so the ratio of the medians is the
+/// ratio per layer.
+pub fn torch_vs_part_carried(c: &mut Criterion) {
+    let cell = |f: &str| -> Cell {
+        read_cell_file(parts_dir().join("cells").join(f))
+            .unwrap()
+            .cell
+            .unwrap()
+    };
+    let mut g = c.benchmark_group("torch_vs_part_carried");
+    g.sample_size(10);
+    for (part, delta, pair) in [
+        (
+            "hemisphere.toml",
+            5.0,
+            ["robowam_part_carried.toml", "robowam_torch_carried.toml"],
+        ),
+        (
+            "elbow.toml",
+            2.0,
+            [
+                "kuka_kr16_2_part_carried.toml",
+                "kuka_kr16_2_torch_carried.toml",
+            ],
+        ),
+    ] {
+        let l = layers(part, delta);
+        for file in pair {
+            let cl = cell(file);
+            let opts = OptimiseOptions {
+                configuration: waam_slicer::optimise::ConfigurationChoice::Cell,
+                ..OptimiseOptions::default()
+            };
+            let name = format!(
+                "{}_{}_{}_layers",
+                part.trim_end_matches(".toml"),
+                file.trim_end_matches(".toml"),
+                l.len()
+            );
+            g.bench_function(name, |b| {
+                b.iter(|| optimise(black_box(&cl), black_box(&l), &opts).unwrap())
+            });
+        }
+    }
+    g.finish();
+}

@@ -213,6 +213,13 @@ pub struct PlanArgs {
     /// direction exactly vertical at every point as in the thesis (`vertical`).
     #[arg(long, default_value = "optimised", value_parser = ["optimised", "vertical"])]
     pub positioner: String,
+    /// Bound the turning angle of constant-distance layers to DEG degrees
+    /// (smoothing QP, as `slice --smooth`).
+    #[arg(long, value_name = "DEG")]
+    pub smooth: Option<f64>,
+    /// Distance tolerance of the smoothing, as a fraction of Delta.
+    #[arg(long, default_value_t = 0.05)]
+    pub smooth_tol: f64,
     /// Tool axis and process.
     #[command(flatten)]
     pub axes: AxisArgs,
