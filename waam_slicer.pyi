@@ -78,14 +78,19 @@ class Part:
         travel_speed_mm_s: Optional[float] = None,
         max_layers: Optional[int] = None,
         progress: Optional[Callable[[float], Any]] = None,
+        positioner: Optional[str] = None,
     ) -> "PlannedPart":
         """Plans the part in `cell`: slice, tool axes, layer-by-layer R_Z
         optimisation, joint trajectory, program model. An infeasible layer
         is data (`feasible`, `violations`), not an exception.
 
         rz: the R_Z law, "fixed:DEG", "poly:N" (N <= 8, default "poly:4"),
-            "spline" or "point". Other keywords as in `slice`. Progress is
-            reported at stage boundaries (slicing, optimising, program).
+            "spline" or "point". positioner (torch-carried cells):
+            "optimised" (default: tilt and turn laws within the cell's cone
+            of the vertical) or "vertical" (the build direction exactly
+            vertical, as in the thesis). Other keywords as in `slice`.
+            Progress is reported at stage boundaries (slicing, optimising,
+            program).
         """
     def place(
         self,

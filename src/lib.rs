@@ -26,6 +26,7 @@
 //! | 3. tool axes (local frames, build direction) | [`toolaxis`] | §4 |
 //! | 3b. process: bead, travel speeds, estimates | [`process`] | §5 |
 //! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
+//! | 5a. the torch-carried positioner's tilt and turn laws within the cone of the vertical | [`optimise::positioner`] | §9 |
 //! | 5. layer-by-layer optimisation of `R_Z` (branch, SQP, quality) | [`optimise`] | §7 |
 //! | 6. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
 //!

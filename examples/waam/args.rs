@@ -220,6 +220,9 @@ pub struct PlanArgs {
     /// Distance tolerance of the smoothing, as a fraction of Delta.
     #[arg(long, default_value_t = 0.05)]
     pub smooth_tol: f64,
+    /// Plan the first N layers only.
+    #[arg(long, value_name = "N")]
+    pub max_layers: Option<usize>,
     /// Tool axis and process.
     #[command(flatten)]
     pub axes: AxisArgs,

@@ -41,6 +41,7 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
         format,
         ..PlanOptions::default()
     };
+    opts.slice.max_layers = a.max_layers;
     opts.slice.smoothing = a.smooth.map(|deg| waam_slicer::path::smooth::Smoothing {
         max_turn_rad: deg.to_radians(),
         tolerance: a.smooth_tol,

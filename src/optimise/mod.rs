@@ -14,6 +14,7 @@
 //! | piece | module | entry points |
 //! |---|---|---|
 //! | options (plain data, `validate`) | [`options`] | [`OptimiseOptions`], [`Parameterisation`] |
+//! | torch-carried cell: the positioner's laws within the cone, solved before `R_Z` (stage 5a) | [`positioner`] | [`positioner::positioner_law`], [`positioner::required_rotation_rate`] |
 //! | `R_Z = B c`: polynomials (eq. 4.1–4.2), per point | [`parameterisation`] | [`parameterisation::Basis`] |
 //! | the per-layer problem (objective, constraints, `dq/dR_Z`) | `problem` | — |
 //! | sequential QP with clarabel, trust region, elastic mode | `sqp` | — |

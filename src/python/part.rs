@@ -90,8 +90,10 @@ impl PyPart {
     /// Plans the part in `cell`: slice, tool axes, layer-by-layer `R_Z`
     /// optimisation, joint trajectory, program model. An infeasible layer
     /// is data (`feasible`, `violations`), not an exception. Releases the GIL.
+    /// `positioner`: `"optimised"` (default) or `"vertical"` (the thesis's
+    /// exact vertical), torch-carried cells.
     #[pyo3(signature = (cell, *, delta_mm = None, points = None, chord_mm = None, strategy = None,
-        rz = None, travel_speed_mm_s = None, max_layers = None, progress = None))]
+        rz = None, travel_speed_mm_s = None, max_layers = None, progress = None, positioner = None))]
     #[allow(clippy::too_many_arguments)]
     fn plan(
         &self,
@@ -105,7 +107,18 @@ impl PyPart {
         travel_speed_mm_s: Option<f64>,
         max_layers: Option<i64>,
         progress: Option<Py<PyAny>>,
+        positioner: Option<&str>,
     ) -> PyResult<PyPlannedPart> {
+        use crate::optimise::positioner::{PositionerMode, PositionerOptions};
+        let mode = match positioner {
+            None | Some("optimised") => PositionerMode::Optimised,
+            Some("vertical") => PositionerMode::Vertical,
+            Some(other) => {
+                return Err(waam_error(format!(
+                    "positioner = {other:?}: expected \"optimised\" or \"vertical\""
+                )))
+            }
+        };
         let slice = SliceKeywords {
             strategy,
             delta_mm,
@@ -126,6 +139,10 @@ impl PyPart {
             slice,
             rz,
             format: None,
+            positioner: PositionerOptions {
+                mode,
+                ..PositionerOptions::default()
+            },
             control: host.control.clone(),
         };
         let result = py.detach(|| crate::pipeline::plan_part(&self.part, &cell.cell, &opts));

@@ -4,6 +4,7 @@ to write, a written program checked clean and a corrupted one not, progress
 reports and the GIL released while planning."""
 
 import csv
+import json
 import threading
 import tomllib
 
@@ -151,3 +152,35 @@ def test_the_gil_is_released_while_planning(hemisphere, part_carried):
         ticks += 1
     worker.join()
     assert done and ticks > 10_000
+
+
+def test_torch_carried_positioner_modes(waam_cli, tmp_path):
+    """The positioner's laws (default) against the thesis's exact vertical:
+    the elbow's first layers in the KUKA torch-carried cell; the summary is
+    the CLI's, layer by layer (the largest tilt of b from the vertical within
+    the cell's 15° cone); a bad mode names the keyword."""
+    elbow = ws.Part.read(PARTS / "elbow.toml")
+    cell = ws.Cell.read(CELLS / "kuka_kr16_2_torch_carried.toml")
+    plans = {m: elbow.plan(cell, points=POINTS, max_layers=6, positioner=m)
+             for m in ("optimised", "vertical")}
+    for mode, plan in plans.items():
+        assert plan.joints.shape[1] == 8
+        code, err = waam_cli(
+            "plan", PARTS / "elbow.toml", "--cell", CELLS / "kuka_kr16_2_torch_carried.toml",
+            "--points", POINTS, "--max-layers", 6, "--positioner", mode,
+            "--out", tmp_path / mode,
+        )
+        assert code == (0 if plan.feasible else 2), err
+        rows = read_joints_csv(tmp_path / mode / "joints.csv")
+        want = np.array([[float(r[k]) for k in ("e1", "e2")] for r in rows])
+        np.testing.assert_allclose(plan.joints[:, 6:], want, atol=2e-6)
+        with open(tmp_path / mode / "summary.json", encoding="utf-8") as f:
+            layers = json.load(f)["layer_plans"]
+        tilts = [layer["positioner"]["max_tilt_deg"] for layer in layers]
+        assert all(t <= 15.0 + 1e-6 for t in tilts), tilts
+    # the thesis's positioner keeps b vertical; the laws use the cone
+    with open(tmp_path / "vertical" / "summary.json", encoding="utf-8") as f:
+        assert all(layer["positioner"]["max_tilt_deg"] < 1e-6
+                   for layer in json.load(f)["layer_plans"])
+    with pytest.raises(ws.WaamError, match="positioner"):
+        elbow.plan(cell, points=POINTS, max_layers=1, positioner="sideways")
