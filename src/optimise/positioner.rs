@@ -250,9 +250,16 @@ pub struct PositionerLaw {
     /// The fastest the positioner can turn the part, `v7 + v8` (rad/s; `inf`
     /// when a speed is unknown).
     pub available_rate_rad_s: f64,
-    /// `true` when the bound proves the layer cannot be built in this cell
-    /// whatever the arm and the positioner do: `required > available`.
+    /// `true` when the geometry proves the layer cannot be built in this
+    /// cell whatever the arm and the positioner do: the rate bound
+    /// (`required > available`), or no positioner path reaches
+    /// [`PositionerLaw::unreachable_point`].
     pub proven_infeasible: bool,
+    /// Where a layer the laws could not keep in the cone was also searched
+    /// on a grid of positioner poses ([`unreachable_point`]): the first point
+    /// that no positioner motion within its travel and speeds reaches with
+    /// `b` inside the cone. `None`: not searched, or reached.
+    pub unreachable_point: Option<usize>,
     /// The stretch of the layer `(i, j)` (point indices) where the bound is reached.
     pub required_between: (usize, usize),
 }
@@ -725,6 +732,134 @@ fn lazy_joints(
     Some(out)
 }
 
+/// The first point of a layer that no motion of the positioner reaches
+/// with its build direction inside the cone, searched on a grid of poses of
+/// `cell_rad` (rad) — a proof: `None` when some path may exist.
+///
+/// Reachable sets are propagated along the layer: the poses at point `m`
+/// are those within `v_k·(t_m − t_a)` (each axis) of a pose reachable at an
+/// anchor point `a ≤ m` that keep `b_m` within the cone. On the grid both
+/// tests are relaxed so that no real path is lost: the angle of `b` from the
+/// vertical moves by at most `|Δq7| + |Δq8|` when the axes move (a rotation
+/// moves a direction by at most its angle, and the table's pose is two
+/// rotations), so a cell is kept when its centre is within `cone + cell/2 +
+/// cell/2` of the vertical; cells join when their centres are up to
+/// `v·(t_m − t_a) + cell` apart per axis. The anchor moves on once the
+/// slower bounded axis could have moved four cells, so that the cell of
+/// slack added per anchor stays a quarter of the motion. The tilt
+/// is searched within its travel, the turn modulo a whole turn (a superset
+/// of any travel). An empty set at point `m` is then a proof for the layer,
+/// up to nothing but rounding. `r0`: `base_from_positioner`'s rotation; `b`
+/// in the table frame; `dt` the step times (s).
+pub fn unreachable_point(
+    positioner: &Positioner,
+    r0: &Matrix3,
+    b: &[Vector3],
+    dt: &[f64],
+    cone_rad: f64,
+    cell_rad: f64,
+) -> Option<usize> {
+    use std::f64::consts::{PI, TAU};
+    let l7 = positioner.limits[0];
+    let (lo7, hi7) = if l7.lower_rad.is_finite() && l7.upper_rad.is_finite() {
+        (l7.lower_rad, l7.upper_rad)
+    } else {
+        (-PI, PI)
+    };
+    let n7 = (((hi7 - lo7) / cell_rad).ceil() as usize).max(1);
+    let h7 = (hi7 - lo7) / n7 as f64;
+    let n8 = ((TAU / cell_rad).ceil() as usize).max(1);
+    let h8 = TAU / n8 as f64;
+    // up in the positioner frame, turned back by each tilt: b_w·z = (Ry(−q7)·up)·(Rz(q8)·b)
+    let up = r0.transpose() * Vector3::z();
+    let tilted: Vec<Vector3> = (0..n7)
+        .map(|i| {
+            let q7 = lo7 + (i as f64 + 0.5) * h7;
+            let (s, c) = q7.sin_cos();
+            Vector3::new(c * up.x - s * up.z, up.y, s * up.x + c * up.z)
+        })
+        .collect();
+    let turns: Vec<(f64, f64)> = (0..n8).map(|j| ((j as f64 + 0.5) * h8).sin_cos()).collect();
+    let min_cos = (cone_rad + 0.5 * (h7 + h8)).min(PI).cos();
+    // the set reachable at the anchor point, dilated by the motion since
+    // (one cell of slack per anchor, re-anchored every 4 cells of motion of
+    // the slower bounded axis, so that the slack stays a quarter at most)
+    let mut anchor = vec![true; n7 * n8];
+    let mut t_anchor = 0.0;
+    let mut t = 0.0;
+    let mut reach = vec![true; n7 * n8];
+    let mut next = vec![false; n7 * n8];
+    let mut count: Vec<usize> = Vec::with_capacity(3 * n8.max(n7) + 1);
+    let (v7, v8) = (positioner.max_speed_rad_s[0], positioner.max_speed_rad_s[1]);
+    for (m, bm) in b.iter().enumerate() {
+        if m > 0 {
+            t += dt[m];
+            let span = t - t_anchor;
+            let cells = |v: f64, h: f64| -> usize {
+                if v.is_finite() {
+                    ((v * span + h) / h).floor() as usize
+                } else {
+                    usize::MAX
+                }
+            };
+            let (d7, d8) = (cells(v7, h7), cells(v8, h8));
+            // sliding windows by prefix counts: the turn is periodic
+            for i in 0..n7 {
+                let row = &anchor[i * n8..(i + 1) * n8];
+                if d8 >= n8 / 2 {
+                    let any = row.iter().any(|&x| x);
+                    next[i * n8..(i + 1) * n8].fill(any);
+                    continue;
+                }
+                count.clear();
+                count.push(0);
+                for k in 0..3 * n8 {
+                    let c = count[k] + usize::from(row[k % n8]);
+                    count.push(c);
+                }
+                for j in 0..n8 {
+                    // cells j − d8 ..= j + d8, shifted by one turn
+                    let (a, z) = (j + n8 - d8, j + n8 + d8 + 1);
+                    next[i * n8 + j] = count[z] > count[a];
+                }
+            }
+            for j in 0..n8 {
+                count.clear();
+                count.push(0);
+                for i in 0..n7 {
+                    let c = count[i] + usize::from(next[i * n8 + j]);
+                    count.push(c);
+                }
+                for i in 0..n7 {
+                    let a = i.saturating_sub(d7);
+                    let z = i.saturating_add(d7).min(n7 - 1) + 1;
+                    reach[i * n8 + j] = count[z] > count[a];
+                }
+            }
+        }
+        let mut any = false;
+        for (i, t) in tilted.iter().enumerate() {
+            for (j, (s, c)) in turns.iter().enumerate() {
+                let k = i * n8 + j;
+                if reach[k] {
+                    let w = Vector3::new(c * bm.x - s * bm.y, s * bm.x + c * bm.y, bm.z);
+                    reach[k] = t.dot(&w) >= min_cos;
+                    any |= reach[k];
+                }
+            }
+        }
+        if !any {
+            return Some(m);
+        }
+        let moved = |v: f64, h: f64| !v.is_finite() || v * (t - t_anchor) >= 4.0 * h;
+        if m == 0 || (moved(v7, h7) && moved(v8, h8)) {
+            anchor.copy_from_slice(&reach);
+            t_anchor = t;
+        }
+    }
+    None
+}
+
 /// Positioner laws of one layer [module doc]. `travel_speed_mm_s`: the
 /// programmed speed of the torch over the part (mm/s); `margin_rad`: how far
 /// inside its travel each axis stays (rad); `q8_hint`: the turn the layer
@@ -929,10 +1064,28 @@ fn finish(
     let c = check(pb, &joints);
     let (required, between) = required_rotation_rate(&pb.b, &pb.dt, pb.cone);
     let available = pb.max_speed[0] + pb.max_speed[1];
+    // a law that leaves the cone, not proven by the rate: search every
+    // positioner path on a grid (only where a speed is bounded: an
+    // unlimited positioner reaches any pose at every point)
+    let left_cone = matches!(c.binding, Some((_, PositionerBinding::Cone { .. })));
+    let unreachable =
+        if left_cone && required <= available && pb.max_speed.iter().any(|v| v.is_finite()) {
+            unreachable_point(
+                &pb.cell.positioner,
+                &pb.r0,
+                &pb.b,
+                &pb.dt,
+                pb.cone,
+                2f64.to_radians(),
+            )
+        } else {
+            None
+        };
     PositionerLaw {
         required_rate_rad_s: required,
         available_rate_rad_s: available,
-        proven_infeasible: required > available,
+        proven_infeasible: required > available || unreachable.is_some(),
+        unreachable_point: unreachable,
         required_between: between,
         max_tilt_rad: c.max_tilt.0,
         max_tilt_point: c.max_tilt.1,
@@ -1010,6 +1163,38 @@ mod tests {
         let mut dt2 = dt[..11].to_vec();
         dt2[10] = 0.0;
         assert!(required_rotation_rate(&corner, &dt2, cone).0.is_infinite());
+    }
+
+    /// The grid search proves what the rate bound cannot: `b` tilting from
+    /// −40° to +40° about the table's Y axis in 1 s needs the tilt to move
+    /// by 50° (the turn cannot lessen a tilt from the table normal), which a
+    /// 10°/s tilt cannot, however fast the turn (the rate bound sees
+    /// 10 + 1000°/s); at 100°/s a path exists and none is claimed.
+    #[test]
+    fn the_grid_search_proves_a_tilt_too_slow_for_the_layer() {
+        let mut pos = Positioner::robowam_nominal();
+        pos.limits[0] = crate::robot::model::JointLimit {
+            lower_rad: -135f64.to_radians(),
+            upper_rad: 135f64.to_radians(),
+        };
+        let n = 51;
+        let b: Vec<Vector3> = (0..n)
+            .map(|m| {
+                let a = (-40.0 + 80.0 * m as f64 / (n - 1) as f64).to_radians();
+                Vector3::new(a.sin(), 0.0, a.cos())
+            })
+            .collect();
+        let dt = vec![0.02; n];
+        let cone = 15f64.to_radians();
+        let r0 = Matrix3::identity();
+        let cell = 1f64.to_radians();
+        pos.max_speed_rad_s = [10f64.to_radians(), 1000f64.to_radians()];
+        let (rate, _) = required_rotation_rate(&b, &dt, cone);
+        assert!(rate < pos.max_speed_rad_s[0] + pos.max_speed_rad_s[1]);
+        let at = unreachable_point(&pos, &r0, &b, &dt, cone, cell);
+        assert!(at.is_some_and(|m| m > 0 && m < n), "{at:?}");
+        pos.max_speed_rad_s = [100f64.to_radians(), 1000f64.to_radians()];
+        assert_eq!(unreachable_point(&pos, &r0, &b, &dt, cone, cell), None);
     }
 
     fn cell(cone_deg: f64) -> TorchCarriedCell {

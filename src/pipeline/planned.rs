@@ -441,9 +441,14 @@ impl PlannedPart {
                 let law = l.positioner.as_ref()?;
                 law.proven_infeasible.then(|| json!({
                     "layer": l.layer,
+                    // "rate": the positioner cannot turn the part fast
+                    // enough between the two points; "reachability": no
+                    // positioner path reaches the point within the cone
+                    "proof": if law.required_rate_rad_s > law.available_rate_rad_s { "rate" } else { "reachability" },
                     "required_rate_deg_s": finite_or_null(law.required_rate_rad_s.to_degrees()),
                     "available_rate_deg_s": finite_or_null(law.available_rate_rad_s.to_degrees()),
                     "between_points": [law.required_between.0, law.required_between.1],
+                    "unreachable_point": law.unreachable_point,
                 }))
             }).collect::<Vec<_>>(),
             "violations": violations,
@@ -529,6 +534,7 @@ fn positioner_summary(law: &crate::optimise::positioner::PositionerLaw) -> Value
         "available_rate_deg_s": finite_or_null(law.available_rate_rad_s.to_degrees()),
         "required_between_points": [law.required_between.0, law.required_between.1],
         "proven_infeasible": law.proven_infeasible,
+        "unreachable_point": law.unreachable_point,
         "iterations": law.iterations,
         "samples": law.samples,
     })

@@ -239,7 +239,12 @@ fn a_layer_without_joints_exits_2_with_its_summary_and_report() {
             assert!(!unbuildable.is_empty());
             for u in unbuildable {
                 let need = u["required_rate_deg_s"].as_f64().unwrap_or(f64::INFINITY);
-                assert!(need > u["available_rate_deg_s"].as_f64().unwrap());
+                let rate = need > u["available_rate_deg_s"].as_f64().unwrap();
+                match u["proof"].as_str().unwrap() {
+                    "rate" => assert!(rate, "{u}"),
+                    "reachability" => assert!(!rate && u["unreachable_point"].is_u64(), "{u}"),
+                    other => panic!("{other}"),
+                }
             }
             let tilt = plans[10]["positioner"]["max_tilt_deg"].as_f64().unwrap();
             assert!(tilt <= 15.0 + 1e-6, "{tilt}");
