@@ -4,38 +4,10 @@
 //! SPEC §6.1 (independent of the library's model); the placed cell file reads
 //! back and stays feasible when placed again; bad bounds name their field.
 
-use crate::common::part_path;
+use crate::common::{part_path, rx, ry, rz, spec_fk};
 use waam_slicer::math::{Matrix3, Vector3};
 use waam_slicer::pipeline::{place_part, PlaceRequest};
 use waam_slicer::{plan_part, Cell, Part, PlanOptions, SliceOverrides};
-
-fn rx(a: f64) -> Matrix3 {
-    let (s, c) = a.sin_cos();
-    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
-}
-fn ry(a: f64) -> Matrix3 {
-    let (s, c) = a.sin_cos();
-    Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
-}
-fn rz(a: f64) -> Matrix3 {
-    let (s, c) = a.sin_cos();
-    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
-}
-
-/// ArcMate 120iC flange pose from controller joints (rad), SPEC §6.1:
-/// p = Rz(J1)[150,0,0] + Rz(J1)Ry(J2)[0,0,790] + Rz(J1)Ry(-J3)[835,0,250] + R6[100,0,0],
-/// flange rotation R6·[[0,0,1],[0,-1,0],[1,0,0]].
-fn spec_fk(q: &[f64; 6]) -> (Matrix3, Vector3) {
-    let r1 = rz(q[0]);
-    let r3 = r1 * ry(-q[2]);
-    let r6 = r3 * rx(-q[3]) * ry(-q[4]) * rx(-q[5]);
-    let p = r1 * Vector3::new(150.0, 0.0, 0.0)
-        + r1 * ry(q[1]) * Vector3::new(0.0, 0.0, 790.0)
-        + r3 * Vector3::new(835.0, 0.0, 250.0)
-        + r6 * Vector3::new(100.0, 0.0, 0.0);
-    let flange = r6 * Matrix3::new(0.0, 0.0, 1.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0);
-    (flange, p)
-}
 
 #[test]
 fn spec_fk_reproduces_the_spec_check_values() {

@@ -11,23 +11,10 @@
 //! Infeasible layers must be named: proven unbuildable by the geometric rate
 //! bound, or bound by a named constraint.
 
-use crate::common::part_path;
+use crate::common::{part_path, rx, ry, rz, spec_fk, SAMPLE_PARTS};
 use waam_slicer::math::{Matrix3, Vector3};
 use waam_slicer::optimise::LayerStatus;
 use waam_slicer::{plan_part, Cell, Part, PlanOptions, SliceOverrides};
-
-fn rx(a: f64) -> Matrix3 {
-    let (s, c) = a.sin_cos();
-    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
-}
-fn ry(a: f64) -> Matrix3 {
-    let (s, c) = a.sin_cos();
-    Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
-}
-fn rz(a: f64) -> Matrix3 {
-    let (s, c) = a.sin_cos();
-    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
-}
 
 /// A rigid transform as (rotation, translation mm).
 type Frame = (Matrix3, Vector3);
@@ -49,17 +36,7 @@ fn xyzwpr(v: &[f64]) -> Frame {
 
 /// ArcMate 120iC flange from controller joints (rad), SPEC §6.1.
 fn fanuc_fk(q: &[f64; 6]) -> Frame {
-    let r1 = rz(q[0]);
-    let r3 = r1 * ry(-q[2]);
-    let r6 = r3 * rx(-q[3]) * ry(-q[4]) * rx(-q[5]);
-    let p = r1 * Vector3::new(150.0, 0.0, 0.0)
-        + r1 * ry(q[1]) * Vector3::new(0.0, 0.0, 790.0)
-        + r3 * Vector3::new(835.0, 0.0, 250.0)
-        + r6 * Vector3::new(100.0, 0.0, 0.0);
-    (
-        r6 * Matrix3::new(0.0, 0.0, 1.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0),
-        p,
-    )
+    spec_fk(q)
 }
 
 /// A URDF serial chain: per joint the origin (mm, no rotation) and the
@@ -317,17 +294,10 @@ const TORCH_CELLS: [&str; 3] = [
     "abb_irb2600_torch_carried.toml",
 ];
 
-const ALL_PARTS: [&str; 9] = [
-    "hemisphere.toml",
-    "nozzle.toml",
-    "half-catenoid.toml",
-    "quarter-torus.toml",
-    "general-tube.toml",
-    "torus-on-cylinder.toml",
-    "elbow.toml",
-    "helix.toml",
-    "s-bend.toml",
-];
+/// The eight sample parts and the S-bend.
+fn all_parts() -> impl Iterator<Item = &'static str> {
+    SAMPLE_PARTS.into_iter().chain(["s-bend.toml"])
+}
 
 /// Plans every sample part in every torch-carried cell at `slice`, checks
 /// it, and returns per pair the feasible and infeasible layer counts.
@@ -336,7 +306,7 @@ fn matrix(slice: &SliceOverrides) -> Vec<(String, usize, usize, usize)> {
     for cell_file in TORCH_CELLS {
         let cell = Cell::read(part_path(&format!("cells/{cell_file}"))).unwrap();
         let d = cell_data(cell_file);
-        for part_file in ALL_PARTS {
+        for part_file in all_parts() {
             let part = Part::read(part_path(part_file)).unwrap();
             let opts = PlanOptions {
                 slice: slice.clone(),
