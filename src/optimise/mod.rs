@@ -157,6 +157,25 @@ pub struct LayerPoints {
     pub points: Vec<CellPoint>,
 }
 
+impl LayerPoints {
+    /// The same layer with the positioner joints `[q7, q8]` (rad) planned
+    /// for its points, one per point.
+    pub fn with_positioner(&self, joints: &[crate::robot::positioner::PositionerJoints]) -> Self {
+        Self {
+            layer: self.layer,
+            points: self
+                .points
+                .iter()
+                .zip(joints)
+                .map(|(p, q)| CellPoint {
+                    positioner: Some(*q),
+                    ..*p
+                })
+                .collect(),
+        }
+    }
+}
+
 /// Layers of `path` with the tool axes and build directions of `frames`
 /// (from [`toolaxis::local_frames`](crate::toolaxis::local_frames)).
 pub fn layer_points(path: &Path, frames: &[Vec<LocalFrame>]) -> Vec<LayerPoints> {
@@ -322,19 +341,7 @@ fn vertical_alternative(
     if !alt.feasible {
         return None;
     }
-    let points = LayerPoints {
-        layer: layer.layer,
-        points: layer
-            .points
-            .iter()
-            .zip(&alt.joints)
-            .map(|(p, q)| CellPoint {
-                positioner: Some(*q),
-                ..*p
-            })
-            .collect(),
-    };
-    let plan = optimise_layer(cell, &points, opts, None).0;
+    let plan = optimise_layer(cell, &layer.with_positioner(&alt.joints), opts, None).0;
     plan.status.is_feasible().then_some((plan, alt))
 }
 
@@ -398,18 +405,7 @@ fn schedule_positioner(
     let scheduled = layers
         .iter()
         .zip(&laws)
-        .map(|(l, law)| LayerPoints {
-            layer: l.layer,
-            points: l
-                .points
-                .iter()
-                .zip(&law.joints)
-                .map(|(p, q)| CellPoint {
-                    positioner: Some(*q),
-                    ..*p
-                })
-                .collect(),
-        })
+        .map(|(l, law)| l.with_positioner(&law.joints))
         .collect();
     (Some(scheduled), Some(laws))
 }

@@ -280,27 +280,38 @@ impl Basis {
         self.with_coefficients(self.len() + 1)
     }
 
+    /// `BᵀB` and `Bᵀ(r − r0)`: the normal equations of a fit to `r`.
+    fn normal_equations(
+        &self,
+        r: &[f64],
+        r0: f64,
+    ) -> (nalgebra::DMatrix<f64>, nalgebra::DVector<f64>) {
+        let k = self.len();
+        let mut ata = nalgebra::DMatrix::<f64>::zeros(k, k);
+        let mut atb = nalgebra::DVector::<f64>::zeros(k);
+        let mut row = Vec::new();
+        for (m, rm) in r.iter().enumerate() {
+            self.row(m, &mut row);
+            for &(i, a) in &row {
+                atb[i] += a * (rm - r0);
+                for &(j, b) in &row {
+                    ata[(i, j)] += a * b;
+                }
+            }
+        }
+        (ata, atb)
+    }
+
     /// Least-squares coefficients reproducing the values `r` (rad) per point
     /// (normal equations; exact when `r` is in the span).
     pub fn fit(&self, r: &[f64]) -> Vec<f64> {
         match self {
             Self::PerPoint { .. } => r.to_vec(),
             Self::Spline { .. } => {
-                // normal equations with a tiny ridge (a span without points
-                // leaves its coefficient to its neighbours)
+                // a tiny ridge: a span without points leaves its
+                // coefficient to its neighbours
+                let (mut ata, atb) = self.normal_equations(r, 0.0);
                 let k = self.len();
-                let mut ata = nalgebra::DMatrix::<f64>::zeros(k, k);
-                let mut atb = nalgebra::DVector::<f64>::zeros(k);
-                let mut row = Vec::new();
-                for (m, rm) in r.iter().enumerate() {
-                    self.row(m, &mut row);
-                    for &(i, a) in &row {
-                        atb[i] += a * rm;
-                        for &(j, b) in &row {
-                            ata[(i, j)] += a * b;
-                        }
-                    }
-                }
                 let ridge = 1e-14 * (ata.trace() / k as f64).max(1e-300);
                 for i in 0..k {
                     ata[(i, i)] += ridge;
@@ -316,20 +327,7 @@ impl Basis {
                 ..
             } => {
                 let k = *coefficients;
-                let r0 = anchor.unwrap_or(0.0);
-                let mut ata = nalgebra::DMatrix::<f64>::zeros(k, k);
-                let mut atb = nalgebra::DVector::<f64>::zeros(k);
-                let mut row = Vec::new();
-                for (m, rm) in r.iter().enumerate() {
-                    let rm = rm - r0;
-                    self.row(m, &mut row);
-                    for &(i, a) in &row {
-                        atb[i] += a * rm;
-                        for &(j, b) in &row {
-                            ata[(i, j)] += a * b;
-                        }
-                    }
-                }
+                let (ata, atb) = self.normal_equations(r, anchor.unwrap_or(0.0));
                 match ata.cholesky() {
                     Some(ch) => ch.solve(&atb).iter().copied().collect(),
                     None => {
