@@ -178,8 +178,10 @@ pub fn stl(bytes: &[u8]) {
 
 use std::sync::OnceLock;
 use waam_slicer::io::cell_file::parse_cell_file;
-use waam_slicer::program::readback::{abb::parse_mod, kuka::parse_krl, parse_ls};
-use waam_slicer::program::validate::{validate_abb, validate_fanuc, validate_kuka};
+use waam_slicer::program::{abb::parse_mod, fanuc::parse_ls, kuka::parse_krl};
+use waam_slicer::program::abb::validate_abb;
+use waam_slicer::program::fanuc::validate_fanuc;
+use waam_slicer::program::kuka::validate_kuka;
 use waam_slicer::robot::{Cell, CellPoint};
 
 /// Cell-file target: text → `parse_cell_file`; errors must name the file.
@@ -217,6 +219,7 @@ pub fn cell_file(text: &str) {
             position_mm: Point3::new(10.0 * i as f64, -5.0, 2.0),
             tool_axis: UnitVector3::new_normalize(*a),
             build_direction: None,
+            positioner: None,
         };
         for r_z in [0.0, 1.0, -2.5] {
             if let Ok((q, pose)) = cell.joints(&p, r_z, near.as_ref(), 0.0) {

@@ -313,11 +313,7 @@ impl PlannedPart {
                 first: self.refusal.clone().unwrap_or_default(),
             })?;
         let settings = &self.cell.program;
-        Ok(match format {
-            ProgramFormat::Fanuc => crate::program::fanuc::fanuc_files(program, &settings.fanuc())?,
-            ProgramFormat::Kuka => crate::program::kuka::kuka_files(program, &settings.kuka())?,
-            ProgramFormat::Abb => crate::program::abb::abb_files(program, &settings.abb())?,
-        })
+        Ok(crate::program::contract::emit(program, settings)?)
     }
 
     /// Writes the robot program in `format` into `dir` (created if missing),

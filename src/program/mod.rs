@@ -11,15 +11,23 @@
 //! | piece | module | entry points |
 //! |---|---|---|
 //! | the program as data, feasibility check | this module | [`build_program`], [`Program`], [`ProgramPoint`], [`ArcFlag`] |
-//! | FANUC TP ASCII `.ls`, split at a point limit | [`fanuc`], [`split`] | [`fanuc::fanuc_files`], [`fanuc::write_ls`], [`split::chunks`] |
-//! | KUKA KRL `.src` + `.dat` | [`kuka`] | [`kuka::write_src`], [`kuka::write_dat`] |
-//! | ABB RAPID `.mod` | [`abb`] | [`abb::write_mod`] |
+//! | the vendor contract: options, emit, read, decode, one dispatch | [`contract`] | [`contract::Controller`], [`contract::emit`], [`contract::check_files`] |
+//! | FANUC TP ASCII `.ls` (emitter, reader, decoder) | [`fanuc`] | [`fanuc::Fanuc`], [`fanuc::fanuc_files`], [`fanuc::parse_ls`], [`fanuc::validate_fanuc`] |
+//! | KUKA KRL `.src` + `.dat` | [`kuka`] | [`kuka::Kuka`], [`kuka::kuka_files`], [`kuka::parse_krl`], [`kuka::validate_kuka`] |
+//! | ABB RAPID `.mod` | [`abb`] | [`abb::Abb`], [`abb::abb_files`], [`abb::parse_mod`], [`abb::validate_abb`] |
+//! | vendor-neutral words: move kinds, position modes | [`kinds`] | [`MoveKind`], [`PositionMode`] |
+//! | splitting at a point limit | [`split`] | [`split::chunks`] |
 //! | CSV of every point | [`csv`] | [`csv::write_csv`] |
-//! | readers of our FANUC, KUKA and ABB output | [`readback`] | [`readback::parse_ls`], [`readback::kuka::parse_krl`], [`readback::abb::parse_mod`] |
-//! | validator (file + cell) | [`validate`] | [`validate::validate_fanuc`], [`validate::validate_kuka`], [`validate::validate_abb`] |
+//! | the one checker of decoded steps (file + cell) | [`validate`] | [`validate::check_steps`], [`validate::Step`] |
 //! | approach and retract points | this module | [`build_program_with`], [`ProgramOptions`] |
+//! | arc-off transits against the wall | [`transit`] | [`transit::joint_move_clearance`] |
 //! | tool and work frames of every emitter | [`frames`] | [`frames::ToolFrames`], [`frames::held_tool`] |
 //! | number formatting | [`fmt`] | [`fmt::Fixed`] |
+//!
+//! Each vendor's folder holds its emitter (`mod.rs`), its reader
+//! (`read.rs`) and its decoder into the checker's steps (`decode.rs`), and
+//! implements [`contract::Controller`]; nothing outside [`contract`]
+//! chooses among vendors.
 //!
 //! JSON of every point: [`Program`] implements `serde::Serialize`; serialise
 //! it with any serde format (the command-line tool uses `serde_json`).
@@ -28,15 +36,18 @@
 //! rename).
 
 pub mod abb;
+pub mod contract;
 pub mod csv;
 pub mod fanuc;
 pub mod fmt;
 pub mod frames;
+pub mod kinds;
 pub mod kuka;
-pub mod readback;
 pub mod split;
 pub mod transit;
 pub mod validate;
+
+pub use kinds::{MoveKind, PositionMode};
 
 use std::path::Path;
 

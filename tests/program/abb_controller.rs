@@ -43,9 +43,10 @@
 use std::process::Command;
 
 use waam_slicer::math::{Point3, Vector3};
+use waam_slicer::program::abb::read::{parse_mod, RapidOp};
+use waam_slicer::program::abb::validate_abb;
 use waam_slicer::program::abb::{abb_files, AbbLoad, AbbOptions};
-use waam_slicer::program::readback::abb::{parse_mod, RapidOp};
-use waam_slicer::program::validate::{validate_abb, ProblemKind, ValidationReport};
+use waam_slicer::program::validate::{ProblemKind, ValidationReport};
 use waam_slicer::program::{
     build_program, BeadSetup, EmittedFile, HomePosition, Payload, ProcessControl, Program,
     ProgramError, TravelSpeed,
@@ -322,8 +323,7 @@ fn coordinated_work_object_and_v_reax() {
             .iter()
             .find(|t| t.name == format!("p{}", i + 1))
             .unwrap();
-        let waam_slicer::program::readback::abb::RapidTargetValue::Rob { pose, .. } = &t.value
-        else {
+        let waam_slicer::program::abb::read::RapidTargetValue::Rob { pose, .. } = &t.value else {
             panic!()
         };
         // the torch's TCP over the part frame (oframe = table_from_part = identity here)

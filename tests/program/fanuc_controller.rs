@@ -55,14 +55,14 @@
 //! else in the program (the pair is set up on the controller).
 
 use waam_slicer::math::Point3;
+use waam_slicer::program::fanuc::decode::fanuc_steps;
+use waam_slicer::program::fanuc::parse_ls;
+use waam_slicer::program::fanuc::validate_fanuc;
 use waam_slicer::program::fanuc::{
-    fanuc_files, joint_speed_ratio, FanucOptions, Op, PositionMode, TpProgram, JOINT_SPEED_MARGIN,
+    fanuc_files, joint_speed_ratio, FanucOptions, Op, TpProgram, JOINT_SPEED_MARGIN,
 };
-use waam_slicer::program::readback::fanuc::fanuc_steps;
-use waam_slicer::program::readback::parse_ls;
-use waam_slicer::program::validate::{
-    validate_fanuc, MotionSpeed, ProblemKind, Step, ValidationReport,
-};
+use waam_slicer::program::validate::{MotionSpeed, ProblemKind, Step, ValidationReport};
+use waam_slicer::program::PositionMode;
 use waam_slicer::program::{
     BeadSetup, HomePosition, Payload, Program, ProgramError, ProgramOptions,
 };
@@ -307,7 +307,7 @@ fn torch_carried_programs_are_coordinated_with_a_positioner_home() {
         }
         for ins in &tps[0].instructions {
             if let Op::Move { kind, options, .. } = ins.op {
-                let linear = kind == waam_slicer::program::fanuc::MoveKind::Linear;
+                let linear = kind == waam_slicer::program::MoveKind::Linear;
                 assert_eq!(options.coord, linear, "line {}", ins.line);
                 assert!(!options.rtcp);
             }

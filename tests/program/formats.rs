@@ -3,15 +3,17 @@
 //! file, a configuration flip) are rejected with a message naming the line.
 
 use waam_slicer::math::Point3;
+use waam_slicer::program::abb::read::parse_mod;
+use waam_slicer::program::abb::validate_abb;
 use waam_slicer::program::abb::{abb_files, AbbOptions};
-use waam_slicer::program::fanuc::{fanuc_files, FanucOptions, PositionMode};
+use waam_slicer::program::fanuc::parse_ls;
+use waam_slicer::program::fanuc::validate_fanuc;
+use waam_slicer::program::fanuc::{fanuc_files, FanucOptions};
+use waam_slicer::program::kuka::read::parse_krl;
+use waam_slicer::program::kuka::validate_kuka;
 use waam_slicer::program::kuka::{kuka_files, KukaOptions};
-use waam_slicer::program::readback::abb::parse_mod;
-use waam_slicer::program::readback::kuka::parse_krl;
-use waam_slicer::program::readback::parse_ls;
-use waam_slicer::program::validate::{
-    validate_abb, validate_fanuc, validate_kuka, ValidationReport,
-};
+use waam_slicer::program::validate::ValidationReport;
+use waam_slicer::program::PositionMode;
 use waam_slicer::program::{EmittedFile, Program, ProgramError};
 use waam_slicer::robot::Cell;
 

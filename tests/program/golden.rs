@@ -56,8 +56,9 @@ use std::path::PathBuf;
 
 use waam_slicer::program::abb::{abb_files, AbbOptions};
 use waam_slicer::program::csv::write_csv;
-use waam_slicer::program::fanuc::{fanuc_files, FanucOptions, PositionMode, SpeedUnit};
+use waam_slicer::program::fanuc::{fanuc_files, FanucOptions, SpeedUnit};
 use waam_slicer::program::kuka::{kuka_files, KukaOptions};
+use waam_slicer::program::PositionMode;
 use waam_slicer::program::{EmittedFile, ProcessControl, Program};
 
 use crate::fixture::{cell, part_carried, program};

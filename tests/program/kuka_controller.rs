@@ -60,9 +60,10 @@
 //! Not verified: that a KR C2/KR C4 loads and runs these files (no
 //! controller or KUKA.OfficeLite was available).
 
+use waam_slicer::program::kuka::read::{parse_krl, KrlOp};
+use waam_slicer::program::kuka::validate_kuka;
 use waam_slicer::program::kuka::{kuka_files, KukaOptions, HOME_NAME};
-use waam_slicer::program::readback::kuka::{parse_krl, KrlOp};
-use waam_slicer::program::validate::{validate_kuka, ProblemKind, ValidationReport};
+use waam_slicer::program::validate::{ProblemKind, ValidationReport};
 use waam_slicer::program::{
     BeadSetup, EmittedFile, HomePosition, Payload, ProcessControl, Program,
 };
@@ -370,7 +371,7 @@ fn the_positioner_is_math_coupled_when_coordinated() {
         .filter(|(_, p)| p.arc.is_bead())
     {
         let pos = &p.positions[i];
-        let waam_slicer::program::readback::kuka::KrlValue::Pos { xyzabc, .. } = pos.value else {
+        let waam_slicer::program::kuka::read::KrlValue::Pos { xyzabc, .. } = pos.value else {
             panic!("{} is not an E6POS", pos.name)
         };
         let v = std::f64::consts::TAU * pt.point as f64 / 8.0;

@@ -5,6 +5,7 @@
 mod abb_controller;
 mod api;
 mod cells;
+mod contract;
 mod fanuc_controller;
 mod fixture;
 mod formats;

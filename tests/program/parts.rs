@@ -12,13 +12,11 @@ use std::time::Instant;
 use waam_slicer::math::Point3;
 use waam_slicer::optimise::{layer_points, optimise, OptimiseOptions};
 use waam_slicer::path::slice;
-use waam_slicer::program::abb::{abb_files, AbbOptions};
-use waam_slicer::program::fanuc::{fanuc_files, FanucOptions, PositionMode};
-use waam_slicer::program::kuka::{kuka_files, KukaOptions};
-use waam_slicer::program::readback::abb::parse_mod;
-use waam_slicer::program::readback::kuka::parse_krl;
-use waam_slicer::program::readback::parse_ls;
-use waam_slicer::program::validate::{validate_abb, validate_fanuc, validate_kuka};
+use waam_slicer::program::abb::AbbOptions;
+use waam_slicer::program::contract::{Abb, Controller, Fanuc, Kuka};
+use waam_slicer::program::fanuc::FanucOptions;
+use waam_slicer::program::kuka::KukaOptions;
+use waam_slicer::program::PositionMode;
 use waam_slicer::program::{build_program, Program, TravelSpeed};
 use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions};
 use waam_slicer::robot::{Cell, Vendor};
@@ -68,49 +66,47 @@ fn plan_program(part: &str, cell: &Cell, layers_max: usize) -> Result<Program, S
         .map_err(|e| e.to_string())
 }
 
+/// Emits `prog` with `C`'s emitter, reads it back with `C`'s reader and
+/// validates it against `cell` and the planned points: no problem, every
+/// motion and bead found. The one round trip of every vendor.
+fn round_trip<C: Controller>(what: &str, prog: &Program, cell: &Cell, opts: &C::Options) {
+    let planned: Vec<Point3> = prog.bead_points().map(|p| p.position_mm).collect();
+    let files = C::emit(prog, opts).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let read = C::read(&files).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let r = C::validate(&read, cell, opts, Some(&planned));
+    assert!(r.is_ok(), "{what}, {}:\n{r}", C::EMITTER);
+    assert_eq!(
+        (r.motions, r.beads),
+        (prog.points.len(), prog.num_beads()),
+        "{what}"
+    );
+}
+
 /// Emits, reads back and validates `prog` in the format of the cell
 /// robot's vendor (FANUC joint and Cartesian, KUKA joint and Cartesian, or
 /// ABB); panics naming the first problem.
 fn check_all_formats(what: &str, prog: &Program, cell: &Cell) {
-    let planned: Vec<Point3> = prog.bead_points().map(|p| p.position_mm).collect();
-    let beads = prog.num_beads();
-    let motions = prog.points.len();
-    let vendor = cell.robot().vendor;
     for positions in [PositionMode::Joint, PositionMode::Cartesian] {
-        if vendor == Vendor::Fanuc {
-            let opts = FanucOptions {
-                positions,
-                ..Default::default()
-            };
-            let tps: Vec<_> = fanuc_files(prog, &opts)
-                .unwrap()
-                .iter()
-                .map(|f| parse_ls(&f.text, &f.name).unwrap_or_else(|e| panic!("{what}: {e}")))
-                .collect();
-            let r = validate_fanuc(&tps, cell, &opts, Some(&planned));
-            assert!(r.is_ok(), "{what}, FANUC {positions:?}:\n{r}");
-            assert_eq!((r.motions, r.beads), (motions, beads), "{what}");
+        match cell.robot().vendor {
+            Vendor::Fanuc => {
+                let opts = FanucOptions {
+                    positions,
+                    ..Default::default()
+                };
+                round_trip::<Fanuc>(what, prog, cell, &opts);
+            }
+            Vendor::Kuka => {
+                let opts = KukaOptions {
+                    positions,
+                    ..Default::default()
+                };
+                round_trip::<Kuka>(what, prog, cell, &opts);
+            }
+            Vendor::Abb if positions == PositionMode::Joint => {
+                round_trip::<Abb>(what, prog, cell, &AbbOptions::default());
+            }
+            Vendor::Abb => {}
         }
-        if vendor == Vendor::Kuka {
-            let kopts = KukaOptions {
-                positions,
-                ..Default::default()
-            };
-            let k = kuka_files(prog, &kopts).unwrap();
-            let krl = parse_krl(&k[0].text, &k[0].name, &k[1].text, &k[1].name)
-                .unwrap_or_else(|e| panic!("{what}: {e}"));
-            let r = validate_kuka(&krl, cell, &kopts, Some(&planned));
-            assert!(r.is_ok(), "{what}, KUKA {positions:?}:\n{r}");
-            assert_eq!((r.motions, r.beads), (motions, beads), "{what}");
-        }
-    }
-    if vendor == Vendor::Abb {
-        let aopts = AbbOptions::default();
-        let a = abb_files(prog, &aopts).unwrap();
-        let m = parse_mod(&a[0].text, &a[0].name).unwrap_or_else(|e| panic!("{what}: {e}"));
-        let r = validate_abb(&m, cell, &aopts, Some(&planned));
-        assert!(r.is_ok(), "{what}, ABB:\n{r}");
-        assert_eq!((r.motions, r.beads), (motions, beads), "{what}");
     }
 }
 

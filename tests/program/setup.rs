@@ -12,11 +12,11 @@
 //! lie inside the torch's nozzle column).
 
 use waam_slicer::math::{Point3, Vector3};
-use waam_slicer::program::fanuc::MoveKind;
 use waam_slicer::program::transit::{joint_move_clearance, torch_in_part, wall_of};
 use waam_slicer::program::validate::{
     check_steps, Motion, MotionSpeed, ProblemKind, Step, ValidationReport,
 };
+use waam_slicer::program::MoveKind;
 use waam_slicer::program::{
     build_program_with, ArcFlag, ProgramError, ProgramOptions, TravelSpeed,
 };

@@ -4,11 +4,10 @@
 //! concatenated motions are the unsplit program's; a bead longer than N is
 //! refused.
 
-use waam_slicer::program::fanuc::{
-    fanuc_files, ArmPosition, FanucOptions, MoveKind, Op, TpProgram,
-};
-use waam_slicer::program::readback::parse_ls;
-use waam_slicer::program::validate::validate_fanuc;
+use waam_slicer::program::fanuc::parse_ls;
+use waam_slicer::program::fanuc::validate_fanuc;
+use waam_slicer::program::fanuc::{fanuc_files, ArmPosition, FanucOptions, Op, TpProgram};
+use waam_slicer::program::MoveKind;
 
 use crate::fixture::{part_carried, program};
 

@@ -1,11 +1,13 @@
 //! The validator accepts our programs and rejects corrupted files, naming
 //! the line; the program stage refuses infeasible plans.
 
+use waam_slicer::program::fanuc::parse_ls;
+use waam_slicer::program::fanuc::validate_fanuc;
 use waam_slicer::program::fanuc::{
-    fanuc_files, write_ls, FanucOptions, MotionTiming, Op, PositionMode, TpProgram,
+    fanuc_files, write_ls, FanucOptions, MotionTiming, Op, TpProgram,
 };
-use waam_slicer::program::readback::parse_ls;
-use waam_slicer::program::validate::{validate_fanuc, ProblemKind, ValidationReport};
+use waam_slicer::program::validate::{ProblemKind, ValidationReport};
+use waam_slicer::program::PositionMode;
 use waam_slicer::program::{build_program, ProgramError, TravelSpeed};
 use waam_slicer::robot::Cell;
 

@@ -130,7 +130,7 @@ fn deeply_nested_abb_aggregate_is_refused() {
             "[".repeat(depth),
             "]".repeat(depth)
         );
-        let e = waam_slicer::program::readback::abb::parse_mod(&text, "deep.mod").unwrap_err();
+        let e = waam_slicer::program::abb::read::parse_mod(&text, "deep.mod").unwrap_err();
         let msg = e.to_string();
         assert!(
             msg.starts_with("deep.mod:2: ") && msg.contains("nest more than 16 deep"),
@@ -144,7 +144,7 @@ fn deeply_nested_abb_aggregate_is_refused() {
 /// each answers (accepts or refuses) in well under a second per megabyte.
 #[test]
 fn program_readers_answer_large_inputs_quickly() {
-    use waam_slicer::program::readback::{abb::parse_mod, kuka::parse_krl, parse_ls};
+    use waam_slicer::program::{abb::parse_mod, fanuc::parse_ls, kuka::parse_krl};
     let golden = |name: &str| {
         std::fs::read_to_string(
             Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -5,8 +5,8 @@
 use std::f64::consts::PI;
 
 use crate::math::Point3;
-use crate::program::fanuc::MoveKind;
 use crate::program::transit::{joint_move_clearance, WallBeads};
+use crate::program::MoveKind;
 use crate::program::ProgramOptions;
 use crate::robot::{Cell, Joints};
 use crate::toolaxis::collision::Torch;

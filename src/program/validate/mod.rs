@@ -13,26 +13,20 @@
 //! with decoded joints, process on and off, in execution order); one checker
 //! ([`check_steps`], in `check`) validates them; the decoders of FANUC,
 //! KUKA and ABB files are `fanuc`, `kuka` and `abb`, one a controller,
-//! each taking its [`readback`](super::readback) reader's output. Bead points are the motions made with
+//! each taking its vendor folder's reader's output. Bead points are the motions made with
 //! the process on plus the motion that reaches a bead's first point (the one
 //! before the process starts); the other motions (approach, retract,
 //! transitions) are checked for limits, configuration and speeds but not
 //! compared with the planned points.
 
-mod abb;
 mod check;
-mod fanuc;
-mod kuka;
 
-pub use abb::validate_abb;
 pub use check::check_steps;
-pub use fanuc::{parse_config, validate_fanuc};
-pub use kuka::validate_kuka;
 
 use std::fmt;
 
 use crate::math::{Isometry3, Point3};
-use crate::program::fanuc::MoveKind;
+use crate::program::MoveKind;
 use crate::robot::ik::wrap_pi;
 use crate::robot::{ArmSide, Cell, Configuration, Elbow, Joints, RobotModel, Vendor, Wrist};
 

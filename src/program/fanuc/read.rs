@@ -3,20 +3,14 @@
 //! [SPEC §8]. Errors name the file and line; a file without `/END`
 //! (truncated) is an error.
 //!
-//! KUKA and ABB output are read by [`kuka`] and [`abb`]; [`fanuc`] turns
-//! the TP programs into the validator's steps.
-//!
 //! [`write_ls`]: crate::program::fanuc::write_ls
 
-pub mod abb;
-pub mod fanuc;
-pub mod kuka;
-
+use crate::program::contract::read_file;
 use crate::program::fanuc::{
     ArmPosition, Instruction, MotionOptions, MoveKind, Op, PayloadField, Position, Speed,
     Termination, TpProgram,
 };
-use crate::program::ProgramError;
+use crate::program::{EmittedFile, ProgramError};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Section {
@@ -556,4 +550,49 @@ fn finish(p: Partial) -> Result<Position, (usize, String)> {
         value_lines,
         group2_line: p.group2_line,
     })
+}
+
+/// Most sub-programs a FANUC main program may call (directly or not).
+const MAX_CALLED_PROGRAMS: usize = 10_000;
+
+/// The files of the FANUC program at `main` and of every program it calls,
+/// read from the same folder (`NAME.ls`), each once, in the order first
+/// called; each named by its path.
+///
+/// # Errors
+/// [`ProgramError::Read`] naming the file (and the line for a parse error).
+pub fn files_with_calls(main: &std::path::Path) -> Result<Vec<EmittedFile>, ProgramError> {
+    let dir = main
+        .parent()
+        .map(std::path::Path::to_path_buf)
+        .unwrap_or_default();
+    let first = read_file(main)?;
+    let mut names = vec![parse_ls(&first.text, &first.name)?.name];
+    let mut files = vec![first];
+    let mut k = 0;
+    while k < files.len() {
+        let calls: Vec<String> = parse_ls(&files[k].text, &files[k].name)?
+            .instructions
+            .into_iter()
+            .filter_map(|i| match i.op {
+                Op::Call(n) => Some(n),
+                _ => None,
+            })
+            .collect();
+        for called in calls {
+            if !names.contains(&called) {
+                if files.len() >= MAX_CALLED_PROGRAMS {
+                    return Err(ProgramError::Read {
+                        file: main.display().to_string(),
+                        line: 0,
+                        reason: format!("calls more than {MAX_CALLED_PROGRAMS} programs"),
+                    });
+                }
+                files.push(read_file(&dir.join(format!("{called}.ls")))?);
+                names.push(called);
+            }
+        }
+        k += 1;
+    }
+    Ok(files)
 }

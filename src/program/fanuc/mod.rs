@@ -104,6 +104,17 @@
 //! schedule's inertia is left as set on the controller), dwell (`WAIT
 //! 30.00(sec)`), interpass wait (`WAIT DI[n]=ON`).
 
+pub mod decode;
+pub mod read;
+
+pub use decode::{fanuc_steps, parse_config, validate_fanuc};
+pub use read::parse_ls;
+
+use crate::program::contract::Controller;
+use crate::program::validate::{Step, ValidationReport};
+use crate::program::{ProgramOptions, ProgramSettings};
+use std::path::Path;
+
 use std::io::Write;
 
 use serde::{Deserialize, Serialize};
@@ -111,6 +122,7 @@ use serde::{Deserialize, Serialize};
 use crate::math::Isometry3;
 use crate::program::fmt::{ascii_comment, ceil_to, floor_to, FanucDeg, FanucMm, Fixed};
 use crate::program::frames::{fixed_torch_at, held_tool};
+use crate::program::kinds::{MoveKind, PositionMode};
 use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
 use crate::program::{
     check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
@@ -139,17 +151,6 @@ pub fn near_turn_edge(q: &Joints) -> bool {
 
 /// The remark opening a program with time-based linear moves (≤ 32 characters).
 pub const TIME_BASED_REMARK: &str = "TIMED: TORCH SPEED OVER PART";
-
-/// How positions are written.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PositionMode {
-    /// `J1..J6` in degrees (the thesis's articular mode: the branch is ours).
-    #[default]
-    Joint,
-    /// `X Y Z W P R` with configuration string and turn numbers.
-    Cartesian,
-}
 
 /// Unit of linear speeds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -611,15 +612,6 @@ impl std::fmt::Display for Termination {
     }
 }
 
-/// Joint (`J`) or linear (`L`) move.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MoveKind {
-    /// `J`.
-    Joint,
-    /// `L`.
-    Linear,
-}
-
 /// One `/MN` instruction.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Op {
@@ -776,7 +768,7 @@ pub struct Position {
 }
 
 /// A TP program as data: what [`write_ls`] prints and
-/// [`parse_ls`](crate::program::readback::parse_ls) reads.
+/// [`parse_ls`] reads.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TpProgram {
     /// `/PROG` name.
@@ -1384,6 +1376,51 @@ pub fn fanuc_files(
             })
         })
         .collect()
+}
+
+/// FANUC TP ASCII `.ls` programs: the [`Controller`] implementation.
+#[derive(Debug, Clone, Copy)]
+pub struct Fanuc;
+
+impl Controller for Fanuc {
+    const VENDOR: Vendor = Vendor::Fanuc;
+    const EMITTER: &'static str = EMITTER;
+    const EXTENSIONS: &'static [&'static str] = &["ls"];
+    type Options = FanucOptions;
+    type Read = Vec<TpProgram>;
+
+    fn options(settings: &ProgramSettings) -> FanucOptions {
+        settings.fanuc()
+    }
+
+    fn common(opts: &FanucOptions) -> &ProgramOptions {
+        &opts.common
+    }
+
+    fn emit(program: &Program, opts: &FanucOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+        fanuc_files(program, opts)
+    }
+
+    fn read(files: &[EmittedFile]) -> Result<Vec<TpProgram>, ProgramError> {
+        files.iter().map(|f| parse_ls(&f.text, &f.name)).collect()
+    }
+
+    fn files_on_disk(path: &Path) -> Result<Vec<EmittedFile>, ProgramError> {
+        read::files_with_calls(path)
+    }
+
+    fn main_file(read: &Vec<TpProgram>) -> &str {
+        read.first().map_or("", |p| p.name.as_str())
+    }
+
+    fn steps(
+        read: &Vec<TpProgram>,
+        cell: &Cell,
+        opts: &FanucOptions,
+        report: &mut ValidationReport,
+    ) -> Option<Vec<Step>> {
+        Some(fanuc_steps(read, cell, opts, report))
+    }
 }
 
 #[cfg(test)]

@@ -1,5 +1,5 @@
 //! ABB modules as [`Step`]s: the module read by
-//! [`parse_mod`](crate::program::readback::abb::parse_mod), each
+//! [`parse_mod`](crate::program::abb::read::parse_mod), each
 //! `robtarget` decoded with its `confdata` in the file's own frames (a
 //! fixed, robot-held or positioner-coordinated work object), every
 //! identifier the module uses checked to be declared in it (or to be the
@@ -10,17 +10,15 @@
 use std::f64::consts::TAU;
 
 use crate::math::{Isometry3, Point3};
+use crate::program::abb::read::{RapidFrame, RapidModule, ToolArg};
 use crate::program::abb::{AbbOptions, PREDEFINED_ZONES_MM};
-use crate::program::fanuc::MoveKind;
-use crate::program::readback::abb::{RapidFrame, RapidModule, ToolArg};
+use crate::program::MoveKind;
 use crate::program::ProcessControl;
-use crate::robot::{Cell, Configuration, Vendor};
+use crate::robot::{Cell, Configuration};
 
-use super::ProblemKind;
-use super::{arm_of, wrist_of_j5};
-use super::{
-    check_steps, decode_pose, push, vendor_matches, Motion, MotionSpeed, Step, ValidationReport,
-};
+use crate::program::validate::ProblemKind;
+use crate::program::validate::{arm_of, wrist_of_j5};
+use crate::program::validate::{decode_pose, push, Motion, MotionSpeed, Step, ValidationReport};
 
 /// The value of `q` (its solution in `(-π, π]`) shifted by whole turns to
 /// lie in ABB quadrant `cf` (`floor(q / 90°)`), `None` if more than 1e-6 rad
@@ -234,7 +232,7 @@ fn file_frames(
 }
 
 /// The module's declarations by name.
-type Decls<'a> = std::collections::HashMap<&'a str, &'a crate::program::readback::abb::RapidDecl>;
+type Decls<'a> = std::collections::HashMap<&'a str, &'a crate::program::abb::read::RapidDecl>;
 
 /// Pushes a Declaration problem unless `name` is declared with type `ty`
 /// (or `predefined`); `true` when it is.
@@ -327,7 +325,7 @@ fn check_motion_args(
 }
 
 /// Validates an ABB module read by
-/// [`parse_mod`](crate::program::readback::abb::parse_mod) against `cell`
+/// [`parse_mod`](crate::program::abb::read::parse_mod) against `cell`
 /// with the options `opts`; the frames are the file's own `tooldata` and
 /// `wobjdata` (held, coordinated with the positioner, or stationary tool).
 /// `robtarget`s are decoded with their `confdata`: `cfx` gives the branch
@@ -346,27 +344,32 @@ pub fn validate_abb(
     opts: &AbbOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
-    use crate::program::readback::abb::{RapidOp, RapidTargetValue};
-    let mut report = ValidationReport::default();
-    if !vendor_matches(
-        cell,
-        Vendor::Abb,
-        crate::program::abb::EMITTER,
-        &module.file,
-        &mut report,
-    ) {
-        return report;
-    }
+    use crate::program::contract::{Abb, Controller};
+    Abb::validate(module, cell, opts, planned)
+}
+
+/// The [`Step`]s of an ABB module (motions decoded, process on and off,
+/// waits, payloads) in execution order, with the problems of the file
+/// itself (declarations, frames, motion arguments) added to `report`;
+/// `None` when the options themselves are unusable (the problem is in
+/// `report`). The cell's robot must be an ABB arm.
+pub(crate) fn abb_steps(
+    module: &RapidModule,
+    cell: &Cell,
+    opts: &AbbOptions,
+    report: &mut ValidationReport,
+) -> Option<Vec<Step>> {
+    use crate::program::abb::read::{RapidOp, RapidTargetValue};
     let file = &module.file;
     let slots = match opts.positioner_slots() {
         Ok(s) => s,
         Err(e) => {
-            push(&mut report, ProblemKind::Options, file, 1, e.to_string());
-            return report;
+            push(report, ProblemKind::Options, file, 1, e.to_string());
+            return None;
         }
     };
     let robot = cell.robot();
-    let frames = file_frames(module, cell, opts, &mut report);
+    let frames = file_frames(module, cell, opts, report);
     let decls: Decls = module
         .declarations
         .iter()
@@ -404,7 +407,7 @@ pub fn validate_abb(
             RapidOp::WaitDi { signal, value } => {
                 if *signal != opts.interpass_signal {
                     push(
-                        &mut report,
+                        report,
                         ProblemKind::Declaration,
                         file,
                         line,
@@ -415,7 +418,7 @@ pub fn validate_abb(
                     );
                 } else if *value != 1 {
                     push(
-                        &mut report,
+                        report,
                         ProblemKind::Instruction,
                         file,
                         line,
@@ -425,7 +428,7 @@ pub fn validate_abb(
                     match opts.common.interpass_input {
                         Some(n) => steps.push(wait(None, Some(n))),
                         None => push(
-                            &mut report,
+                            report,
                             ProblemKind::Options,
                             file,
                             line,
@@ -438,8 +441,7 @@ pub fn validate_abb(
             RapidOp::GripLoad(name) => {
                 let load = if name == "load0" {
                     Some(crate::program::abb::LOAD0).map(|l| (l.mass_kg, Point3::from(l.cog_mm)))
-                } else if check_declared(module, &decls, name, "loaddata", false, line, &mut report)
-                {
+                } else if check_declared(module, &decls, name, "loaddata", false, line, report) {
                     module
                         .loads
                         .iter()
@@ -469,7 +471,7 @@ pub fn validate_abb(
                         line,
                     }),
                     _ => push(
-                        &mut report,
+                        report,
                         ProblemKind::Instruction,
                         file,
                         line,
@@ -479,7 +481,7 @@ pub fn validate_abb(
                 continue;
             }
             RapidOp::MoveAbsJ { target, zone, tool } => {
-                check_motion_args(module, &decls, zone, tool, line, &mut report);
+                check_motion_args(module, &decls, zone, tool, line, report);
                 (target, None, MoveKind::Joint, None, None)
             }
             RapidOp::Linear {
@@ -493,13 +495,13 @@ pub fn validate_abb(
                 zone,
                 tool,
             } => {
-                check_motion_args(module, &decls, zone, tool, line, &mut report);
+                check_motion_args(module, &decls, zone, tool, line, report);
                 let arc = instruction != "MoveL";
                 let mut v = *speed_mm_s;
                 if arc {
                     if start.is_some() {
                         push(
-                            &mut report,
+                            report,
                             ProblemKind::Options,
                             file,
                             line,
@@ -507,15 +509,15 @@ pub fn validate_abb(
                         );
                     }
                     if let Some(s) = seam {
-                        check_declared(module, &decls, s, "seamdata", false, line, &mut report);
+                        check_declared(module, &decls, s, "seamdata", false, line, report);
                     }
                     let wd = weld.as_deref().unwrap_or("");
-                    if check_declared(module, &decls, wd, "welddata", false, line, &mut report) {
+                    if check_declared(module, &decls, wd, "welddata", false, line, report) {
                         let d = module.welds.iter().find(|d| d.name == wd);
                         if let (Some(d), Some(sched)) = (d, schedule) {
                             if d.sched != sched as f64 {
                                 push(
-                                    &mut report,
+                                    report,
                                     ProblemKind::Options,
                                     file,
                                     line,
@@ -530,7 +532,7 @@ pub fn validate_abb(
                         if let (Some(d), true) = (d, instruction != "ArcLStart") {
                             if (d.weld_speed_mm_s - v).abs() > 1e-9 {
                                 push(
-                                    &mut report,
+                                    report,
                                     ProblemKind::Timing,
                                     file,
                                     line,
@@ -587,7 +589,7 @@ pub fn validate_abb(
         };
         if kind == MoveKind::Linear && !conf_l {
             push(
-                &mut report,
+                report,
                 ProblemKind::Configuration,
                 file,
                 line,
@@ -597,7 +599,7 @@ pub fn validate_abb(
         }
         let Some(t) = targets.get(target.as_str()).copied() else {
             push(
-                &mut report,
+                report,
                 ProblemKind::Declaration,
                 file,
                 line,
@@ -617,7 +619,7 @@ pub fn validate_abb(
             let turn = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).to_degrees();
             if turn / v_reax < time - 1e-3 {
                 push(
-                    &mut report,
+                    report,
                     ProblemKind::Timing,
                     file,
                     line,
@@ -642,7 +644,7 @@ pub fn validate_abb(
                 };
                 if !(0..8).contains(&conf[3]) || cfg != cell.configuration() {
                     push(
-                        &mut report, ProblemKind::Configuration,
+                        report, ProblemKind::Configuration,
                         file,
                         t.line,
                         format!(
@@ -657,7 +659,7 @@ pub fn validate_abb(
                     let at = f.at(cell, positioner);
                     if at.is_none() {
                         push(
-                            &mut report,
+                            report,
                             ProblemKind::Format,
                             file,
                             t.line,
@@ -685,14 +687,14 @@ pub fn validate_abb(
                         &t.name,
                         file,
                         t.line,
-                        &mut report,
+                        report,
                     )
                 });
                 (q, true)
             }
             _ => {
                 push(
-                    &mut report,
+                    report,
                     ProblemKind::Declaration,
                     file,
                     line,
@@ -726,6 +728,5 @@ pub fn validate_abb(
             None => {}
         }
     }
-    check_steps(&steps, cell, planned, &opts.common, &mut report);
-    report
+    Some(steps)
 }

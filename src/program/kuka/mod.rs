@@ -85,15 +85,26 @@
 //! programming manual's Status table as quoted on robot-forum.com (not
 //! checked against the manual itself).
 
+pub mod decode;
+pub mod read;
+
+pub use decode::validate_kuka;
+pub use read::parse_krl;
+
+use crate::program::contract::{read_file, Controller};
+use crate::program::validate::{Step, ValidationReport};
+use crate::program::{ProgramOptions, ProgramSettings};
+use std::path::Path;
+
 use std::io::Write;
 
 use serde::{Deserialize, Serialize};
 
 use crate::math::Isometry3;
-use crate::program::fanuc::PositionMode;
 use crate::program::fmt::{ascii_comment, floor_to, Deg, Fixed, Mm};
 pub use crate::program::frames::fixed_torch_at;
 use crate::program::frames::{held_tool, ToolFrames};
+use crate::program::PositionMode;
 use crate::program::{
     check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
     ArcFlag, BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
@@ -916,6 +927,65 @@ pub fn kuka_files(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFi
             text: render(|w| write_dat(w, program, opts))?,
         },
     ])
+}
+
+/// KUKA KRL `.src`/`.dat` programs: the [`Controller`] implementation.
+#[derive(Debug, Clone, Copy)]
+pub struct Kuka;
+
+impl Controller for Kuka {
+    const VENDOR: Vendor = Vendor::Kuka;
+    const EMITTER: &'static str = EMITTER;
+    const EXTENSIONS: &'static [&'static str] = &["src", "dat"];
+    type Options = KukaOptions;
+    type Read = read::KrlProgram;
+
+    fn options(settings: &ProgramSettings) -> KukaOptions {
+        settings.kuka()
+    }
+
+    fn common(opts: &KukaOptions) -> &ProgramOptions {
+        &opts.common
+    }
+
+    fn emit(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+        kuka_files(program, opts)
+    }
+
+    fn read(files: &[EmittedFile]) -> Result<read::KrlProgram, ProgramError> {
+        let find = |ext: &str| {
+            files
+                .iter()
+                .find(|f| f.name.to_ascii_lowercase().ends_with(ext))
+                .ok_or_else(|| ProgramError::Read {
+                    file: files.first().map_or_else(String::new, |f| f.name.clone()),
+                    line: 0,
+                    reason: format!("a KRL program needs its `{ext}` file"),
+                })
+        };
+        let (src, dat) = (find(".src")?, find(".dat")?);
+        parse_krl(&src.text, &src.name, &dat.text, &dat.name)
+    }
+
+    fn files_on_disk(path: &Path) -> Result<Vec<EmittedFile>, ProgramError> {
+        Ok(vec![
+            read_file(&path.with_extension("src"))?,
+            read_file(&path.with_extension("dat"))?,
+        ])
+    }
+
+    fn main_file(read: &read::KrlProgram) -> &str {
+        &read.src_file
+    }
+
+    fn steps(
+        read: &read::KrlProgram,
+        cell: &Cell,
+        opts: &KukaOptions,
+        report: &mut ValidationReport,
+    ) -> Option<Vec<Step>> {
+        Some(decode::kuka_steps(read, cell, opts, report))
+    }
 }
 
 #[cfg(test)]

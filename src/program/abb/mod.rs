@@ -92,6 +92,17 @@
 //!   axes are rotational: `v_leax` stays 5000 mm/s). The work object is
 //!   fixed (`[FALSE, TRUE, "", uframe, oframe]`).
 
+pub mod decode;
+pub mod read;
+
+pub use decode::validate_abb;
+pub use read::parse_mod;
+
+use crate::program::contract::{read_file, Controller};
+use crate::program::validate::{Step, ValidationReport};
+use crate::program::{ProgramOptions, ProgramSettings};
+use std::path::Path;
+
 use std::io::Write;
 
 use serde::{Deserialize, Serialize};
@@ -831,6 +842,56 @@ pub fn abb_files(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile
         name: format!("{}.mod", program.name),
         text: render(|w| write_mod(w, program, opts))?,
     }])
+}
+
+/// ABB RAPID `.mod` modules: the [`Controller`] implementation.
+#[derive(Debug, Clone, Copy)]
+pub struct Abb;
+
+impl Controller for Abb {
+    const VENDOR: Vendor = Vendor::Abb;
+    const EMITTER: &'static str = EMITTER;
+    const EXTENSIONS: &'static [&'static str] = &["mod"];
+    type Options = AbbOptions;
+    type Read = read::RapidModule;
+
+    fn options(settings: &ProgramSettings) -> AbbOptions {
+        settings.abb()
+    }
+
+    fn common(opts: &AbbOptions) -> &ProgramOptions {
+        &opts.common
+    }
+
+    fn emit(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+        abb_files(program, opts)
+    }
+
+    fn read(files: &[EmittedFile]) -> Result<read::RapidModule, ProgramError> {
+        let main = files.first().ok_or_else(|| ProgramError::Read {
+            file: String::new(),
+            line: 0,
+            reason: "no module to read".into(),
+        })?;
+        parse_mod(&main.text, &main.name)
+    }
+
+    fn files_on_disk(path: &Path) -> Result<Vec<EmittedFile>, ProgramError> {
+        Ok(vec![read_file(path)?])
+    }
+
+    fn main_file(read: &read::RapidModule) -> &str {
+        &read.file
+    }
+
+    fn steps(
+        read: &read::RapidModule,
+        cell: &Cell,
+        opts: &AbbOptions,
+        report: &mut ValidationReport,
+    ) -> Option<Vec<Step>> {
+        decode::abb_steps(read, cell, opts, report)
+    }
 }
 
 #[cfg(test)]

@@ -22,16 +22,17 @@ use std::collections::HashMap;
 use std::f64::consts::TAU;
 
 use crate::math::{Isometry3, Point3};
+use crate::program::contract::{validate_decoded, Fanuc};
 use crate::program::fanuc::{
     parse_frame_remark, ArmPosition, FanucFrames, FanucOptions, FrameKind, MoveKind, Op,
     PayloadField, TpProgram,
 };
 use crate::program::validate::{
-    decode_pose, parse_config, push, Motion, MotionSpeed, ProblemKind, Step, ValidationReport,
+    decode_pose, push, Motion, MotionSpeed, ProblemKind, Step, ValidationReport,
 };
 use crate::program::ProcessControl;
 use crate::robot::orientation::FanucPose;
-use crate::robot::Cell;
+use crate::robot::{Cell, Configuration};
 
 /// Largest difference between a stated frame and the options' frame:
 /// position (mm) and rotation (deg); the remarks print 3 decimals.
@@ -41,7 +42,7 @@ pub const FRAME_TOLERANCE: f64 = 0.005;
 /// into the others by name) in `cell` with `opts`, in execution order; what
 /// cannot be decoded or disagrees with the options is added to `report`
 /// (module doc). The cell's robot is assumed to be a FANUC arm (checked by
-/// [`validate_fanuc`](crate::program::validate::validate_fanuc)).
+/// [`validate_fanuc`]).
 pub fn fanuc_steps(
     programs: &[TpProgram],
     cell: &Cell,
@@ -511,4 +512,37 @@ fn xyzwpr(v: &[f64; 6]) -> String {
         "({:.3}, {:.3}, {:.3}, {:.3}, {:.3}, {:.3})",
         v[0], v[1], v[2], v[3], v[4], v[5]
     )
+}
+
+/// Validates `programs` (the first is executed; `CALL`s are followed into
+/// the others by name) against `cell`, with the frames and process of
+/// `opts`. `planned`: the planned deposition points of the beads (part
+/// frame, mm), one per bead motion in execution order, when available.
+/// A cell whose robot is not a FANUC arm is refused: the report holds that
+/// one problem ([`ProgramError::VendorMismatch`](crate::program::ProgramError::VendorMismatch)'s
+/// message, line 1 of the main program).
+pub fn validate_fanuc(
+    programs: &[TpProgram],
+    cell: &Cell,
+    opts: &FanucOptions,
+    planned: Option<&[Point3]>,
+) -> ValidationReport {
+    let main = programs.first().map_or("", |p| p.name.as_str());
+    validate_decoded::<Fanuc>(cell, main, opts, planned, |report| {
+        Some(fanuc_steps(programs, cell, opts, report))
+    })
+}
+
+/// Parses `F U T, 0, 0, 1` into the branch and the turns of J1, J4, J6.
+pub fn parse_config(s: &str) -> Option<(Configuration, [i32; 3])> {
+    let mut parts = s.split(',');
+    let cfg = Configuration::from_fanuc(parts.next()?)?;
+    let mut turns = [0; 3];
+    for t in &mut turns {
+        *t = parts.next()?.trim().parse().ok()?;
+    }
+    if parts.next().is_some() {
+        return None;
+    }
+    Some((cfg, turns))
 }

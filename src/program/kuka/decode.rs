@@ -1,5 +1,5 @@
 //! KUKA programs as [`Step`]s: the `.src`/`.dat` pair read by
-//! [`parse_krl`](crate::program::readback::kuka::parse_krl), each position
+//! [`parse_krl`](crate::program::kuka::read::parse_krl), each position
 //! decoded (`E6AXIS`, or `E6POS` with its Status and Turn bits).
 
 use std::f64::consts::TAU;
@@ -7,18 +7,16 @@ use std::f64::consts::TAU;
 use std::ops::{Mul, Sub};
 
 use crate::math::{Isometry3, Point3};
-use crate::program::fanuc::MoveKind;
 use crate::program::kuka::StatedBase;
-use crate::robot::{Cell, Configuration, Joints, Vendor};
+use crate::program::MoveKind;
+use crate::robot::{Cell, Configuration, Joints};
 
-use super::ProblemKind;
-use super::{arm_of, wrist_of_j5};
-use super::{
-    check_steps, decode_pose, push, vendor_matches, Motion, MotionSpeed, Step, ValidationReport,
-};
+use crate::program::validate::ProblemKind;
+use crate::program::validate::{arm_of, wrist_of_j5};
+use crate::program::validate::{decode_pose, push, Motion, MotionSpeed, Step, ValidationReport};
 
 /// Validates a KUKA program read by
-/// [`parse_krl`](crate::program::readback::kuka::parse_krl) against `cell`
+/// [`parse_krl`](crate::program::kuka::read::parse_krl) against `cell`
 /// with the frames, tool/base numbers and process of `opts` (as the
 /// [`Step`]s of the module doc). `E6POS` targets are decoded with the
 /// Status bits (branch, checked against the cell's) and, for `PTP`, the
@@ -27,24 +25,13 @@ use super::{
 /// value nearest the previous position. A cell whose robot is not a KUKA
 /// arm is refused: the report holds that one problem (line 1 of the `.src`).
 pub fn validate_kuka(
-    program: &crate::program::readback::kuka::KrlProgram,
+    program: &crate::program::kuka::read::KrlProgram,
     cell: &Cell,
     opts: &crate::program::kuka::KukaOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
-    let mut report = ValidationReport::default();
-    if !vendor_matches(
-        cell,
-        Vendor::Kuka,
-        crate::program::kuka::EMITTER,
-        &program.src_file,
-        &mut report,
-    ) {
-        return report;
-    }
-    let steps = kuka_steps(program, cell, opts, &mut report);
-    check_steps(&steps, cell, planned, &opts.common, &mut report);
-    report
+    use crate::program::contract::{Controller, Kuka};
+    Kuka::validate(program, cell, opts, planned)
 }
 
 /// The [`Step`]s of a KUKA program (motions decoded, process on and off,
@@ -52,12 +39,12 @@ pub fn validate_kuka(
 /// itself (frames, triggers, ignition handshake, end times) added to
 /// `report_out`. The cell's robot must be a KUKA arm.
 pub(crate) fn kuka_steps(
-    program: &crate::program::readback::kuka::KrlProgram,
+    program: &crate::program::kuka::read::KrlProgram,
     cell: &Cell,
     opts: &crate::program::kuka::KukaOptions,
     report_out: &mut ValidationReport,
 ) -> Vec<Step> {
-    use crate::program::readback::kuka::{KrlOp, KrlValue};
+    use crate::program::kuka::read::{KrlOp, KrlValue};
     use crate::robot::orientation::KukaAbc;
     let mut report = std::mem::take(report_out);
     let robot = cell.robot();
@@ -793,8 +780,8 @@ fn missing_burn_back(
 mod tests {
     use super::*;
     use crate::math::{UnitVector3, Vector3};
+    use crate::program::kuka::read::parse_krl;
     use crate::program::kuka::{kuka_files, KukaOptions, HOME_NAME};
-    use crate::program::readback::kuka::parse_krl;
     use crate::program::{build_program, BeadSetup, HomePosition, Payload, TravelSpeed};
     use crate::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
 

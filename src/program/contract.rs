@@ -1,0 +1,251 @@
+//! The one contract every robot controller's program format implements:
+//! its options (from the cell file's `[program]` table), its emitter (a
+//! [`Program`] to files), its reader (files back to the controller's own
+//! program model) and its decoder (that model to the checker's [`Step`]s,
+//! checked by the one [`check_steps`]).
+//! FANUC, KUKA and ABB each implement [`Controller`] in their own folder;
+//! [`with_controller`] is the one place that turns a [`Vendor`] into its
+//! implementation, so nothing else spells out the vendor list.
+
+use std::path::Path;
+
+use crate::math::Point3;
+pub use crate::program::abb::Abb;
+pub use crate::program::fanuc::Fanuc;
+pub use crate::program::kuka::Kuka;
+use crate::program::validate::{check_steps, vendor_matches, Step, ValidationReport};
+use crate::program::{EmittedFile, Program, ProgramError, ProgramOptions, ProgramSettings};
+use crate::robot::{Cell, Vendor};
+
+/// A robot controller's program format: options, emit, read, decode.
+///
+/// The round trip `emit` → `read` → `validate` of a feasible program gives
+/// a report without problems (tests/program/contract.rs, for every vendor).
+pub trait Controller {
+    /// The controller's vendor: only that vendor's arms are written or read.
+    const VENDOR: Vendor;
+    /// The format's name in messages, e.g. `FANUC TP`.
+    const EMITTER: &'static str;
+    /// Extensions of the format's files, lower case without the dot.
+    const EXTENSIONS: &'static [&'static str];
+    /// The emitter's options.
+    type Options: Clone + std::fmt::Debug;
+    /// The files read back: the controller's program model.
+    type Read;
+
+    /// The emitter's options from a cell file's `[program]` table, the
+    /// vendor-neutral set-up (`common`) included.
+    fn options(settings: &ProgramSettings) -> Self::Options;
+
+    /// The vendor-neutral set-up inside the options.
+    fn common(opts: &Self::Options) -> &ProgramOptions;
+
+    /// The program's files, the main (entry) file first.
+    ///
+    /// # Errors
+    /// [`ProgramError::VendorMismatch`] for another vendor's robot,
+    /// [`ProgramError::InvalidOptions`] naming the field, and what the
+    /// format cannot hold, named.
+    fn emit(program: &Program, opts: &Self::Options) -> Result<Vec<EmittedFile>, ProgramError>;
+
+    /// Reads files of this format (the main first; the others are what it
+    /// calls or pairs with).
+    ///
+    /// # Errors
+    /// [`ProgramError::Read`] naming the file and line.
+    fn read(files: &[EmittedFile]) -> Result<Self::Read, ProgramError>;
+
+    /// The files a program on disk is made of, starting from `path` (one of
+    /// them): its pair, the programs it calls, read from the same folder.
+    ///
+    /// # Errors
+    /// [`ProgramError::Read`] naming the file that cannot be read.
+    fn files_on_disk(path: &Path) -> Result<Vec<EmittedFile>, ProgramError>;
+
+    /// The file that problems about the whole program are reported against.
+    fn main_file(read: &Self::Read) -> &str;
+
+    /// Decodes the program into the checker's steps in execution order,
+    /// adding what is wrong with the files themselves to `report`; `None`
+    /// when the options cannot be used to decode (the problem is in
+    /// `report`).
+    fn steps(
+        read: &Self::Read,
+        cell: &Cell,
+        opts: &Self::Options,
+        report: &mut ValidationReport,
+    ) -> Option<Vec<Step>>;
+
+    /// Validates a program read back against `cell`: the vendor, the
+    /// files, then every step ([`check_steps`]). `planned`: the planned
+    /// deposition points of the bead motions (part frame, mm), when known.
+    fn validate(
+        read: &Self::Read,
+        cell: &Cell,
+        opts: &Self::Options,
+        planned: Option<&[Point3]>,
+    ) -> ValidationReport
+    where
+        Self: Sized,
+    {
+        validate_decoded::<Self>(cell, Self::main_file(read), opts, planned, |report| {
+            Self::steps(read, cell, opts, report)
+        })
+    }
+}
+
+/// [`Controller::validate`] with the decoding given: the vendor checked
+/// (against `main_file`, line 1), then `decode`'s steps checked.
+pub(crate) fn validate_decoded<C: Controller>(
+    cell: &Cell,
+    main_file: &str,
+    opts: &C::Options,
+    planned: Option<&[Point3]>,
+    decode: impl FnOnce(&mut ValidationReport) -> Option<Vec<Step>>,
+) -> ValidationReport {
+    let mut report = ValidationReport::default();
+    if !vendor_matches(cell, C::VENDOR, C::EMITTER, main_file, &mut report) {
+        return report;
+    }
+    if let Some(steps) = decode(&mut report) {
+        check_steps(&steps, cell, planned, C::common(opts), &mut report);
+    }
+    report
+}
+
+/// Something done with one controller's implementation, chosen at run time
+/// by [`with_controller`].
+pub trait ControllerTask {
+    /// What the task returns.
+    type Output;
+    /// Runs the task with controller `C`.
+    fn run<C: Controller>(self) -> Self::Output;
+}
+
+/// Runs `task` with the implementation of `vendor`'s controller: the one
+/// place the vendor list is spelt out.
+pub fn with_controller<T: ControllerTask>(vendor: Vendor, task: T) -> T::Output {
+    match vendor {
+        Vendor::Fanuc => task.run::<Fanuc>(),
+        Vendor::Kuka => task.run::<Kuka>(),
+        Vendor::Abb => task.run::<Abb>(),
+    }
+}
+
+/// Every vendor with a program format, in the order of messages.
+pub const VENDORS: [Vendor; 3] = [Vendor::Fanuc, Vendor::Kuka, Vendor::Abb];
+
+/// The vendor whose format uses files with extension `ext` (any case, no
+/// dot).
+pub fn vendor_of_extension(ext: &str) -> Option<Vendor> {
+    struct Owns<'a>(&'a str);
+    impl ControllerTask for Owns<'_> {
+        type Output = bool;
+        fn run<C: Controller>(self) -> bool {
+            C::EXTENSIONS.iter().any(|e| e.eq_ignore_ascii_case(self.0))
+        }
+    }
+    VENDORS.into_iter().find(|v| with_controller(*v, Owns(ext)))
+}
+
+/// The files of `program` in its robot's format, with that format's
+/// options from `settings`.
+///
+/// # Errors
+/// As [`Controller::emit`].
+pub fn emit(
+    program: &Program,
+    settings: &ProgramSettings,
+) -> Result<Vec<EmittedFile>, ProgramError> {
+    struct Emit<'a>(&'a Program, &'a ProgramSettings);
+    impl ControllerTask for Emit<'_> {
+        type Output = Result<Vec<EmittedFile>, ProgramError>;
+        fn run<C: Controller>(self) -> Self::Output {
+            C::emit(self.0, &C::options(self.1))
+        }
+    }
+    with_controller(program.cell.robot().vendor, Emit(program, settings))
+}
+
+/// Reads `files` as a program of `vendor`'s format and validates it against
+/// `cell` with the options of `settings`.
+///
+/// # Errors
+/// [`ProgramError::Read`] naming the file and line that cannot be read.
+pub fn check_files(
+    vendor: Vendor,
+    files: &[EmittedFile],
+    cell: &Cell,
+    settings: &ProgramSettings,
+    planned: Option<&[Point3]>,
+) -> Result<ValidationReport, ProgramError> {
+    struct Check<'a> {
+        files: &'a [EmittedFile],
+        cell: &'a Cell,
+        settings: &'a ProgramSettings,
+        planned: Option<&'a [Point3]>,
+    }
+    impl ControllerTask for Check<'_> {
+        type Output = Result<ValidationReport, ProgramError>;
+        fn run<C: Controller>(self) -> Self::Output {
+            let read = C::read(self.files)?;
+            Ok(C::validate(
+                &read,
+                self.cell,
+                &C::options(self.settings),
+                self.planned,
+            ))
+        }
+    }
+    with_controller(
+        vendor,
+        Check {
+            files,
+            cell,
+            settings,
+            planned,
+        },
+    )
+}
+
+/// The files of the program on disk at `path`, and its vendor (from the
+/// extension).
+///
+/// # Errors
+/// [`ProgramError::Read`] naming the file: an extension of no format, or a
+/// file that cannot be read.
+pub fn files_on_disk(path: &Path) -> Result<(Vendor, Vec<EmittedFile>), ProgramError> {
+    struct OnDisk<'a>(&'a Path);
+    impl ControllerTask for OnDisk<'_> {
+        type Output = Result<Vec<EmittedFile>, ProgramError>;
+        fn run<C: Controller>(self) -> Self::Output {
+            C::files_on_disk(self.0)
+        }
+    }
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let vendor = vendor_of_extension(ext).ok_or_else(|| ProgramError::Read {
+        file: path.display().to_string(),
+        line: 0,
+        reason: format!(
+            "unknown program type `.{}`; expected .ls (FANUC), .src/.dat (KUKA) or .mod (ABB)",
+            ext.to_ascii_lowercase()
+        ),
+    })?;
+    Ok((vendor, with_controller(vendor, OnDisk(path))?))
+}
+
+/// Reads the text of `path` as an [`EmittedFile`] named by its file name.
+///
+/// # Errors
+/// [`ProgramError::Read`] naming the file.
+pub fn read_file(path: &Path) -> Result<EmittedFile, ProgramError> {
+    let text = std::fs::read_to_string(path).map_err(|e| ProgramError::Read {
+        file: path.display().to_string(),
+        line: 0,
+        reason: format!("cannot read: {e}"),
+    })?;
+    Ok(EmittedFile {
+        name: path.display().to_string(),
+        text,
+    })
+}
