@@ -200,6 +200,7 @@ struct PositionerSection {
     lower_deg: Option<[f64; 2]>,
     upper_deg: Option<[f64; 2]>,
     max_speed_deg_s: Option<[f64; 2]>,
+    turn_stroke_deg: Option<[f64; 2]>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -377,7 +378,27 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
                     ))
                 }
             };
+            let turn_stroke = match ps.turn_stroke_deg {
+                None => None,
+                Some(_) if limits[1].lower_rad.is_finite() || limits[1].upper_rad.is_finite() => {
+                    return Err(invalid(
+                        "torch_carried.positioner.turn_stroke_deg",
+                        "give a stroke only for an endless turn (lower_deg/upper_deg -inf/inf): a finite travel is the stroke",
+                    ))
+                }
+                Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && hi - lo >= 360.0) => {
+                    return Err(invalid(
+                        "torch_carried.positioner.turn_stroke_deg",
+                        "must be finite and at least 360 degrees wide, so that every angle of the endless turn has a value in it",
+                    ))
+                }
+                Some([lo, hi]) => Some(JointLimit {
+                    lower_rad: lo.to_radians(),
+                    upper_rad: hi.to_radians(),
+                }),
+            };
             let positioner = Positioner {
+                turn_stroke,
                 name: ps.name,
                 tilt_to_table_mm: ps.tilt_to_table_mm,
                 limits,

@@ -28,6 +28,12 @@ pub trait Controller {
     const EMITTER: &'static str;
     /// Extensions of the format's files, lower case without the dot.
     const EXTENSIONS: &'static [&'static str];
+    /// `true` when the controller turns an endless external axis modulo
+    /// 360°, the shortest way, at most 180° a motion (KUKA: infinitely
+    /// rotating axis, KR C2 machine data §2.1.4). An endless positioner
+    /// turn without a stated stroke is then written modulo 360°; on the
+    /// others it is unwound by whole turns into a stroke.
+    const ENDLESS_TURN_MODULO: bool = false;
     /// The emitter's options.
     type Options: Clone + std::fmt::Debug;
     /// The files read back: the controller's program model.
@@ -129,6 +135,38 @@ pub fn with_controller<T: ControllerTask>(vendor: Vendor, task: T) -> T::Output 
         Vendor::Fanuc => task.run::<Fanuc>(),
         Vendor::Kuka => task.run::<Kuka>(),
         Vendor::Abb => task.run::<Abb>(),
+    }
+}
+
+/// The stroke of `cell`'s positioner turn on its robot's controller
+/// ([`Positioner::turn_stroke`](crate::robot::positioner::Positioner::turn_stroke)
+/// with the controller's [`Controller::ENDLESS_TURN_MODULO`]); `None`
+/// without a positioner. `UNLIMITED` for an endless turn the controller
+/// writes modulo 360°.
+pub fn turn_stroke(cell: &Cell) -> Option<crate::robot::JointLimit> {
+    match cell {
+        Cell::TorchCarried(c) => Some(c.positioner.turn_stroke(turn_modulo(cell))),
+        Cell::PartCarried(_) => None,
+    }
+}
+
+/// `true` when `cell`'s robot controller turns endless axes modulo 360°
+/// ([`Controller::ENDLESS_TURN_MODULO`]) and its positioner's turn is
+/// endless without a stated stroke: the turn is then written modulo 360°.
+pub fn turn_modulo(cell: &Cell) -> bool {
+    struct Modulo;
+    impl ControllerTask for Modulo {
+        type Output = bool;
+        fn run<C: Controller>(self) -> bool {
+            C::ENDLESS_TURN_MODULO
+        }
+    }
+    match cell {
+        Cell::TorchCarried(c) => {
+            with_controller(c.robot.vendor, Modulo)
+                && c.positioner.turn_stroke(true) == crate::robot::JointLimit::UNLIMITED
+        }
+        Cell::PartCarried(_) => false,
     }
 }
 

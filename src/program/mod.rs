@@ -857,6 +857,7 @@ pub fn build_program_with(
     if let Some(h) = &home {
         check_home(cell, h)?;
     }
+    unwind_turns(cell, &mut out, home.as_ref())?;
     let bead_setup = out
         .iter()
         .filter(|p| p.arc == ArcFlag::Start)
@@ -882,6 +883,67 @@ pub fn build_program_with(
     Ok(program)
 }
 
+/// Shifts the positioner's turn of each bead's block of points (approach,
+/// bead, retract) by whole turns into the turn's stroke
+/// ([`Positioner::turn_stroke`](crate::robot::positioner::Positioner::turn_stroke)),
+/// choosing, of the shifts that fit, the one that starts the block nearest
+/// where the table is (the previous block's last point, or home): the
+/// table unwinds during the arc-off joint move between beads, never during
+/// a bead. The turn is periodic, so the arm's joints and the deposition
+/// point are unchanged. Nothing to do without a positioner.
+///
+/// # Errors
+/// [`ProgramError::Infeasible`] naming the layer whose bead turns the
+/// table through more than the stroke holds.
+fn unwind_turns(
+    cell: &Cell,
+    points: &mut [ProgramPoint],
+    home: Option<&HomePosition>,
+) -> Result<(), ProgramError> {
+    use std::f64::consts::TAU;
+    let Cell::TorchCarried(c) = cell else {
+        return Ok(());
+    };
+    let stroke = contract::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
+    let mut at = home.and_then(|h| h.positioner).map_or(0.0, |q| q[1]);
+    for b in blocks(points) {
+        let turns: Vec<f64> = points[b.first..=b.last]
+            .iter()
+            .filter_map(|p| p.positioner.map(|q| q[1]))
+            .collect();
+        let Some(&start) = turns.first() else {
+            continue;
+        };
+        let lo = turns.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = turns.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        // Shifts k·2π with stroke.lower <= lo + k·2π and hi + k·2π <= stroke.upper.
+        let k_min = ((stroke.lower_rad - lo) / TAU).ceil();
+        let k_max = ((stroke.upper_rad - hi) / TAU).floor();
+        if k_min > k_max {
+            return Err(ProgramError::Infeasible {
+                count: 1,
+                first: format!(
+                    "layer {}: the bead turns the positioner's table from {:.1}° to {:.1}° ({:.1}°), more than its stroke [{:.1}°, {:.1}°] holds",
+                    points[b.start].layer,
+                    lo.to_degrees(),
+                    hi.to_degrees(),
+                    (hi - lo).to_degrees(),
+                    stroke.lower_rad.to_degrees(),
+                    stroke.upper_rad.to_degrees()
+                ),
+            });
+        }
+        let k = ((at - start) / TAU).round().clamp(k_min, k_max);
+        for p in &mut points[b.first..=b.last] {
+            if let Some(q) = &mut p.positioner {
+                q[1] += k * TAU;
+            }
+        }
+        at = points[b.last].positioner.map_or(at, |q| q[1]);
+    }
+    Ok(())
+}
+
 /// Refuses a home position outside the arm's (or positioner's) travel.
 fn check_home(cell: &Cell, h: &HomePosition) -> Result<(), ProgramError> {
     let bad = |what: String| ProgramError::InvalidOptions {
@@ -893,7 +955,9 @@ fn check_home(cell: &Cell, h: &HomePosition) -> Result<(), ProgramError> {
         return Err(bad(format!("J{} = {:.3}°", j + 1, v.to_degrees())));
     }
     if let (Cell::TorchCarried(c), Some(qp)) = (cell, h.positioner) {
-        for (i, (l, v)) in c.positioner.limits.iter().zip(qp).enumerate() {
+        let turn = contract::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
+        let stroke = [c.positioner.limits[0], turn];
+        for (i, (l, v)) in stroke.iter().zip(qp).enumerate() {
             if !l.contains(v) {
                 return Err(ProgramError::InvalidOptions {
                     field: "home_positioner_deg",
@@ -1144,7 +1208,9 @@ fn clearance_point(
         position_mm,
         tool_axis: p.tool_axis,
         build_direction: input.build_direction,
-        positioner: input.positioner,
+        // the planned positioner as the program writes it (its turn
+        // unwound by whole turns, `unwind_turns`)
+        positioner: input.positioner.and(p.positioner),
     };
     let q8 = p.positioner.map_or(0.0, |q| q[1]);
     let (q, pose) = cell

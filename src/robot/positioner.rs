@@ -33,12 +33,48 @@ pub struct Positioner {
     pub limits: [JointLimit; 2],
     /// Maximum speeds of `q7`, `q8` (rad/s); `inf` if unknown.
     pub max_speed_rad_s: [f64; 2],
+    /// The values of the turn `q8` (rad) the controller accepts when the
+    /// turn is endless (`limits[1]` unlimited): planning treats the turn as
+    /// endless, and the program stage shifts each bead's block of points by
+    /// whole turns into this stroke, unwinding the table during the arc-off
+    /// move between beads. `None`: [`DEFAULT_TURN_STROKE_RAD`]. Ignored
+    /// when the turn has a finite travel: that travel is then the stroke.
+    #[serde(default)]
+    pub turn_stroke: Option<JointLimit>,
 }
+
+/// The stroke of an endless turn when the cell states none: ±360° (rad).
+/// Every bead turning the table through at most 720° fits in it, and a
+/// limited rotary axis (KUKA: software limits within ±358°) can be set to
+/// hold a one-turn layer.
+pub const DEFAULT_TURN_STROKE_RAD: f64 = TAU;
 
 /// Joint values of the positioner `[q7, q8]` (rad).
 pub type PositionerJoints = [f64; 2];
 
 impl Positioner {
+    /// The programmed values the turn `q8` may take (rad) on a controller
+    /// that needs a stroke: its travel when finite, else the stated
+    /// [`turn_stroke`](Self::turn_stroke), else ±[`DEFAULT_TURN_STROKE_RAD`].
+    /// `modulo`: the controller turns an endless axis modulo 360° (KUKA's
+    /// infinitely rotating axes, [`Controller::ENDLESS_TURN_MODULO`](crate::program::contract::Controller::ENDLESS_TURN_MODULO)):
+    /// an endless turn without a stated stroke then has none (`UNLIMITED`).
+    pub fn turn_stroke(&self, modulo: bool) -> JointLimit {
+        let travel = self.limits[1];
+        if travel.lower_rad.is_finite() || travel.upper_rad.is_finite() {
+            travel
+        } else {
+            match self.turn_stroke {
+                Some(s) => s,
+                None if modulo => JointLimit::UNLIMITED,
+                None => JointLimit {
+                    lower_rad: -DEFAULT_TURN_STROKE_RAD,
+                    upper_rad: DEFAULT_TURN_STROKE_RAD,
+                },
+            }
+        }
+    }
+
     /// The ROBOWAM positioner with the nominal `|C7C8| = 150` mm [fig. 3.13].
     /// Travel and speeds are not given in the thesis: both unlimited.
     pub fn robowam_nominal() -> Self {
@@ -47,6 +83,7 @@ impl Positioner {
             tilt_to_table_mm: 150.0,
             limits: [JointLimit::UNLIMITED, JointLimit::UNLIMITED],
             max_speed_rad_s: [f64::INFINITY, f64::INFINITY],
+            turn_stroke: None,
         }
     }
 

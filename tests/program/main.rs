@@ -17,5 +17,6 @@ mod setup;
 #[path = "../common/mod.rs"]
 mod shared;
 mod split;
+mod strokes;
 mod transit_wall;
 mod validate;

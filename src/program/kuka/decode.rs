@@ -63,6 +63,15 @@ pub(crate) fn kuka_steps(
     let mut vel: Option<f64> = None;
     let mut pending: Vec<(u8, String, usize)> = Vec::new();
     let mut prev_q: Option<Joints> = None;
+    // An endless turn written modulo 360°: the controller takes the
+    // shortest way from where the table is (home's turn before the first
+    // motion).
+    let modulo = crate::program::contract::turn_modulo(cell);
+    let mut turn_at: f64 = opts
+        .common
+        .home(cell)
+        .and_then(|h| h.positioner)
+        .map_or(0.0, |q| q[1]);
     // external axes' path speeds (%), as the last `BAS (#VEL_PTP,n)` or
     // `$VEL_EXTAX[n]` left them (assumed 100 before either)
     let mut vel_extax = [100.0; 6];
@@ -561,8 +570,25 @@ pub(crate) fn kuka_steps(
                 ),
             );
         }
-        let positioner =
+        let mut positioner =
             matches!(cell, Cell::TorchCarried(_)).then(|| pos.external.map(f64::to_radians));
+        if let (true, Some(qp)) = (modulo, positioner.as_mut()) {
+            if qp[1].abs() > std::f64::consts::PI + 1e-9 {
+                push(
+                    report_out,
+                    ProblemKind::JointLimit,
+                    dat,
+                    pos.line,
+                    format!(
+                        "{}: E2 = {:.3}° on an infinitely rotating axis: written modulo 360° in (-180°, 180°]",
+                        pos.name,
+                        qp[1].to_degrees()
+                    ),
+                );
+            }
+            qp[1] = turn_at + crate::robot::ik::wrap_pi(qp[1] - turn_at);
+            turn_at = qp[1];
+        }
         let (joints, from_cartesian) = match &pos.value {
             KrlValue::Axis(a) => (Some(a.map(f64::to_radians)), false),
             KrlValue::Pos {

@@ -837,8 +837,14 @@ pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     check_vendor(&program.cell, Vendor::Kuka, EMITTER).map_err(std::io::Error::other)?;
     let robot = program.cell.robot();
     let (_, tool) = opts.frames(&program.cell);
+    // An endless turn written modulo 360° (the controller's infinitely
+    // rotating axis takes the shortest way, at most 180° a motion).
+    let modulo = crate::program::contract::turn_modulo(&program.cell);
     let ext_of = |q: Option<[f64; 2]>| {
-        let e = q.unwrap_or([0.0; 2]).map(f64::to_degrees);
+        let mut e = q.unwrap_or([0.0; 2]).map(f64::to_degrees);
+        if modulo {
+            e[1] = modulo_180(e[1]);
+        }
         format!(
             "E1 {},E2 {},E3 0.0,E4 0.0,E5 0.0,E6 0.0",
             Deg(e[0]),
@@ -929,6 +935,17 @@ pub fn kuka_files(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFi
     ])
 }
 
+/// `deg` in (−180°, 180°], the value an infinitely rotating KUKA axis is
+/// written with.
+pub fn modulo_180(deg: f64) -> f64 {
+    let r = deg.rem_euclid(360.0);
+    if r > 180.0 {
+        r - 360.0
+    } else {
+        r
+    }
+}
+
 /// KUKA KRL `.src`/`.dat` programs: the [`Controller`] implementation.
 #[derive(Debug, Clone, Copy)]
 pub struct Kuka;
@@ -937,6 +954,7 @@ impl Controller for Kuka {
     const VENDOR: Vendor = Vendor::Kuka;
     const EMITTER: &'static str = EMITTER;
     const EXTENSIONS: &'static [&'static str] = &["src", "dat"];
+    const ENDLESS_TURN_MODULO: bool = true;
     type Options = KukaOptions;
     type Read = read::KrlProgram;
 

@@ -143,7 +143,10 @@ pub fn check_steps(
                     format!("{}: no positioner values", m.label),
                 ),
                 Some(qp) => {
-                    for (n, l) in c.positioner.limits.iter().enumerate() {
+                    let turn = crate::program::contract::turn_stroke(cell)
+                        .unwrap_or(c.positioner.limits[1]);
+                    let travel = [c.positioner.limits[0], turn];
+                    for (n, l) in travel.iter().enumerate() {
                         if !l.contains(qp[n]) {
                             push(
                                 report,
@@ -325,22 +328,31 @@ fn check_setup(
         })
         .collect();
     if let Some(h) = common.home(cell) {
-        let is_home = |m: &Motion| {
-            m.kind == MoveKind::Joint
-                && m.joints.is_some_and(|q| {
-                    q.iter()
-                        .zip(h.joints)
-                        .all(|(a, b)| (a - b).abs() <= HOME_TOLERANCE_RAD)
-                })
-                && match (h.positioner, m.positioner) {
-                    (Some(a), Some(b)) => a
-                        .iter()
-                        .zip(b)
-                        .all(|(x, y)| (x - y).abs() <= HOME_TOLERANCE_RAD),
-                    (None, _) => true,
-                    (Some(_), None) => false,
-                }
+        // an endless turn written modulo 360° is home at any whole turn
+        let modulo = crate::program::contract::turn_modulo(cell);
+        let turn_difference = |n: usize, d: f64| {
+            if modulo && n == 1 {
+                crate::robot::ik::wrap_pi(d)
+            } else {
+                d
+            }
         };
+        let is_home =
+            |m: &Motion| {
+                m.kind == MoveKind::Joint
+                    && m.joints.is_some_and(|q| {
+                        q.iter()
+                            .zip(h.joints)
+                            .all(|(a, b)| (a - b).abs() <= HOME_TOLERANCE_RAD)
+                    })
+                    && match (h.positioner, m.positioner) {
+                        (Some(a), Some(b)) => a.iter().zip(b).enumerate().all(|(n, (x, y))| {
+                            turn_difference(n, x - y).abs() <= HOME_TOLERANCE_RAD
+                        }),
+                        (None, _) => true,
+                        (Some(_), None) => false,
+                    }
+            };
         let home_deg = |h: &crate::program::HomePosition| {
             h.joints
                 .iter()
