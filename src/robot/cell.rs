@@ -479,6 +479,10 @@ impl TorchCarriedCell {
 
 /// Either cell (closed set).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "a handful of cells per run, read by reference in the hot loops; boxing would only add an indirection"
+)]
 pub enum Cell {
     /// Fixed torch, the robot holds the part.
     PartCarried(PartCarriedCell),
