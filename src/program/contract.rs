@@ -34,6 +34,12 @@ pub trait Controller {
     /// turn without a stated stroke is then written modulo 360°; on the
     /// others it is unwound by whole turns into a stroke.
     const ENDLESS_TURN_MODULO: bool = false;
+    /// `true` when the controller always moves the part-carried cell's
+    /// linear moves about the fixed torch (KUKA's external TCP, ABB's
+    /// stationary tool): the path is linear over the part. `false`: only
+    /// with [`ProgramOptions::remote_tcp`] (FANUC `RTCP`), else the held
+    /// tool's pose is interpolated in the robot base frame.
+    const FIXED_TOOL_MOVES: bool = false;
     /// The emitter's options.
     type Options: Clone + std::fmt::Debug;
     /// The files read back: the controller's program model.
@@ -167,6 +173,24 @@ pub fn turn_modulo(cell: &Cell) -> bool {
                 && c.positioner.turn_stroke(true) == crate::robot::JointLimit::UNLIMITED
         }
         Cell::PartCarried(_) => false,
+    }
+}
+
+/// `true` when `cell`'s linear moves are interpolated in the part frame
+/// (the part is the moving frame: a fixed tool about which the part-carried
+/// robot moves, or coordinated motion with the positioner); `false` when
+/// in the robot base frame.
+pub fn moves_in_part_frame(cell: &Cell, opts: &ProgramOptions) -> bool {
+    struct FixedTool;
+    impl ControllerTask for FixedTool {
+        type Output = bool;
+        fn run<C: Controller>(self) -> bool {
+            C::FIXED_TOOL_MOVES
+        }
+    }
+    match cell {
+        Cell::TorchCarried(_) => opts.coordinated,
+        Cell::PartCarried(_) => opts.remote_tcp || with_controller(cell.robot().vendor, FixedTool),
     }
 }
 

@@ -36,6 +36,7 @@
 //! rename).
 
 pub mod abb;
+pub mod compress;
 pub mod contract;
 pub mod csv;
 pub mod fanuc;
@@ -43,6 +44,7 @@ pub mod fmt;
 pub mod frames;
 pub mod kinds;
 pub mod kuka;
+pub mod moves;
 pub mod split;
 pub mod transit;
 pub mod validate;
@@ -216,6 +218,10 @@ pub struct Program {
     pub home: Option<HomePosition>,
     /// What happens before each bead, one per bead in order (empty: nothing).
     pub bead_setup: Vec<BeadSetup>,
+    /// The planned deposition points of every bead in order (part frame,
+    /// mm), before the beads were thinned into moves
+    /// ([`moves::thin_beads`]): what a checker compares the moves with.
+    pub planned: Vec<Point3>,
 }
 
 impl Program {
@@ -477,6 +483,14 @@ pub struct ProgramOptions {
     /// cannot be loaded with Coordinated Motion, whose Cartesian `RX…RR`
     /// positions are not publicly specified). Default off.
     pub remote_tcp: bool,
+    /// Largest distance between the controller's interpolated path and the
+    /// planned points, over the part (mm): each bead is written with the
+    /// fewest linear moves within it ([`moves::thin_beads`]). 0: every
+    /// planned point is a move. Default 0.05 mm.
+    pub path_tolerance_mm: f64,
+    /// Largest angle between the interpolated and the planned torch axis
+    /// (deg, > 0) when beads are thinned. Default 0.5°.
+    pub orientation_tolerance_deg: f64,
 }
 
 impl Default for ProgramOptions {
@@ -496,6 +510,8 @@ impl Default for ProgramOptions {
             bead_radius_mm: 2.0,
             coordinated: true,
             remote_tcp: false,
+            path_tolerance_mm: 0.05,
+            orientation_tolerance_deg: 0.5,
         }
     }
 }
@@ -518,6 +534,20 @@ impl ProgramOptions {
                 "clearance_mm",
                 self.clearance_mm.to_string(),
                 "must be finite and >= 0",
+            );
+        }
+        if !(self.path_tolerance_mm.is_finite() && self.path_tolerance_mm >= 0.0) {
+            return bad(
+                "path_tolerance_mm",
+                self.path_tolerance_mm.to_string(),
+                "must be finite and >= 0 (0: every planned point is a move)",
+            );
+        }
+        if !(self.orientation_tolerance_deg.is_finite() && self.orientation_tolerance_deg > 0.0) {
+            return bad(
+                "orientation_tolerance_deg",
+                self.orientation_tolerance_deg.to_string(),
+                "must be finite and > 0",
             );
         }
         if !(self.approach_speed_mm_s.is_finite() && self.approach_speed_mm_s > 0.0) {
@@ -876,10 +906,13 @@ pub fn build_program_with(
         points: out,
         home,
         bead_setup,
+        planned: Vec::new(),
     };
     if opts.transit_check {
         safe_transits(&mut program, points, opts)?;
     }
+    program.planned = program.bead_points().map(|p| p.position_mm).collect();
+    moves::thin_beads(&mut program, opts)?;
     Ok(program)
 }
 

@@ -61,7 +61,7 @@ const PART: &str = "abb_irb2600_part_carried.toml";
 const TORCH: &str = "abb_irb2600_torch_carried.toml";
 
 fn planned(prog: &Program) -> Vec<Point3> {
-    prog.bead_points().map(|p| p.position_mm).collect()
+    prog.planned.clone()
 }
 
 fn check(text: &str, c: &Cell, opts: &AbbOptions, plan: &[Point3]) -> ValidationReport {

@@ -62,7 +62,7 @@ fn every_sample_cell_round_trips_through_the_contract() {
             Vendor::Kuka => same_as_direct::<Kuka>(&prog, &settings),
             Vendor::Abb => same_as_direct::<Abb>(&prog, &settings),
         };
-        let planned: Vec<_> = prog.bead_points().map(|p| p.position_mm).collect();
+        let planned: Vec<_> = prog.planned.clone();
         let r = check_files(vendor, &files, &cell, &settings, Some(&planned)).unwrap();
         assert!(r.is_ok(), "{file}:\n{r}");
         assert_eq!((r.motions, r.beads), (prog.points.len(), 3), "{file}");

@@ -29,7 +29,7 @@ fn abb_part_carried() -> Cell {
 
 fn hemi(cell: &Cell) -> (Program, Vec<Point3>) {
     let (prog, _) = program(cell, 0..4, 24);
-    let planned = prog.bead_points().map(|p| p.position_mm).collect();
+    let planned = prog.planned.clone();
     (prog, planned)
 }
 
@@ -500,7 +500,7 @@ fn abb_arc_start_after_moveabsj_is_not_timed() {
     for l in starts {
         assert!(!l.contains("\\T"), "{l}");
     }
-    let planned: Vec<Point3> = prog.bead_points().map(|p| p.position_mm).collect();
+    let planned: Vec<Point3> = prog.planned.clone();
     let r = abb_check(text, &c, &planned);
     assert!(r.is_ok(), "{r}");
 }

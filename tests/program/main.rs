@@ -18,5 +18,6 @@ mod setup;
 mod shared;
 mod split;
 mod strokes;
+mod thinning;
 mod transit_wall;
 mod validate;

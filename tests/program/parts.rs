@@ -70,7 +70,7 @@ fn plan_program(part: &str, cell: &Cell, layers_max: usize) -> Result<Program, S
 /// validates it against `cell` and the planned points: no problem, every
 /// motion and bead found. The one round trip of every vendor.
 fn round_trip<C: Controller>(what: &str, prog: &Program, cell: &Cell, opts: &C::Options) {
-    let planned: Vec<Point3> = prog.bead_points().map(|p| p.position_mm).collect();
+    let planned: Vec<Point3> = prog.planned.clone();
     let files = C::emit(prog, opts).unwrap_or_else(|e| panic!("{what}: {e}"));
     let read = C::read(&files).unwrap_or_else(|e| panic!("{what}: {e}"));
     let r = C::validate(&read, cell, opts, Some(&planned));

@@ -59,16 +59,13 @@ fn the_plan_winds_the_turn_and_the_program_unwinds_it_between_beads() {
             }
         }
         // The program's points are the planned ones shifted by whole turns.
-        let planned: Vec<f64> = path
+        let planned: std::collections::HashMap<(usize, usize), f64> = path
             .iter()
-            .filter_map(|p| p.positioner.map(|q| q[1]))
+            .filter_map(|p| p.positioner.map(|q| ((p.layer, p.point), q[1])))
             .collect();
-        if !planned.is_empty() {
-            let bead: Vec<f64> = prog
-                .bead_points()
-                .map(|p| p.positioner.unwrap()[1])
-                .collect();
-            for (a, b) in bead.iter().zip(&planned) {
+        for p in prog.bead_points() {
+            if let Some(b) = planned.get(&(p.layer, p.point)) {
+                let a = p.positioner.unwrap()[1];
                 let turns = (a - b) / std::f64::consts::TAU;
                 assert!((turns - turns.round()).abs() < 1e-9, "{file}: {a} vs {b}");
             }

@@ -852,6 +852,7 @@ impl Controller for Abb {
     const VENDOR: Vendor = Vendor::Abb;
     const EMITTER: &'static str = EMITTER;
     const EXTENSIONS: &'static [&'static str] = &["mod"];
+    const FIXED_TOOL_MOVES: bool = true;
     type Options = AbbOptions;
     type Read = read::RapidModule;
 

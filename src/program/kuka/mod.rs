@@ -954,6 +954,7 @@ impl Controller for Kuka {
     const VENDOR: Vendor = Vendor::Kuka;
     const EMITTER: &'static str = EMITTER;
     const EXTENSIONS: &'static [&'static str] = &["src", "dat"];
+    const FIXED_TOOL_MOVES: bool = true;
     const ENDLESS_TURN_MODULO: bool = true;
     type Options = KukaOptions;
     type Read = read::KrlProgram;

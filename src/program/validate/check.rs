@@ -11,6 +11,7 @@ use crate::program::ProgramOptions;
 use crate::robot::{Cell, Joints};
 use crate::toolaxis::collision::Torch;
 
+use super::between::{check_between, LinearMove};
 use super::ProblemKind;
 use super::{
     deposition_point, push, Motion, MotionSpeed, Step, ValidationReport, NAMES, REACH_TOLERANCE_MM,
@@ -50,6 +51,10 @@ pub fn check_steps(
     let robot = cell.robot();
     let mut arc_on: Option<(String, usize)> = None;
     let mut prev: Option<(Joints, Option<[f64; 2]>, Option<Point3>)> = None;
+    // the planned point each bead motion lands on, in order: thinned
+    // programs skip planned points, none goes back
+    let mut plan_cursor = 0;
+    let mut prev_matched: Option<usize> = None;
     let mut bead_motions = 0;
     let mut first_file: Option<String> = None;
     for (i, s) in steps.iter().enumerate() {
@@ -98,6 +103,7 @@ pub fn check_steps(
         }
         let Some(q) = m.joints else {
             prev = None;
+            prev_matched = None;
             continue;
         };
         for (j, name) in NAMES.iter().enumerate() {
@@ -166,17 +172,38 @@ pub fn check_steps(
             }
         }
         let dep = deposition_point(cell, &q, qp);
+        let mut matched = None;
         if let (true, Some(plan), Some(d)) = (bead[i], planned, dep) {
-            if let Some(target) = plan.get(k) {
-                let e = (d - target).norm();
-                if e > REACH_TOLERANCE_MM {
+            matched =
+                (plan_cursor..plan.len()).find(|&j| (d - plan[j]).norm() <= REACH_TOLERANCE_MM);
+            match matched {
+                // a bead's first motion lands on the next planned point:
+                // no bead is skipped
+                Some(j) if prev_matched.is_none() && j != plan_cursor => {
                     push(
                         report,
                         ProblemKind::Deviation,
                         &m.record_file,
                         m.value_lines[0],
                         format!(
-                            "{}: deposition point {e:.4} mm from the planned point {k}",
+                            "{}: a bead starts at planned point {j}, but the plan continues at point {plan_cursor}: planned points skipped",
+                            m.label
+                        ),
+                    );
+                    plan_cursor = j + 1;
+                }
+                Some(j) => plan_cursor = j + 1,
+                None => {
+                    let e = plan
+                        .get(plan_cursor.min(plan.len().saturating_sub(1)))
+                        .map_or(f64::INFINITY, |t| (d - t).norm());
+                    push(
+                        report,
+                        ProblemKind::Deviation,
+                        &m.record_file,
+                        m.value_lines[0],
+                        format!(
+                            "{}: deposition point on no planned point from {plan_cursor} on ({e:.4} mm from it; bead motion {k})",
                             m.label
                         ),
                     );
@@ -242,6 +269,35 @@ pub fn check_steps(
                 }
                 _ => None,
             };
+            // with the plan known, a move between neighbouring planned
+            // points is the plan's own discretisation (the planner checked
+            // it); the moves that skip planned points are sampled
+            let skips = match (planned, prev_matched, matched) {
+                (Some(_), Some(j0), Some(j1)) => j1 > j0 + 1,
+                (Some(_), _, _) => false,
+                (None, _, _) => true,
+            };
+            if let (Some((duration_s, _)), MoveKind::Linear, true) = (&dt, m.kind, skips) {
+                let planned_between = match (planned, prev_matched, matched) {
+                    // a move between neighbouring planned points is the
+                    // plan's own discretisation: only moves that skip planned
+                    // points are held to the planned polyline
+                    (Some(plan), Some(j0), Some(j1)) if bead[i] && j1 > j0 + 1 => {
+                        Some(&plan[j0..=j1])
+                    }
+                    _ => None,
+                };
+                msgs.extend(check_between(
+                    cell,
+                    common,
+                    &LinearMove {
+                        from: (pq, *pqp),
+                        to: (&q, qp),
+                        duration_s: *duration_s,
+                        planned: planned_between,
+                    },
+                ));
+            }
             if let Some((dt, how)) = dt {
                 for j in 0..6 {
                     let sp = (q[j] - pq[j]).abs() / dt;
@@ -274,6 +330,7 @@ pub fn check_steps(
             }
         }
         prev = Some((q, qp, dep));
+        prev_matched = matched;
     }
     if let Some((file, line)) = arc_on {
         push(
@@ -287,14 +344,14 @@ pub fn check_steps(
     }
     check_setup(steps, cell, common, &bead, report);
     if let Some(p) = planned {
-        if p.len() != bead_motions {
+        if plan_cursor != p.len() {
             push(
                 report,
                 ProblemKind::Deviation,
                 first_file.as_deref().unwrap_or(""),
                 0,
                 format!(
-                    "{bead_motions} bead motions in the programs, {} planned points",
+                    "{bead_motions} bead motions in the programs end at planned point {plan_cursor} of {}: the rest of the plan is not built",
                     p.len()
                 ),
             );

@@ -1,0 +1,218 @@
+//! Stage 7, the moves a controller is given: each bead of a [`Program`]
+//! thinned to the fewest linear moves whose interpolated path stays within
+//! [`ProgramOptions::path_tolerance_mm`] and
+//! [`ProgramOptions::orientation_tolerance_deg`] of every planned point
+//! ([`compress`](crate::program::compress::compress)). The controller's
+//! model of a linear move is the one the emitters ask for: the tool centre
+//! point moves on a straight line and its orientation turns by slerp in the
+//! frame the move is programmed in, extra axes (the positioner) linearly —
+//! the part frame where the part is the moving frame (remote/fixed tool in
+//! the part-carried cell, coordinated motion in the torch-carried one),
+//! else the robot base frame with the positioner turning the part under it.
+//! The deviation is measured over the part in both cases. Bead ends, speed
+//! changes and every point outside beads are kept.
+
+use crate::math::Isometry3;
+use crate::program::compress::{compress, CompressOptions, ControllerPose, Move};
+use crate::program::contract::moves_in_part_frame;
+use crate::program::frames::fixed_torch_at;
+use crate::program::{ArcFlag, Program, ProgramError, ProgramOptions, ProgramPoint};
+use crate::robot::Cell;
+
+/// What thinning did to a program's beads.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct Thinning {
+    /// Bead points before (one per planned point).
+    pub bead_points_before: usize,
+    /// Bead points kept (one move each).
+    pub bead_points_after: usize,
+    /// Largest distance between the interpolated path and the planned
+    /// points or polyline, over the part (mm).
+    pub max_path_error_mm: f64,
+    /// Largest angle between the interpolated and the planned torch axis
+    /// (deg).
+    pub max_orientation_error_deg: f64,
+}
+
+/// Relative speed change that makes a point a must-keep (a move carries one
+/// speed).
+const SPEED_CHANGE: f64 = 1e-9;
+
+/// Largest turn of any joint over one thinned move (rad): a controller
+/// solves the joints between two positions itself, and near the wrist
+/// singularity a small change of orientation is a large one of J4 and J6;
+/// a move stops where the planned joints have turned this much, so that
+/// the controller's joints cannot take the other way round.
+const MAX_JOINT_TURN_PER_MOVE_RAD: f64 = std::f64::consts::FRAC_PI_4;
+
+/// The bead points every thinned move must stop at: where the speed
+/// changes (a move carries one), and where the joints have turned
+/// [`MAX_JOINT_TURN_PER_MOVE_RAD`] since the last such point.
+fn must_keep(bead: &[ProgramPoint]) -> Vec<bool> {
+    let mut keep = vec![false; bead.len()];
+    let mut anchor = 0;
+    for k in 1..bead.len() {
+        let speed = (bead[k].speed_mm_s - bead[k - 1].speed_mm_s).abs()
+            > SPEED_CHANGE * bead[k].speed_mm_s.abs();
+        let turned = bead[k]
+            .joints
+            .iter()
+            .zip(&bead[anchor].joints)
+            .any(|(a, b)| (a - b).abs() > MAX_JOINT_TURN_PER_MOVE_RAD);
+        if speed || turned {
+            // stop at the last point before the turn grows too large
+            let at = if turned && k - 1 > anchor { k - 1 } else { k };
+            keep[at] = true;
+            anchor = at;
+        }
+    }
+    keep
+}
+
+/// The tool centre point's pose and the positioner joints as the controller
+/// interpolates them for point `p` (module doc): part frame when `in_part`,
+/// else robot base frame.
+fn controller_pose(cell: &Cell, p: &ProgramPoint, in_part: bool) -> ControllerPose {
+    controller_pose_at(cell, &p.joints, p.positioner, in_part)
+}
+
+/// [`controller_pose`] of the arm at joints `q` (rad) and the positioner
+/// at `qp` (rad).
+pub(crate) fn controller_pose_at(
+    cell: &Cell,
+    q: &crate::robot::Joints,
+    qp: Option<[f64; 2]>,
+    in_part: bool,
+) -> ControllerPose {
+    let flange = cell.robot().flange_pose(q);
+    let (tcp, ext): (Isometry3, Vec<f64>) = match cell {
+        Cell::PartCarried(c) if in_part => {
+            let base_from_part = flange * c.flange_from_part;
+            let torch = fixed_torch_at(&c.deposition_point_mm);
+            (base_from_part.inverse() * torch, Vec::new())
+        }
+        // the held tool (the flange) in the base frame
+        Cell::PartCarried(_) => (flange, Vec::new()),
+        Cell::TorchCarried(c) => {
+            let tcp = flange * c.flange_from_tcp;
+            let qp = qp.unwrap_or([0.0; 2]);
+            let tcp = if in_part {
+                c.base_from_part(&qp).inverse() * tcp
+            } else {
+                tcp
+            };
+            (tcp, qp.to_vec())
+        }
+    };
+    ControllerPose::new(tcp.translation.vector.into(), tcp.rotation, ext)
+}
+
+/// The flange pose (robot base frame) that puts the controller's tool at
+/// `pose` ([`controller_pose_at`]'s inverse), with the positioner at
+/// `pose.ext`.
+pub(crate) fn flange_of(cell: &Cell, pose: &ControllerPose, in_part: bool) -> Isometry3 {
+    let controller = Isometry3::from_parts(pose.p.coords.into(), pose.q);
+    match cell {
+        Cell::PartCarried(c) if in_part => {
+            // controller = (flange · F_fp)⁻¹ · torch
+            fixed_torch_at(&c.deposition_point_mm)
+                * controller.inverse()
+                * c.flange_from_part.inverse()
+        }
+        Cell::PartCarried(_) => controller,
+        Cell::TorchCarried(c) => {
+            let tcp = if in_part {
+                c.base_from_part(&[pose.ext[0], pose.ext[1]]) * controller
+            } else {
+                controller
+            };
+            tcp * c.flange_from_tcp.inverse()
+        }
+    }
+}
+
+/// Thins every bead of `program` (module doc); `None` when
+/// `opts.path_tolerance_mm` is 0 (every point kept).
+///
+/// # Errors
+/// [`ProgramError::InvalidOptions`] for a tolerance the compressor refuses;
+/// [`ProgramError::Mismatch`] naming the layer when a bead's poses cannot
+/// be compressed (not finite).
+pub fn thin_beads(
+    program: &mut Program,
+    opts: &ProgramOptions,
+) -> Result<Option<Thinning>, ProgramError> {
+    if opts.path_tolerance_mm == 0.0 {
+        return Ok(None);
+    }
+    let copts = CompressOptions {
+        path_tolerance_mm: opts.path_tolerance_mm,
+        orientation_tolerance_deg: opts.orientation_tolerance_deg,
+        allow_circular: false,
+        // the joints follow the whole rotation, R_Z included
+        rotation_tolerance_deg: Some(opts.orientation_tolerance_deg),
+        ..CompressOptions::default()
+    };
+    let cell = program.cell.clone();
+    // the part frame is the moving frame unless a torch-carried cell moves
+    // without coordination
+    let in_part = moves_in_part_frame(&cell, opts);
+    let map = |pose: &ControllerPose| -> (crate::math::Point3, crate::math::Vector3) {
+        let controller = Isometry3::from_parts(pose.p.coords.into(), pose.q);
+        let frame = match (&cell, in_part) {
+            (_, true) => controller,
+            (Cell::TorchCarried(c), false) => {
+                let qp = [pose.ext[0], pose.ext[1]];
+                c.base_from_part(&qp).inverse() * controller
+            }
+            // the fixed torch seen from the part held by the interpolated flange
+            (Cell::PartCarried(c), false) => {
+                (controller * c.flange_from_part).inverse() * fixed_torch_at(&c.deposition_point_mm)
+            }
+        };
+        (
+            frame.translation.vector.into(),
+            frame.rotation * crate::math::Vector3::z(),
+        )
+    };
+    let mut report = Thinning::default();
+    let mut kept: Vec<ProgramPoint> = Vec::with_capacity(program.points.len());
+    let points = std::mem::take(&mut program.points);
+    let mut i = 0;
+    while i < points.len() {
+        if points[i].arc != ArcFlag::Start {
+            kept.push(points[i]);
+            i += 1;
+            continue;
+        }
+        let end = (i..points.len())
+            .find(|&k| points[k].arc == ArcFlag::End)
+            .unwrap_or(points.len() - 1);
+        let bead = &points[i..=end];
+        let poses: Vec<ControllerPose> = bead
+            .iter()
+            .map(|p| controller_pose(&cell, p, in_part))
+            .collect();
+        let keep = must_keep(bead);
+        let c = compress(&poses, &keep, &map, &copts).map_err(|e| ProgramError::Mismatch {
+            index: i,
+            reason: format!("layer {}: move compression: {e}", bead[0].layer),
+        })?;
+        report.bead_points_before += bead.len();
+        report.max_path_error_mm = report.max_path_error_mm.max(c.max_path_error_mm);
+        report.max_orientation_error_deg = report
+            .max_orientation_error_deg
+            .max(c.max_orientation_error_deg);
+        kept.push(bead[0]);
+        for m in &c.moves {
+            let to = match *m {
+                Move::Linear { to } | Move::Circular { to, .. } => to,
+            };
+            kept.push(bead[to]);
+        }
+        report.bead_points_after += 1 + c.moves.len();
+        i = end + 1;
+    }
+    program.points = kept;
+    Ok(Some(report))
+}
