@@ -60,9 +60,9 @@
 //! Not verified: that a KR C2/KR C4 loads and runs these files (no
 //! controller or KUKA.OfficeLite was available).
 
-use waam_slicer::program::kuka::read::{parse_krl, KrlOp};
+use waam_slicer::program::kuka::read::{parse_krl, InterruptAction, KrlOp};
 use waam_slicer::program::kuka::validate_kuka;
-use waam_slicer::program::kuka::{kuka_files, KukaOptions, HOME_NAME};
+use waam_slicer::program::kuka::{kuka_files, ArcLoss, KukaOptions, HOME_NAME};
 use waam_slicer::program::validate::{ProblemKind, ValidationReport};
 use waam_slicer::program::{
     BeadSetup, EmittedFile, HomePosition, Payload, ProcessControl, Program,
@@ -142,9 +142,14 @@ fn trigger_calls_need_prio() {
             .count(),
         2
     );
-    // no ignition handshake or end times for a custom process
+    // no ignition handshake, end times or arc-loss supervision for a
+    // custom process
     assert!(
         !src.contains("$TIMER") && !src.contains("WAIT SEC"),
+        "{src}"
+    );
+    assert!(
+        !src.contains("INTERRUPT DECL 20") && !src.contains("WAAM_ARC_LOST"),
         "{src}"
     );
     let r = check(&f, src, &f[1].text, &c, &opts);
@@ -162,10 +167,14 @@ fn trigger_calls_need_prio() {
     )));
 }
 
-/// The arc process: arc on at the exact first point, then the ignition
-/// handshake; a program without the wait, without the HALT, with another
-/// timeout, or switching the arc by a trigger (no wait possible) is named.
-/// At the end: crater fill with the arc on, arc off, burn-back.
+/// The arc process: arc on at the exact first point inside the ignition
+/// handshake, a `LOOP` left only with the arc established (a failed
+/// ignition: arc off, message, `HALT`, and the start tries again: never the
+/// bead without the arc); a program without the wait, without the HALT,
+/// with another timeout, with the old `IF NOT $IN[n] … HALT ENDIF` (the
+/// start after its HALT ran the bead with the arc off), or switching the
+/// arc by a trigger (no wait possible) is named. At the end: crater fill
+/// with the arc on, arc off, burn-back.
 #[test]
 fn the_arc_waits_for_ignition_and_ends_with_crater_and_burn_back() {
     let (prog, c) = two_layers(PART);
@@ -177,28 +186,37 @@ fn the_arc_waits_for_ignition_and_ends_with_crater_and_burn_back() {
     };
     let f = kuka_files(&prog, &opts).unwrap();
     let (src, dat) = (&f[0].text, &f[1].text);
-    let on = line_eq(src, "  $OUT[1]=TRUE", 0);
+    let on = line_eq(src, "    $OUT[1]=TRUE", 0);
     let lines: Vec<&str> = src.lines().collect();
     assert_eq!(
-        lines[on..on + 6],
+        lines[on - 2..on + 10],
         [
-            "  $TIMER_STOP[3] = TRUE",
-            "  $TIMER[3] = -1500",
-            "  $TIMER_STOP[3] = FALSE",
-            "  WAIT FOR $IN[5] OR $TIMER_FLAG[3]",
-            "  $TIMER_STOP[3] = TRUE",
-            "  IF NOT $IN[5] THEN",
+            "  LOOP",
+            "    $OUT[1]=TRUE",
+            "    $TIMER_STOP[3] = TRUE",
+            "    $TIMER[3] = -1500",
+            "    $TIMER_STOP[3] = FALSE",
+            "    WAIT FOR $IN[5] OR $TIMER_FLAG[3]",
+            "    $TIMER_STOP[3] = TRUE",
+            "    IF $IN[5] THEN",
+            "      EXIT",
+            "    ENDIF",
+            "    $OUT[1]=FALSE",
+            "    WAAM_MSG = {MODUL[] \"WAAM\",NR 1,MSG_TXT[] \"No arc: IN 5 off 1.500 s after arc on, layer 0\"}",
         ]
     );
+    assert_eq!(lines[on + 12..on + 14], ["    HALT", "  ENDLOOP"]);
     // the motion before the arc on reaches the bead's first point exactly
-    assert_eq!(lines[on - 3], "  LIN P2");
+    assert_eq!(lines[on - 4], "  LIN P2");
     let off = line_eq(src, "  $OUT[1]=FALSE", 0);
     assert_eq!(
-        lines[off - 4..off + 2],
+        lines[off - 6..off + 2],
         [
             "  LIN P9",
             "  ; crater fill, arc on",
             "  WAIT SEC 0.200",
+            "  ; arc-loss supervision off (interrupt 20), then arc off",
+            "  INTERRUPT OFF 20",
             "  $OUT[1]=FALSE",
             "  ; burn-back",
             "  WAIT SEC 0.100"
@@ -209,8 +227,8 @@ fn the_arc_waits_for_ignition_and_ends_with_crater_and_burn_back() {
     assert!(r.is_ok(), "{r}");
     assert_eq!(r.beads, 2);
     // no wait
-    let wait = line_eq(src, "  WAIT FOR $IN[5] OR $TIMER_FLAG[3]", 0);
-    let bad = replace_line(src, wait, Some("  ; WAIT removed"));
+    let wait = line_eq(src, "    WAIT FOR $IN[5] OR $TIMER_FLAG[3]", 0);
+    let bad = replace_line(src, wait, Some("    ; WAIT removed"));
     let r = check(&f, &bad, dat, &c, &opts);
     assert!(
         has(
@@ -234,6 +252,34 @@ fn the_arc_waits_for_ignition_and_ends_with_crater_and_burn_back() {
         ),
         "{r}"
     );
+    // the old form: `IF NOT $IN[5] THEN … HALT ENDIF` and no loop, where the
+    // start after the HALT ran the bead with the arc off
+    let endloop = line_eq(src, "  ENDLOOP", on);
+    let old: String = lines
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| match i + 1 {
+            n if n == on - 1 || n == on + 6 || n == on + 7 => None,
+            n if n == on + 8 => Some("  IF NOT $IN[5] THEN\n".to_string()),
+            n if n == endloop => Some("  ENDIF\n".to_string()),
+            _ => Some(format!("{l}\n")),
+        })
+        .collect();
+    let r = check(&f, &old, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            on - 1,
+            "without the ignition handshake"
+        ) && has(
+            &r,
+            ProblemKind::Instruction,
+            on + 5,
+            "outside the ignition handshake: after a HALT in it the start goes on without the arc"
+        ),
+        "{old}\n{r}"
+    );
     // another timeout than the options'
     let other = KukaOptions {
         ignition_timeout_s: 2.0,
@@ -251,18 +297,21 @@ fn the_arc_waits_for_ignition_and_ends_with_crater_and_burn_back() {
     };
     let r = check(&f, src, dat, &c, &other);
     assert!(has(&r, ProblemKind::Options, wait, "$IN[5]"), "{r}");
-    // the old form: the arc switched on by a trigger while moving
+    // the old form: the arc switched on by a trigger while moving, no
+    // handshake
     let mut old = replace_line(
         src,
-        on,
+        on - 1,
         Some("  TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[1]=TRUE"),
     );
-    for _ in 0..12 {
-        // drop the handshake after it (through ENDIF)
-        old = replace_line(&old, on + 1, None);
+    for _ in on..=endloop {
+        old = replace_line(&old, on, None);
     }
     let r = check(&f, &old, dat, &c, &opts);
-    assert!(has(&r, ProblemKind::Instruction, on, "by a TRIGGER"), "{r}");
+    assert!(
+        has(&r, ProblemKind::Instruction, on - 1, "by a TRIGGER"),
+        "{r}"
+    );
     // crater and burn-back times other than the options'
     let other = KukaOptions {
         crater_fill_s: 0.5,
@@ -505,4 +554,439 @@ fn home_dwell_interpass_payload_golden_and_read_back() {
     opts.common.transit_check = false;
     let r = check(&f, src, dat, &c, &opts);
     assert!(r.is_ok(), "{r}");
+}
+
+/// The main routine's lines (up to its `END`), trimmed.
+fn main_lines(src: &str) -> Vec<&str> {
+    src.lines()
+        .map(str::trim)
+        .take_while(|l| *l != "END")
+        .collect()
+}
+
+/// Arc supervision (issue 32): one `INTERRUPT DECL 20 WHEN $IN[1]==FALSE
+/// DO WAAM_ARC_LOST( )` before the first bead; in every bead `INTERRUPT ON
+/// 20` right after the ignition handshake's `ENDLOOP` (the arc is
+/// established: the interrupt fires on the input's fall, an edge) and
+/// `INTERRUPT OFF 20` just before the arc off, every motion with the arc on
+/// in between; the handler a local `DEF` with `BRAKE F`, the arc off and an
+/// endless `HALT` (abort, the default). Removing bead 2's `INTERRUPT ON` is
+/// named at that bead's first motion; removing bead 1's `INTERRUPT OFF`
+/// at its arc off (the handler would fire at the bead's end); removing the
+/// declaration at the first arc on; a declaration on another input or
+/// priority than the options' at its line.
+///
+/// Sources for the rules checked (vendor notes §1): priorities 1, 2, 4–39
+/// and 81–128 are the user's, 3 and 40–80 the system's (a CSDN article
+/// based on KUKA College training material, "中断程序的编写规则"; not
+/// checked in the KSS manual itself); an interrupt fires when its condition
+/// becomes true, not while it is (industrialmonitordirect.com "KUKA
+/// interrupt 10 trigger", third-party); `BRAKE F` brakes as fast as
+/// possible, `BRAKE` with the normal ramp (Beckhoff mxAutomation for KUKA,
+/// `KRC_DeclareInterrupt`).
+#[test]
+fn every_bead_is_supervised_by_the_arc_loss_interrupt() {
+    let (prog, c) = two_layers(PART);
+    let opts = KukaOptions::default();
+    let f = kuka_files(&prog, &opts).unwrap();
+    let (src, dat) = (&f[0].text, &f[1].text);
+    let decl = "  INTERRUPT DECL 20 WHEN $IN[1]==FALSE DO WAAM_ARC_LOST( )";
+    assert_eq!(src.matches(decl).count(), 1, "{src}");
+    let decl_line = line_eq(src, decl, 0);
+    assert!(decl_line < line_eq(src, "  LOOP", 0));
+    // walk the main routine: armed only between the handshake and arc off
+    let code: Vec<&str> = main_lines(src)
+        .into_iter()
+        .filter(|l| !l.starts_with(';'))
+        .collect();
+    let (mut arc, mut armed, mut ons, mut offs, mut bead_moves) = (false, false, 0, 0, 0);
+    for (k, l) in code.iter().enumerate() {
+        match *l {
+            "ENDLOOP" => {
+                assert_eq!(
+                    code[k + 1],
+                    "INTERRUPT ON 20",
+                    "armed right after the handshake"
+                );
+                arc = true;
+            }
+            "INTERRUPT ON 20" => {
+                assert!(arc && !armed);
+                (armed, ons) = (true, ons + 1);
+            }
+            "INTERRUPT OFF 20" => {
+                assert!(armed);
+                assert_eq!(
+                    code[k + 1],
+                    "$OUT[1]=FALSE",
+                    "disarmed just before the arc off"
+                );
+                (armed, offs) = (false, offs + 1);
+            }
+            "$OUT[1]=FALSE" if arc => {
+                assert!(!armed);
+                arc = false;
+            }
+            l if arc && (l.starts_with("LIN ") || l.starts_with("PTP ")) => {
+                assert!(armed, "{l} with the arc on, not supervised");
+                bead_moves += 1;
+            }
+            _ => {}
+        }
+    }
+    assert_eq!((ons, offs, bead_moves), (2, 2, 14));
+    let r = check(&f, src, dat, &c, &opts);
+    assert!(r.is_ok(), "{r}");
+    // the reader's model: the declaration, the controls, the handler
+    let p = parse_krl(src, "HEMI.src", dat, "HEMI.dat").unwrap();
+    assert!(p.statements.iter().any(|s| s.line == decl_line
+        && s.op
+            == KrlOp::InterruptDecl {
+                global: false,
+                prio: 20,
+                when: "$IN[1]==FALSE".into(),
+                handler: "WAAM_ARC_LOST".into(),
+            }));
+    let h = p.routine("WAAM_ARC_LOST").expect("the handler DEF");
+    let ops: Vec<&KrlOp> = h
+        .statements
+        .iter()
+        .map(|s| &s.op)
+        .filter(|op| !matches!(op, KrlOp::Other(t) if !t.starts_with("$OUT")))
+        .collect();
+    assert_eq!(
+        ops,
+        [
+            &KrlOp::Interrupt {
+                action: InterruptAction::Off,
+                prio: Some(20)
+            },
+            &KrlOp::Brake { fast: true },
+            &KrlOp::Other("$OUT[1]=FALSE".into()),
+            &KrlOp::WaitSec(0.1),
+            &KrlOp::Loop,
+            &KrlOp::Halt,
+            &KrlOp::EndLoop,
+        ]
+    );
+
+    // bead 2 without its INTERRUPT ON: named at its first motion with the arc on
+    let on2 = line_eq(
+        src,
+        "  INTERRUPT ON 20",
+        line_eq(src, "  INTERRUPT ON 20", 0),
+    );
+    let bad = replace_line(src, on2, Some("  ; INTERRUPT ON removed"));
+    let first_move = line_eq(&bad, "  LIN P13 C_DIS", on2);
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            first_move,
+            "bead 2: LIN P13 with the arc on while the arc-loss interrupt 20 is not on"
+        ),
+        "{r}"
+    );
+    assert_eq!(r.problems.len(), 1, "{r}");
+    // bead 1 without its INTERRUPT OFF: the arc off would fire the handler
+    let off1 = line_eq(src, "  INTERRUPT OFF 20", 0);
+    let bad = replace_line(src, off1, Some("  ; INTERRUPT OFF removed"));
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            off1 + 1,
+            "arc off with the arc-loss interrupt 20 on"
+        ),
+        "{r}"
+    );
+    // armed before the ignition (the edge would be missed or fire in it)
+    let early = replace_line(src, on2, None);
+    let loop2 = line_eq(&early, "  LOOP", off1);
+    let early = replace_line(&early, loop2, Some("  INTERRUPT ON 20\n  LOOP"));
+    let r = check(&f, &early, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            loop2,
+            "INTERRUPT ON 20 before the arc is established"
+        ),
+        "{r}"
+    );
+    // no declaration: the file has no supervision
+    let bad = replace_line(src, decl_line, None);
+    let r = check(&f, &bad, dat, &c, &opts);
+    let arc_on = line_eq(&bad, "    $OUT[1]=TRUE", 0);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            arc_on,
+            "no arc-loss supervision"
+        ),
+        "{r}"
+    );
+    // the declaration on another input, or another priority, than the options'
+    let bad = replace_line(
+        src,
+        decl_line,
+        Some("  INTERRUPT DECL 20 WHEN $IN[2]==FALSE DO WAAM_ARC_LOST( )"),
+    );
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(&r, ProblemKind::Options, decl_line, "`$IN[1]==FALSE`"),
+        "{r}"
+    );
+    let other = KukaOptions {
+        arc_loss_interrupt: 25,
+        ..Default::default()
+    };
+    let r = check(&f, src, dat, &c, &other);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Options,
+            decl_line,
+            "arc-loss interrupt priority 20, the options give 25"
+        ),
+        "{r}"
+    );
+}
+
+/// The handler never lets the bead go on with the arc off: one that does
+/// not switch the arc off, does not brake, returns into the bead (no
+/// endless HALT, no re-ignition), or is missing from the file is named at
+/// its `DEF` (or the declaration) line; an abort handler checked against
+/// `arc_loss = "reignite"` is an options problem.
+#[test]
+fn an_arc_loss_handler_that_leaves_the_arc_on_or_returns_is_named() {
+    let (prog, c) = two_layers(TORCH);
+    let opts = KukaOptions::default();
+    let f = kuka_files(&prog, &opts).unwrap();
+    let (src, dat) = (&f[0].text, &f[1].text);
+    assert!(check(&f, src, dat, &c, &opts).is_ok());
+    let def = line_eq(src, "DEF WAAM_ARC_LOST( )", 0);
+    let brake = line_eq(src, "  BRAKE F", def);
+    assert_eq!(src.lines().nth(brake).unwrap(), "  $OUT[1]=FALSE");
+    // no arc off
+    let bad = replace_line(src, brake + 1, Some("  ; arc off removed"));
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            def,
+            "does not switch the arc off (`$OUT[1]=FALSE`)"
+        ),
+        "{r}"
+    );
+    // no BRAKE F, or the normal ramp
+    let bad = replace_line(src, brake, None);
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(&r, ProblemKind::Instruction, def, "does not stop the robot"),
+        "{r}"
+    );
+    let bad = replace_line(src, brake, Some("  BRAKE"));
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            brake,
+            "`BRAKE F` stops on the path"
+        ),
+        "{r}"
+    );
+    // the endless HALT replaced by one HALT: the start returns into the bead
+    let lp = line_eq(src, "  LOOP", def);
+    let mut bad = replace_line(src, lp, None);
+    bad = replace_line(&bad, lp + 1, None);
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            def,
+            "returns into the bead with the arc off"
+        ),
+        "{bad}\n{r}"
+    );
+    // RESUME: the rest of the bead abandoned
+    let bad = replace_line(src, lp, Some("  RESUME\n  LOOP"));
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            lp,
+            "abandons the rest of the bead"
+        ),
+        "{r}"
+    );
+    // the handler missing from the file
+    let main_only: String = src
+        .lines()
+        .take(def - 2)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let decl = line_eq(
+        src,
+        "  INTERRUPT DECL 20 WHEN $IN[1]==FALSE DO WAAM_ARC_LOST( )",
+        0,
+    );
+    let r = check(&f, &main_only, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Declaration,
+            decl,
+            "calls WAAM_ARC_LOST( ), which is not a DEF"
+        ),
+        "{r}"
+    );
+    // an abort handler where the options want re-ignition
+    let other = KukaOptions {
+        arc_loss: ArcLoss::Reignite,
+        ..Default::default()
+    };
+    let r = check(&f, src, dat, &c, &other);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Options,
+            def,
+            "ends the program (abort), the options give arc_loss = \"reignite\""
+        ),
+        "{r}"
+    );
+}
+
+/// `arc_loss = "reignite"`: the handler halts, then the start re-runs the
+/// ignition handshake where the robot stopped (arc on, wait with the
+/// timeout, `EXIT` only with the arc, else arc off, message and `HALT`
+/// again), then re-arms the interrupt and returns: the bead goes on with
+/// the arc. Without the re-arm, or without the handshake, it is named; the
+/// file checked with the default options (abort) is an options problem.
+#[test]
+fn reignite_mode_emits_the_ignition_handshake_in_the_handler() {
+    let (prog, c) = two_layers(PART);
+    let opts: KukaOptions =
+        toml::from_str("arc_loss = \"reignite\"\narc_loss_interrupt = 25").unwrap();
+    assert_eq!(
+        (opts.arc_loss, opts.arc_loss_interrupt),
+        (ArcLoss::Reignite, 25)
+    );
+    let f = kuka_files(&prog, &opts).unwrap();
+    let (src, dat) = (&f[0].text, &f[1].text);
+    let def = line_eq(src, "DEF WAAM_ARC_LOST( )", 0);
+    let handler: Vec<&str> = src
+        .lines()
+        .skip(def)
+        .map(str::trim)
+        .filter(|l| !l.starts_with(';') && !l.starts_with("DECL") && !l.starts_with("WAAM_"))
+        .collect();
+    assert_eq!(
+        handler,
+        [
+            "INTERRUPT OFF 25",
+            "BRAKE F",
+            "$OUT[1]=FALSE",
+            "WAIT SEC 0.100",
+            "HALT",
+            "LOOP",
+            "$OUT[1]=TRUE",
+            "$TIMER_STOP[1] = TRUE",
+            "$TIMER[1] = -1000",
+            "$TIMER_STOP[1] = FALSE",
+            "WAIT FOR $IN[1] OR $TIMER_FLAG[1]",
+            "$TIMER_STOP[1] = TRUE",
+            "IF $IN[1] THEN",
+            "EXIT",
+            "ENDIF",
+            "$OUT[1]=FALSE",
+            "HALT",
+            "ENDLOOP",
+            "INTERRUPT ON 25",
+            "END",
+        ]
+    );
+    assert!(src.contains("  INTERRUPT DECL 25 WHEN $IN[1]==FALSE DO WAAM_ARC_LOST( )\n"));
+    let r = check(&f, src, dat, &c, &opts);
+    assert!(r.is_ok(), "{r}");
+    // not re-armed after the re-ignition
+    let rearm = line_eq(src, "  INTERRUPT ON 25", def);
+    let bad = replace_line(src, rearm, None);
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            def,
+            "does not re-arm the interrupt"
+        ),
+        "{r}"
+    );
+    // the re-ignition dropped: the start returns into the bead, arc off
+    let lp = line_eq(src, "  LOOP", def);
+    let end = line_eq(src, "  ENDLOOP", lp);
+    let mut bad = src.to_string();
+    for _ in lp..=end {
+        bad = replace_line(&bad, lp, None);
+    }
+    let r = check(&f, &bad, dat, &c, &opts);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Instruction,
+            def,
+            "returns into the bead with the arc off"
+        ),
+        "{r}"
+    );
+    // the re-igniting handler where the options say abort
+    let abort = KukaOptions {
+        arc_loss_interrupt: 25,
+        ..Default::default()
+    };
+    let r = check(&f, src, dat, &c, &abort);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Options,
+            def,
+            "re-ignites, the options give arc_loss = \"abort\""
+        ),
+        "{r}"
+    );
+}
+
+/// The arc-loss interrupt's priority must be a KRL user priority (1, 2,
+/// 4–39, 81–128; vendor notes §1, KUKA College training material): 3 (the
+/// `IR_STOPM` stop-message interrupt of the INI fold) and 40–80 (system
+/// applications) are refused naming the field, as are 0 and 129.
+#[test]
+fn the_arc_loss_interrupt_priority_is_a_user_priority() {
+    let (prog, _) = two_layers(PART);
+    for bad in [0, 3, 40, 50, 80, 129] {
+        let opts = KukaOptions {
+            arc_loss_interrupt: bad,
+            ..Default::default()
+        };
+        let e = kuka_files(&prog, &opts).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("`arc_loss_interrupt` = \"{bad}\"")) && e.contains("reserved"),
+            "{e}"
+        );
+    }
+    for ok in [1, 2, 4, 20, 39, 81, 128] {
+        let opts = KukaOptions {
+            arc_loss_interrupt: ok,
+            ..Default::default()
+        };
+        assert!(opts.validate().is_ok(), "{ok}");
+    }
 }

@@ -1,13 +1,21 @@
 //! KUKA programs as [`Step`]s: the `.src`/`.dat` pair read by
 //! [`parse_krl`](crate::program::kuka::read::parse_krl), each position
-//! decoded (`E6AXIS`, or `E6POS` with its Status and Turn bits).
+//! decoded (`E6AXIS`, or `E6POS` with its Status and Turn bits). With the
+//! arc process the file's own safety is checked too: each bead's ignition
+//! handshake, and its arc-loss supervision (the interrupt declared on the
+//! options' input, on for every motion with the arc on, off before the arc
+//! off, and a handler that brakes, switches the arc off and never returns
+//! into the bead with the arc off; module doc of [`crate::program::kuka`]).
 
 use std::f64::consts::TAU;
 
 use std::ops::{Mul, Sub};
 
 use crate::math::{Isometry3, Point3};
-use crate::program::kuka::StatedBase;
+use crate::program::kuka::read::{
+    falling_input, InterruptAction, KrlOp, KrlProgram, KrlRoutine, KrlStatement,
+};
+use crate::program::kuka::{ArcLoss, KukaOptions, StatedBase, ARC_LOST_HANDLER};
 use crate::program::MoveKind;
 use crate::robot::{Cell, Configuration, Joints};
 
@@ -25,9 +33,9 @@ use crate::program::validate::{decode_pose, push, Motion, MotionSpeed, Step, Val
 /// value nearest the previous position. A cell whose robot is not a KUKA
 /// arm is refused: the report holds that one problem (line 1 of the `.src`).
 pub fn validate_kuka(
-    program: &crate::program::kuka::read::KrlProgram,
+    program: &KrlProgram,
     cell: &Cell,
-    opts: &crate::program::kuka::KukaOptions,
+    opts: &KukaOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
     use crate::program::contract::{Controller, Kuka};
@@ -36,25 +44,21 @@ pub fn validate_kuka(
 
 /// The [`Step`]s of a KUKA program (motions decoded, process on and off,
 /// waits, payloads) in execution order, with the problems of the file
-/// itself (frames, triggers, ignition handshake, end times) added to
-/// `report_out`. The cell's robot must be a KUKA arm.
+/// itself (frames, triggers, ignition handshake, arc-loss supervision and
+/// its handler, end times) added to `report_out`. The cell's robot must be
+/// a KUKA arm.
 pub(crate) fn kuka_steps(
-    program: &crate::program::kuka::read::KrlProgram,
+    program: &KrlProgram,
     cell: &Cell,
-    opts: &crate::program::kuka::KukaOptions,
+    opts: &KukaOptions,
     report_out: &mut ValidationReport,
 ) -> Vec<Step> {
-    use crate::program::kuka::read::{KrlOp, KrlValue};
+    use crate::program::kuka::read::KrlValue;
     use crate::robot::orientation::KukaAbc;
     let mut report = std::mem::take(report_out);
     let robot = cell.robot();
     let (_, tool) = opts.frames(cell);
     let (on, off) = crate::program::kuka::switch_statements(opts);
-    let same = |a: &str, b: &str| {
-        a.chars()
-            .filter(|c| !c.is_whitespace())
-            .eq(b.chars().filter(|c| !c.is_whitespace()))
-    };
     let arc = opts.arc_process();
     let coordinated = opts.coordinated(cell);
     let src = &program.src_file;
@@ -80,9 +84,11 @@ pub(crate) fn kuka_steps(
     let mut tool_stated = false;
     let mut base_stated = false;
     let mut first_motion = true;
-    // the arc process: ignition handshake after each arc on, end times
-    let mut ign: Option<Ignition> = None;
-    let mut in_if: Option<(usize, bool)> = None; // (line, HALT seen)
+    // the arc process: the ignition handshake (a LOOP) at each bead's
+    // start, the arc-loss supervision around each bead, the end times
+    let mut sup = Supervision::default();
+    // line of a stray `IF NOT $IN[n] THEN` (reported, its body skipped)
+    let mut in_if: Option<usize> = None;
     let mut arc_is_on = false;
     let mut crater: Option<(f64, usize)> = None;
     let mut after_off: Option<usize> = None;
@@ -90,7 +96,10 @@ pub(crate) fn kuka_steps(
     let frame_problem = |report: &mut ValidationReport, line: usize, msg: String| {
         push(report, ProblemKind::Frame, src, line, msg)
     };
-    for st in &program.statements {
+    let stmts = &program.statements;
+    let mut next = 0;
+    while let Some(st) = stmts.get(next) {
+        next += 1;
         let line = st.line;
         // the burn-back wait is the statement right after the arc off
         if let Some(l) = after_off.take() {
@@ -100,31 +109,16 @@ pub(crate) fn kuka_steps(
             }
             missing_burn_back(&mut report, src, l, opts);
         }
-        if let Some((l, halted)) = &mut in_if {
-            // inside `IF NOT $IN[n] THEN … ENDIF`: the failed-ignition branch
+        if in_if.is_some() {
+            // inside a stray `IF NOT $IN[n] THEN … ENDIF` (reported)
             match &st.op {
-                KrlOp::Halt => *halted = true,
-                KrlOp::EndIf => {
-                    if let Some(g) = &mut ign {
-                        g.halt = *halted;
-                    }
-                    if !*halted {
-                        push(
-                            &mut report,
-                            ProblemKind::Instruction,
-                            src,
-                            *l,
-                            "the failed-ignition branch does not stop the program (no HALT)".into(),
-                        );
-                    }
-                    in_if = None;
-                }
+                KrlOp::EndIf => in_if = None,
                 KrlOp::Ptp(_) | KrlOp::Lin { .. } => push(
                     &mut report,
                     ProblemKind::Instruction,
                     src,
                     line,
-                    "motion inside the failed-ignition branch".into(),
+                    "motion inside `IF NOT $IN[n] THEN … ENDIF`".into(),
                 ),
                 _ => {}
             }
@@ -327,99 +321,96 @@ pub(crate) fn kuka_steps(
                 });
                 continue;
             }
-            KrlOp::Timer { timer, ms } => {
-                if let Some(g) = &mut ign {
-                    if *timer == opts.ignition_timer {
-                        g.timer_ms = Some(*ms);
-                    }
-                }
-                continue;
-            }
-            KrlOp::TimerStop { timer, stop } => {
-                if let Some(g) = &mut ign {
-                    if *timer == opts.ignition_timer && !stop && g.timer_ms.is_some() {
-                        g.started = true;
-                    }
-                }
-                continue;
-            }
-            KrlOp::WaitInOrTimer { input, timer } => {
-                match &mut ign {
-                    Some(g) => {
-                        if *input != opts.arc_ok_input || *timer != opts.ignition_timer {
-                            push(
-                                &mut report,
-                                ProblemKind::Options,
-                                src,
-                                line,
-                                format!(
-                                    "ignition wait on $IN[{input}] / $TIMER_FLAG[{timer}], the options give $IN[{}] / $TIMER_FLAG[{}]",
-                                    opts.arc_ok_input, opts.ignition_timer
-                                ),
-                            );
-                        }
-                        let want = -(opts.ignition_timeout_s * 1000.0).round();
-                        match (g.timer_ms, g.started) {
-                            (Some(ms), true) if (ms - want).abs() <= 0.5 => {}
-                            (Some(ms), true) => push(
-                                &mut report,
-                                ProblemKind::Options,
-                                src,
-                                line,
-                                format!(
-                                    "ignition timeout {:.3} s ($TIMER[{timer}] = {ms}), the options give {:.3} s",
-                                    -ms / 1000.0,
-                                    opts.ignition_timeout_s
-                                ),
-                            ),
-                            _ => push(
-                                &mut report,
-                                ProblemKind::Instruction,
-                                src,
-                                line,
-                                format!("ignition wait without its timer: $TIMER[{timer}] not set to minus the timeout and started"),
-                            ),
-                        }
-                        g.waited = Some(*input);
-                    }
-                    None => steps.push(Step::Wait {
-                        file: src.clone(),
-                        line,
-                        seconds: None,
-                        input: Some(*input),
-                    }),
-                }
+            // outside the ignition handshake: plain statements
+            KrlOp::Timer { .. } | KrlOp::TimerStop { .. } => continue,
+            KrlOp::WaitInOrTimer { input, .. } => {
+                steps.push(Step::Wait {
+                    file: src.clone(),
+                    line,
+                    seconds: None,
+                    input: Some(*input),
+                });
                 continue;
             }
             KrlOp::IfNotIn(n) => {
-                if ign.as_ref().is_some_and(|g| g.waited == Some(*n)) {
-                    in_if = Some((line, false));
-                } else {
-                    push(
-                        &mut report,
-                        ProblemKind::Instruction,
-                        src,
-                        line,
-                        format!("`IF NOT $IN[{n}] THEN` outside an ignition check"),
-                    );
-                    in_if = Some((line, false));
-                }
-                continue;
-            }
-            KrlOp::EndIf | KrlOp::Halt => {
                 push(
                     &mut report,
                     ProblemKind::Instruction,
                     src,
                     line,
                     format!(
-                        "unexpected `{}`",
-                        if st.op == KrlOp::Halt {
-                            "HALT"
-                        } else {
-                            "ENDIF"
-                        }
+                        "`IF NOT $IN[{n}] THEN` outside the ignition handshake: after a HALT in it the start goes on without the arc ({})",
+                        handshake_form(opts)
                     ),
+                );
+                in_if = Some(line);
+                continue;
+            }
+            KrlOp::Loop => {
+                let Some(end) = loop_end(stmts, next - 1) else {
+                    push(
+                        &mut report,
+                        ProblemKind::Instruction,
+                        src,
+                        line,
+                        "LOOP without ENDLOOP".into(),
+                    );
+                    break;
+                };
+                let block = &stmts[next - 1..=end];
+                next = end + 1;
+                match read_handshake(block, opts, &on, &off, src, &mut report) {
+                    Some(h) if arc => {
+                        steps.push(Step::ProcessOn {
+                            file: src.clone(),
+                            line: h.on_line,
+                        });
+                        arc_is_on = true;
+                        sup.bead_start(h.on_line, true);
+                    }
+                    _ => push(
+                        &mut report,
+                        ProblemKind::Instruction,
+                        src,
+                        line,
+                        format!(
+                            "a LOOP in the main routine that is not the ignition handshake ({})",
+                            handshake_form(opts)
+                        ),
+                    ),
+                }
+                continue;
+            }
+            KrlOp::InterruptDecl {
+                prio,
+                when,
+                handler,
+                ..
+            } => {
+                if arc {
+                    sup.declare(*prio, when, handler, line, opts, src, &mut report);
+                }
+                continue;
+            }
+            KrlOp::Interrupt { action, prio } => {
+                if arc {
+                    sup.control(*action, *prio, line, arc_is_on, opts, src, &mut report);
+                }
+                continue;
+            }
+            KrlOp::EndIf
+            | KrlOp::Halt
+            | KrlOp::IfIn(_)
+            | KrlOp::EndLoop
+            | KrlOp::Exit
+            | KrlOp::Brake { .. }
+            | KrlOp::Resume => {
+                push(
+                    &mut report,
+                    ProblemKind::Instruction,
+                    src,
+                    line,
+                    format!("unexpected `{}`", keyword(&st.op)),
                 );
                 continue;
             }
@@ -431,10 +422,17 @@ pub(crate) fn kuka_steps(
                     });
                     arc_is_on = true;
                     if arc {
-                        ign = Some(Ignition {
+                        sup.bead_start(line, false);
+                        push(
+                            &mut report,
+                            ProblemKind::Instruction,
+                            src,
                             line,
-                            ..Default::default()
-                        });
+                            format!(
+                                "arc on without the ignition handshake ({})",
+                                handshake_form(opts)
+                            ),
+                        );
                     }
                 } else if same(text, &off) {
                     steps.push(Step::ProcessOff {
@@ -443,6 +441,7 @@ pub(crate) fn kuka_steps(
                     });
                     arc_is_on = false;
                     if arc {
+                        sup.arc_off(line, src, &mut report);
                         let (s, _) = crater.take().unwrap_or((0.0, line));
                         check_time(&mut report, src, line, "crater fill", s, opts.crater_fill_s);
                         after_off = Some(line);
@@ -480,19 +479,9 @@ pub(crate) fn kuka_steps(
                 );
             }
         }
-        if let Some(g) = ign.take() {
-            if g.waited.is_none() || !g.halt {
-                push(
-                    &mut report,
-                    ProblemKind::Instruction,
-                    src,
-                    g.line,
-                    format!(
-                        "arc on without the ignition handshake before the next motion (WAIT FOR $IN[{}] OR $TIMER_FLAG[{}] with a {:.3} s timeout, then IF NOT $IN[{}] THEN … HALT ENDIF)",
-                        opts.arc_ok_input, opts.ignition_timer, opts.ignition_timeout_s, opts.arc_ok_input
-                    ),
-                );
-            }
+        if arc && arc_is_on {
+            let what = format!("{} {target}", if linear { "LIN" } else { "PTP" });
+            sup.motion(line, &what, opts, src, &mut report);
         }
         if let Some((_, l)) = mass.take() {
             push(
@@ -694,7 +683,7 @@ pub(crate) fn kuka_steps(
     if let Some(l) = after_off {
         missing_burn_back(&mut report, src, l, opts);
     }
-    if let Some((l, _)) = in_if {
+    if let Some(l) = in_if {
         push(
             &mut report,
             ProblemKind::Instruction,
@@ -703,34 +692,559 @@ pub(crate) fn kuka_steps(
             "IF without ENDIF".into(),
         );
     }
-    if let Some(g) = ign {
-        if g.waited.is_none() || !g.halt {
-            push(
-                &mut report,
-                ProblemKind::Instruction,
-                src,
-                g.line,
-                "arc on without the ignition handshake".into(),
-            );
-        }
+    if arc {
+        sup.finish(program, opts, &on, &off, &mut report);
     }
     *report_out = report;
     steps
 }
 
-/// The ignition handshake after an arc on, as read so far.
+/// Whitespace-insensitive equality of two statements.
+fn same(a: &str, b: &str) -> bool {
+    a.chars()
+        .filter(|c| !c.is_whitespace())
+        .eq(b.chars().filter(|c| !c.is_whitespace()))
+}
+
+/// The statement keyword of `op` in messages.
+fn keyword(op: &KrlOp) -> String {
+    match op {
+        KrlOp::EndIf => "ENDIF".into(),
+        KrlOp::Halt => "HALT".into(),
+        KrlOp::IfIn(n) => format!("IF $IN[{n}] THEN"),
+        KrlOp::Loop => "LOOP".into(),
+        KrlOp::EndLoop => "ENDLOOP".into(),
+        KrlOp::Exit => "EXIT".into(),
+        KrlOp::Brake { fast: true } => "BRAKE F".into(),
+        KrlOp::Brake { fast: false } => "BRAKE".into(),
+        KrlOp::Resume => "RESUME".into(),
+        other => format!("{other:?}"),
+    }
+}
+
+/// The expected ignition handshake, in messages.
+fn handshake_form(opts: &KukaOptions) -> String {
+    let (n, t) = (opts.arc_ok_input, opts.ignition_timer);
+    format!(
+        "expected a LOOP: arc on, WAIT FOR $IN[{n}] OR $TIMER_FLAG[{t}] with a {:.3} s timeout, IF $IN[{n}] THEN EXIT ENDIF, arc off, HALT, ENDLOOP",
+        opts.ignition_timeout_s
+    )
+}
+
+/// Index of the `ENDLOOP` closing the `LOOP` at `start`.
+fn loop_end(stmts: &[KrlStatement], start: usize) -> Option<usize> {
+    let mut depth = 0usize;
+    for (k, st) in stmts.iter().enumerate().skip(start) {
+        match st.op {
+            KrlOp::Loop => depth += 1,
+            KrlOp::EndLoop => {
+                depth -= 1;
+                if depth == 0 {
+                    return Some(k);
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+/// An ignition handshake as read ([`read_handshake`]).
+#[derive(Debug)]
+struct Handshake {
+    /// Line of the arc on in it.
+    on_line: usize,
+    /// Nothing missing: its problems, if any, were reported.
+    complete: bool,
+}
+
+/// Reads `block` (a `LOOP` to its `ENDLOOP`) as the ignition handshake the
+/// emitter writes: arc on, `$TIMER[t]` set to minus the timeout and
+/// started, `WAIT FOR $IN[n] OR $TIMER_FLAG[t]`, `IF $IN[n] THEN EXIT
+/// ENDIF`, then the failed branch: arc off, message, `HALT`. `None` when
+/// the loop switches no arc on (not a handshake). What is missing or
+/// differs from `opts` is added to `report`.
+fn read_handshake(
+    block: &[KrlStatement],
+    opts: &KukaOptions,
+    on: &str,
+    off: &str,
+    src: &str,
+    report: &mut ValidationReport,
+) -> Option<Handshake> {
+    let body = &block[1..block.len() - 1];
+    let on_line = body
+        .iter()
+        .find(|s| matches!(&s.op, KrlOp::Other(t) if same(t, on)))?
+        .line;
+    let (mut timer_ms, mut started, mut waited) = (None, false, None);
+    // after `IF $IN[n] THEN EXIT ENDIF`: the failed branch
+    let mut exit_on: Option<u32> = None;
+    let (mut failed_off, mut halt) = (false, false);
+    let mut k = 0;
+    while let Some(st) = body.get(k) {
+        k += 1;
+        let line = st.line;
+        let mut problem = |kind, msg: String| push(report, kind, src, line, msg);
+        match &st.op {
+            KrlOp::Timer { timer, ms } if *timer == opts.ignition_timer => timer_ms = Some(*ms),
+            KrlOp::TimerStop { timer, stop: false }
+                if *timer == opts.ignition_timer && timer_ms.is_some() =>
+            {
+                started = true;
+            }
+            KrlOp::WaitInOrTimer { input, timer } => {
+                if *input != opts.arc_ok_input || *timer != opts.ignition_timer {
+                    problem(
+                        ProblemKind::Options,
+                        format!(
+                            "ignition wait on $IN[{input}] / $TIMER_FLAG[{timer}], the options give $IN[{}] / $TIMER_FLAG[{}]",
+                            opts.arc_ok_input, opts.ignition_timer
+                        ),
+                    );
+                }
+                let want = -(opts.ignition_timeout_s * 1000.0).round();
+                match (timer_ms, started) {
+                    (Some(ms), true) if (ms - want).abs() <= 0.5 => {}
+                    (Some(ms), true) => problem(
+                        ProblemKind::Options,
+                        format!(
+                            "ignition timeout {:.3} s ($TIMER[{timer}] = {ms}), the options give {:.3} s",
+                            -ms / 1000.0,
+                            opts.ignition_timeout_s
+                        ),
+                    ),
+                    _ => problem(
+                        ProblemKind::Instruction,
+                        format!("ignition wait without its timer: $TIMER[{timer}] not set to minus the timeout and started"),
+                    ),
+                }
+                waited = Some(*input);
+            }
+            KrlOp::IfIn(n) if exit_on.is_none() => {
+                let exits = matches!(
+                    (body.get(k).map(|s| &s.op), body.get(k + 1).map(|s| &s.op)),
+                    (Some(KrlOp::Exit), Some(KrlOp::EndIf))
+                );
+                if !exits {
+                    problem(
+                        ProblemKind::Instruction,
+                        format!("expected `IF $IN[{n}] THEN`, `EXIT`, `ENDIF`: the loop is left only with the arc established"),
+                    );
+                    continue;
+                }
+                k += 2;
+                if waited.is_some_and(|w| w != *n) {
+                    problem(
+                        ProblemKind::Instruction,
+                        format!(
+                            "the ignition loop is left on $IN[{n}], not on the input waited for, $IN[{}]",
+                            waited.unwrap_or_default()
+                        ),
+                    );
+                }
+                exit_on = Some(*n);
+            }
+            KrlOp::Exit => problem(
+                ProblemKind::Instruction,
+                "EXIT of the ignition loop without the arc established: the bead would start without the arc".into(),
+            ),
+            KrlOp::Other(t) if exit_on.is_some() && same(t, off) => failed_off = true,
+            KrlOp::Other(t) if exit_on.is_some() && same(t, on) => problem(
+                ProblemKind::Instruction,
+                "arc on in the failed-ignition branch".into(),
+            ),
+            KrlOp::Halt if exit_on.is_some() => halt = true,
+            KrlOp::Ptp(_) | KrlOp::Lin { .. } => problem(
+                ProblemKind::Instruction,
+                "motion inside the ignition loop".into(),
+            ),
+            _ => {}
+        }
+    }
+    let complete = waited.is_some() && exit_on.is_some() && halt;
+    if !complete {
+        push(
+            report,
+            ProblemKind::Instruction,
+            src,
+            on_line,
+            format!(
+                "arc on without the ignition handshake ({})",
+                handshake_form(opts)
+            ),
+        );
+    } else if !failed_off {
+        push(
+            report,
+            ProblemKind::Instruction,
+            src,
+            block[0].line,
+            format!("the failed-ignition branch halts with the arc output on (expected `{off}` before its HALT)"),
+        );
+    }
+    Some(Handshake {
+        on_line,
+        complete: complete && failed_off,
+    })
+}
+
+/// The arc-loss supervision of a program's main routine as read (module
+/// doc of [`crate::program::kuka`], "Arc supervision").
 #[derive(Debug, Default)]
-struct Ignition {
-    /// Line of the arc on.
-    line: usize,
-    /// `$TIMER[t] = v` (ms).
-    timer_ms: Option<f64>,
-    /// `$TIMER_STOP[t] = FALSE` after it.
-    started: bool,
-    /// The input waited for with the timeout.
-    waited: Option<u32>,
-    /// The failed-ignition branch stops the program.
-    halt: bool,
+struct Supervision {
+    /// The arc-loss interrupt's `INTERRUPT DECL`: priority, routine, line.
+    decl: Option<(u8, String, usize)>,
+    /// `INTERRUPT ON` of it, not `OFF` since.
+    on: bool,
+    /// `INTERRUPT DISABLE` of it, not `ENABLE` since.
+    disabled: bool,
+    /// Beads started so far.
+    beads: usize,
+    /// Line of the first bead's arc on.
+    first_bead: Option<usize>,
+    /// The current bead's ignition handshake was read.
+    established: bool,
+    /// The current bead's unsupervised motion was reported.
+    reported: bool,
+}
+
+impl Supervision {
+    fn armed(&self) -> bool {
+        self.on && !self.disabled
+    }
+
+    fn prio(&self, opts: &KukaOptions) -> u8 {
+        self.decl.as_ref().map_or(opts.arc_loss_interrupt, |d| d.0)
+    }
+
+    /// An `INTERRUPT DECL`: the arc-loss interrupt if it has the options'
+    /// priority or fires on the arc-established input going off.
+    #[allow(clippy::too_many_arguments)]
+    fn declare(
+        &mut self,
+        prio: u8,
+        when: &str,
+        handler: &str,
+        line: usize,
+        opts: &KukaOptions,
+        src: &str,
+        report: &mut ValidationReport,
+    ) {
+        let input = falling_input(when);
+        if prio != opts.arc_loss_interrupt && input != Some(opts.arc_ok_input) {
+            return; // another interrupt (the INI fold's IR_STOPM)
+        }
+        let mut problem = |kind, msg: String| push(report, kind, src, line, msg);
+        if prio != opts.arc_loss_interrupt {
+            problem(
+                ProblemKind::Options,
+                format!(
+                    "arc-loss interrupt priority {prio}, the options give {}",
+                    opts.arc_loss_interrupt
+                ),
+            );
+        }
+        if input != Some(opts.arc_ok_input) {
+            problem(
+                ProblemKind::Options,
+                format!(
+                    "the arc-loss interrupt {prio} fires on `{when}`, the options give the arc-established input going off, `$IN[{}]==FALSE`",
+                    opts.arc_ok_input
+                ),
+            );
+        }
+        if let Some(first) = self.first_bead {
+            problem(
+                ProblemKind::Instruction,
+                format!("the arc-loss interrupt is declared after the first bead (arc on at line {first})"),
+            );
+        }
+        self.decl = Some((prio, handler.to_string(), line));
+    }
+
+    /// `INTERRUPT action [prio]`.
+    #[allow(clippy::too_many_arguments)]
+    fn control(
+        &mut self,
+        action: InterruptAction,
+        prio: Option<u8>,
+        line: usize,
+        arc_is_on: bool,
+        opts: &KukaOptions,
+        src: &str,
+        report: &mut ValidationReport,
+    ) {
+        let ours = match (&self.decl, prio) {
+            (Some(_), None) => true,
+            (Some(d), Some(p)) => d.0 == p,
+            (None, p) => {
+                if p == Some(opts.arc_loss_interrupt) {
+                    push(
+                        report,
+                        ProblemKind::Instruction,
+                        src,
+                        line,
+                        format!(
+                            "INTERRUPT {} {} before its INTERRUPT DECL",
+                            action.keyword(),
+                            opts.arc_loss_interrupt
+                        ),
+                    );
+                }
+                false
+            }
+        };
+        if !ours {
+            return;
+        }
+        match action {
+            InterruptAction::On => {
+                if !(arc_is_on && self.established) {
+                    push(
+                        report,
+                        ProblemKind::Instruction,
+                        src,
+                        line,
+                        format!(
+                            "INTERRUPT ON {} before the arc is established: it fires when $IN[{}] goes off (an edge), so it is armed after the ignition handshake",
+                            self.prio(opts),
+                            opts.arc_ok_input
+                        ),
+                    );
+                }
+                self.on = true;
+            }
+            InterruptAction::Off => self.on = false,
+            InterruptAction::Disable => self.disabled = true,
+            InterruptAction::Enable => self.disabled = false,
+        }
+    }
+
+    /// An arc on at `line`; `established`: in an ignition handshake.
+    fn bead_start(&mut self, line: usize, established: bool) {
+        self.beads += 1;
+        self.first_bead.get_or_insert(line);
+        self.established = established;
+        self.reported = false;
+    }
+
+    /// A motion (`what`, e.g. `LIN P3`) with the arc on: the interrupt must
+    /// be on (reported once a bead).
+    fn motion(
+        &mut self,
+        line: usize,
+        what: &str,
+        opts: &KukaOptions,
+        src: &str,
+        report: &mut ValidationReport,
+    ) {
+        if self.armed() || self.reported {
+            return;
+        }
+        self.reported = true;
+        let (b, p, n) = (self.beads, self.prio(opts), opts.arc_ok_input);
+        let msg = match self.decl {
+            None => format!(
+                "bead {b}: {what} with the arc on and no arc-loss supervision (INTERRUPT DECL {p} WHEN $IN[{n}]==FALSE DO {ARC_LOST_HANDLER}( ) before the first bead, INTERRUPT ON {p} after each ignition): an arc loss goes unseen"
+            ),
+            Some(_) => format!(
+                "bead {b}: {what} with the arc on while the arc-loss interrupt {p} is not on (INTERRUPT ON {p} after the ignition handshake, INTERRUPT OFF {p} only before the arc off): an arc loss here goes unseen"
+            ),
+        };
+        push(report, ProblemKind::Instruction, src, line, msg);
+    }
+
+    /// The arc switched off at `line` (a bead's end).
+    fn arc_off(&mut self, line: usize, src: &str, report: &mut ValidationReport) {
+        if self.armed() {
+            let p = self.decl.as_ref().map_or(0, |d| d.0);
+            push(
+                report,
+                ProblemKind::Instruction,
+                src,
+                line,
+                format!("arc off with the arc-loss interrupt {p} on: the input going off fires it at every bead's end (INTERRUPT OFF {p} before the arc off)"),
+            );
+        }
+        self.established = false;
+    }
+
+    /// After the main routine: the declaration exists and its routine is
+    /// the handler the options give.
+    fn finish(
+        &self,
+        program: &KrlProgram,
+        opts: &KukaOptions,
+        on: &str,
+        off: &str,
+        report: &mut ValidationReport,
+    ) {
+        let src = &program.src_file;
+        let Some(first) = self.first_bead else {
+            return;
+        };
+        match &self.decl {
+            None => push(
+                report,
+                ProblemKind::Instruction,
+                src,
+                first,
+                format!(
+                    "no arc-loss supervision: `INTERRUPT DECL {p} WHEN $IN[{n}]==FALSE DO {ARC_LOST_HANDLER}( )` missing before the first bead, so an arc loss in a bead is never seen",
+                    p = opts.arc_loss_interrupt,
+                    n = opts.arc_ok_input
+                ),
+            ),
+            Some((prio, handler, line)) => match program.routine(handler) {
+                None => push(
+                    report,
+                    ProblemKind::Declaration,
+                    src,
+                    *line,
+                    format!("the arc-loss interrupt calls {handler}( ), which is not a DEF in {src}"),
+                ),
+                Some(r) => check_handler(r, *prio, opts, on, off, src, report),
+            },
+        }
+    }
+}
+
+/// Checks the arc-loss interrupt routine `r` (priority `prio`): it stops
+/// the robot (`BRAKE F`), switches the arc off, and never returns into the
+/// bead with the arc off: an endless `HALT` (abort) or, after a `HALT`, the
+/// ignition handshake and the interrupt re-armed (reignite), as
+/// [`KukaOptions::arc_loss`] gives.
+fn check_handler(
+    r: &KrlRoutine,
+    prio: u8,
+    opts: &KukaOptions,
+    on: &str,
+    off: &str,
+    src: &str,
+    report: &mut ValidationReport,
+) {
+    let name = &r.name;
+    let stmts = &r.statements;
+    let (mut brake, mut arc_off, mut halt) = (false, false, false);
+    // the routine ends in an endless LOOP with a HALT
+    let mut endless = false;
+    // an ignition handshake read (complete?), then the interrupt re-armed
+    let mut reignite: Option<bool> = None;
+    let mut rearmed = false;
+    let mut next = 0;
+    while let Some(st) = stmts.get(next) {
+        next += 1;
+        let line = st.line;
+        let mut problem = |msg: String| push(report, ProblemKind::Instruction, src, line, msg);
+        match &st.op {
+            KrlOp::Brake { fast } => {
+                brake = true;
+                if !fast {
+                    problem(format!("`BRAKE` in the arc-loss handler {name} stops with the normal ramp: `BRAKE F` stops on the path as fast as possible"));
+                }
+            }
+            KrlOp::Other(t) if same(t, off) => {
+                if reignite.is_some() {
+                    problem(format!("arc off after the re-ignition in {name}: the bead goes on with the arc off"));
+                } else {
+                    arc_off = true;
+                }
+            }
+            KrlOp::Other(t) if same(t, on) => problem(format!(
+                "arc on in {name} outside the ignition handshake ({})",
+                handshake_form(opts)
+            )),
+            KrlOp::Halt => halt = true,
+            KrlOp::Loop => {
+                let Some(end) = loop_end(stmts, next - 1) else {
+                    problem("LOOP without ENDLOOP".into());
+                    break;
+                };
+                let block = &stmts[next - 1..=end];
+                next = end + 1;
+                if let Some(h) = read_handshake(block, opts, on, off, src, report) {
+                    if !halt {
+                        push(
+                            report,
+                            ProblemKind::Instruction,
+                            src,
+                            h.on_line,
+                            format!("{name} re-ignites without a HALT first: the operator does not see the arc loss"),
+                        );
+                    }
+                    reignite = Some(h.complete);
+                    continue;
+                }
+                let body = &block[1..block.len() - 1];
+                let exits = body.iter().any(|s| s.op == KrlOp::Exit);
+                let halts = body.iter().any(|s| s.op == KrlOp::Halt);
+                if !exits && halts {
+                    endless = true;
+                    break; // nothing after it runs
+                }
+                push(
+                    report,
+                    ProblemKind::Instruction,
+                    src,
+                    line,
+                    format!("a LOOP in {name} that is neither an endless HALT nor the ignition handshake"),
+                );
+            }
+            KrlOp::Interrupt {
+                action: InterruptAction::On | InterruptAction::Enable,
+                prio: p,
+            } if p.is_none_or(|p| p == prio) => {
+                if reignite.is_some() {
+                    rearmed = true;
+                } else {
+                    problem(format!("INTERRUPT ON {prio} in {name} before the arc is established again"));
+                }
+            }
+            KrlOp::Ptp(_) | KrlOp::Lin { .. } => problem(format!("motion in the arc-loss handler {name}")),
+            KrlOp::Resume => problem(format!(
+                "RESUME in the arc-loss handler {name}: it abandons the rest of the bead, and the program goes on without it"
+            )),
+            KrlOp::Exit => problem(format!("EXIT outside a loop in {name}")),
+            _ => {}
+        }
+    }
+    let mut problem = |kind, msg: String| push(report, kind, src, r.line, msg);
+    if !brake {
+        problem(
+            ProblemKind::Instruction,
+            format!("the arc-loss handler {name} does not stop the robot (`BRAKE F`)"),
+        );
+    }
+    if !arc_off {
+        problem(
+            ProblemKind::Instruction,
+            format!("the arc-loss handler {name} does not switch the arc off (`{off}`): the output stays on while the robot stands"),
+        );
+    }
+    let quoted = |m: ArcLoss| match m {
+        ArcLoss::Abort => "\"abort\"",
+        ArcLoss::Reignite => "\"reignite\"",
+    };
+    match (endless, reignite, opts.arc_loss) {
+        (false, None, _) => problem(
+            ProblemKind::Instruction,
+            format!("the arc-loss handler {name} returns into the bead with the arc off: the start goes on without the arc (abort: end in LOOP HALT ENDLOOP; reignite: HALT, then the ignition handshake)"),
+        ),
+        (true, _, ArcLoss::Reignite) => problem(
+            ProblemKind::Options,
+            format!("the arc-loss handler {name} ends the program (abort), the options give arc_loss = {}", quoted(opts.arc_loss)),
+        ),
+        (false, Some(_), ArcLoss::Abort) => problem(
+            ProblemKind::Options,
+            format!("the arc-loss handler {name} re-ignites, the options give arc_loss = {}", quoted(opts.arc_loss)),
+        ),
+        (false, Some(_), ArcLoss::Reignite) if !rearmed => problem(
+            ProblemKind::Instruction,
+            format!("the arc-loss handler {name} re-ignites but does not re-arm the interrupt (INTERRUPT ON {prio} before its END): a second arc loss in the bead goes unseen"),
+        ),
+        _ => {}
+    }
 }
 
 /// Largest difference between a stated frame and the expected one: 0.001
@@ -782,12 +1296,7 @@ fn check_time(
 }
 
 /// An arc off (line `l`) not followed by the burn-back wait the options give.
-fn missing_burn_back(
-    report: &mut ValidationReport,
-    file: &str,
-    l: usize,
-    opts: &crate::program::kuka::KukaOptions,
-) {
+fn missing_burn_back(report: &mut ValidationReport, file: &str, l: usize, opts: &KukaOptions) {
     if opts.burn_back_s > 0.0 {
         push(
             report,

@@ -13,15 +13,51 @@
 //!   `$VEL.CP` (m/s) blended with `C_DIS` inside the bead, the last one
 //!   exact.
 //! * **Arc process** (`$OUT[schedule]`): the arc is switched on at the
-//!   bead's first point, where the robot stands (exact stop), followed by
-//!   the ignition handshake: `$TIMER[t]` set to minus the timeout (ms) and
-//!   started, `WAIT FOR $IN[arc_ok] OR $TIMER_FLAG[t]` (KRL's `WAIT FOR`
-//!   has no timeout; the flag turns on when the timer reaches 0), and if
-//!   the input is still off: arc off, a message (`Set_KrlMsg(#QUIT, …)`,
-//!   KSS 8) and `HALT`. At the bead's last point (exact): `WAIT SEC
+//!   bead's first point, where the robot stands (exact stop), inside the
+//!   ignition handshake, a `LOOP` left only with the arc established: arc
+//!   on, `$TIMER[t]` set to minus the timeout (ms) and started, `WAIT FOR
+//!   $IN[arc_ok] OR $TIMER_FLAG[t]` (KRL's `WAIT FOR` has no timeout; the
+//!   flag turns on when the timer reaches 0), `IF $IN[arc_ok] THEN EXIT
+//!   ENDIF`; else arc off, a message (`Set_KrlMsg(#QUIT, …)`, KSS 8) and
+//!   `HALT`, and the operator's start tries again: the bead never starts
+//!   without the arc (before issue 32 the start after that `HALT` ran the
+//!   bead with the arc off). At the bead's last point (exact): `WAIT SEC
 //!   crater` with the arc on, arc off, `WAIT SEC burn-back`
 //!   ([`KukaOptions::arc_ok_input`], [`KukaOptions::ignition_timeout_s`],
 //!   [`KukaOptions::crater_fill_s`], [`KukaOptions::burn_back_s`]).
+//! * **Arc supervision** (arc process only: a custom process switches a
+//!   device through lines we cannot interpret and has no input to watch,
+//!   so it gets none). An arc lost during a bead stops the robot and
+//!   switches the arc off, and the bead never goes on without the arc:
+//!   - `INTERRUPT DECL p WHEN $IN[arc_ok]==FALSE DO WAAM_ARC_LOST( )` once
+//!     in the main routine, before the first bead (`p` =
+//!     [`KukaOptions::arc_loss_interrupt`], a user priority: 1, 2, 4–39 or
+//!     81–128, default 20; 3 and 40–80 are the system's).
+//!   - `INTERRUPT ON p` right after each bead's handshake: a KRL interrupt
+//!     fires when its condition *becomes* true (an edge), so it is armed
+//!     with the arc established and fires on its loss. `INTERRUPT OFF p`
+//!     just before the arc off at the bead's end, after the crater wait; a
+//!     crater time of 0 is written `WAIT SEC 0.000`, an advance-run stop,
+//!     so that the `INTERRUPT OFF` never runs in the advance run while the
+//!     bead's last motions still do (whether `INTERRUPT ON/OFF` stop the
+//!     advance run themselves was not confirmed). The crater fill is thus
+//!     supervised too.
+//!   - The handler [`ARC_LOST_HANDLER`], a local `DEF` after the main
+//!     routine's `END`: `INTERRUPT OFF p`, `BRAKE F` (stop on the path as
+//!     fast as possible), arc off and burn-back as at a bead's end, a
+//!     message, then per [`KukaOptions::arc_loss`]: *abort* (default)
+//!     `LOOP HALT ENDLOOP`, the start never leaves it and the program must
+//!     be cancelled; *reignite* `HALT`, then where the robot stopped the
+//!     ignition handshake and `INTERRUPT ON p`, after which the interrupted
+//!     motion goes on with the arc. (Jogging the robot during that `HALT`
+//!     would move the re-ignition off the path: the handler runs before
+//!     the controller returns to the path; inferred, not checked.)
+//!   - No `RESUME`: it abandons the rest of the interrupted subprogram and
+//!     goes on after its call, which here would skip the rest of the bead
+//!     (a partial layer, then the next bead), the very failure supervised;
+//!     it would also need each bead in a subprogram one level below the
+//!     declaring routine and the advance run stopped there. Without it the
+//!     beads stay in the main routine, where the interrupt is declared.
 //! * **Custom process**: the user's statements, switched by `TRIGGER WHEN
 //!   DISTANCE=0` before the first `LIN` (fires at the exact first point)
 //!   and `TRIGGER WHEN DISTANCE=1` before the last `LIN` (fires at its
@@ -149,7 +185,8 @@ pub struct KukaOptions {
     /// Digital input `$IN[n]` on once the power source reports the arc
     /// established (arc process only): after switching the arc on at a
     /// bead's first point the program waits for it at most
-    /// [`KukaOptions::ignition_timeout_s`], then stops with a message.
+    /// [`KukaOptions::ignition_timeout_s`], then stops with a message; in
+    /// the bead its fall fires the arc-loss interrupt (module doc).
     /// Default 1 (our choice: the input paired with the default arc output
     /// `$OUT[1]`; the controller's I/O mapping decides).
     pub arc_ok_input: u32,
@@ -175,6 +212,15 @@ pub struct KukaOptions {
     /// the math-coupled base `$BASE = EK(...)` of a torch-carried cell
     /// (2–32; 1 is the robot). Default 2, the first external kinematic.
     pub ek_machine: u8,
+    /// What the arc-loss handler does once the robot has stopped and the
+    /// arc is off (arc process only; module doc, "Arc supervision"). Default
+    /// [`ArcLoss::Abort`].
+    pub arc_loss: ArcLoss,
+    /// Priority of the arc-loss interrupt `INTERRUPT DECL p WHEN
+    /// $IN[arc_ok_input]==FALSE DO …` (arc process only): a user priority,
+    /// 1, 2, 4–39 or 81–128 (1 the highest; 3 and 40–80 are the system's).
+    /// Default 20 (our choice, inside 4–39 and clear of ArcTech's 3).
+    pub arc_loss_interrupt: u8,
     /// The vendor-independent options (home, dwell, interpass wait,
     /// payload, transit, coordination) the validator checks the file
     /// against; not a key of `[program.<vendor>]` (set from `[program]` by
@@ -202,6 +248,8 @@ impl Default for KukaOptions {
             crater_fill_s: 0.2,
             burn_back_s: 0.1,
             ek_machine: 2,
+            arc_loss: ArcLoss::Abort,
+            arc_loss_interrupt: 20,
             common: Default::default(),
         }
     }
@@ -331,6 +379,13 @@ impl KukaOptions {
                 "must be in 1..=16",
             ));
         }
+        if !is_user_interrupt(self.arc_loss_interrupt) {
+            return Err(bad(
+                "arc_loss_interrupt",
+                self.arc_loss_interrupt.to_string(),
+                "KRL user interrupt priorities are 1, 2, 4..=39 and 81..=128 (3 and 40..=80 are reserved for the system)",
+            ));
+        }
         if !(2..=32).contains(&self.ek_machine) {
             return Err(bad(
                 "ek_machine",
@@ -354,6 +409,36 @@ impl KukaOptions {
         Ok(())
     }
 }
+
+/// What the arc-loss handler does after `BRAKE F` and arc off (module doc,
+/// "Arc supervision"): in either case the bead never continues with the arc
+/// off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ArcLoss {
+    /// A message, then `HALT` in an endless `LOOP`: the start never leaves
+    /// the handler, the program must be cancelled (the bead and its layer
+    /// are incomplete; the operator decides how to go on).
+    #[default]
+    Abort,
+    /// A message and `HALT`; the start then re-runs the ignition handshake
+    /// where the robot stopped (arc on, wait for the arc-established input
+    /// with the timeout, arc off, message and `HALT` again without it) and
+    /// only with the arc established re-arms the interrupt and returns: the
+    /// bead continues from there.
+    Reignite,
+}
+
+/// `true` for a priority KRL leaves to user interrupts: 1, 2, 4–39 and
+/// 81–128 (3 and 40–80 are reserved for system applications; KUKA College
+/// training material, vendor notes §1).
+pub fn is_user_interrupt(prio: u8) -> bool {
+    matches!(prio, 1 | 2 | 4..=39 | 81..=128)
+}
+
+/// Name of the arc-loss interrupt routine, a local `DEF` after the main
+/// routine's `END` in the `.src`.
+pub const ARC_LOST_HANDLER: &str = "WAAM_ARC_LOST";
 
 /// The `$BASE` a program states (module doc, "Frames").
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -568,10 +653,7 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     )?;
     if arc {
         // the message of a failed ignition (KSS 8 Set_KrlMsg)
-        writeln!(w, "  DECL KRLMSG_T WAAM_MSG")?;
-        writeln!(w, "  DECL KRLMSGPAR_T WAAM_PAR[3]")?;
-        writeln!(w, "  DECL KRLMSGOPT_T WAAM_OPT")?;
-        writeln!(w, "  DECL INT WAAM_H")?;
+        write_message_decls(w)?;
     }
     writeln!(w, "  ;FOLD INI")?;
     writeln!(
@@ -620,6 +702,18 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     }
     writeln!(w, "  $APO.CDIS = {}", Mm(opts.cdis_mm))?;
     writeln!(w, "  BAS (#VEL_PTP,{} )", opts.ptp_percent)?;
+    if arc {
+        writeln!(
+            w,
+            "  ; arc-loss supervision: interrupt {} fires when IN {} (arc established) goes off; on only in the beads",
+            opts.arc_loss_interrupt, opts.arc_ok_input
+        )?;
+        writeln!(
+            w,
+            "  INTERRUPT DECL {} WHEN $IN[{}]==FALSE DO {ARC_LOST_HANDLER}( )",
+            opts.arc_loss_interrupt, opts.arc_ok_input
+        )?;
+    }
     // external-axis speeds (%) written since the last PTP speed setting
     let mut extax: [Option<f64>; 2] = [None; 2];
     // before a PTP after timed moves: the PTP speeds again (BAS sets the
@@ -733,6 +827,9 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
         writeln!(w, "  PTP {HOME_NAME}")?;
     }
     writeln!(w, "END")?;
+    if arc {
+        write_arc_lost_handler(w, opts, &on, &off)?;
+    }
     Ok(())
 }
 
@@ -770,9 +867,10 @@ fn write_bead_setup(w: &mut dyn Write, setup: &BeadSetup) -> std::io::Result<()>
     Ok(())
 }
 
-/// Arc on at a bead's first point (the robot stands there, exact stop),
-/// then the ignition handshake: wait for the arc-established input with a
-/// `$TIMER` timeout, and if it did not come, arc off, a message and `HALT`.
+/// Arc on at a bead's first point (the robot stands there, exact stop)
+/// with the ignition handshake ([`write_handshake`]), then the arc-loss
+/// interrupt armed: the arc is established, so the interrupt fires on its
+/// loss (an edge).
 fn write_ignition(
     w: &mut dyn Write,
     opts: &KukaOptions,
@@ -780,51 +878,191 @@ fn write_ignition(
     off: &str,
     layer: usize,
 ) -> std::io::Result<()> {
-    let (t, n) = (opts.ignition_timer, opts.arc_ok_input);
-    let ms = (opts.ignition_timeout_s * 1000.0).round() as i64;
     writeln!(
         w,
-        "  ; arc on, then wait at most {} s for the arc (IN {n})",
-        sec(opts.ignition_timeout_s)
+        "  ; arc on, then wait at most {} s for the arc (IN {}); without it: arc off, message, HALT, and the start tries again",
+        sec(opts.ignition_timeout_s),
+        opts.arc_ok_input
     )?;
-    writeln!(w, "  {on}")?;
-    writeln!(w, "  $TIMER_STOP[{t}] = TRUE")?;
-    writeln!(w, "  $TIMER[{t}] = -{ms}")?;
-    writeln!(w, "  $TIMER_STOP[{t}] = FALSE")?;
-    writeln!(w, "  WAIT FOR $IN[{n}] OR $TIMER_FLAG[{t}]")?;
-    writeln!(w, "  $TIMER_STOP[{t}] = TRUE")?;
-    writeln!(w, "  IF NOT $IN[{n}] THEN")?;
-    writeln!(w, "    {off}")?;
+    write_handshake(w, opts, on, off, "  ", &format!("arc on, layer {layer}"))?;
     writeln!(
         w,
-        "    WAAM_MSG = {{MODUL[] \"WAAM\",NR 1,MSG_TXT[] \"No arc: IN {n} off {} s after arc on, layer {layer}\"}}",
-        sec(opts.ignition_timeout_s)
+        "  ; arc established: arc-loss supervision on (interrupt {})",
+        opts.arc_loss_interrupt
     )?;
-    writeln!(
-        w,
-        "    WAAM_OPT = {{VL_STOP TRUE,CLEAR_P_RESET TRUE,CLEAR_P_SAW FALSE,LOG_TO_DB TRUE}}"
-    )?;
-    writeln!(
-        w,
-        "    WAAM_H = SET_KRLMSG(#QUIT,WAAM_MSG,WAAM_PAR[],WAAM_OPT)"
-    )?;
-    writeln!(w, "    HALT")?;
-    writeln!(w, "  ENDIF")?;
+    writeln!(w, "  INTERRUPT ON {}", opts.arc_loss_interrupt)?;
     Ok(())
 }
 
-/// At a bead's last point (exact stop): crater fill with the arc on, arc
-/// off, burn-back wait.
+/// The ignition handshake at `indent`, a `LOOP` left only with the arc
+/// established: arc on, `$TIMER[t]` set to minus the timeout (ms) and
+/// started, `WAIT FOR $IN[n] OR $TIMER_FLAG[t]` (KRL's `WAIT FOR` has no
+/// timeout; the flag turns on when the timer reaches 0), `EXIT` if the
+/// input is on; else arc off, a message ("No arc … after `after`") and
+/// `HALT`, and the operator's start tries again.
+fn write_handshake(
+    w: &mut dyn Write,
+    opts: &KukaOptions,
+    on: &str,
+    off: &str,
+    indent: &str,
+    after: &str,
+) -> std::io::Result<()> {
+    let (t, n) = (opts.ignition_timer, opts.arc_ok_input);
+    let ms = (opts.ignition_timeout_s * 1000.0).round() as i64;
+    writeln!(w, "{indent}LOOP")?;
+    writeln!(w, "{indent}  {on}")?;
+    writeln!(w, "{indent}  $TIMER_STOP[{t}] = TRUE")?;
+    writeln!(w, "{indent}  $TIMER[{t}] = -{ms}")?;
+    writeln!(w, "{indent}  $TIMER_STOP[{t}] = FALSE")?;
+    writeln!(w, "{indent}  WAIT FOR $IN[{n}] OR $TIMER_FLAG[{t}]")?;
+    writeln!(w, "{indent}  $TIMER_STOP[{t}] = TRUE")?;
+    writeln!(w, "{indent}  IF $IN[{n}] THEN")?;
+    writeln!(w, "{indent}    EXIT")?;
+    writeln!(w, "{indent}  ENDIF")?;
+    writeln!(w, "{indent}  {off}")?;
+    write_message(
+        w,
+        &format!("{indent}  "),
+        1,
+        &format!(
+            "No arc: IN {n} off {} s after {after}",
+            sec(opts.ignition_timeout_s)
+        ),
+    )?;
+    writeln!(w, "{indent}  HALT")?;
+    writeln!(w, "{indent}ENDLOOP")?;
+    Ok(())
+}
+
+/// A message the operator acknowledges (`Set_KrlMsg(#QUIT, …)`, KSS 8)
+/// with number `nr`, in the routine's `WAAM_MSG`/`WAAM_PAR`/`WAAM_OPT`/
+/// `WAAM_H` ([`write_message_decls`]). KRL's `MSG_TXT[]` holds 80
+/// characters.
+fn write_message(w: &mut dyn Write, indent: &str, nr: u32, text: &str) -> std::io::Result<()> {
+    debug_assert!(text.len() <= 80, "{text}");
+    writeln!(
+        w,
+        "{indent}WAAM_MSG = {{MODUL[] \"WAAM\",NR {nr},MSG_TXT[] \"{text}\"}}"
+    )?;
+    writeln!(
+        w,
+        "{indent}WAAM_OPT = {{VL_STOP TRUE,CLEAR_P_RESET TRUE,CLEAR_P_SAW FALSE,LOG_TO_DB TRUE}}"
+    )?;
+    writeln!(
+        w,
+        "{indent}WAAM_H = SET_KRLMSG(#QUIT,WAAM_MSG,WAAM_PAR[],WAAM_OPT)"
+    )?;
+    Ok(())
+}
+
+/// The declarations [`write_message`] uses, at the top of a routine.
+fn write_message_decls(w: &mut dyn Write) -> std::io::Result<()> {
+    writeln!(w, "  DECL KRLMSG_T WAAM_MSG")?;
+    writeln!(w, "  DECL KRLMSGPAR_T WAAM_PAR[3]")?;
+    writeln!(w, "  DECL KRLMSGOPT_T WAAM_OPT")?;
+    writeln!(w, "  DECL INT WAAM_H")?;
+    Ok(())
+}
+
+/// At a bead's last point (exact stop): crater fill with the arc on (a
+/// `WAIT SEC 0.000` without one: an advance-run stop, so that what follows
+/// runs when the robot stands at the last point), the arc-loss interrupt
+/// off, arc off, burn-back wait.
 fn write_arc_end(w: &mut dyn Write, opts: &KukaOptions, off: &str) -> std::io::Result<()> {
     if opts.crater_fill_s > 0.0 {
         writeln!(w, "  ; crater fill, arc on")?;
-        writeln!(w, "  WAIT SEC {}", sec(opts.crater_fill_s))?;
+    } else {
+        writeln!(
+            w,
+            "  ; advance-run stop: the supervision goes off at the bead's last point"
+        )?;
     }
-    writeln!(w, "  {off}")?;
+    writeln!(w, "  WAIT SEC {}", sec(opts.crater_fill_s))?;
+    writeln!(
+        w,
+        "  ; arc-loss supervision off (interrupt {}), then arc off",
+        opts.arc_loss_interrupt
+    )?;
+    writeln!(w, "  INTERRUPT OFF {}", opts.arc_loss_interrupt)?;
+    write_arc_off(w, opts, off, "  ")
+}
+
+/// Arc off, then the burn-back wait: the end of a bead and of the arc-loss
+/// handler.
+fn write_arc_off(
+    w: &mut dyn Write,
+    opts: &KukaOptions,
+    off: &str,
+    indent: &str,
+) -> std::io::Result<()> {
+    writeln!(w, "{indent}{off}")?;
     if opts.burn_back_s > 0.0 {
-        writeln!(w, "  ; burn-back")?;
-        writeln!(w, "  WAIT SEC {}", sec(opts.burn_back_s))?;
+        writeln!(w, "{indent}; burn-back")?;
+        writeln!(w, "{indent}WAIT SEC {}", sec(opts.burn_back_s))?;
     }
+    Ok(())
+}
+
+/// The arc-loss interrupt routine ([`ARC_LOST_HANDLER`], a local `DEF`
+/// after the main routine): interrupt off, `BRAKE F`, arc off as at a
+/// bead's end, a message, then per [`KukaOptions::arc_loss`] an endless
+/// `HALT` (abort) or `HALT`, the ignition handshake and the interrupt
+/// re-armed (reignite). Module doc, "Arc supervision".
+fn write_arc_lost_handler(
+    w: &mut dyn Write,
+    opts: &KukaOptions,
+    on: &str,
+    off: &str,
+) -> std::io::Result<()> {
+    let (p, n) = (opts.arc_loss_interrupt, opts.arc_ok_input);
+    writeln!(w)?;
+    writeln!(w, "DEF {ARC_LOST_HANDLER}( )")?;
+    writeln!(
+        w,
+        "  ; arc lost in a bead (interrupt {p}: IN {n} off): stop on the path, arc off; the bead never goes on with the arc off"
+    )?;
+    write_message_decls(w)?;
+    writeln!(w, "  INTERRUPT OFF {p}")?;
+    writeln!(w, "  BRAKE F")?;
+    write_arc_off(w, opts, off, "  ")?;
+    match opts.arc_loss {
+        ArcLoss::Abort => {
+            write_message(
+                w,
+                "  ",
+                2,
+                &format!("Arc lost (IN {n} off) in a bead: layer incomplete, cancel the program"),
+            )?;
+            writeln!(w, "  ; abort: the start never leaves this routine")?;
+            writeln!(w, "  LOOP")?;
+            writeln!(w, "    HALT")?;
+            writeln!(w, "  ENDLOOP")?;
+        }
+        ArcLoss::Reignite => {
+            write_message(
+                w,
+                "  ",
+                2,
+                &format!(
+                    "Arc lost (IN {n} off) in a bead: start re-ignites here, the bead goes on"
+                ),
+            )?;
+            writeln!(w, "  HALT")?;
+            writeln!(
+                w,
+                "  ; re-ignite where the robot stopped: arc on, then wait at most {} s for the arc (IN {n}); without it: arc off, message, HALT, and the start tries again",
+                sec(opts.ignition_timeout_s)
+            )?;
+            write_handshake(w, opts, on, off, "  ", "re-ignition")?;
+            writeln!(
+                w,
+                "  ; arc established again: supervision on, the bead goes on from here"
+            )?;
+            writeln!(w, "  INTERRUPT ON {p}")?;
+        }
+    }
+    writeln!(w, "END")?;
     Ok(())
 }
 
@@ -921,6 +1159,13 @@ pub fn kuka_files(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFi
             field: "name",
             value: program.name.clone(),
             reason: "KRL names (DEF, DEFDAT, file name) have at most 24 characters",
+        });
+    }
+    if opts.arc_process() && program.name.eq_ignore_ascii_case(ARC_LOST_HANDLER) {
+        return Err(ProgramError::InvalidOptions {
+            field: "name",
+            value: program.name.clone(),
+            reason: "taken by the arc-loss interrupt routine, a local DEF in the same .src",
         });
     }
     Ok(vec![

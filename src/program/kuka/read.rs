@@ -1,9 +1,12 @@
 //! Reader of our own KUKA KRL output (`.src` + `.dat`, the subset
 //! [`write_src`](crate::program::kuka::write_src) and
-//! [`write_dat`](crate::program::kuka::write_dat) write). Errors name the
-//! file and line; a `.src` without `END` or a `.dat` without `ENDDAT`
-//! (truncated) is an error.
+//! [`write_dat`](crate::program::kuka::write_dat) write): the `.src`'s main
+//! routine and the local subprograms after it (the arc-loss interrupt
+//! routine), the `.dat`'s positions. Errors name the file and line; a
+//! `.src` routine without `END` or a `.dat` without `ENDDAT` (truncated) is
+//! an error.
 
+use crate::program::kuka::is_call;
 use crate::program::ProgramError;
 
 /// One `.src` statement.
@@ -75,10 +78,43 @@ pub enum KrlOp {
     },
     /// `IF NOT $IN[n] THEN`.
     IfNotIn(u32),
+    /// `IF $IN[n] THEN`.
+    IfIn(u32),
     /// `ENDIF`.
     EndIf,
     /// `HALT`.
     Halt,
+    /// `LOOP`: an endless loop, left only by `EXIT`.
+    Loop,
+    /// `ENDLOOP`.
+    EndLoop,
+    /// `EXIT`: leaves the innermost loop.
+    Exit,
+    /// `[GLOBAL] INTERRUPT DECL prio WHEN condition DO handler( )`.
+    InterruptDecl {
+        /// `GLOBAL`: valid in the callers too.
+        global: bool,
+        /// Priority (1 the highest).
+        prio: u8,
+        /// The condition, as written (see [`falling_input`]).
+        when: String,
+        /// The interrupt routine's name (arguments dropped).
+        handler: String,
+    },
+    /// `INTERRUPT ON|OFF|ENABLE|DISABLE [prio]`.
+    Interrupt {
+        /// What is done.
+        action: InterruptAction,
+        /// The priority; `None`: all interrupts.
+        prio: Option<u8>,
+    },
+    /// `BRAKE` (normal ramp) or `BRAKE F` (as fast as possible).
+    Brake {
+        /// `BRAKE F`.
+        fast: bool,
+    },
+    /// `RESUME`: aborts the interrupted routine's motions.
+    Resume,
     /// `$IPO_MODE = #TCP` (`true`) or `#BASE` (`false`).
     IpoTcp(bool),
     /// `$VEL_EXTAX[n] = p`: external axis `n` (1-based) at `p` % of its
@@ -97,6 +133,42 @@ pub enum KrlOp {
     Base(u8),
     /// Anything else (other `BAS (...)`, `$APO.CDIS = ...`), as written.
     Other(String),
+}
+
+/// What `INTERRUPT … [prio]` does to a declared interrupt.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InterruptAction {
+    /// `ON`: the condition is monitored (an edge: it fires when the
+    /// condition becomes true).
+    On,
+    /// `OFF`: not monitored.
+    Off,
+    /// `ENABLE`: events detected are handled again.
+    Enable,
+    /// `DISABLE`: events are detected and kept, handled at `ENABLE`.
+    Disable,
+}
+
+impl InterruptAction {
+    /// The KRL keyword (`ON`, `OFF`, `ENABLE`, `DISABLE`).
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Self::On => "ON",
+            Self::Off => "OFF",
+            Self::Enable => "ENABLE",
+            Self::Disable => "DISABLE",
+        }
+    }
+}
+
+/// Input `n` when `when` is `$IN[n]==FALSE` (or `NOT $IN[n]`): the
+/// condition of an interrupt that fires when the input goes off.
+pub fn falling_input(when: &str) -> Option<u32> {
+    let c: String = when.chars().filter(|c| !c.is_whitespace()).collect();
+    let input = c
+        .strip_suffix("==FALSE")
+        .or_else(|| c.strip_prefix("NOT"))?;
+    index_of(input, "$IN[").and_then(|n| u32::try_from(n).ok())
 }
 
 /// A statement with its `.src` line (1-based).
@@ -137,6 +209,18 @@ pub struct KrlPosition {
     pub external: [f64; 2],
 }
 
+/// A local subprogram: a `DEF … END` after the main routine's in the same
+/// `.src` (the arc-loss interrupt routine).
+#[derive(Debug, Clone, PartialEq)]
+pub struct KrlRoutine {
+    /// `DEF` name.
+    pub name: String,
+    /// Line of its `DEF`.
+    pub line: usize,
+    /// Its statements in order (the `DECL`s as [`KrlOp::Other`]).
+    pub statements: Vec<KrlStatement>,
+}
+
 /// A KRL program as read.
 #[derive(Debug, Clone, PartialEq)]
 pub struct KrlProgram {
@@ -146,8 +230,10 @@ pub struct KrlProgram {
     pub src_file: String,
     /// `.dat` file name.
     pub dat_file: String,
-    /// The `.src` statements in order.
+    /// The main routine's statements in order.
     pub statements: Vec<KrlStatement>,
+    /// The local subprograms after the main routine, in order.
+    pub routines: Vec<KrlRoutine>,
     /// The `.dat` positions.
     pub positions: Vec<KrlPosition>,
 }
@@ -164,7 +250,7 @@ pub fn parse_krl(
     dat: &str,
     dat_file: &str,
 ) -> Result<KrlProgram, ProgramError> {
-    let (name, statements) = parse_src(src, src_file)?;
+    let (name, statements, routines) = parse_src(src, src_file)?;
     let (dat_name, positions) = parse_dat(dat, dat_file)?;
     if !dat_name.eq_ignore_ascii_case(&name) {
         return Err(ProgramError::Read {
@@ -178,8 +264,18 @@ pub fn parse_krl(
         src_file: src_file.into(),
         dat_file: dat_file.into(),
         statements,
+        routines,
         positions,
     })
+}
+
+impl KrlProgram {
+    /// The local subprogram `name` (any case).
+    pub fn routine(&self, name: &str) -> Option<&KrlRoutine> {
+        self.routines
+            .iter()
+            .find(|r| r.name.eq_ignore_ascii_case(name))
+    }
 }
 
 fn err(file: &str, line: usize, reason: String) -> ProgramError {
@@ -199,30 +295,56 @@ fn code(raw: &str) -> &str {
     l.split(';').next().unwrap_or("").trim()
 }
 
-fn parse_src(text: &str, file: &str) -> Result<(String, Vec<KrlStatement>), ProgramError> {
+type Routines = Vec<KrlRoutine>;
+
+/// The main routine's name and statements, and the local subprograms after
+/// it.
+fn parse_src(
+    text: &str,
+    file: &str,
+) -> Result<(String, Vec<KrlStatement>, Routines), ProgramError> {
     let name_of = |rest: &str| rest.split('(').next().unwrap_or("").trim().to_string();
-    parse_block(text, file, ("DEF", "name( )", "END"), name_of, |l, n| {
-        Ok(KrlStatement {
-            line: n,
-            op: parse_statement(l)?,
+    let mut blocks = parse_blocks(
+        text,
+        file,
+        ("DEF", "name( )", "END"),
+        true,
+        name_of,
+        |l, n| {
+            Ok(KrlStatement {
+                line: n,
+                op: parse_statement(l)?,
+            })
+        },
+    )?
+    .into_iter();
+    let (name, _, statements) = blocks.next().expect("parse_blocks gives one block or more");
+    let routines = blocks
+        .map(|(name, line, statements)| KrlRoutine {
+            name,
+            line,
+            statements,
         })
-    })
+        .collect();
+    Ok((name, statements, routines))
 }
 
-/// Reads a `DEF … END` or `DEFDAT … ENDDAT` file: the header's name (from
-/// the text after `open` by `name_of`), then each code line up to `close`
-/// through `body`; errors name the file and line (text after the end, a
-/// missing header or end).
-fn parse_block<T>(
+/// Reads the `DEF … END` blocks of a `.src` (`many`: local subprograms
+/// after the first) or the one `DEFDAT … ENDDAT` of a `.dat`: each header's
+/// name (from the text after `open` by `name_of`) and line, then each code
+/// line up to `close` through `body`; errors name the file and line (text
+/// after the end, a missing header or end).
+fn parse_blocks<T>(
     text: &str,
     file: &str,
     (open, header, close): (&str, &str, &str),
+    many: bool,
     name_of: impl Fn(&str) -> String,
     body: impl Fn(&str, usize) -> Result<T, String>,
-) -> Result<(String, Vec<T>), ProgramError> {
-    let mut name: Option<String> = None;
-    let mut ended = false;
-    let mut out = Vec::new();
+) -> Result<Vec<(String, usize, Vec<T>)>, ProgramError> {
+    let mut blocks: Vec<(String, usize, Vec<T>)> = Vec::new();
+    // inside a block (its header read, its end not yet)
+    let mut open_block = false;
     let mut last = 0;
     for (i, raw) in text.lines().enumerate() {
         let n = i + 1;
@@ -231,38 +353,52 @@ fn parse_block<T>(
         if l.is_empty() {
             continue;
         }
-        if ended {
-            return Err(err(file, n, format!("text after {close}")));
-        }
-        if name.is_none() {
+        if !open_block {
+            if !blocks.is_empty() && !many {
+                return Err(err(file, n, format!("text after {close}")));
+            }
             let rest = l
                 .strip_prefix(open)
                 .and_then(|r| r.strip_prefix(' '))
-                .ok_or_else(|| err(file, n, format!("expected `{open} {header}`, got `{l}`")))?;
+                .ok_or_else(|| {
+                    if blocks.is_empty() {
+                        err(file, n, format!("expected `{open} {header}`, got `{l}`"))
+                    } else {
+                        err(
+                            file,
+                            n,
+                            format!("text after {close}: expected `{open} {header}` of a local subprogram, got `{l}`"),
+                        )
+                    }
+                })?;
             let nm = name_of(rest);
             if nm.is_empty() {
                 return Err(err(file, n, format!("{open} without a name")));
             }
-            name = Some(nm);
+            blocks.push((nm, n, Vec::new()));
+            open_block = true;
             continue;
         }
         if l == close {
-            ended = true;
+            open_block = false;
             continue;
         }
-        out.push(body(l, n).map_err(|r| err(file, n, r))?);
+        let item = body(l, n).map_err(|r| err(file, n, r))?;
+        if let Some(b) = blocks.last_mut() {
+            b.2.push(item);
+        }
     }
-    let Some(name) = name else {
+    if blocks.is_empty() {
         return Err(err(file, last.max(1), format!("no {open} (empty file?)")));
-    };
-    if !ended {
+    }
+    if open_block {
         return Err(err(
             file,
             last,
             format!("file ends without {close} (truncated?)"),
         ));
     }
-    Ok((name, out))
+    Ok(blocks)
 }
 
 fn parse_statement(l: &str) -> Result<KrlOp, String> {
@@ -326,15 +462,32 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
         Some("WAIT") => return parse_wait(l),
         Some("HALT") if tokens.len() == 1 => return Ok(KrlOp::Halt),
         Some("ENDIF") if tokens.len() == 1 => return Ok(KrlOp::EndIf),
+        Some("LOOP") if tokens.len() == 1 => return Ok(KrlOp::Loop),
+        Some("ENDLOOP") if tokens.len() == 1 => return Ok(KrlOp::EndLoop),
+        Some("EXIT") if tokens.len() == 1 => return Ok(KrlOp::Exit),
+        Some("RESUME") if tokens.len() == 1 => return Ok(KrlOp::Resume),
+        Some("BRAKE") => {
+            return match tokens.as_slice() {
+                [_] => Ok(KrlOp::Brake { fast: false }),
+                [_, "F"] => Ok(KrlOp::Brake { fast: true }),
+                _ => Err(format!("expected `BRAKE [F]`, got `{l}`")),
+            };
+        }
+        Some("INTERRUPT" | "GLOBAL") => return parse_interrupt(l),
         Some("IF") => {
-            if let Some(n) = l
-                .strip_prefix("IF NOT ")
-                .and_then(|r| r.strip_suffix("THEN"))
-                .and_then(|r| index_of(r.trim(), "$IN["))
+            let input = |r: &str| {
+                index_of(r.trim(), "$IN[")
+                    .map(|n| u32::try_from(n).map_err(|_| format!("bad input in `{l}`")))
+            };
+            let cond = l.strip_prefix("IF ").and_then(|r| r.strip_suffix("THEN"));
+            if let Some(n) = cond
+                .and_then(|r| r.trim().strip_prefix("NOT "))
+                .and_then(input)
             {
-                return Ok(KrlOp::IfNotIn(
-                    u32::try_from(n).map_err(|_| format!("bad input in `{l}`"))?,
-                ));
+                return Ok(KrlOp::IfNotIn(n?));
+            }
+            if let Some(n) = cond.and_then(input) {
+                return Ok(KrlOp::IfIn(n?));
             }
         }
         Some(b) if b.starts_with("BAS") => {
@@ -468,6 +621,61 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
     Ok(KrlOp::Other(l.to_string()))
 }
 
+/// `[GLOBAL] INTERRUPT DECL p WHEN cond DO name(args)` and `INTERRUPT
+/// ON|OFF|ENABLE|DISABLE [p]`.
+fn parse_interrupt(l: &str) -> Result<KrlOp, String> {
+    let (global, rest) = match l.strip_prefix("GLOBAL ") {
+        Some(r) => (true, r.trim_start()),
+        None => (false, l),
+    };
+    let rest = rest
+        .strip_prefix("INTERRUPT ")
+        .ok_or_else(|| format!("expected `INTERRUPT …`, got `{l}`"))?
+        .trim();
+    let prio_of = |p: &str| {
+        p.trim()
+            .parse::<u8>()
+            .ok()
+            .filter(|p| (1..=128).contains(p))
+            .ok_or_else(|| format!("bad interrupt priority `{}` in `{l}` (1..=128)", p.trim()))
+    };
+    if let Some(decl) = rest.strip_prefix("DECL ") {
+        let bad = || format!("expected `INTERRUPT DECL prio WHEN condition DO name( )`, got `{l}`");
+        let (prio, rest) = decl.trim().split_once(' ').ok_or_else(bad)?;
+        let rest = rest.trim().strip_prefix("WHEN ").ok_or_else(bad)?;
+        let (when, handler) = rest.rsplit_once(" DO ").ok_or_else(bad)?;
+        let handler = handler.trim();
+        if !is_call(handler) || when.trim().is_empty() {
+            return Err(bad());
+        }
+        return Ok(KrlOp::InterruptDecl {
+            global,
+            prio: prio_of(prio)?,
+            when: when.trim().to_string(),
+            handler: handler.split('(').next().unwrap_or("").trim().to_string(),
+        });
+    }
+    if global {
+        return Err(format!("GLOBAL only before `INTERRUPT DECL`, got `{l}`"));
+    }
+    let (action, prio) = match rest.split_once(' ') {
+        Some((a, p)) => (a, Some(prio_of(p)?)),
+        None => (rest, None),
+    };
+    let action = match action {
+        "ON" => InterruptAction::On,
+        "OFF" => InterruptAction::Off,
+        "ENABLE" => InterruptAction::Enable,
+        "DISABLE" => InterruptAction::Disable,
+        _ => {
+            return Err(format!(
+                "expected `INTERRUPT ON|OFF|ENABLE|DISABLE [prio]`, got `{l}`"
+            ))
+        }
+    };
+    Ok(KrlOp::Interrupt { action, prio })
+}
+
 /// `n` of `PREFIX n]` at the start of `s` (`$IN[3]`, `$TIMER[1]`).
 fn index_of(s: &str, prefix: &str) -> Option<i64> {
     s.strip_prefix(prefix)?
@@ -595,12 +803,23 @@ fn parse_ek(v: &str) -> Result<KrlOp, String> {
 
 fn parse_dat(text: &str, file: &str) -> Result<(String, Vec<KrlPosition>), ProgramError> {
     let name_of = |rest: &str| rest.split_whitespace().next().unwrap_or("").to_string();
-    parse_block(text, file, ("DEFDAT", "name", "ENDDAT"), name_of, |l, n| {
-        Ok(KrlPosition {
-            line: n,
-            ..parse_decl(l)?
-        })
-    })
+    let (name, _, positions) = parse_blocks(
+        text,
+        file,
+        ("DEFDAT", "name", "ENDDAT"),
+        false,
+        name_of,
+        |l, n| {
+            Ok(KrlPosition {
+                line: n,
+                ..parse_decl(l)?
+            })
+        },
+    )?
+    .into_iter()
+    .next()
+    .expect("parse_blocks gives one block or more");
+    Ok((name, positions))
 }
 
 fn parse_decl(l: &str) -> Result<KrlPosition, String> {
@@ -678,4 +897,87 @@ fn parse_decl(l: &str) -> Result<KrlPosition, String> {
         value,
         external: [get("E1")?, get("E2")?],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interrupt_statements() {
+        assert_eq!(
+            parse_statement("GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )"),
+            Ok(KrlOp::InterruptDecl {
+                global: true,
+                prio: 3,
+                when: "$STOPMESS==TRUE".into(),
+                handler: "IR_STOPM".into(),
+            })
+        );
+        assert_eq!(
+            parse_statement("INTERRUPT OFF 20"),
+            Ok(KrlOp::Interrupt {
+                action: InterruptAction::Off,
+                prio: Some(20)
+            })
+        );
+        assert_eq!(
+            parse_statement("INTERRUPT DISABLE"),
+            Ok(KrlOp::Interrupt {
+                action: InterruptAction::Disable,
+                prio: None
+            })
+        );
+        assert_eq!(parse_statement("BRAKE F"), Ok(KrlOp::Brake { fast: true }));
+        assert_eq!(parse_statement("IF $IN[7] THEN"), Ok(KrlOp::IfIn(7)));
+        assert_eq!(parse_statement("IF NOT $IN[7] THEN"), Ok(KrlOp::IfNotIn(7)));
+        for bad in [
+            "INTERRUPT ON 0",
+            "INTERRUPT ON 129",
+            "INTERRUPT 20 ON",
+            "INTERRUPT DECL 20 WHEN $IN[1]==FALSE",
+            "INTERRUPT DECL 20 WHEN DO ARC( )",
+            "GLOBAL INTERRUPT ON 20",
+            "BRAKE X",
+        ] {
+            assert!(parse_statement(bad).is_err(), "{bad}");
+        }
+        assert_eq!(falling_input("$IN[12] == FALSE"), Some(12));
+        assert_eq!(falling_input("NOT $IN[4]"), Some(4));
+        assert_eq!(falling_input("$IN[4]==TRUE"), None);
+        assert_eq!(falling_input("$STOPMESS==FALSE"), None);
+    }
+
+    /// Local subprograms after the main routine are read as routines; other
+    /// text after its `END`, or a routine without `END`, is an error naming
+    /// the line.
+    #[test]
+    fn local_subprograms() {
+        let dat = "DEFDAT P\nENDDAT\n";
+        let src = "DEF P( )\n  HALT\nEND\n\nDEF SUB( )\n  BRAKE F\nEND\n";
+        let p = parse_krl(src, "P.src", dat, "P.dat").unwrap();
+        assert_eq!(p.statements.len(), 1);
+        let r = p.routine("sub").unwrap();
+        assert_eq!((r.name.as_str(), r.line), ("SUB", 5));
+        assert_eq!(r.statements[0].op, KrlOp::Brake { fast: true });
+        let e = parse_krl("DEF P( )\nEND\nHALT\n", "P.src", dat, "P.dat").unwrap_err();
+        assert!(e.to_string().starts_with("P.src:3: text after END"), "{e}");
+        let e =
+            parse_krl("DEF P( )\nEND\nDEF SUB( )\n  HALT\n", "P.src", dat, "P.dat").unwrap_err();
+        assert!(
+            e.to_string().contains("P.src:4: file ends without END"),
+            "{e}"
+        );
+        let e = parse_krl(
+            "DEF P( )\nEND\n",
+            "P.src",
+            "DEFDAT P\nENDDAT\nDEFDAT Q\n",
+            "P.dat",
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().starts_with("P.dat:3: text after ENDDAT"),
+            "{e}"
+        );
+    }
 }
