@@ -28,10 +28,23 @@
 //!   at 3, 9, 12, 15; `welddata weld1:=[6,0,[5,0,24,120,0,0,0,0,0],[0,...]]`
 //!   = `[weld_speed, org_weld_speed, main_arc, org_arc]`, `arcdata` of 9),
 //!   and a data-type page giving `weld_speed` in mm/s. The component names
-//!   (purge_time, preflow_time, ign_arc, ..., postflow_time) are from
-//!   memory of the Arc application manual, not checked against it.
+//!   (purge_time, preflow_time, ign_arc, ..., postflow_time) agree with the
+//!   vendor notes' sources (§3, below), not with the Arc application manual
+//!   itself.
 //! * `WaitTime`, `WaitDI signal, 1`, `MoveAbsJ`, `ConfL \On`, `\T`,
 //!   `\WObj`: RAPID reference from memory, and published modules.
+//! * Names (issue 32): RAPID reference, "Basic Characteristics RAPID" §3.1
+//!   routine scope and §5.1 data scope (yumpu 5679047 pp. 87, 96): `LOCAL
+//!   PROC`/`LOCAL PERS|VAR|CONST` are visible in their module only, hide a
+//!   global of the same name, and are allowed at module level only; routine
+//!   and module names share one name space (vendor notes §3: RoboDK's ABB
+//!   post writes `MODULE MOD_<prog>` holding `PROC <prog>()`). So the module
+//!   is `MOD_<name>`, its one global routine `<name>`, all else `LOCAL`.
+//! * `ActUnit STN1;` / `DeactUnit STN1;` (a `mecunit` argument): published
+//!   controller modules (vendor notes §3, "Mechanical units").
+//! * `seamdata` gas times: components 1 (`purge_time`), 2 (`preflow_time`)
+//!   and 16 (`postflow_time`) of the 16 (vendor notes §3: ABB's SeamData.js
+//!   field order, zwj12/ZhongXunRapid modules, RW 6.15 `seamdata.xml`).
 //!
 //! Not verified: that a controller (or RobotStudio) loads these modules;
 //! that ArcWare accepts `sched` with every other `arcdata` component 0 for
@@ -55,7 +68,7 @@ use waam_slicer::robot::Cell;
 
 use crate::fixture::{cell, program, ABB_CELLS};
 use crate::golden::check_golden;
-use crate::rapid_grammar::check_module;
+use crate::rapid_grammar::{check_module, check_task};
 
 const PART: &str = "abb_irb2600_part_carried.toml";
 const TORCH: &str = "abb_irb2600_torch_carried.toml";
@@ -386,6 +399,27 @@ fn bad_options_and_set_ups_are_refused_naming_the_field() {
         ),
         (
             AbbOptions {
+                purge_time_s: -0.1,
+                ..opts.clone()
+            },
+            "`purge_time_s`",
+        ),
+        (
+            AbbOptions {
+                preflow_time_s: f64::NAN,
+                ..opts.clone()
+            },
+            "`preflow_time_s`",
+        ),
+        (
+            AbbOptions {
+                postflow_time_s: f64::INFINITY,
+                ..opts.clone()
+            },
+            "`postflow_time_s`",
+        ),
+        (
+            AbbOptions {
                 tool_load: Some(AbbLoad {
                     mass_kg: 0.0,
                     cog_mm: [0.0; 3],
@@ -508,4 +542,380 @@ fn every_emitted_module_passes_rapidchecker() {
     let text = std::fs::read_to_string(&paths[0]).unwrap();
     std::fs::write(&broken, text.replacen("ConfL \\On;", "ConfL \\On", 1)).unwrap();
     assert!(!run(&[broken]).status.success(), "a missing `;` passed");
+}
+
+/// Issue 32: the module's names. Every module the emitter writes is
+/// `MODULE MOD_HEMI` with one global routine, `PROC HEMI()` (no `PROC
+/// main`), and every other declaration at module level `LOCAL` (RAPID
+/// reference §3.1, §5.1; module doc), read here from the text, not by our
+/// reader.
+#[test]
+fn every_name_but_the_entry_routine_is_local() {
+    let (prog, opts) = setup_program();
+    let mut files = abb_files(&prog, &opts).unwrap();
+    for file in ABB_CELLS {
+        files.extend(abb_files(&program(&cell(file), 0..2, 8).0, &AbbOptions::default()).unwrap());
+    }
+    for f in &files {
+        let text = &f.text;
+        assert_eq!(f.name, "HEMI.mod");
+        assert_eq!(text.lines().next(), Some("MODULE MOD_HEMI"), "{text}");
+        assert!(!text.to_ascii_lowercase().contains("proc main"), "{text}");
+        let mut in_routine = false;
+        let mut globals = Vec::new();
+        for l in text.lines().skip(1).map(str::trim) {
+            if l.is_empty() || l.starts_with('!') || l == "ENDMODULE" {
+                continue;
+            }
+            if l == "ENDPROC" {
+                in_routine = false;
+                continue;
+            }
+            if in_routine {
+                continue;
+            }
+            if l.contains("PROC ") {
+                in_routine = true;
+            }
+            if !l.starts_with("LOCAL ") {
+                globals.push(l.to_string());
+            }
+        }
+        assert_eq!(globals, ["PROC HEMI()"], "{text}");
+    }
+}
+
+/// A task's own main module, the usual one: a global `main` that calls the
+/// part's entry routine, and a global `tWaam`, `wWaam` and `p1` of its own.
+const TASK_MAIN: &str = "MODULE MainModule
+  PERS tooldata tWaam := [TRUE,[[0,0,100],[1,0,0,0]],[1,[0,0,1],[1,0,0,0],0,0,0]];
+  PERS wobjdata wWaam := [FALSE,TRUE,\"\",[[0,0,0],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];
+  CONST robtarget p1 := [[500,0,500],[1,0,0,0],[0,0,0,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
+  PROC main()
+    HEMI;
+    NOZZLE;
+  ENDPROC
+ENDMODULE
+";
+
+/// Issue 32: the module loads into a task that already has a global
+/// `main`, `tWaam`, `wWaam` and `p1`, next to another part's module (same
+/// local names, other entry routine), in the independent scope model of
+/// [`crate::rapid_grammar::check_task`]. The live checks: the same module
+/// with its `LOCAL`s removed, or with the old `PROC main`, clashes.
+#[test]
+fn the_module_loads_into_a_task_with_its_own_main() {
+    for file in ABB_CELLS {
+        let c = cell(file);
+        let (hemi, _) = program(&c, 0..2, 8);
+        let mut nozzle = hemi.clone();
+        nozzle.name = "NOZZLE".into();
+        let a = &abb_files(&hemi, &AbbOptions::default()).unwrap()[0].text;
+        let b = &abb_files(&nozzle, &AbbOptions::default()).unwrap()[0].text;
+        assert!(b.starts_with("MODULE MOD_NOZZLE\n") && b.contains("  PROC NOZZLE()\n"));
+        check_task(&[TASK_MAIN, a, b]).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let global = a.replace("  LOCAL ", "  ");
+        let e = check_task(&[TASK_MAIN, &global]).unwrap_err();
+        assert!(e.contains("tWaam"), "{e}");
+        let old = a.replace("PROC HEMI()", "PROC main()");
+        let e = check_task(&[TASK_MAIN, &old]).unwrap_err();
+        assert!(e.contains("main"), "{e}");
+        // a module named like its routine
+        let same = a.replace("MODULE MOD_HEMI", "MODULE HEMI");
+        assert!(check_task(&[TASK_MAIN, &same]).is_err());
+    }
+}
+
+/// Names the entry routine cannot take are refused naming `name`: `main`
+/// (the task's), one of the module's own (`p1` as `P1`, `jHome`), an
+/// instruction it uses, the mechanical unit, a reserved word, and more
+/// than 28 characters (`MOD_` + 28 = RAPID's 32).
+#[test]
+fn entry_names_that_would_clash_are_refused() {
+    let (prog, _) = program(&cell(TORCH), 0..1, 8);
+    for name in [
+        "main",
+        "MAIN",
+        "P1",
+        "j12",
+        "JHOME",
+        "tWaam",
+        "weldWaam3",
+        "MoveL",
+        "ActUnit",
+        "STN1",
+        "MODULE",
+        "A234567890123456789012345678X",
+    ] {
+        let mut p = prog.clone();
+        p.name = name.into();
+        let e = abb_files(&p, &AbbOptions::default()).unwrap_err();
+        assert!(
+            matches!(e, ProgramError::InvalidOptions { field: "name", .. }),
+            "{name}: {e}"
+        );
+    }
+    let mut p = prog.clone();
+    p.name = "PART_2".into();
+    assert!(abb_files(&p, &AbbOptions::default()).is_ok());
+}
+
+/// Issue 32: in the torch-carried cell `ActUnit STN1` comes before the
+/// first motion (`MoveAbsJ`, `MoveL`, `Arc*`) and `DeactUnit STN1` after
+/// the last; none in the part-carried cell. The decoder reports a missing
+/// `ActUnit` at the first motion, a missing `DeactUnit` at the last, a
+/// motion after `DeactUnit`, another unit (options) and a unit in a cell
+/// without a positioner.
+#[test]
+fn positioner_unit_is_active_for_every_motion() {
+    let is_motion = |l: &str| {
+        let l = l.trim_start();
+        l.starts_with("Move") || l.starts_with("Arc")
+    };
+    let c = cell(TORCH);
+    let (prog, _) = program(&c, 0..2, 8);
+    let plan = planned(&prog);
+    let mut opts = AbbOptions::default();
+    let mut with_home = prog.clone();
+    with_home.home = Some(HomePosition {
+        joints: prog.points[0].joints,
+        positioner: prog.points[0].positioner,
+    });
+    opts.common.home_deg = Some(prog.points[0].joints.map(f64::to_degrees));
+    opts.common.home_positioner_deg = prog.points[0].positioner.map(|q| q.map(f64::to_degrees));
+    let text = &abb_files(&with_home, &opts).unwrap()[0].text;
+    let lines: Vec<&str> = text.lines().collect();
+    let act = line_of(text, "    ActUnit STN1;");
+    let deact = line_of(text, "    DeactUnit STN1;");
+    let first = lines.iter().position(|l| is_motion(l)).unwrap() + 1;
+    let last = lines.iter().rposition(|l| is_motion(l)).unwrap() + 1;
+    assert!(lines[first - 1].contains("MoveAbsJ jHome"), "{text}");
+    assert!(line_of(text, "PROC HEMI()") < act && act < first, "{text}");
+    assert!(last < deact && lines[deact].trim() == "ENDPROC", "{text}");
+    let r = check(text, &c, &opts, &plan);
+    assert!(r.is_ok(), "{r}");
+    let drop = |n: usize| -> String {
+        lines
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| k + 1 != n)
+            .map(|(_, l)| format!("{l}\n"))
+            .collect()
+    };
+    // without ActUnit: the first motion (one line up)
+    let r = check(&drop(act), &c, &opts, &plan);
+    assert!(
+        has(&r, ProblemKind::Setup, first - 1, "before ActUnit STN1"),
+        "{r}"
+    );
+    // without DeactUnit: the last motion
+    let r = check(&drop(deact), &c, &opts, &plan);
+    assert!(
+        has(&r, ProblemKind::Setup, last, "no DeactUnit STN1"),
+        "{r}"
+    );
+    // DeactUnit before the last (home) move
+    let mut early: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    early.swap(last - 1, deact - 1);
+    let r = check(&(early.join("\n") + "\n"), &c, &opts, &plan);
+    assert!(
+        has(&r, ProblemKind::Setup, deact, "after DeactUnit STN1"),
+        "{r}"
+    );
+    let other = text.replace("ActUnit STN1;", "ActUnit STN2;");
+    let r = check(&other, &c, &opts, &plan);
+    assert!(has(&r, ProblemKind::Options, act, "ActUnit STN2"), "{r}");
+    // the part-carried cell: no unit to activate
+    let (part_prog, _) = program(&cell(PART), 0..2, 8);
+    let part = &abb_files(&part_prog, &AbbOptions::default()).unwrap()[0].text;
+    assert!(
+        !part.contains("ActUnit") && !part.contains("DeactUnit"),
+        "{part}"
+    );
+    let conf = line_of(part, "ConfL \\On;");
+    let with_unit = part.replacen(
+        "    ConfL \\On;\n",
+        "    ActUnit STN1;\n    ConfL \\On;\n",
+        1,
+    );
+    let r = check(
+        &with_unit,
+        &cell(PART),
+        &AbbOptions::default(),
+        &planned(&part_prog),
+    );
+    assert!(
+        has(&r, ProblemKind::Instruction, conf, "no positioner"),
+        "{r}"
+    );
+}
+
+/// Issue 32: the gas times are written into `seamdata` from the options
+/// (components 1, 2 and 16, to the ms), read back, and checked against the
+/// options by the decoder, naming the option; a negative time is refused
+/// naming its field.
+#[test]
+fn gas_times_are_written_from_the_options() {
+    let (prog, _) = program(&cell(PART), 0..2, 8);
+    let plan = planned(&prog);
+    let d = &abb_files(&prog, &AbbOptions::default()).unwrap()[0].text;
+    assert!(
+        d.contains("  LOCAL PERS seamdata seamWaam := [0.500,0.300,[1,0,0,0,0,0,0,0,0],0,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],1.500];\n"),
+        "{d}"
+    );
+    let opts = AbbOptions {
+        purge_time_s: 0.0,
+        preflow_time_s: 0.45,
+        postflow_time_s: 2.0,
+        ..Default::default()
+    };
+    let text = &abb_files(&prog, &opts).unwrap()[0].text;
+    let m = parse_mod(text, "HEMI.mod").unwrap();
+    assert_eq!(m.seams.len(), 1);
+    let s = &m.seams[0];
+    assert_eq!(
+        (s.purge_time_s, s.preflow_time_s, s.postflow_time_s),
+        (0.0, 0.45, 2.0)
+    );
+    assert!(check(text, &cell(PART), &opts, &plan).is_ok());
+    // read with the default options: all three differ, named
+    let r = check(text, &cell(PART), &AbbOptions::default(), &plan);
+    let l = line_of(text, "seamdata seamWaam");
+    for field in [
+        "purge_time_s = 0.5",
+        "preflow_time_s = 0.3",
+        "postflow_time_s = 1.5",
+    ] {
+        assert!(has(&r, ProblemKind::Options, l, field), "{field}: {r}");
+    }
+    for (o, field) in [
+        (
+            AbbOptions {
+                purge_time_s: -0.5,
+                ..Default::default()
+            },
+            "`purge_time_s`",
+        ),
+        (
+            AbbOptions {
+                preflow_time_s: -1e-9,
+                ..Default::default()
+            },
+            "`preflow_time_s`",
+        ),
+        (
+            AbbOptions {
+                postflow_time_s: -2.0,
+                ..Default::default()
+            },
+            "`postflow_time_s`",
+        ),
+    ] {
+        let e = abb_files(&prog, &o).unwrap_err();
+        assert!(
+            matches!(e, ProgramError::InvalidOptions { .. }) && e.to_string().contains(field),
+            "{e}"
+        );
+    }
+}
+
+/// Issue 32: the decoder reports, at its line, a declaration whose `LOCAL`
+/// was removed (tool, target, seamdata), a global routine that is not the
+/// entry routine, an entry routine named `main` or not after the program,
+/// a module not named `MOD_<program>`, and a module without a global
+/// routine.
+#[test]
+fn a_removed_local_is_reported_by_the_decoder() {
+    let (prog, opts) = setup_program();
+    let text = &abb_files(&prog, &opts).unwrap()[0].text;
+    let c = cell(PART);
+    let plan = planned(&prog);
+    assert!(check(text, &c, &opts, &plan).is_ok());
+    for needle in [
+        "LOCAL PERS tooldata tWaam",
+        "LOCAL CONST robtarget p5 ",
+        "LOCAL PERS seamdata seamWaam",
+        "LOCAL CONST jointtarget jHome",
+    ] {
+        let l = line_of(text, needle);
+        let bad = text.replacen(needle, &needle["LOCAL ".len()..], 1);
+        let r = check(&bad, &c, &opts, &plan);
+        let name = needle.split_whitespace().nth(3).unwrap();
+        assert!(
+            has(
+                &r,
+                ProblemKind::Declaration,
+                l,
+                &format!("{name} is not LOCAL")
+            ),
+            "{needle}: {r}"
+        );
+        assert_eq!(r.problems.len(), 1, "{r}");
+    }
+    let proc_line = line_of(text, "  PROC HEMI()");
+    let r = check(
+        &text.replace("PROC HEMI()", "PROC main()"),
+        &c,
+        &opts,
+        &plan,
+    );
+    assert!(has(&r, ProblemKind::Declaration, proc_line, "main"), "{r}");
+    let r = check(
+        &text.replace("PROC HEMI()", "PROC PART2()"),
+        &c,
+        &opts,
+        &plan,
+    );
+    assert!(
+        has(
+            &r,
+            ProblemKind::Declaration,
+            proc_line,
+            "not named after the module's program HEMI"
+        ),
+        "{r}"
+    );
+    let r = check(
+        &text.replace("MODULE MOD_HEMI", "MODULE HEMI"),
+        &c,
+        &opts,
+        &plan,
+    );
+    assert!(has(&r, ProblemKind::Declaration, 1, "MOD_<program>"), "{r}");
+    let r = check(
+        &text.replace("PROC HEMI()", "LOCAL PROC HEMI()"),
+        &c,
+        &opts,
+        &plan,
+    );
+    assert!(
+        has(&r, ProblemKind::Declaration, 1, "no global routine"),
+        "{r}"
+    );
+    let extra = text.replace(
+        "ENDMODULE",
+        "  PROC helper()\n    WaitTime 1.000;\n  ENDPROC\nENDMODULE",
+    );
+    let l = line_of(&extra, "PROC helper()");
+    let r = check(&extra, &c, &opts, &plan);
+    assert!(
+        has(
+            &r,
+            ProblemKind::Declaration,
+            l,
+            "global PROC helper: the module holds one routine"
+        ),
+        "{r}"
+    );
+    // LOCAL is refused inside a routine (module level only)
+    let e = parse_mod(
+        &text.replace(
+            "    ConfL \\On;",
+            "    LOCAL VAR num k := 1;\n    ConfL \\On;",
+        ),
+        "HEMI.mod",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("module level only"), "{e}");
 }

@@ -3,13 +3,14 @@
 //! manual – RAPID kernel: lexical elements, data declarations, routine
 //! declarations, statements, procedure calls with required, named and
 //! optional (`\switch`, `\arg := value`) arguments, aggregates), not from
-//! our reader (`src/program/readback/abb.rs`), with which it shares no
+//! our reader (`src/program/abb/read.rs`), with which it shares no
 //! code. It accepts the subset a generated motion module needs:
 //!
 //! ```text
 //! module      = "MODULE" ident [ "(" ident { "," ident } ")" ] { data_decl } { routine } "ENDMODULE"
-//! data_decl   = [ "LOCAL" | "TASK" ] ( "PERS" | "VAR" | "CONST" ) ident ident [ ":=" expr ] ";"
-//! routine     = [ "LOCAL" ] "PROC" ident "(" ")" { data_decl } { statement } "ENDPROC"
+//! data_decl   = [ "LOCAL" | "TASK" ] routine_data
+//! routine_data = ( "PERS" | "VAR" | "CONST" ) ident ident [ ":=" expr ] ";"
+//! routine     = [ "LOCAL" ] "PROC" ident "(" ")" { routine_data } { statement } "ENDPROC"
 //! statement   = ident ":=" expr ";" | ident [ arguments ] ";"
 //! arguments   = argument { "," argument | optional }   (the first may be an optional)
 //! argument    = optional | [ ident ":=" ] expr
@@ -24,6 +25,16 @@
 //! `digits [. digits] [E [+|-] digits]` (or `. digits`); strings are in
 //! double quotes on one line (at most 80 characters); `!` starts a comment
 //! to the end of the line; every other character is an error.
+//!
+//! [`check_task`] adds a scope model of a task made of several modules, from
+//! the RAPID reference ("Basic Characteristics RAPID", §3.1 routine scope,
+//! §5.1 data scope; as published on yumpu, document 5679047 pp. 87 and 96):
+//! a name declared `LOCAL` is visible in its module only and hides a global
+//! one of the same name; a global name is visible in every module of the
+//! task, so two globals of one name clash; routine and module names share
+//! one name space (vendor notes §3, after RoboDK's ABB post, which names
+//! its modules `MOD_<prog>` for that reason); names are compared without
+//! case.
 
 /// A token with its line.
 #[derive(Debug, Clone, PartialEq)]
@@ -200,9 +211,21 @@ fn lex(text: &str) -> Result<Vec<(Tok, usize)>, String> {
     Ok(out)
 }
 
+/// A name declared at module level: data or routine.
+#[derive(Debug, Clone)]
+struct Symbol {
+    name: String,
+    local: bool,
+    line: usize,
+}
+
 struct Parser {
     toks: Vec<(Tok, usize)>,
     at: usize,
+    /// The module's name.
+    module: String,
+    /// The names declared at module level, in order.
+    symbols: Vec<Symbol>,
 }
 
 impl Parser {
@@ -265,7 +288,7 @@ impl Parser {
 
     fn module(&mut self) -> Result<(), String> {
         self.word("MODULE")?;
-        self.ident()?;
+        self.module = self.ident()?;
         if self.is_punct("(") {
             self.at += 1;
             loop {
@@ -283,7 +306,7 @@ impl Parser {
             self.punct(")")?;
         }
         while self.starts_data_decl() {
-            self.data_decl()?;
+            self.data_decl(true)?;
         }
         while !self.is_word("ENDMODULE") {
             self.routine()?;
@@ -304,8 +327,13 @@ impl Parser {
             || (matches!(w(0), "LOCAL" | "TASK") && matches!(w(1), "PERS" | "VAR" | "CONST"))
     }
 
-    fn data_decl(&mut self) -> Result<(), String> {
-        if self.is_word("LOCAL") || self.is_word("TASK") {
+    /// A data declaration; `LOCAL` and `TASK` at module level only.
+    fn data_decl(&mut self, module_level: bool) -> Result<(), String> {
+        let local = self.is_word("LOCAL");
+        if local || self.is_word("TASK") {
+            if !module_level {
+                return self.err("routine data without LOCAL or TASK (module level only)");
+            }
             self.at += 1;
         }
         if self.is_word("PERS") || self.is_word("VAR") || self.is_word("CONST") {
@@ -314,7 +342,11 @@ impl Parser {
             return self.err("PERS, VAR or CONST");
         }
         self.ident()?; // type
-        self.ident()?; // name
+        let line = self.line();
+        let name = self.ident()?;
+        if module_level {
+            self.symbols.push(Symbol { name, local, line });
+        }
         if self.is_punct(":=") {
             self.at += 1;
             self.expr()?;
@@ -323,15 +355,18 @@ impl Parser {
     }
 
     fn routine(&mut self) -> Result<(), String> {
-        if self.is_word("LOCAL") {
+        let local = self.is_word("LOCAL");
+        if local {
             self.at += 1;
         }
         self.word("PROC")?;
-        self.ident()?;
+        let line = self.line();
+        let name = self.ident()?;
+        self.symbols.push(Symbol { name, local, line });
         self.punct("(")?;
         self.punct(")")?;
         while self.starts_data_decl() {
-            self.data_decl()?;
+            self.data_decl(false)?;
         }
         while !self.is_word("ENDPROC") {
             if self.peek().is_none() {
@@ -451,8 +486,69 @@ impl Parser {
 /// # Errors
 /// The first syntax error with its line.
 pub fn check_module(text: &str) -> Result<(), String> {
+    parse(text).map(|_| ())
+}
+
+/// The module's name and module-level symbols.
+fn parse(text: &str) -> Result<(String, Vec<Symbol>), String> {
     let toks = lex(text)?;
-    Parser { toks, at: 0 }.module()
+    let mut p = Parser {
+        toks,
+        at: 0,
+        module: String::new(),
+        symbols: Vec::new(),
+    };
+    p.module()?;
+    Ok((p.module, p.symbols))
+}
+
+/// Checks that `modules` (each one module's text) load together into one
+/// task: each in the grammar, and no name clash in the scope model of the
+/// module doc. Names are compared without case.
+///
+/// # Errors
+/// The first syntax error (with the module's index) or the first clash,
+/// naming both sides.
+pub fn check_task(modules: &[&str]) -> Result<(), String> {
+    let mut parsed = Vec::new();
+    for (k, text) in modules.iter().enumerate() {
+        parsed.push(parse(text).map_err(|e| format!("module {k}: {e}"))?);
+    }
+    let key = |s: &str| s.to_ascii_lowercase();
+    // the task's global name space: module names and global symbols
+    let mut global: std::collections::HashMap<String, String> = std::collections::HashMap::new();
+    let mut add = |name: &str, what: String| match global.get(&key(name)) {
+        Some(other) => Err(format!("{what} clashes with {other}")),
+        None => {
+            global.insert(key(name), what);
+            Ok(())
+        }
+    };
+    for (module, _) in &parsed {
+        add(module, format!("MODULE {module}"))?;
+    }
+    for (module, symbols) in &parsed {
+        for s in symbols.iter().filter(|s| !s.local) {
+            add(
+                &s.name,
+                format!("global {} ({module} line {})", s.name, s.line),
+            )?;
+        }
+    }
+    // inside a module: every name once, whatever its scope
+    for (module, symbols) in &parsed {
+        let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+        seen.insert(key(module), 0);
+        for s in symbols {
+            if let Some(l) = seen.insert(key(&s.name), s.line) {
+                return Err(format!(
+                    "{} ({module} line {}) is declared twice in its module (line {l}; 0 = the module's own name)",
+                    s.name, s.line
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The recogniser itself: it accepts a hand-written module in the style of
@@ -511,7 +607,72 @@ ENDMODULE
             "text after ENDMODULE",
         ),
         (good.replace("\"n = \"", "\"n = "), "unterminated string"),
+        (
+            good.replace("VAR num k := 2;", "LOCAL VAR num k := 2;"),
+            "LOCAL inside a routine",
+        ),
     ] {
         assert!(check_module(&bad).is_err(), "accepted with {why}:\n{bad}");
+    }
+}
+
+/// The scope model: `LOCAL` names of one spelling in two modules load
+/// together, as do a routine and a module of different names; two globals
+/// of one name (in any case), a routine named like a module, and a name
+/// declared twice in one module clash.
+#[test]
+fn the_scope_model_accepts_local_names_and_rejects_clashes() {
+    let a = "MODULE A
+  LOCAL PERS num n := 1;
+  LOCAL PROC helper()
+    Stop;
+  ENDPROC
+  PROC runA()
+    helper;
+  ENDPROC
+ENDMODULE
+";
+    let b = "MODULE B
+  LOCAL PERS num n := 2;
+  PERS num shared := 0;
+  LOCAL PROC helper()
+    Stop;
+  ENDPROC
+  PROC main()
+    runA;
+  ENDPROC
+ENDMODULE
+";
+    check_task(&[a, b]).unwrap_or_else(|e| panic!("{e}"));
+    for (task, why) in [
+        (
+            vec![
+                a.to_string(),
+                b.replace("LOCAL PERS num n", "PERS num n"),
+                a.replace("MODULE A", "MODULE C")
+                    .replace("LOCAL PERS num n", "PERS num N")
+                    .replace("runA", "runC"),
+            ],
+            "two globals n and N",
+        ),
+        (
+            vec![a.to_string(), b.replace("PROC main", "PROC runA")],
+            "two global routines runA",
+        ),
+        (
+            vec![a.replace("PROC runA", "PROC B"), b.to_string()],
+            "a routine named like a module",
+        ),
+        (
+            vec![
+                a.replace("LOCAL PROC helper", "LOCAL PROC n"),
+                b.to_string(),
+            ],
+            "a name twice in one module",
+        ),
+        (vec![a.to_string(), a.to_string()], "two modules A"),
+    ] {
+        let texts: Vec<&str> = task.iter().map(String::as_str).collect();
+        assert!(check_task(&texts).is_err(), "accepted {why}");
     }
 }

@@ -5,7 +5,12 @@
 //! identifier the module uses checked to be declared in it (or to be the
 //! controller data named in the options, or RobotWare's predefined `fine`,
 //! `z<n>`, `load0`), ArcWare's weld speed taken from the `welddata`, and
-//! `WaitTime`, `WaitDI` and `GripLoad` read as waits and payloads.
+//! `WaitTime`, `WaitDI` and `GripLoad` read as waits and payloads. The
+//! module's names are checked (one global routine, named
+//! after the program of `MODULE MOD_<program>`, every data `LOCAL`), the
+//! positioner's unit active for every motion in the torch-carried cell
+//! (`ActUnit` before the first, `DeactUnit` after the last), and the
+//! `seamdata` gas times against the options.
 
 use std::f64::consts::TAU;
 
@@ -231,6 +236,155 @@ fn file_frames(
     Some(frames)
 }
 
+/// The module's names (pushed as [`ProblemKind::Declaration`] problems at
+/// their line): `MODULE MOD_<program>`; one routine, the entry routine,
+/// global and named `<program>` (never `main`, the task's own); every data
+/// declaration `LOCAL`, so that nothing in the module clashes with a global
+/// of the task it is loaded into (RAPID reference, "Basic Characteristics",
+/// §3.1 and §5.1: a `LOCAL` name hides a global one). Names are compared
+/// without case, as RAPID does.
+fn check_scope(module: &RapidModule, report: &mut ValidationReport) {
+    use crate::program::abb::MODULE_PREFIX;
+    let file = &module.file;
+    let program = module
+        .name
+        .strip_prefix(MODULE_PREFIX)
+        .filter(|p| !p.is_empty());
+    if program.is_none() {
+        push(
+            report,
+            ProblemKind::Declaration,
+            file,
+            module.line,
+            format!(
+                "MODULE {}: expected MODULE {MODULE_PREFIX}<program> (the entry routine takes the program's name, which its module cannot share)",
+                module.name
+            ),
+        );
+    }
+    let entry = module.routines.iter().position(|r| !r.local);
+    match entry.map(|k| &module.routines[k]) {
+        None => push(
+            report,
+            ProblemKind::Declaration,
+            file,
+            module.line,
+            format!(
+                "no global routine: the entry routine {} must be global (the task's main calls it)",
+                program.unwrap_or("<program>")
+            ),
+        ),
+        Some(r) if r.name.eq_ignore_ascii_case("main") => push(
+            report,
+            ProblemKind::Declaration,
+            file,
+            r.line,
+            format!(
+                "PROC {}: clashes with the task's own main; the entry routine is named after the program ({})",
+                r.name,
+                program.unwrap_or("<program>")
+            ),
+        ),
+        Some(r) => {
+            if let Some(p) = program.filter(|p| !r.name.eq_ignore_ascii_case(p)) {
+                push(
+                    report,
+                    ProblemKind::Declaration,
+                    file,
+                    r.line,
+                    format!(
+                        "entry routine {} is not named after the module's program {p} (MODULE {})",
+                        r.name, module.name
+                    ),
+                );
+            }
+        }
+    }
+    // without a global routine the first one stands for the entry routine
+    let first = entry.or((!module.routines.is_empty()).then_some(0));
+    for (k, r) in module.routines.iter().enumerate() {
+        if Some(k) == first {
+            continue;
+        }
+        let scope = if r.local { "LOCAL PROC" } else { "global PROC" };
+        push(
+            report,
+            ProblemKind::Declaration,
+            file,
+            r.line,
+            format!(
+                "{scope} {}: the module holds one routine, its entry routine{}",
+                r.name,
+                first.map_or(String::new(), |e| format!(
+                    " {} (line {})",
+                    module.routines[e].name, module.routines[e].line
+                ))
+            ),
+        );
+    }
+    for d in &module.declarations {
+        if d.scope.as_deref() != Some("LOCAL") {
+            let scope = d
+                .scope
+                .as_deref()
+                .map_or(String::new(), |s| format!("{s} "));
+            push(
+                report,
+                ProblemKind::Declaration,
+                file,
+                d.line,
+                format!(
+                    "{scope}{} {} {} is not LOCAL: a global would clash with the task's own {} (only the entry routine is global)",
+                    d.storage, d.ty, d.name, d.name
+                ),
+            );
+        }
+    }
+}
+
+/// The `seamdata` gas times against [`AbbOptions::purge_time_s`],
+/// [`AbbOptions::preflow_time_s`] and [`AbbOptions::postflow_time_s`]
+/// (written to the ms): an [`ProblemKind::Options`] problem at the
+/// declaration for each that differs.
+fn check_gas_times(module: &RapidModule, opts: &AbbOptions, report: &mut ValidationReport) {
+    for s in &module.seams {
+        for (component, read, field, want) in [
+            (
+                "purge_time",
+                s.purge_time_s,
+                "purge_time_s",
+                opts.purge_time_s,
+            ),
+            (
+                "preflow_time",
+                s.preflow_time_s,
+                "preflow_time_s",
+                opts.preflow_time_s,
+            ),
+            (
+                "postflow_time",
+                s.postflow_time_s,
+                "postflow_time_s",
+                opts.postflow_time_s,
+            ),
+        ] {
+            // written with 3 decimals
+            if !((read - want).abs() <= 5e-4 + 1e-9) {
+                push(
+                    report,
+                    ProblemKind::Options,
+                    &module.file,
+                    s.line,
+                    format!(
+                        "{}: {component} {read} s, the options give {field} = {want} s",
+                        s.name
+                    ),
+                );
+            }
+        }
+    }
+}
+
 /// The module's declarations by name.
 type Decls<'a> = std::collections::HashMap<&'a str, &'a crate::program::abb::read::RapidDecl>;
 
@@ -369,6 +523,8 @@ pub(crate) fn abb_steps(
         }
     };
     let robot = cell.robot();
+    check_scope(module, report);
+    check_gas_times(module, opts, report);
     let frames = file_frames(module, cell, opts, report);
     let decls: Decls = module
         .declarations
@@ -387,8 +543,12 @@ pub(crate) fn abb_steps(
     let mut steps = Vec::new();
     let mut conf_l = false;
     let mut prev_positioner: Option<[f64; 2]> = None;
+    let mut unit = UnitState::new(matches!(cell, Cell::TorchCarried(_)));
     for ins in &module.instructions {
         let line = ins.line;
+        if matches!(ins.op, RapidOp::MoveAbsJ { .. } | RapidOp::Linear { .. }) {
+            unit.motion(file, line, &opts.ufmec, report);
+        }
         let wait = |seconds, input| Step::Wait {
             file: file.clone(),
             line,
@@ -436,6 +596,11 @@ pub(crate) fn abb_steps(
                         ),
                     }
                 }
+                continue;
+            }
+            RapidOp::ActUnit(u) | RapidOp::DeactUnit(u) => {
+                let act = matches!(ins.op, RapidOp::ActUnit(_));
+                unit.switch(act, u, file, line, &opts.ufmec, report);
                 continue;
             }
             RapidOp::GripLoad(name) => {
@@ -728,5 +893,99 @@ pub(crate) fn abb_steps(
             None => {}
         }
     }
+    unit.end(file, &opts.ufmec, report);
     Some(steps)
+}
+
+/// The positioner's mechanical unit along the entry routine: in the
+/// torch-carried cell every motion runs with it active (`ActUnit` before
+/// the first motion) and it is deactivated after the last (`DeactUnit`).
+#[derive(Debug)]
+struct UnitState {
+    /// The cell has a positioner.
+    needed: bool,
+    /// Activated and not deactivated since.
+    active: bool,
+    /// Line of the last `DeactUnit` of the unit, if any.
+    deactivated: Option<usize>,
+    /// Line of the last motion.
+    last_motion: Option<usize>,
+    /// A motion with the unit inactive was reported (once).
+    reported: bool,
+}
+
+impl UnitState {
+    fn new(needed: bool) -> Self {
+        Self {
+            needed,
+            active: false,
+            deactivated: None,
+            last_motion: None,
+            reported: false,
+        }
+    }
+
+    fn motion(&mut self, file: &str, line: usize, unit: &str, report: &mut ValidationReport) {
+        self.last_motion = Some(line);
+        if self.needed && !self.active && !self.reported {
+            self.reported = true;
+            let why = match self.deactivated {
+                Some(d) => format!("after DeactUnit {unit} (line {d})"),
+                None => format!("before ActUnit {unit}"),
+            };
+            push(
+                report,
+                ProblemKind::Setup,
+                file,
+                line,
+                format!("motion {why}: the positioner's mechanical unit {unit} is not active"),
+            );
+        }
+    }
+
+    fn switch(
+        &mut self,
+        act: bool,
+        u: &str,
+        file: &str,
+        line: usize,
+        unit: &str,
+        report: &mut ValidationReport,
+    ) {
+        let ins = if act { "ActUnit" } else { "DeactUnit" };
+        if !self.needed {
+            push(
+                report,
+                ProblemKind::Instruction,
+                file,
+                line,
+                format!("{ins} {u}: the cell has no positioner"),
+            );
+        } else if u != unit {
+            push(
+                report,
+                ProblemKind::Options,
+                file,
+                line,
+                format!("{ins} {u}: the options give the positioner's unit ufmec = {unit}"),
+            );
+        } else {
+            self.active = act;
+            if !act {
+                self.deactivated = Some(line);
+            }
+        }
+    }
+
+    fn end(&self, file: &str, unit: &str, report: &mut ValidationReport) {
+        if let (true, true, Some(l)) = (self.needed, self.active, self.last_motion) {
+            push(
+                report,
+                ProblemKind::Setup,
+                file,
+                l,
+                format!("no DeactUnit {unit} after the last motion: the positioner's mechanical unit stays active"),
+            );
+        }
+    }
 }

@@ -1,5 +1,34 @@
-//! ABB RAPID module (`.mod`) [SPEC §8].
+//! ABB RAPID module (`.mod`) [SPEC §8]: [`abb_files`] takes a [`Program`]
+//! (joints rad, positions mm, speeds mm/s) and [`AbbOptions`] and gives one
+//! module `<name>.mod` that a task loads next to its own modules.
 //!
+//! * **Names: one entry routine, everything else `LOCAL`.** The module is
+//!   `MODULE MOD_<name>` ([`module_name`]) and holds one global routine,
+//!   `PROC <name>()`, named after the program (the task's `main` calls it:
+//!   `<name>;`, or `%"<name>"%;` after `Load`/`StartLoad` of
+//!   `<name>.mod`). RAPID routine and module names are one name space, so
+//!   the routine cannot take the module's name; the routine keeps the
+//!   program's name because it is what a caller writes, and it matches the
+//!   file's (RoboDK's ABB post names its modules `MOD_<prog>` for the same
+//!   reason). Every data declaration (`tooldata`, `wobjdata`, `seamdata`,
+//!   `welddata`, `loaddata`, `robtarget`s, `jointtarget`s) is `LOCAL` (`LOCAL
+//!   PERS`, `LOCAL CONST`): visible in this module only, hiding a global of
+//!   the same name (RAPID reference, "Basic Characteristics", §3.1 routine
+//!   scope, §5.1 data scope), so that a task that already has a `main`, a
+//!   `tWaam` or another program's `p1` accepts the module. The tool and work
+//!   object stay `PERS` (what motion instructions expect of them). The name
+//!   must not be one the module uses or RAPID reserves
+//!   ([`check_entry_name`]).
+//! * **Mechanical units.** In the torch-carried cell the positioner's unit
+//!   ([`AbbOptions::ufmec`], default `STN1`) is activated by `ActUnit
+//!   <unit>;` at the start of the entry routine, before the first motion,
+//!   and deactivated by `DeactUnit <unit>;` after the last.
+//! * **Gas times** ([`AbbOptions::purge_time_s`],
+//!   [`AbbOptions::preflow_time_s`], [`AbbOptions::postflow_time_s`], s,
+//!   written to the ms) are `seamdata`'s `purge_time`, `preflow_time` and
+//!   `postflow_time`. The defaults (0.5, 0.3, 1.5 s) are typical GMAW/CMT
+//!   values; the qualified ones come from the process qualification (the
+//!   welding procedure).
 //! * Positions as `robtarget`s (`[[x,y,z],[q1,q2,q3,q4],[cf1,cf4,cf6,cfx],
 //!   [e1..e6]]`: the tool in the work object, mm, quaternion `[w,x,y,z]`)
 //!   with `confdata` derived from the chosen joints (`cf1 cf4 cf6` the
@@ -10,14 +39,14 @@
 //!   axes `eax_a`, `eax_b` (deg; [`AbbOptions::positioner_axes`]), the
 //!   others `9E+09`.
 //! * `ConfL \On` so that the controller keeps our branch on linear moves.
-//! * **Every identifier the module uses is declared in it**, except the
-//!   controller data named in [`AbbOptions`] (the interpass input signal
-//!   [`AbbOptions::interpass_signal`], the positioner's mechanical unit
-//!   [`AbbOptions::ufmec`]) and RobotWare's predefined `fine`, `z<n>`:
-//!   `tWaam` (`tooldata`), `wWaam` (`wobjdata`), `seamWaam` (`seamdata`),
-//!   `weldWaam<k>` (`welddata`, one per planned travel speed),
-//!   `loadWaam<k>` (`loaddata`, one per payload update), `jHome`, `j<n>`,
-//!   `p<n>`.
+//! * **Every identifier the module uses is declared in it** (`LOCAL`),
+//!   except the controller data named in [`AbbOptions`] (the interpass
+//!   input signal [`AbbOptions::interpass_signal`], the positioner's
+//!   mechanical unit [`AbbOptions::ufmec`]) and RobotWare's predefined
+//!   `fine`, `z<n>`: `tWaam` (`tooldata`), `wWaam` (`wobjdata`), `seamWaam`
+//!   (`seamdata`), `weldWaam<k>` (`welddata`, one per planned travel
+//!   speed), `loadWaam<k>` (`loaddata`, one per payload update), `jHome`,
+//!   `j<n>`, `p<n>`.
 //! * Arc process (ArcWare, RobotWare 6 Arc data layouts): `ArcLStart`
 //!   (`fine`) / `ArcL` (`z<n>`) / `ArcLEnd` (`fine`) with `seamWaam` and
 //!   `weldWaam<k>`. ArcWare takes the speed of the arc-on moves (`ArcL`,
@@ -33,7 +62,8 @@
 //!   bback_arc, postflow_time]`, `arcdata` = `[sched, mode, voltage,
 //!   wirefeed, control, current, voltage2, wirefeed2, control2]` with
 //!   `sched` = the process schedule (the power source's program or job)
-//!   and everything else 0: gas times, ignition, heat, crater fill and
+//!   and everything else 0 but the gas times (`purge_time`, `preflow_time`,
+//!   `postflow_time` from the options): ignition, heat, crater fill and
 //!   burn-back are left to the power source's program (tune them on the
 //!   controller). The data are `LOCAL PERS` so that a program loaded after
 //!   another one does not inherit that one's persistent values.
@@ -139,6 +169,176 @@ pub const LOAD0: AbbLoad = AbbLoad {
 /// [`AbbOptions::tool_load`].
 pub const DEFAULT_TORCH_MASS_KG: f64 = 3.0;
 
+/// Default [`AbbOptions::purge_time_s`] (s): a short purge, run while the
+/// robot moves to the seam. A typical value, not a qualified one: take the
+/// gas times from the process qualification (the welding procedure).
+pub const DEFAULT_PURGE_TIME_S: f64 = 0.5;
+
+/// Default [`AbbOptions::preflow_time_s`] (s): in the 0.3–0.5 s usual for
+/// GMAW/CMT. Take the qualified value.
+pub const DEFAULT_PREFLOW_TIME_S: f64 = 0.3;
+
+/// Default [`AbbOptions::postflow_time_s`] (s): in the 1–2 s usual for
+/// GMAW/CMT on steel (reactive alloys need more). Take the qualified value.
+pub const DEFAULT_POSTFLOW_TIME_S: f64 = 1.5;
+
+/// The prefix of the module's name: `MODULE MOD_<name>` holds `PROC
+/// <name>()`, since a routine and its module may not share a name (RAPID
+/// routine and module names are one name space; RoboDK's ABB post writes
+/// `MODULE MOD_<prog>` for the same reason).
+pub const MODULE_PREFIX: &str = "MOD_";
+
+/// The module that holds program `name`: `MOD_<name>`.
+pub fn module_name(name: &str) -> String {
+    format!("{MODULE_PREFIX}{name}")
+}
+
+/// RAPID's reserved words (RAPID kernel reference, "Reserved words"): none
+/// may name the entry routine.
+pub const RAPID_RESERVED: &[&str] = &[
+    "ALIAS",
+    "AND",
+    "BACKWARD",
+    "CASE",
+    "CONNECT",
+    "CONST",
+    "DEFAULT",
+    "DIV",
+    "DO",
+    "ELSE",
+    "ELSEIF",
+    "ENDFOR",
+    "ENDFUNC",
+    "ENDIF",
+    "ENDMODULE",
+    "ENDPROC",
+    "ENDRECORD",
+    "ENDTEST",
+    "ENDTRAP",
+    "ENDWHILE",
+    "ERROR",
+    "EXIT",
+    "FALSE",
+    "FOR",
+    "FROM",
+    "FUNC",
+    "GOTO",
+    "IF",
+    "INOUT",
+    "LOCAL",
+    "MOD",
+    "MODULE",
+    "NOSTEPIN",
+    "NOT",
+    "NOVIEW",
+    "OR",
+    "PERS",
+    "PROC",
+    "RAISE",
+    "READONLY",
+    "RECORD",
+    "RETRY",
+    "RETURN",
+    "STEP",
+    "SYSMODULE",
+    "TASK",
+    "TEST",
+    "THEN",
+    "TO",
+    "TRAP",
+    "TRUE",
+    "TRYNEXT",
+    "UNDO",
+    "VAR",
+    "VIEWONLY",
+    "WHILE",
+    "WITH",
+    "XOR",
+];
+
+/// The names the module uses besides its entry routine (compared without
+/// case, as RAPID does): the data types, instructions and predefined data
+/// it names, and its own `LOCAL` data (`tWaam`, `wWaam`, `seamWaam`,
+/// `jHome`); with a number after them, `p<n>`, `j<n>`, `weldWaam<k>`,
+/// `loadWaam<k>`, `z<n>`.
+const USED_NAMES: &[&str] = &[
+    "tooldata",
+    "wobjdata",
+    "seamdata",
+    "welddata",
+    "loaddata",
+    "robtarget",
+    "jointtarget",
+    "speeddata",
+    "zonedata",
+    "ConfL",
+    "MoveAbsJ",
+    "MoveL",
+    "ArcLStart",
+    "ArcL",
+    "ArcLEnd",
+    "WaitTime",
+    "WaitDI",
+    "GripLoad",
+    "ActUnit",
+    "DeactUnit",
+    "fine",
+    "load0",
+    "tool0",
+    "wobj0",
+    "tWaam",
+    "wWaam",
+    "seamWaam",
+    "jHome",
+];
+const NUMBERED_NAMES: &[&str] = &["p", "j", "weldWaam", "loadWaam", "z"];
+
+/// Checks that `name` can name the module's entry routine (`PROC
+/// <name>()`, global in the task) and its module (`MOD_<name>`): at most 28
+/// characters (a RAPID name has 32), not a reserved word, not `main` (the
+/// task's own entry routine, which calls ours), and none of the names the
+/// module declares or uses (`p<n>`, `j<n>`, `tWaam`, `MoveL`, the
+/// mechanical unit, the interpass signal, ...): a routine with such a name
+/// would clash with the module's own data or hide an instruction. RAPID
+/// names are compared without case.
+///
+/// # Errors
+/// [`ProgramError::InvalidOptions`] naming `name`.
+pub fn check_entry_name(name: &str, opts: &AbbOptions) -> Result<(), ProgramError> {
+    let bad = |reason: &'static str| {
+        Err(ProgramError::InvalidOptions {
+            field: "name",
+            value: name.to_string(),
+            reason,
+        })
+    };
+    check_name(name)?;
+    if name.len() + MODULE_PREFIX.len() > 32 {
+        return bad(
+            "at most 28 characters for ABB: the module is MOD_<name>, a RAPID name at most 32",
+        );
+    }
+    let is = |w: &str| name.eq_ignore_ascii_case(w);
+    if RAPID_RESERVED.iter().any(|w| is(w)) {
+        return bad("a RAPID reserved word cannot name the entry routine");
+    }
+    if is("main") {
+        return bad(
+            "`main` is the task's own entry routine: the program's routine must not clash with it",
+        );
+    }
+    let numbered = NUMBERED_NAMES.iter().any(|p| {
+        name.len() > p.len()
+            && name[..p.len()].eq_ignore_ascii_case(p)
+            && name[p.len()..].bytes().all(|b| b.is_ascii_digit())
+    });
+    if numbered || USED_NAMES.iter().any(|w| is(w)) || is(&opts.ufmec) || is(&opts.interpass_signal)
+    {
+        return bad("a name the module declares or uses (p<n>, j<n>, jHome, tWaam, wWaam, seamWaam, weldWaam<k>, loadWaam<k>, its instructions and data types, the mechanical unit, the interpass signal): the entry routine would clash with it");
+    }
+    Ok(())
+}
+
 /// A RAPID `loaddata` as a point mass or with principal inertia about axes
 /// parallel to the frame's (`aom` identity). Plain data.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -200,8 +400,10 @@ pub struct AbbOptions {
     /// the system's mechanical units are configured. Default `['a', 'b']`.
     pub positioner_axes: [char; 2],
     /// The positioner's mechanical unit (controller data, the system
-    /// parameters' name), the `ufmec` of the coordinated work object in the
-    /// torch-carried cell. Default `"STN1"`.
+    /// parameters' name) in the torch-carried cell: activated with
+    /// `ActUnit <ufmec>` before the program's first motion and deactivated
+    /// with `DeactUnit <ufmec>` after its last, and the `ufmec` of the
+    /// coordinated work object. Default `"STN1"`.
     pub ufmec: String,
     /// The digital input signal (controller data, a RAPID name) that
     /// `[program] interpass_input = n` waits for: `WaitDI
@@ -210,6 +412,16 @@ pub struct AbbOptions {
     pub interpass_signal: String,
     /// The tool load `tWaam.tload` (flange frame); `None`: module doc.
     pub tool_load: Option<AbbLoad>,
+    /// Gas purge before each seam (s, finite, ≥ 0): `seamdata.purge_time`,
+    /// gas through the hose and torch while the robot moves to the seam's
+    /// start. Default 0.5 s (module doc: gas times).
+    pub purge_time_s: f64,
+    /// Gas pre-flow at the seam's start before the arc ignites (s, finite,
+    /// ≥ 0): `seamdata.preflow_time`. Default 0.3 s.
+    pub preflow_time_s: f64,
+    /// Gas post-flow after the arc ends, shielding the cooling crater (s,
+    /// finite, ≥ 0): `seamdata.postflow_time`. Default 1.5 s.
+    pub postflow_time_s: f64,
     /// The vendor-independent options (home, dwell, interpass wait,
     /// payload, transit, coordination) the validator checks the file
     /// against; not a key of `[program.<vendor>]` (set from `[program]` by
@@ -232,6 +444,9 @@ impl Default for AbbOptions {
             ufmec: "STN1".into(),
             interpass_signal: "diInterpass".into(),
             tool_load: None,
+            purge_time_s: DEFAULT_PURGE_TIME_S,
+            preflow_time_s: DEFAULT_PREFLOW_TIME_S,
+            postflow_time_s: DEFAULT_POSTFLOW_TIME_S,
             common: Default::default(),
         }
     }
@@ -315,6 +530,15 @@ impl AbbOptions {
                 self.interpass_signal.clone(),
                 "a signal name: a letter, then letters, digits or `_`, at most 32 characters",
             );
+        }
+        for (field, v) in [
+            ("purge_time_s", self.purge_time_s),
+            ("preflow_time_s", self.preflow_time_s),
+            ("postflow_time_s", self.postflow_time_s),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(field, v.to_string(), "a time in s, finite and >= 0");
+            }
         }
         if let Some(l) = &self.tool_load {
             let finite = l
@@ -492,9 +716,12 @@ fn tool_load(program: &Program, opts: &AbbOptions, frames: &AbbFrames) -> AbbLoa
 ///
 /// # Errors
 /// I/O errors of `w`; an error of kind `Other` wrapping
-/// [`ProgramError::VendorMismatch`] when the cell's robot is not an ABB arm.
+/// [`ProgramError::VendorMismatch`] when the cell's robot is not an ABB arm,
+/// or [`ProgramError::InvalidOptions`] for a program name that cannot name
+/// the entry routine ([`check_entry_name`]).
 pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std::io::Result<()> {
     check_vendor(&program.cell, Vendor::Abb, EMITTER).map_err(std::io::Error::other)?;
+    check_entry_name(&program.name, opts).map_err(std::io::Error::other)?;
     let robot = program.cell.robot();
     let frames = opts.frames(&program.cell);
     let slots = opts.positioner_slots().map_err(std::io::Error::other)?;
@@ -503,13 +730,18 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         (Cell::TorchCarried(c), true) => Some(c),
         _ => None,
     };
-    writeln!(w, "MODULE {}", program.name)?;
+    writeln!(w, "MODULE {}", module_name(&program.name))?;
     writeln!(
         w,
         "  ! waam-slicer: {}, {} points, {} beads",
         ascii_comment(program.cell.name()),
         program.points.len(),
         program.num_beads()
+    )?;
+    writeln!(
+        w,
+        "  ! entry routine {} (call it from the task's main); every other name is LOCAL to this module",
+        program.name
     )?;
     let (tool_held, tool, wobj_held, wobj) = match frames {
         AbbFrames::Held {
@@ -546,7 +778,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     writeln!(w, "  ! tWaam.tload: {load_note}")?;
     writeln!(
         w,
-        "  PERS tooldata tWaam := [{tool_held},{},{}];",
+        "  LOCAL PERS tooldata tWaam := [{tool_held},{},{}];",
         pose_line(&tool),
         tload.line(tload.cog_mm)
     )?;
@@ -559,14 +791,14 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             )?;
             writeln!(
                 w,
-                "  PERS wobjdata wWaam := [FALSE,FALSE,\"{}\",[[0,0,0],[1,0,0,0]],{}];",
+                "  LOCAL PERS wobjdata wWaam := [FALSE,FALSE,\"{}\",[[0,0,0],[1,0,0,0]],{}];",
                 opts.ufmec,
                 pose_line(&c.table_from_part)
             )?;
         }
         None => writeln!(
             w,
-            "  PERS wobjdata wWaam := [{wobj_held},TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];",
+            "  LOCAL PERS wobjdata wWaam := [{wobj_held},TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];",
             pose_line(&wobj)
         )?,
     }
@@ -585,9 +817,18 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         )?;
         let zeros = "[0,0,0,0,0,0,0,0,0]";
         let arc = format!("[{schedule},0,0,0,0,0,0,0,0]");
+        let (purge, preflow, postflow) = (
+            Fixed::new(opts.purge_time_s, 3),
+            Fixed::new(opts.preflow_time_s, 3),
+            Fixed::new(opts.postflow_time_s, 3),
+        );
         writeln!(
             w,
-            "  LOCAL PERS seamdata seamWaam := [0,0,{arc},0,0,0,0,0,{zeros},0,0,{zeros},0,0,{zeros},0];"
+            "  ! gas (s): purge_time {purge}, preflow_time {preflow}, postflow_time {postflow} ([program.abb] purge_time_s, preflow_time_s, postflow_time_s)"
+        )?;
+        writeln!(
+            w,
+            "  LOCAL PERS seamdata seamWaam := [{purge},{preflow},{arc},0,0,0,0,0,{zeros},0,0,{zeros},0,0,{zeros},{postflow}];"
         )?;
         for (k, v) in weld_speeds.iter().enumerate() {
             writeln!(
@@ -619,7 +860,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     if let Some(h) = &program.home {
         writeln!(
             w,
-            "  CONST jointtarget jHome := {};",
+            "  LOCAL CONST jointtarget jHome := {};",
             jointtarget(&h.joints, h.positioner, slots)
         )?;
     }
@@ -641,7 +882,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         let pl = pose_line(&pose);
         writeln!(
             w,
-            "  CONST robtarget p{} := [{},[{},{},{},{}],{}];",
+            "  LOCAL CONST robtarget p{} := [{},[{},{},{},{}],{}];",
             i + 1,
             &pl[1..pl.len() - 1],
             c[0],
@@ -654,13 +895,22 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         if opens_bead(prev, p.arc) {
             writeln!(
                 w,
-                "  CONST jointtarget j{} := {};",
+                "  LOCAL CONST jointtarget j{} := {};",
                 i + 1,
                 jointtarget(&p.joints, p.positioner, slots)
             )?;
         }
     }
-    writeln!(w, "  PROC main()")?;
+    writeln!(w, "  PROC {}()", program.name)?;
+    // the positioner's unit moves only while active
+    let unit = matches!(program.cell, Cell::TorchCarried(_)).then_some(opts.ufmec.as_str());
+    if let Some(u) = unit {
+        writeln!(
+            w,
+            "    ! positioner: mechanical unit {u} active for the program"
+        )?;
+        writeln!(w, "    ActUnit {u};")?;
+    }
     writeln!(w, "    ConfL \\On;")?;
     let tw = "tWaam\\WObj:=wWaam";
     let zone = format!("z{}", opts.zone_mm);
@@ -773,6 +1023,9 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         writeln!(w, "    ! home")?;
         writeln!(w, "    MoveAbsJ jHome, {joint_speed}, fine, {tw};")?;
     }
+    if let Some(u) = unit {
+        writeln!(w, "    DeactUnit {u};")?;
+    }
     writeln!(w, "  ENDPROC")?;
     writeln!(w, "ENDMODULE")?;
     Ok(())
@@ -825,10 +1078,12 @@ fn check_setup(program: &Program) -> Result<(), ProgramError> {
     Ok(())
 }
 
-/// The `.mod` file of `program`.
+/// The `.mod` file of `program`: `<name>.mod`, holding `MODULE
+/// MOD_<name>` with the entry routine `PROC <name>()` (module doc).
 ///
 /// # Errors
-/// [`ProgramError::InvalidOptions`] for bad options or name;
+/// [`ProgramError::InvalidOptions`] for bad options (naming the field) or
+/// a name that cannot name the entry routine ([`check_entry_name`]);
 /// [`ProgramError::VendorMismatch`] when the cell's robot is not an ABB arm;
 /// [`ProgramError::Mismatch`] for a bead set-up list that does not fit the
 /// beads or holds non-finite values.
@@ -837,7 +1092,7 @@ pub fn abb_files(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile
     program.check_finite()?;
     check_setup(program)?;
     opts.validate()?;
-    check_name(&program.name)?;
+    check_entry_name(&program.name, opts)?;
     Ok(vec![EmittedFile {
         name: format!("{}.mod", program.name),
         text: render(|w| write_mod(w, program, opts))?,

@@ -1,9 +1,12 @@
 //! Reader of our own ABB RAPID output (the subset
 //! [`write_mod`](crate::program::abb::write_mod) writes): the declarations
 //! (`[LOCAL|TASK] PERS|CONST|VAR type name := value;`: tool, work object,
-//! `seamdata`, `welddata`, `loaddata`, `robtarget`s and `jointtarget`s), and
-//! the motion, process, wait and payload instructions of `main`. Errors name
-//! the file and line; a module without `ENDMODULE` (truncated) is an error.
+//! `seamdata`, `welddata`, `loaddata`, `robtarget`s and `jointtarget`s), the
+//! routines (`[LOCAL] PROC name()`), and the motion, process, wait, payload
+//! and mechanical-unit (`ActUnit`, `DeactUnit`) instructions of the
+//! routines. Errors name the file and line; a module without `ENDMODULE`
+//! (truncated) and `LOCAL` inside a routine (RAPID allows it at module
+//! level only) are errors.
 
 use crate::math::{Isometry3, Point3, Vector3};
 use crate::program::ProgramError;
@@ -222,6 +225,33 @@ pub struct RapidWeld {
     pub sched: f64,
 }
 
+/// A `seamdata` declaration (RobotWare 6 Arc, 16 components): its gas
+/// times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidSeam {
+    /// Name.
+    pub name: String,
+    /// Line.
+    pub line: usize,
+    /// `purge_time` (s), component 1.
+    pub purge_time_s: f64,
+    /// `preflow_time` (s), component 2.
+    pub preflow_time_s: f64,
+    /// `postflow_time` (s), component 16.
+    pub postflow_time_s: f64,
+}
+
+/// A routine: `[LOCAL] PROC name()`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RapidRoutine {
+    /// Name.
+    pub name: String,
+    /// `true` when declared `LOCAL`.
+    pub local: bool,
+    /// Line of `PROC`.
+    pub line: usize,
+}
+
 /// Any declaration: storage class, type and name.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RapidDecl {
@@ -273,7 +303,7 @@ pub struct ToolArg {
     pub wobj: Option<String>,
 }
 
-/// One instruction of `main`.
+/// One instruction of a routine.
 #[derive(Debug, Clone, PartialEq)]
 pub enum RapidOp {
     /// `MoveAbsJ target, speed, zone, tool\WObj:=wobj`.
@@ -320,6 +350,10 @@ pub enum RapidOp {
     },
     /// `GripLoad load`.
     GripLoad(String),
+    /// `ActUnit unit`: the mechanical unit.
+    ActUnit(String),
+    /// `DeactUnit unit`: the mechanical unit.
+    DeactUnit(String),
     /// Any other statement, as written without `;`.
     Other(String),
 }
@@ -338,6 +372,8 @@ pub struct RapidInstruction {
 pub struct RapidModule {
     /// Module name.
     pub name: String,
+    /// Line of `MODULE`.
+    pub line: usize,
     /// File name (for messages).
     pub file: String,
     /// The (last) `tooldata` declared.
@@ -350,9 +386,13 @@ pub struct RapidModule {
     pub welds: Vec<RapidWeld>,
     /// `loaddata` declarations: name, line, value.
     pub loads: Vec<(String, usize, RapidLoad)>,
-    /// Every declaration, in order.
+    /// `seamdata` declarations.
+    pub seams: Vec<RapidSeam>,
+    /// Every data declaration at module level, in order.
     pub declarations: Vec<RapidDecl>,
-    /// `main`'s instructions.
+    /// The routines, in order (the format has one: the entry routine).
+    pub routines: Vec<RapidRoutine>,
+    /// The routines' instructions, in file order.
     pub instructions: Vec<RapidInstruction>,
 }
 
@@ -376,18 +416,22 @@ pub fn parse_mod(text: &str, file: &str) -> Result<RapidModule, ProgramError> {
     };
     let mut m = RapidModule {
         name: String::new(),
+        line: 0,
         file: file.into(),
         tool: None,
         wobj: None,
         targets: Vec::new(),
         welds: Vec::new(),
         loads: Vec::new(),
+        seams: Vec::new(),
         declarations: Vec::new(),
+        routines: Vec::new(),
         instructions: Vec::new(),
     };
     let mut names = std::collections::HashSet::new();
     let mut started = false;
-    let mut in_main = false;
+    // the routine being read
+    let mut in_proc: Option<String> = None;
     let mut ended = false;
     let mut last = 0;
     for (i, raw) in text.lines().enumerate() {
@@ -405,29 +449,59 @@ pub fn parse_mod(text: &str, file: &str) -> Result<RapidModule, ProgramError> {
                 .strip_prefix("MODULE ")
                 .ok_or_else(|| err(n, format!("expected `MODULE name`, got `{l}`")))?;
             m.name = name.trim().to_string();
+            m.line = n;
             started = true;
             continue;
         }
         if l == "ENDMODULE" {
-            if in_main {
-                return Err(err(n, "ENDMODULE inside PROC main (no ENDPROC)".into()));
+            if let Some(p) = &in_proc {
+                return Err(err(n, format!("ENDMODULE inside PROC {p} (no ENDPROC)")));
             }
             ended = true;
             continue;
         }
-        if l.starts_with("PROC ") {
-            in_main = true;
+        let (local, rest) = match l.strip_prefix("LOCAL ") {
+            Some(r) => (true, r.trim_start()),
+            None => (false, l),
+        };
+        if let Some(head) = rest.strip_prefix("PROC ") {
+            if let Some(p) = &in_proc {
+                return Err(err(n, format!("PROC inside PROC {p} (no ENDPROC)")));
+            }
+            let name = head
+                .trim()
+                .strip_suffix("()")
+                .map(str::trim_end)
+                .filter(|s| crate::program::abb::is_rapid_name(s))
+                .ok_or_else(|| err(n, format!("expected `[LOCAL] PROC name()`, got `{l}`")))?;
+            if !names.insert(name.to_string()) {
+                return Err(err(n, format!("`{name}` is declared twice")));
+            }
+            m.routines.push(RapidRoutine {
+                name: name.to_string(),
+                local,
+                line: n,
+            });
+            in_proc = Some(name.to_string());
             continue;
         }
         if l == "ENDPROC" {
-            in_main = false;
+            if in_proc.take().is_none() {
+                return Err(err(n, "ENDPROC outside a routine".into()));
+            }
             continue;
+        }
+        if local && in_proc.is_some() {
+            return Err(err(
+                n,
+                "LOCAL inside a routine: RAPID allows it at module level only".into(),
+            ));
         }
         let stmt = l
             .strip_suffix(';')
             .ok_or_else(|| err(n, "statement without `;`".into()))?
             .trim();
-        if in_main {
+        if in_proc.is_some() {
             let op = parse_instruction(stmt).map_err(|r| err(n, r))?;
             m.instructions.push(RapidInstruction { line: n, op });
         } else {
@@ -435,7 +509,7 @@ pub fn parse_mod(text: &str, file: &str) -> Result<RapidModule, ProgramError> {
         }
     }
     if !ended {
-        let where_ = if in_main { " inside PROC main" } else { "" };
+        let where_ = in_proc.map_or(String::new(), |p| format!(" inside PROC {p}"));
         return Err(err(
             last,
             format!("file ends{where_} without ENDMODULE (truncated?)"),
@@ -555,6 +629,13 @@ fn parse_declaration(
                     it.num()?;
                 }
             }
+            m.seams.push(RapidSeam {
+                name: name.to_string(),
+                line,
+                purge_time_s: items[0].num()?,
+                preflow_time_s: items[1].num()?,
+                postflow_time_s: items[15].num()?,
+            });
         }
         "welddata" => {
             if items.len() != 4 {
@@ -717,6 +798,14 @@ fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
                 Ok(RapidOp::GripLoad(load.clone()))
             }
             _ => Err(format!("GripLoad: expected one loaddata: `{stmt}`")),
+        },
+        "ActUnit" | "DeactUnit" => match args.as_slice() {
+            [unit] if crate::program::abb::is_rapid_name(unit) => Ok(if name == "ActUnit" {
+                RapidOp::ActUnit(unit.clone())
+            } else {
+                RapidOp::DeactUnit(unit.clone())
+            }),
+            _ => Err(format!("{name}: expected one mechanical unit: `{stmt}`")),
         },
         _ => Ok(RapidOp::Other(stmt.to_string())),
     }
