@@ -2,7 +2,7 @@
 //! thinned to the fewest linear moves whose interpolated path stays within
 //! [`ProgramOptions::path_tolerance_mm`] and
 //! [`ProgramOptions::orientation_tolerance_deg`] of every planned point
-//! ([`compress`](crate::program::compress::compress)). The controller's
+//! ([`compress`]). The controller's
 //! model of a linear move is the one the emitters ask for: the tool centre
 //! point moves on a straight line and its orientation turns by slerp in the
 //! frame the move is programmed in, extra axes (the positioner) linearly —
