@@ -1009,6 +1009,9 @@ struct Checker<'a, F> {
     planned_bounds: ChordBounds,
     /// Span of the last acceptable move of each [`Kind`], a search start.
     last_span: [usize; 2],
+    /// Cumulative controller travel (mm) and turning (rad) from the first
+    /// pose, for [`CompressOptions::rotation_tolerance_deg`] (empty without).
+    controller_cum: (Vec<f64>, Vec<f64>),
 }
 
 impl<'a, F> Checker<'a, F>
@@ -1034,6 +1037,13 @@ where
             sample_bounds: ChordBounds::default(),
             planned_bounds: ChordBounds::default(),
             last_span: [1; 2],
+            controller_cum: match opts.rotation_tolerance_deg {
+                Some(_) => (
+                    cumulative(poses.windows(2).map(|w| (w[1].p - w[0].p).norm())),
+                    cumulative(poses.windows(2).map(|w| w[0].q.angle_to(&w[1].q))),
+                ),
+                None => (Vec::new(), Vec::new()),
+            },
         }
     }
 
@@ -1148,30 +1158,19 @@ where
             return true;
         };
         let poses = self.poses;
-        let steps: Vec<(f64, f64)> = poses[i..=j]
-            .windows(2)
-            .map(|w| ((w[1].p - w[0].p).norm(), w[0].q.angle_to(&w[1].q)))
-            .collect();
-        let (len, turn) = steps
-            .iter()
-            .fold((0.0, 0.0), |(l, t), (a, b)| (l + a, t + b));
-        let (mut l, mut t) = (0.0, 0.0);
-        for (k, (dl, dt)) in steps.iter().enumerate().take(j - i - 1) {
-            l += dl;
-            t += dt;
+        let (cl, ct) = &self.controller_cum;
+        let (len, turn) = (cl[j] - cl[i], ct[j] - ct[i]);
+        ((i + 1)..j).all(|k| {
             let s = if len > f64::EPSILON {
-                l / len
+                (cl[k] - cl[i]) / len
             } else if turn > 0.0 {
-                t / turn
+                (ct[k] - ct[i]) / turn
             } else {
                 0.0
             };
             let expected = poses[i].q.slerp(&poses[j].q, s);
-            if expected.angle_to(&poses[i + k + 1].q).to_degrees() > tol {
-                return false;
-            }
-        }
-        true
+            expected.angle_to(&poses[k].q).to_degrees() <= tol
+        })
     }
 
     /// The via for a circular move `i -> j`, if that arc is allowed.

@@ -11,6 +11,29 @@ use waam_slicer::program::ProgramSettings;
 
 use crate::fixture::{cell, hemisphere, law, trajectory, TS_MM_S};
 
+/// The program of the hemisphere's `layers` at 240 points a layer (1.2 mm
+/// apart on the 45 mm sphere) in `c`, thinned at the default tolerances,
+/// and the planned path points.
+fn thinned_hemisphere(
+    c: &waam_slicer::robot::Cell,
+    layers: std::ops::Range<usize>,
+) -> (
+    waam_slicer::program::Program,
+    Vec<waam_slicer::robot::trajectory::PathPointInput>,
+) {
+    let path = hemisphere(layers, 240, law(c));
+    let tr = trajectory(c, &path);
+    let prog = waam_slicer::program::build_program(
+        "HEMI",
+        c,
+        &path,
+        &tr,
+        &waam_slicer::program::TravelSpeed::Constant(TS_MM_S),
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", c.name()));
+    (prog, path)
+}
+
 /// The hemisphere's first three layers at 240 points a layer (1.2 mm
 /// apart on the 45 mm sphere) in every sample cell: at least 2.5x fewer
 /// bead positions than planned points (3x to 14x by cell), and the
@@ -23,16 +46,7 @@ fn beads_need_fewer_positions_and_stay_on_the_plan() {
         .chain(&crate::fixture::ABB_CELLS)
     {
         let c = cell(file);
-        let path = hemisphere(0..3, 240, law(&c));
-        let tr = trajectory(&c, &path);
-        let prog = waam_slicer::program::build_program(
-            "HEMI",
-            &c,
-            &path,
-            &tr,
-            &waam_slicer::program::TravelSpeed::Constant(TS_MM_S),
-        )
-        .unwrap_or_else(|e| panic!("{file}: {e}"));
+        let (prog, path) = thinned_hemisphere(&c, 0..3);
         let planned = prog.planned.len();
         let kept = prog.bead_points().count();
         assert_eq!(planned, path.len(), "{file}");
@@ -59,16 +73,7 @@ fn beads_need_fewer_positions_and_stay_on_the_plan() {
 #[test]
 fn a_move_off_the_planned_path_is_reported() {
     let c = cell("kuka_kr16_2_torch_carried.toml");
-    let path = hemisphere(0..1, 240, law(&c));
-    let tr = trajectory(&c, &path);
-    let prog = waam_slicer::program::build_program(
-        "HEMI",
-        &c,
-        &path,
-        &tr,
-        &waam_slicer::program::TravelSpeed::Constant(TS_MM_S),
-    )
-    .unwrap();
+    let (prog, _) = thinned_hemisphere(&c, 0..1);
     let settings = ProgramSettings::default();
     let files = emit(&prog, &settings).unwrap();
     let mut plan = prog.planned.clone();

@@ -312,18 +312,8 @@ pub(crate) fn kuka_steps(
                 }
                 continue;
             }
-            KrlOp::WaitIn(n) => {
-                steps.push(Step::Wait {
-                    file: src.clone(),
-                    line,
-                    seconds: None,
-                    input: Some(*n),
-                });
-                continue;
-            }
-            // outside the ignition handshake: plain statements
-            KrlOp::Timer { .. } | KrlOp::TimerStop { .. } => continue,
-            KrlOp::WaitInOrTimer { input, .. } => {
+            // a wait for an input, with or without the ignition timer
+            KrlOp::WaitIn(input) | KrlOp::WaitInOrTimer { input, .. } => {
                 steps.push(Step::Wait {
                     file: src.clone(),
                     line,
@@ -332,6 +322,8 @@ pub(crate) fn kuka_steps(
                 });
                 continue;
             }
+            // outside the ignition handshake: plain statements
+            KrlOp::Timer { .. } | KrlOp::TimerStop { .. } => continue,
             KrlOp::IfNotIn(n) => {
                 push(
                     &mut report,
