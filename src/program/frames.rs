@@ -5,6 +5,16 @@
 //! from the cell: the torch-carried cell's torch (`flange_from_tcp`), the
 //! part-carried cell's part (`flange_from_part`) and fixed torch at the
 //! deposition point `D_R`.
+//!
+//! **One tool convention in every program**: the torch's tool frame has
+//! **+Z along the wire, out of the torch towards the part** (the usual
+//! welding-torch convention, so that Cartesian moves, tool jogging,
+//! offsets and weaving in the tool frame run the way a welder expects),
+//! whether the torch is held by the arm ([`held_tool`]) or fixed in the
+//! cell ([`fixed_torch_at`]). The planner's own TCP frame (the cell's
+//! `flange_from_tcp`, thesis eq. 4.9) has z the other way, from the wire
+//! tip into the torch (along the tool axis `T`); the programs' tool is that
+//! frame turned half a turn about its x axis ([`wire_out`]), same origin.
 
 use crate::math::{Isometry3, Point3, Vector3};
 use crate::robot::Cell;
@@ -97,22 +107,34 @@ impl ToolFrames {
     }
 }
 
-/// The tool held on the flange (mm): `flange_from_tool` when given, else
-/// the torch-carried cell's torch (`flange_from_tcp`) or, in the
-/// part-carried cell, the flange itself.
+/// The tool held on the flange (mm): `flange_from_tool` when given (the
+/// user's own tool, written as given), else the torch-carried cell's torch
+/// with +Z along the wire out of the torch (`flange_from_tcp ·`
+/// [`wire_out`]) or, in the part-carried cell, the flange itself.
 pub fn held_tool(cell: &Cell, flange_from_tool: Option<Isometry3>) -> Isometry3 {
     match (flange_from_tool, cell) {
         (Some(t), _) => t,
-        (None, Cell::TorchCarried(c)) => c.flange_from_tcp,
+        (None, Cell::TorchCarried(c)) => c.flange_from_tcp * wire_out(),
         (None, Cell::PartCarried(_)) => Isometry3::identity(),
     }
 }
 
-/// A fixed torch at `d` (robot base frame, mm): z down (its approach
-/// direction, towards the part), x along the base X, y along −Y.
+/// Half a turn about x: from the planner's TCP frame (z from the wire tip
+/// into the torch, along `T`) to the programs' tool frame (z along the
+/// wire, out of the torch), same origin, x kept, y reversed.
+pub fn wire_out() -> Isometry3 {
+    Isometry3::from_parts(
+        nalgebra::Translation3::identity(),
+        nalgebra::UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI),
+    )
+}
+
+/// A fixed torch at `d` (robot base frame, mm): z down, along the wire out
+/// of the torch towards the part (the programs' convention, module doc), x
+/// along the base X, y along −Y.
 pub fn fixed_torch_at(d: &Point3) -> Isometry3 {
     Isometry3::from_parts(
         nalgebra::Translation3::from(d.coords),
-        nalgebra::UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI),
-    )
+        nalgebra::UnitQuaternion::identity(),
+    ) * wire_out()
 }

@@ -382,7 +382,7 @@ fn stated_frames_are_the_cell_files() {
 
     let (prog, c) = two_layers(TORCH);
     let f = kuka_files(&prog, &opts).unwrap();
-    let tool = "  $TOOL = {X -86.0000,Y 0.0000,Z 406.0000,A 0.00000,B -36.00000,C -180.00000}";
+    let tool = "  $TOOL = {X -86.0000,Y 0.0000,Z 406.0000,A 0.00000,B -36.00000,C 0.00000}";
     let lt = line_eq(&f[0].text, tool, 0);
     let bad = replace_line(&f[0].text, lt, Some(&tool.replace("B -36.", "B -35.")));
     let r = check(&f, &bad, &f[1].text, &c, &opts);

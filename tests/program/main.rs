@@ -19,5 +19,6 @@ mod shared;
 mod split;
 mod strokes;
 mod thinning;
+mod tool_frames;
 mod transit_wall;
 mod validate;

@@ -677,7 +677,7 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     } else if matches!(program.cell, Cell::TorchCarried(_)) && opts.flange_from_tool.is_none() {
         writeln!(
             w,
-            "  ; the tool is the torch, its z axis along the torch away from the wire tip (not KUKA's +X tool direction)"
+            "  ; the tool is the torch, +Z along the wire out of the torch (set $TOOL_DIRECTION = #Z for tool-frame weaving and jogging)"
         )?;
     }
     writeln!(w, "  $TOOL = {}", frame_literal(&tool))?;
