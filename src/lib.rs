@@ -20,15 +20,22 @@
 //!
 //! | stage | module | SPEC |
 //! |---|---|---|
-//! | 0. read a part file | [`io::part_file`] | §2 |
+//! | — leaf helpers every stage may use: types, tolerances, root finding; atomic writes, decimal text | [`math`], [`util`] | |
 //! | 1. tube geometry: guide curves, frames, profile law, substrates | [`geometry`] | §2 |
 //! | 2. deposition paths: four strategies + spiral, distance map, truncation, seams, smoothing | [`path`] | §3 |
 //! | 3. tool axes (local frames, build direction) | [`toolaxis`] | §4 |
-//! | 3b. process: bead, travel speeds, estimates | [`process`] | §5 |
-//! | 4. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
-//! | 5a. the torch-carried positioner's tilt and turn laws within the cone of the vertical | [`optimise::positioner`] | §9 |
-//! | 5. layer-by-layer optimisation of `R_Z` (branch, SQP, quality) | [`optimise`] | §7 |
-//! | 6. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
+//! | 4. process: bead, travel speeds, estimates | [`process`] | §5 |
+//! | 5. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
+//! | 6. layer-by-layer optimisation of `R_Z` (branch, SQP, quality) | [`optimise`] | §7 |
+//! | 6a. the torch-carried positioner's tilt and turn laws within the cone of the vertical | [`optimise::positioner`] | §9 |
+//! | 7. placement of the part in the cell: an outer search calling 6 as its oracle | [`optimise::place`] | §7 |
+//! | 8. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
+//! | files at the edges: part and cell files read into the stages' types, CSV and STL written | [`io`] | §2, §6 |
+//! | the interactive 3-D report | [`report`] | |
+//! | the front door: one call per job | [`pipeline`] | |
+//!
+//! A module imports only modules above it in this table (the leaf helpers
+//! from everywhere; tests aside); [`error`] gathers every stage's error.
 //!
 //! ## Units and frames
 //!
@@ -95,6 +102,7 @@ pub mod program;
 pub mod report;
 pub mod robot;
 pub mod toolaxis;
+pub mod util;
 
 #[cfg(feature = "python")]
 mod python;

@@ -9,8 +9,8 @@ use crate::args::PlanArgs;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use waam_slicer::io::atomic::write_atomic;
 use waam_slicer::program::ProgramError;
+use waam_slicer::util::atomic::write_atomic;
 use waam_slicer::{plan_part, Cell, Error, Part, PlanOptions, PlannedPart, ProgramFormat};
 
 /// Runs the command; prints errors itself and returns the exit code.

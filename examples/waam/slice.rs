@@ -4,7 +4,7 @@
 use crate::args::{SliceArgs, StrategyArg};
 use std::path::{Path as FsPath, PathBuf};
 use std::time::Instant;
-use waam_slicer::io::atomic::write_atomic;
+use waam_slicer::util::atomic::write_atomic;
 
 /// `write_atomic` for a writer that returns a value.
 fn write_atomic_with<T>(

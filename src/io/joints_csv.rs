@@ -7,15 +7,15 @@
 
 use std::io::Write;
 
-use crate::io::decimal::{push_fixed, push_u64};
 use crate::optimise::{LayerPoints, Plan};
+use crate::util::decimal::{push_fixed, push_u64};
 
 /// The header line without the positioner columns.
 pub const HEADER: &str = "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6";
 
 /// Writes `plan`'s points (made from `layers`); `positioner` adds `e1,e2`.
 /// Numbers with 6 decimals by the fixed-point formatter of
-/// [`decimal`](crate::io::decimal) (within half a unit of the last digit of
+/// [`decimal`](crate::util::decimal) (within half a unit of the last digit of
 /// the standard formatting), one row at a time into a reused buffer.
 ///
 /// # Errors

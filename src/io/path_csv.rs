@@ -4,10 +4,10 @@
 //! `t` tool axis). Also reads such a file back (for distance maps of paths
 //! made elsewhere).
 
-use crate::io::decimal::{push_fixed, push_u64};
 use crate::math::Point3;
 use crate::path::{Layer, PathPoint};
 use crate::toolaxis::LocalFrame;
+use crate::util::decimal::{push_fixed, push_u64};
 use std::io::Write;
 
 /// The header line.

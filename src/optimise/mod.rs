@@ -1,4 +1,4 @@
-//! **Stage 5 — layer-by-layer optimisation of the free rotation `R_Z`.**
+//! **Stage 6 — layer-by-layer optimisation of the free rotation `R_Z`.**
 //! Takes the layers of a path as cell points (part frame: position mm, tool
 //! axis, build direction) and a [`Cell`], and returns a [`Plan`]: per layer
 //! the IK branch (and why), the `R_Z` law (rad), joints per point (rad),

@@ -1,4 +1,4 @@
-//! **Stage 5a — the positioner's laws (torch-carried cell).** Takes the
+//! **Stage 6a — the positioner's laws (torch-carried cell).** Takes the
 //! points of one layer (part frame: position mm, tool axis, build direction)
 //! and a [`TorchCarriedCell`], and returns the tilt `q7` and turn `q8` of its
 //! 2-axis positioner at every point (rad) as smooth laws along the layer

@@ -18,8 +18,7 @@
 
 use std::f64::consts::TAU;
 
-use crate::geometry::{Substrate, Tube};
-use crate::io::part_file::Plane;
+use crate::geometry::{Plane, Substrate, Tube};
 use crate::path::{EndRule, PathPoint, SliceOptions, Strategy, MAX_POINTS_PER_PATH};
 
 /// Columns sampled around the profile (`v` values).

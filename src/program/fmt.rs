@@ -72,7 +72,7 @@ fn fixed_digits(v: f64, decimals: usize, buf: &mut [u8; 24]) -> Option<&str> {
         return None;
     }
     let n = whole as u64 + u64::from(frac > 0.5);
-    let first = crate::io::decimal::scaled_digits(buf, n, v.is_sign_negative(), decimals);
+    let first = crate::util::decimal::scaled_digits(buf, n, v.is_sign_negative(), decimals);
     std::str::from_utf8(&buf[first..]).ok()
 }
 

@@ -1,4 +1,4 @@
-//! **Stage 7 — robot programs.** Takes a planned [`JointTrajectory`] (joints
+//! **Stage 8 — robot programs.** Takes a planned [`JointTrajectory`] (joints
 //! per path point, rad), the path points it was computed for
 //! ([`PathPointInput`]: layer structure, part-frame positions (mm), tool axes,
 //! `R_Z`), the [`Cell`] and the travel speeds (mm/s), checks that the plan is
@@ -1483,7 +1483,7 @@ pub struct EmittedFile {
 pub fn write_files(dir: &Path, files: &[EmittedFile]) -> Result<(), ProgramError> {
     for f in files {
         let path = dir.join(&f.name);
-        crate::io::atomic::write_atomic(&path, |w| w.write_all(f.text.as_bytes())).map_err(
+        crate::util::atomic::write_atomic(&path, |w| w.write_all(f.text.as_bytes())).map_err(
             |source| ProgramError::Io {
                 path: path.display().to_string(),
                 source,

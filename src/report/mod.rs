@@ -241,12 +241,12 @@ pub fn report_html(input: &ReportInput) -> Result<String, ReportError> {
 /// As [`write_report_html`]; [`ReportError::Io`] names `dest`.
 pub fn write_report(dest: &std::path::Path, input: &ReportInput) -> Result<(), ReportError> {
     let data = report_data(input)?;
-    crate::io::atomic::write_atomic(dest, |w| write_page(w, input.title, &data)).map_err(|source| {
-        ReportError::Io {
+    crate::util::atomic::write_atomic(dest, |w| write_page(w, input.title, &data)).map_err(
+        |source| ReportError::Io {
             file: dest.display().to_string(),
             source,
-        }
-    })
+        },
+    )
 }
 
 /// Fills the template: `{{TITLE}}` (HTML-escaped), `{{CSS}}`, `{{DATA}}`
