@@ -4,35 +4,20 @@
 
 use std::time::Instant;
 
+use super::branch_types::{Anchor, BranchOutcome, Degrees};
 use super::parameterisation::Basis;
 use super::point_by_point::point_by_point;
-use super::problem::{Evaluation, LayerProblem, PointFailure};
+use super::problem::{LayerProblem, PointFailure};
 use super::report::finish;
 use super::seed::Seed;
 use super::setup::LayerSetup;
-use super::spiral::Anchor;
-use super::{degree, sqp, LayerPoints};
+use super::{degree, sqp, subsample, LayerPoints};
 use super::{
     ConfigurationChoice, ConfigurationChoiceReport, LayerPlan, LayerQuality, LayerStatus,
     ObjectiveReport, OptimiseOptions, Parameterisation, PlannedPoint, RzLaw, SolverReport,
 };
 use crate::robot::cell::Cell;
 use crate::robot::ik::Configuration;
-
-/// What one branch gave.
-pub(super) struct BranchOutcome {
-    pub(super) cfg: Configuration,
-    pub(super) eval: Result<Evaluation, PointFailure>,
-    pub(super) law: RzLaw,
-    pub(super) violation: f64,
-    pub(super) converged: bool,
-    pub(super) iterations: usize,
-    pub(super) qp_solves: usize,
-    pub(super) qp_failures: usize,
-    pub(super) problem_psi: Vec<f64>,
-    /// Points the law was optimised on, when subsampled and certified.
-    pub(super) samples: Option<usize>,
-}
 
 /// One layer (or spiral turn, `anchor` given); also returns the dexterity
 /// floor at its last point (the next spiral turn starts from it).
@@ -303,7 +288,7 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
             max_degree,
             stop_relative_gain,
             ..
-        } => degree::raise_degrees(
+        } => raise_degrees(
             setup,
             &problem,
             seed,
@@ -323,5 +308,50 @@ fn scale_of(problem: &LayerProblem, r: &[f64], smoothness: f64) -> f64 {
     match problem.evaluate(r) {
         Ok(e) => problem.objective(&e, smoothness).max(1e-6),
         Err(_) => 1.0,
+    }
+}
+
+/// Raises the degree of the polynomial `R_Z` law of `setup`'s layer from
+/// `seed`'s up to `max_degree` while the relative objective gain is at least
+/// `stop_relative_gain`, and records the best degree's law and evaluation
+/// (and the SQP's counts) in `outcome`. Spiral turns hold `R_Z` on their
+/// shared point (degree at least 1).
+pub(super) fn raise_degrees(
+    setup: &LayerSetup,
+    problem: &LayerProblem,
+    seed: &Seed,
+    max_degree: usize,
+    stop_relative_gain: f64,
+    outcome: &mut BranchOutcome,
+) {
+    let p = setup.points.len();
+    let x: Vec<f64> = if setup.cylindrical {
+        setup.theta.clone()
+    } else {
+        (0..p).map(|m| m as f64).collect()
+    };
+    let (start, basis) = match setup.anchor {
+        // continuity: R_Z held on the shared point, degree ≥ 1
+        Some(a) => {
+            let d = seed.degree.min(max_degree).max(1);
+            (d, Basis::anchored_polynomial(&x, d, a.r_z))
+        }
+        None => {
+            let d = seed.degree.min(max_degree);
+            (d, Basis::polynomial(&x, d + 1))
+        }
+    };
+    let c = basis.fit(&seed.r);
+    let degrees = Degrees {
+        start,
+        max: max_degree,
+        stop_relative_gain,
+    };
+    if subsample::solve(setup, problem, &basis, &c, &degrees, outcome) {
+        return;
+    }
+    match degree::degree_loop(problem, basis, c, &degrees, &setup.opts.sqp, outcome) {
+        Ok((best, history)) => degree::record(setup, best, history, outcome),
+        Err(f) => outcome.eval = Err(f),
     }
 }

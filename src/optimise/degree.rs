@@ -3,103 +3,11 @@
 //! coefficient starts at 0), until the objective stops improving or the
 //! Gauss–Newton model bounds the next degree's gain below the criterion.
 
-use super::branch::BranchOutcome;
+use super::branch_types::{Best, BranchOutcome, Degrees};
 use super::parameterisation::Basis;
 use super::problem::{Evaluation, LayerProblem, PointFailure};
-use super::seed::Seed;
 use super::setup::LayerSetup;
-use super::{sqp, subsample, RzLaw, SqpOptions};
-
-/// Raises the degree of the polynomial `R_Z` law of `setup`'s layer from
-/// `seed`'s up to `max_degree` while the relative objective gain is at least
-/// `stop_relative_gain`, and records the best degree's law and evaluation
-/// (and the SQP's counts) in `outcome`. Spiral turns hold `R_Z` on their
-/// shared point (degree at least 1).
-pub(super) fn raise_degrees(
-    setup: &LayerSetup,
-    problem: &LayerProblem,
-    seed: &Seed,
-    max_degree: usize,
-    stop_relative_gain: f64,
-    outcome: &mut BranchOutcome,
-) {
-    let p = setup.points.len();
-    let x: Vec<f64> = if setup.cylindrical {
-        setup.theta.clone()
-    } else {
-        (0..p).map(|m| m as f64).collect()
-    };
-    let (start, basis) = match setup.anchor {
-        // continuity: R_Z held on the shared point, degree ≥ 1
-        Some(a) => {
-            let d = seed.degree.min(max_degree).max(1);
-            (d, Basis::anchored_polynomial(&x, d, a.r_z))
-        }
-        None => {
-            let d = seed.degree.min(max_degree);
-            (d, Basis::polynomial(&x, d + 1))
-        }
-    };
-    let c = basis.fit(&seed.r);
-    let degrees = Degrees {
-        start,
-        max: max_degree,
-        stop_relative_gain,
-    };
-    if subsample::solve(setup, problem, &basis, &c, &degrees, outcome) {
-        return;
-    }
-    match degree_loop(problem, basis, c, &degrees, &setup.opts.sqp, outcome) {
-        Ok((best, history)) => record(setup, best, history, outcome),
-        Err(f) => outcome.eval = Err(f),
-    }
-}
-
-/// The degrees a polynomial law goes through: from `start` up to `max`,
-/// while the relative objective gain is at least `stop_relative_gain`.
-pub(super) struct Degrees {
-    pub(super) start: usize,
-    pub(super) max: usize,
-    pub(super) stop_relative_gain: f64,
-}
-
-/// The degree kept by [`degree_loop`]: its coefficients, basis and SQP result.
-pub(super) struct Best {
-    pub(super) degree: usize,
-    pub(super) c: Vec<f64>,
-    pub(super) basis: Basis,
-    pub(super) res: sqp::SqpResult,
-}
-
-impl Best {
-    /// `(violation, objective)` of `best`, `None` before the first degree.
-    pub(super) fn key(best: &Option<Best>) -> Option<(f64, f64)> {
-        best.as_ref().map(|b| (b.res.violation, b.res.objective))
-    }
-
-    /// Offers degree `degree`'s solution `res` (coefficients `c` over
-    /// `basis`) to the best so far: it replaces it when it [`improves`] on
-    /// it. Returns its [`relative_gain`] over the best before it.
-    pub(super) fn offer(
-        best: &mut Option<Best>,
-        degree: usize,
-        c: &[f64],
-        basis: &Basis,
-        res: sqp::SqpResult,
-    ) -> f64 {
-        let last = Best::key(best);
-        let new = (res.violation, res.objective);
-        if improves(new, last) {
-            *best = Some(Best {
-                degree,
-                c: c.to_vec(),
-                basis: basis.clone(),
-                res,
-            });
-        }
-        relative_gain(new, last)
-    }
-}
+use super::{sqp, RzLaw, SqpOptions};
 
 /// Records `best` (with the objective of every degree solved, `history`)
 /// as `outcome`'s law and evaluation.
@@ -230,24 +138,6 @@ pub(super) fn raise_again(
         return sqp::predicted_gain(problem, e, 0.0, raised).is_some_and(|(g, _)| g >= threshold);
     }
     !skip_raise(problem, e, raised, threshold)
-}
-
-/// `true` when a degree's `(violation, objective)` is better than the best
-/// so far (less violation, or as little and a lower objective).
-fn improves(new: (f64, f64), best: Option<(f64, f64)>) -> bool {
-    match best {
-        None => true,
-        Some((bv, bf)) => new.0 < bv || (new.0 <= bv && new.1 < bf),
-    }
-}
-
-/// Relative objective gain of a degree over the best so far when both are
-/// feasible; infinite otherwise (keep raising).
-fn relative_gain(new: (f64, f64), best: Option<(f64, f64)>) -> f64 {
-    match best {
-        Some((bv, bf)) if bv <= 0.0 && new.0 <= 0.0 => (bf - new.1) / bf.abs().max(1e-300),
-        _ => f64::INFINITY,
-    }
 }
 
 /// Fraction of the stop criterion (relative gain) below which the

@@ -107,6 +107,7 @@
 //! ```
 
 mod branch;
+mod branch_types;
 mod degree;
 pub mod options;
 pub mod outcome;

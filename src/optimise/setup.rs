@@ -3,9 +3,9 @@
 //! (rad), and the spiral anchor; builds the layer's [`LayerProblem`] in a
 //! branch and its dexterity floors [SPEC §7, eq. 4.6].
 
+use super::branch_types::Anchor;
 use super::parameterisation::{cylindrical_angles, turns_about_z};
 use super::problem::{encoder_sigma_rad, LayerProblem};
-use super::spiral::Anchor;
 use super::{Abscissa, DexterityFloor, OptimiseOptions, Parameterisation};
 use crate::robot::cell::{Cell, CellPoint};
 use crate::robot::ik::Configuration;

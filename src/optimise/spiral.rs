@@ -5,13 +5,12 @@
 use std::time::Instant;
 
 use super::branch::optimise_layer;
+use super::branch_types::Anchor;
 use super::{
     transitions, validate_input, LayerPlan, LayerPoints, LayerStatus, OptimiseError,
     OptimiseOptions, Plan,
 };
 use crate::robot::cell::Cell;
-use crate::robot::ik::Configuration;
-use crate::robot::model::Joints;
 
 /// Optimises a spiral path (one continuous layer, `per_turn` points a turn,
 /// as [`Path::spiral`](crate::path::Path) gives it) turn by turn [SPEC §7]:
@@ -101,14 +100,4 @@ fn strip_shared_point(plan: &mut LayerPlan) {
         LayerStatus::NoSolution { point, .. } => *point = point.saturating_sub(1),
         _ => {}
     }
-}
-
-/// Where a spiral turn starts: the previous turn's last point.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Anchor {
-    pub(super) r_z: f64,
-    pub(super) joints: Joints,
-    pub(super) configuration: Configuration,
-    /// The previous turn's dexterity floor at its last point.
-    pub(super) floor: f64,
 }

@@ -23,8 +23,8 @@
 //! What the layer reports (joints, constraints, status, quality) is always
 //! computed on every point by the caller.
 
-use super::branch::BranchOutcome;
-use super::degree::{raise_again, record, Best, Degrees};
+use super::branch_types::{Best, BranchOutcome, Degrees};
+use super::degree::{raise_again, record};
 use super::parameterisation::Basis;
 use super::problem::{LayerProblem, SOLVER_MARGIN};
 use super::setup::LayerSetup;
