@@ -85,3 +85,42 @@ pub enum Error {
         stage: &'static str,
     },
 }
+
+/// What kind of failure an [`Error`] is, for a host that reacts by kind
+/// (the CLI's exit code, Python's exception class) without reading messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ErrorKind {
+    /// The input is wrong (a part or cell file's field, an option, a
+    /// program file that does not read back): the message names the file,
+    /// field, layer or point. Fix the input.
+    Input,
+    /// A program was asked of a plan that has an infeasible layer, or that
+    /// the program stage refused: an answer about the part in the cell, not
+    /// a fault of the input.
+    Infeasible,
+    /// The host asked to stop ([`Control`](crate::pipeline::Control)).
+    Cancelled,
+    /// A file could not be read or written (missing, permissions, disk).
+    Io,
+}
+
+impl Error {
+    /// The kind of this error ([`ErrorKind`]); an error wrapped with its
+    /// part file ([`Error::InPart`]) has its source's kind.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            Error::InPart { source, .. } => source.kind(),
+            Error::Cancelled { .. } | Error::Optimise(OptimiseError::Cancelled { .. }) => {
+                ErrorKind::Cancelled
+            }
+            Error::Program(
+                ProgramError::InfeasibleLayer { .. } | ProgramError::Infeasible { .. },
+            ) => ErrorKind::Infeasible,
+            Error::Program(ProgramError::Io { .. })
+            | Error::PartFile(PartFileError::Io { .. })
+            | Error::CellFile(CellFileError::Io { .. })
+            | Error::Report(crate::report::ReportError::Io { .. }) => ErrorKind::Io,
+            _ => ErrorKind::Input,
+        }
+    }
+}

@@ -107,7 +107,7 @@ pub mod util;
 #[cfg(feature = "python")]
 mod python;
 
-pub use error::Error;
+pub use error::{Error, ErrorKind};
 
 // The README's "Use as a library" block runs as a doctest.
 #[cfg(doctest)]

@@ -11,8 +11,8 @@ use crate::shared::part_path;
 use waam_slicer::io::joints_csv::read_joints_csv;
 use waam_slicer::program::ProgramError;
 use waam_slicer::{
-    check_program, plan_part, slice_part, Cell, Control, Error, Part, PlanOptions, ProgramFormat,
-    SliceOverrides,
+    check_program, plan_part, slice_part, Cell, Control, Error, ErrorKind, Part, PlanOptions,
+    ProgramFormat, SliceOverrides,
 };
 
 fn small(points: usize) -> PlanOptions {
@@ -68,7 +68,13 @@ fn an_infeasible_plan_cannot_write_a_program_and_names_its_layer() {
     assert!(!planned.is_feasible());
     let first = planned.plan.infeasible_layers().next().unwrap().layer;
     let dir = tempfile::tempdir().unwrap();
-    match planned.write_programs(dir.path(), ProgramFormat::Fanuc) {
+    let written = planned.write_programs(dir.path(), ProgramFormat::Fanuc);
+    // an answer about the part in the cell, not bad input
+    assert_eq!(
+        written.as_ref().map_err(Error::kind).err(),
+        Some(ErrorKind::Infeasible)
+    );
+    match written {
         Err(Error::Program(ProgramError::InfeasibleLayer {
             layer,
             count,
@@ -117,16 +123,19 @@ fn another_vendors_format_is_refused_before_planning() {
 fn errors_name_the_file_and_field() {
     let e = Part::read(part_path("no-such-part.toml")).unwrap_err();
     assert!(e.to_string().contains("no-such-part.toml"), "{e}");
+    assert_eq!(Error::from(e.clone()).kind(), ErrorKind::Io, "a missing file: {e}");
     // A robot-only cell file is not a cell.
     let e = Cell::read(part_path("cells/kuka_kr16_2.toml")).unwrap_err();
     assert!(e.to_string().contains("kuka_kr16_2.toml"), "{e}");
     assert!(e.to_string().contains("not a cell"), "{e}");
+    assert_eq!(Error::from(e).kind(), ErrorKind::Input);
     // A bad override names the part file and the option.
     let part = Part::read(part_path("hemisphere.toml")).unwrap();
     let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
     let mut opts = small(60);
     opts.slice.delta_mm = Some(-1.0);
     let e: Error = plan_part(&part, &cell, &opts).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Input, "{e}");
     let m = e.to_string();
     assert!(
         m.contains("hemisphere.toml") && m.contains("delta_mm"),
@@ -210,6 +219,7 @@ fn a_cancel_flag_stops_the_run() {
     };
     let e = plan_part(&part, &cell, &opts).unwrap_err();
     assert!(matches!(e, Error::Cancelled { .. }), "{e}");
+    assert_eq!(e.kind(), ErrorKind::Cancelled);
     assert!(seen.lock().unwrap().is_empty());
 }
 
