@@ -98,7 +98,8 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
                 true
             }
             Err(why) => {
-                eprintln!("no program written: {}", why_not(&planned, &why));
+                // the program stage's own refusal (typed, kept by the plan)
+                eprintln!("no program written: {why}");
                 false
             }
         }
@@ -136,14 +137,6 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
         }
     }
     Ok(feasible)
-}
-
-/// The reason the program stage gave, rather than the wrapper's.
-fn why_not(planned: &PlannedPart, e: &Error) -> String {
-    match (e, &planned.refusal) {
-        (Error::Program(ProgramError::Infeasible { .. }), Some(r)) => r.clone(),
-        _ => e.to_string(),
-    }
 }
 
 /// `waam check`: reads a FANUC program and the sub-programs it calls, a KUKA

@@ -16,7 +16,7 @@ use crate::optimise::{
     OptimiseOptions, Plan,
 };
 use crate::program::{
-    build_program_with, check_vendor, write_files, Program, ProgramError, TravelSpeed,
+    build_program_with, check_vendor, write_files, LayerRefusal, Program, ProgramError, TravelSpeed,
 };
 use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
 use crate::Error;
@@ -58,11 +58,12 @@ pub struct PlannedPart {
     pub format: ProgramFormat,
     /// The optimised plan, one entry per layer.
     pub plan: Plan,
-    /// The program model, `Some` when every layer is feasible and the
-    /// trajectory rebuilt from the plan passes the program stage's checks.
-    pub program: Option<Program>,
-    /// Why there is no program (`None` when there is one).
-    pub refusal: Option<String>,
+    /// The program model when every layer is feasible and the trajectory
+    /// rebuilt from the plan passes the program stage's checks; else the
+    /// program stage's refusal ([`ProgramError::InfeasibleLayer`] naming the
+    /// first infeasible layer and its binding constraint, or the check that
+    /// failed).
+    pub program: Result<Program, ProgramError>,
     /// Run times.
     pub times: PlanTimes,
 }
@@ -148,10 +149,7 @@ pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<Planned
     control.report("program", 0.95);
     let t = Instant::now();
     let name = program_name(&part.name);
-    let (program, refusal) = match build(&name, cell, &sliced, &layers, &plan, &optimise_opts) {
-        Ok(p) => (Some(p), None),
-        Err(e) => (None, Some(e.to_string())),
-    };
+    let program = build(&name, cell, &sliced, &layers, &plan, &optimise_opts);
     let t_program = t.elapsed().as_secs_f64();
     control.report("program", 1.0);
     Ok(PlannedPart {
@@ -169,7 +167,6 @@ pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<Planned
         format,
         plan,
         program,
-        refusal,
     })
 }
 
@@ -193,10 +190,7 @@ pub(super) fn build(
         speed,
         &TrajectoryOptions::default(),
     )
-    .map_err(|e| ProgramError::Mismatch {
-        index: 0,
-        reason: format!("joint trajectory: {e}"),
-    })?;
+    .map_err(|source| ProgramError::Trajectory { source })?;
     let common = &cell.program.common;
     let mut program = build_program_with(
         name,
@@ -229,7 +223,7 @@ fn check_every_layer(layers: &[LayerPoints], plan: &Plan) -> Result<(), ProgramE
         return Err(ProgramError::InfeasibleLayer {
             layer: first.layer,
             count: infeasible.len(),
-            status: first.status.to_string(),
+            status: LayerRefusal::Infeasible(first.status.clone()),
         });
     }
     for (i, lp) in layers.iter().enumerate() {
@@ -237,26 +231,25 @@ fn check_every_layer(layers: &[LayerPoints], plan: &Plan) -> Result<(), ProgramE
             return Err(ProgramError::InfeasibleLayer {
                 layer: lp.layer,
                 count: layers.len() - i,
-                status: "no plan for this layer".into(),
+                status: LayerRefusal::NoPlan,
             });
         };
         if pl.layer != lp.layer || pl.points.len() != lp.points.len() {
             return Err(ProgramError::InfeasibleLayer {
                 layer: lp.layer,
                 count: 1,
-                status: format!(
-                    "the plan has {} point(s) for its {} (layer {})",
-                    pl.points.len(),
-                    lp.points.len(),
-                    pl.layer
-                ),
+                status: LayerRefusal::PointCount {
+                    planned: pl.points.len(),
+                    path: lp.points.len(),
+                    plan_layer: pl.layer,
+                },
             });
         }
         if let Some(m) = pl.points.iter().position(|p| p.joints.is_none()) {
             return Err(ProgramError::InfeasibleLayer {
                 layer: lp.layer,
                 count: 1,
-                status: format!("point {m} has no joint solution"),
+                status: LayerRefusal::NoJointSolution { point: m },
             });
         }
     }
@@ -271,7 +264,12 @@ impl PlannedPart {
     /// `true` when every layer is feasible and the program model was built:
     /// [`PlannedPart::write_programs`] will write it.
     pub fn is_feasible(&self) -> bool {
-        self.plan.is_feasible() && self.program.is_some()
+        self.plan.is_feasible() && self.program.is_ok()
+    }
+
+    /// The program stage's refusal, `None` when the program was built.
+    pub fn refusal(&self) -> Option<&ProgramError> {
+        self.program.as_ref().err()
     }
 
     /// The travel speed planned (mm/s).
@@ -305,13 +303,7 @@ impl PlannedPart {
     ) -> Result<Vec<crate::program::EmittedFile>, Error> {
         check_vendor(&self.cell.layout, format.vendor(), format.emitter())?;
         check_every_layer(&self.layers, &self.plan)?;
-        let program = self
-            .program
-            .as_ref()
-            .ok_or_else(|| ProgramError::Infeasible {
-                count: 1,
-                first: self.refusal.clone().unwrap_or_default(),
-            })?;
+        let program = self.program.as_ref().map_err(Clone::clone)?;
         let settings = &self.cell.program;
         Ok(crate::program::contract::emit(program, settings)?)
     }
@@ -330,7 +322,7 @@ impl PlannedPart {
         let dir = dir.as_ref();
         std::fs::create_dir_all(dir).map_err(|source| ProgramError::Io {
             path: dir.display().to_string(),
-            source,
+            source: source.into(),
         })?;
         write_files(dir, &files)?;
         Ok(files.iter().map(|f| dir.join(&f.name)).collect())

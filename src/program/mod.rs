@@ -62,7 +62,9 @@ use crate::robot::trajectory::{JointTrajectory, PathPointInput};
 use crate::robot::{Cell, Configuration, Joints, Vendor};
 
 /// Errors of the program stage; each names the point, field or file at fault.
-#[derive(Debug, thiserror::Error)]
+/// `Clone` (an I/O error is shared), so that a plan can keep the program
+/// stage's refusal as a value ([`PlannedPart::program`](crate::pipeline::PlannedPart::program)).
+#[derive(Debug, Clone, thiserror::Error)]
 #[non_exhaustive]
 pub enum ProgramError {
     /// The plan has violations: no program is written for it.
@@ -83,8 +85,16 @@ pub enum ProgramError {
         layer: usize,
         /// How many layers are in that state.
         count: usize,
-        /// Its status (binding constraint, missing solution).
-        status: String,
+        /// Why it cannot be built.
+        status: LayerRefusal,
+    },
+    /// The joint trajectory rebuilt from a plan fails (a point the plan
+    /// solved no longer has a joint solution): the robot stage's error.
+    #[error("joint trajectory: {source}")]
+    Trajectory {
+        /// The robot stage's error (names the point).
+        #[source]
+        source: crate::robot::RobotError,
     },
     /// Path points, trajectory and speeds do not describe the same path.
     #[error("input mismatch at index {index}: {reason}")]
@@ -109,8 +119,8 @@ pub enum ProgramError {
     Io {
         /// The file.
         path: String,
-        /// The I/O error.
-        source: std::io::Error,
+        /// The I/O error (shared: the error is `Clone`).
+        source: std::sync::Arc<std::io::Error>,
     },
     /// The program's robot is another vendor's than the emitter's: its joints
     /// are in that vendor's controller convention and its Cartesian poses
@@ -138,6 +148,52 @@ pub enum ProgramError {
         /// What is wrong.
         reason: String,
     },
+}
+
+/// Why a layer of a plan cannot be built ([`ProgramError::InfeasibleLayer`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum LayerRefusal {
+    /// The optimiser left the layer infeasible: its status names the
+    /// binding constraint (joint, point, amount).
+    Infeasible(crate::optimise::LayerStatus),
+    /// The plan has no entry for the layer (a host dropped it, or the
+    /// optimiser returned none).
+    NoPlan,
+    /// The plan's entry for the layer has another number of points, or is
+    /// another layer's.
+    PointCount {
+        /// Points in the plan's entry.
+        planned: usize,
+        /// Points of the path's layer.
+        path: usize,
+        /// The layer the plan's entry is for.
+        plan_layer: usize,
+    },
+    /// A point of the layer has no joint solution in the plan.
+    NoJointSolution {
+        /// The point's index in the layer.
+        point: usize,
+    },
+}
+
+impl std::fmt::Display for LayerRefusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LayerRefusal::Infeasible(status) => write!(f, "{status}"),
+            LayerRefusal::NoPlan => write!(f, "no plan for this layer"),
+            LayerRefusal::PointCount {
+                planned,
+                path,
+                plan_layer,
+            } => write!(
+                f,
+                "the plan has {planned} point(s) for its {path} (layer {plan_layer})"
+            ),
+            LayerRefusal::NoJointSolution { point } => {
+                write!(f, "point {point} has no joint solution")
+            }
+        }
+    }
 }
 
 /// What a point is for: a bead point with its arc switching meaning, or a
@@ -1486,7 +1542,7 @@ pub fn write_files(dir: &Path, files: &[EmittedFile]) -> Result<(), ProgramError
         crate::util::atomic::write_atomic(&path, |w| w.write_all(f.text.as_bytes())).map_err(
             |source| ProgramError::Io {
                 path: path.display().to_string(),
-                source,
+                source: source.into(),
             },
         )?;
     }
@@ -1500,10 +1556,10 @@ pub(crate) fn render(
     let mut buf: Vec<u8> = Vec::new();
     f(&mut buf).map_err(|source| ProgramError::Io {
         path: "<memory>".into(),
-        source,
+        source: source.into(),
     })?;
     String::from_utf8(buf).map_err(|e| ProgramError::Io {
         path: "<memory>".into(),
-        source: std::io::Error::other(e),
+        source: std::io::Error::other(e).into(),
     })
 }

@@ -144,10 +144,10 @@ impl PyPlannedPart {
     /// Why no program can be written (None when the plan is feasible).
     #[getter]
     fn refusal(&self) -> Option<String> {
-        match (&self.planned.refusal, self.planned.is_feasible()) {
-            (Some(r), _) => Some(r.clone()),
-            (None, false) => Some("a layer is infeasible".into()),
-            (None, true) => None,
+        match (&self.planned.program, self.planned.is_feasible()) {
+            (Err(e), _) => Some(e.to_string()),
+            (Ok(_), false) => Some("a layer is infeasible".into()),
+            (Ok(_), true) => None,
         }
     }
 

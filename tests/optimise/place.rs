@@ -126,7 +126,7 @@ fn a_refused_hemisphere_plans_after_placement_checked_by_spec_kinematics() {
     // The written cell file reads back and plans (as `plan` would take it).
     let again = Cell::from_toml_str(&placed.toml, "placed.toml").unwrap();
     let planned = plan_part(&part, &again, &opts).unwrap();
-    assert!(planned.is_feasible(), "{:?}", planned.refusal);
+    assert!(planned.is_feasible(), "{:?}", planned.refusal());
 
     // Independent check: every planned point, carried by the SPEC's forward
     // kinematics of the planned joints, is at the placed D_R with its tool
@@ -183,7 +183,7 @@ fn the_s_bent_tube_refused_in_the_robowam_part_carried_cell_plans_after_placemen
         .infeasible_layers()
         .filter(|l| l.status.to_string().contains("J5 travel"))
         .count();
-    assert!(j5 > 0, "refused at J5's travel: {:?}", before.refusal);
+    assert!(j5 > 0, "refused at J5's travel: {:?}", before.refusal());
 
     let req = PlaceRequest {
         slice: coarse,
@@ -193,7 +193,7 @@ fn the_s_bent_tube_refused_in_the_robowam_part_carried_cell_plans_after_placemen
     assert!(placed.placement.feasible, "{:#}", placed.summary());
     let again = Cell::from_toml_str(&placed.toml, "placed.toml").unwrap();
     let planned = plan_part(&part, &again, &opts).unwrap();
-    assert!(planned.is_feasible(), "{:?}", planned.refusal);
+    assert!(planned.is_feasible(), "{:?}", planned.refusal());
     assert_eq!(fk_check(&placed.toml, &planned), 86 * 48);
 }
 
@@ -268,7 +268,7 @@ fn the_s_bent_tube_at_its_own_grid_plans_after_placement() {
     assert!(placed.placement.feasible, "{:#}", placed.summary());
     let again = Cell::from_toml_str(&placed.toml, "placed.toml").unwrap();
     let planned = plan_part(&part, &again, &opts).unwrap();
-    assert!(planned.is_feasible(), "{:?}", planned.refusal);
+    assert!(planned.is_feasible(), "{:?}", planned.refusal());
     assert_eq!(planned.plan.layers.len(), 213);
     assert_eq!(fk_check(&placed.toml, &planned), 213 * 400);
 }

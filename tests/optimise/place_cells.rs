@@ -97,7 +97,7 @@ fn every_sample_part_in_every_sample_cell_plans_after_placement_or_names_its_bin
                 assert!(
                     planned.is_feasible(),
                     "{part_name} in {cell_name}: placed but {:?}",
-                    planned.refusal
+                    planned.refusal()
                 );
                 table.push(format!(
                     "{cell_name} {part_name}: placed ({:.1} s)",

@@ -9,7 +9,8 @@ use std::sync::Arc;
 
 use crate::shared::part_path;
 use waam_slicer::io::joints_csv::read_joints_csv;
-use waam_slicer::program::ProgramError;
+use waam_slicer::optimise::{Constraint, LayerStatus};
+use waam_slicer::program::{LayerRefusal, ProgramError};
 use waam_slicer::{
     check_program, plan_part, slice_part, Cell, Control, Error, ErrorKind, Part, PlanOptions,
     ProgramFormat, SliceOverrides,
@@ -34,7 +35,7 @@ fn one_call_plan_writes_a_program_that_reads_back_clean() {
     let o = sliced.map.overall.unwrap();
     assert!((o.max_mm - o.min_mm) < 1e-4 * sliced.path.delta_mm, "{o:?}");
     let planned = plan_part(&part, &cell, &small(120)).unwrap();
-    assert!(planned.is_feasible(), "{:?}", planned.refusal);
+    assert!(planned.is_feasible(), "{:?}", planned.refusal());
     assert_eq!(planned.format, ProgramFormat::Fanuc);
     let dir = tempfile::tempdir().unwrap();
     let files = planned
@@ -82,7 +83,16 @@ fn an_infeasible_plan_cannot_write_a_program_and_names_its_layer() {
         })) => {
             assert_eq!(layer, first);
             assert!(count >= 1);
-            assert!(status.contains("J5"), "{status}");
+            // typed: R_Z = 0 turns J5 out of its travel (thesis §4.3), the
+            // binding constraint is J5's limit, read without parsing text
+            let binding = match &status {
+                LayerRefusal::Infeasible(
+                    LayerStatus::Infeasible { binding } | LayerStatus::FixedViolates { binding },
+                ) => binding.constraint,
+                other => panic!("expected an infeasible layer's status, got {other:?}"),
+            };
+            assert_eq!(binding, Constraint::JointLimit { joint: 5 }, "{status}");
+            assert!(status.to_string().contains("J5"), "{status}");
         }
         other => panic!("expected InfeasibleLayer, got {other:?}"),
     }

@@ -32,7 +32,7 @@ fn every_sample_cell_writes_programs_with_home_dwell_transit_and_payload_that_ch
         );
         assert!(common.dwell_s > 0.0, "{file}: and a dwell");
         let planned = plan_part(&part, &cell, &opts).unwrap_or_else(|e| panic!("{file}: {e}"));
-        assert!(planned.is_feasible(), "{file}: {:?}", planned.refusal);
+        assert!(planned.is_feasible(), "{file}: {:?}", planned.refusal());
         let program = planned.program.as_ref().unwrap();
         assert!(program.home.is_some(), "{file}");
         assert_eq!(program.bead_setup.len(), 4, "{file}");
