@@ -29,6 +29,7 @@
 //! | 5a. the torch-carried positioner's tilt and turn laws within the cone of the vertical | [`optimise::positioner`] | §9 |
 //! | 5. layer-by-layer optimisation of `R_Z` (branch, SQP, quality) | [`optimise`] | §7 |
 //! | 6. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
+//! | 7. placement of the part in the cell: an outer search over 5 and 6 | [`place`] | — |
 //!
 //! ## Units and frames
 //!
@@ -47,7 +48,9 @@
 //!
 //! Most callers need only the crate root ([`pipeline`]): [`Part::read`],
 //! [`Cell::read`], [`slice_part`], [`plan_part`] →
-//! [`PlannedPart::write_programs`], [`check_program`].
+//! [`PlannedPart::write_programs`], [`check_program`], and [`place_part`]
+//! ([`PlaceRequest`] → [`PlacedCell`]) when a cell refuses a part where it
+//! stands.
 //!
 //! ```no_run
 //! use waam_slicer::{Cell, Part, PlanOptions, ProgramFormat};
@@ -85,6 +88,9 @@ pub mod report;
 pub mod robot;
 pub mod toolaxis;
 
+// Stage 7, after the stages it searches over (see the table above).
+pub mod place;
+
 #[cfg(feature = "python")]
 mod python;
 
@@ -95,6 +101,8 @@ pub use error::Error;
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
 pub use pipeline::{
-    check_program, plan_part, slice_part, slice_part_with, Cell, Control, Part, PlanOptions,
-    PlannedPart, ProgramFormat, RzLaw, SliceOverrides, SlicedPart,
+    check_program, place_part, plan_part, slice_part, slice_part_with, Cell, Control, Part,
+    PlaceRequest, PlacedCell, PlanOptions, PlannedPart, ProgramFormat, RzLaw, SliceOverrides,
+    SlicedPart,
 };
+pub use place::PlaceOptions;

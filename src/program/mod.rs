@@ -140,6 +140,18 @@ pub enum ProgramError {
     },
 }
 
+impl ProgramError {
+    /// The layer (its [`LayerPoints::layer`](crate::optimise::LayerPoints::layer)
+    /// number) the error names in a typed field, if any: the placement
+    /// search brings it into its subsample.
+    pub fn layer(&self) -> Option<usize> {
+        match self {
+            ProgramError::InfeasibleLayer { layer, .. } => Some(*layer),
+            _ => None,
+        }
+    }
+}
+
 /// What a point is for: a bead point with its arc switching meaning, or a
 /// transit point with the arc off (rs-opw's `PathFlags`: approach, trace,
 /// retract) [SPEC §8].
