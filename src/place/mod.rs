@@ -3,7 +3,7 @@
 //! outer search over stages 5 and 6: takes a [`Cell`], the layers of a path
 //! (part frame, mm) and [`PlacementBounds`] on the cell's placement
 //! variables (robot base frame; mm, rad), judges candidates with the `R_Z`
-//! optimisation ([`optimise`](crate::optimise::optimise)) as its oracle and
+//! optimisation ([`optimise`]) as its oracle and
 //! the caller's program check ([`Accept`]), and returns a [`Placement`]: the
 //! placement ([`PlacementValues`]) that makes every layer feasible with the
 //! widest worst-layer margin (joint-limit distance, speed headroom, reach,
