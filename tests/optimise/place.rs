@@ -329,7 +329,10 @@ fn a_refused_placement_names_the_joint_limit_as_a_typed_binding() {
     let binding = p.binding.as_ref().expect("a refused placement names why");
     assert_eq!(binding.limit(), Some(&Limit::Layer(j5)), "{binding:?}");
     assert!(
-        matches!(binding, Binding::Subsample { .. } | Binding::FullPath { .. }),
+        matches!(
+            binding,
+            Binding::Subsample { .. } | Binding::FullPath { .. }
+        ),
         "{binding:?}"
     );
     assert!(binding.share() > 0.0 && binding.share() <= 1.0);
