@@ -253,14 +253,18 @@ impl Search<'_> {
                     return Ok(RoundEnd::Chosen);
                 }
                 Err(e) => {
-                    // The layer the refusal names joins the subsample: its
+                    // The layers the refusal names join the subsample: its
                     // screen then sees the move refused; and the layers
                     // that bind the margins, which the subsample missed (a
                     // refused transit follows a law pressed against a stop).
+                    // A refusal naming its layers in words only (the
+                    // transit check's and the turn stroke's
+                    // `ProgramError::Infeasible`) brings none: only the
+                    // margin-binding layers follow it.
                     let named: Vec<usize> = e
-                        .layer()
-                        .and_then(|n| self.layers.iter().position(|l| l.layer == n))
-                        .into_iter()
+                        .layers()
+                        .iter()
+                        .filter_map(|n| self.layers.iter().position(|l| l.layer == *n))
                         .collect();
                     self.refusal.get_or_insert(Arc::new(e));
                     if named.is_empty() && f.weakest.is_empty() {

@@ -143,8 +143,8 @@ impl PlaceOptions {
 
 /// A caller's check of a plan feasible on every layer it has (e.g. the
 /// program stage's), given the layers the plan is of (the subsample's while
-/// screening, every layer at certification). A refusal naming a layer
-/// ([`ProgramError::layer`]) brings that layer into the subsample at full
+/// screening, every layer at certification). A refusal naming layers
+/// ([`ProgramError::layers`]) brings them into the subsample at full
 /// resolution.
 pub type Accept<'a> = &'a (dyn Fn(&Cell, &[LayerPoints], &Plan) -> Result<(), ProgramError> + Sync);
 

@@ -128,23 +128,23 @@ fn a_binding_reads_as_placement_json_has_it() {
     }
 }
 
-/// The layer a program-stage refusal brings into the subsample comes from
-/// the error's typed field: `InfeasibleLayer` names one; an error whose
-/// layer is only in its words names none.
+/// The layers a program-stage refusal brings into the subsample come from
+/// the error's typed fields: `InfeasibleLayer` names one; an error whose
+/// layers are only in its words names none (nothing reads them back).
 #[test]
-fn a_refusal_names_its_layer_from_a_typed_field_only() {
+fn a_refusal_names_its_layers_from_typed_fields_only() {
     use crate::program::ProgramError;
     let e = ProgramError::InfeasibleLayer {
         layer: 80,
         count: 2,
         status: "no plan for this layer".into(),
     };
-    assert_eq!(e.layer(), Some(80));
+    assert_eq!(e.layers(), vec![80]);
     let e = ProgramError::Infeasible {
         count: 1,
         first: "layer 80: the arc-off joint move to layer 81's approach".into(),
     };
-    assert_eq!(e.layer(), None);
+    assert!(e.layers().is_empty());
 }
 
 /// Typed values and the table's order agree, for both cell kinds: the

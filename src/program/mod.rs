@@ -141,13 +141,15 @@ pub enum ProgramError {
 }
 
 impl ProgramError {
-    /// The layer (its [`LayerPoints::layer`](crate::optimise::LayerPoints::layer)
-    /// number) the error names in a typed field, if any: the placement
-    /// search brings it into its subsample.
-    pub fn layer(&self) -> Option<usize> {
+    /// The layers (their [`LayerPoints::layer`](crate::optimise::LayerPoints::layer)
+    /// numbers) the error names in typed fields, e.g. the first infeasible
+    /// layer; empty when it names none that way (`Infeasible` carries its
+    /// layers in its words only). The placement search brings them into its
+    /// subsample.
+    pub fn layers(&self) -> Vec<usize> {
         match self {
-            ProgramError::InfeasibleLayer { layer, .. } => Some(*layer),
-            _ => None,
+            ProgramError::InfeasibleLayer { layer, .. } => vec![*layer],
+            _ => Vec::new(),
         }
     }
 }
