@@ -38,14 +38,16 @@
 //! 2. **Refinement**: a compass search from the best few, on the subsample
 //!    (after a feedback, from the best one with half the evaluations).
 //! 3. **Certification**, best first (the cell as given first unless beaten
-//!    by [`KEEP_MARGIN`]), of the candidates feasible on the subsample: every layer at full resolution, in an order that meets the
-//!    layers that failed before first and spreads the others over the part,
+//!    by [`KEEP_MARGIN`]), of the candidates feasible on the subsample:
+//!    every layer at full resolution, in an order that meets the layers
+//!    that failed before first and spreads the others over the part,
 //!    in parallel chunks, stopping at the first chunk with an infeasible
 //!    layer; a feasible plan is then offered to the caller's own check (the
 //!    program stage's transit check, in [`place_part`](crate::place_part)).
 //! 4. **Feedback**: when certification fails, the failing layers join the
 //!    subsample at full resolution (the subsample misses speed peaks at cusps
-//!    between its points), and so do the layers of the certified plan that
+//!    between its points), or the layers the caller's refusal names in typed
+//!    fields ([`ProgramError::layers`]), and so do the layers of the certified plan that
 //!    bind its joint-stop, speed or reach margin below the score's
 //!    comfortable values (the subsample missed them); the best candidates
 //!    are judged again on it, and when fewer than two of them stay feasible
