@@ -28,8 +28,8 @@
 //! | 5. robot kinematics, orientation conventions, cells | [`robot`] | §6 |
 //! | 6. layer-by-layer optimisation of `R_Z` (branch, SQP, quality) | [`optimise`] | §7 |
 //! | 6a. the torch-carried positioner's tilt and turn laws within the cone of the vertical | [`optimise::positioner`] | §9 |
-//! | 7. placement of the part in the cell: an outer search calling 6 as its oracle | [`optimise::place`] | §7 |
-//! | 8. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
+//! | 7. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
+//! | 8. placement of the part in the cell: an outer search over 6 and 7 (the optimiser as its oracle, the program stage's checks in certification) | [`place`] | — |
 //! | files at the edges: part and cell files read into the stages' types, CSV and STL written | [`io`] | §2, §6 |
 //! | the interactive 3-D report | [`report`] | |
 //! | the front door: one call per job | [`pipeline`] | |
@@ -54,7 +54,9 @@
 //!
 //! Most callers need only the crate root ([`pipeline`]): [`Part::read`],
 //! [`Cell::read`], [`slice_part`], [`plan_part`] →
-//! [`PlannedPart::write_programs`], [`check_program`].
+//! [`PlannedPart::write_programs`], [`check_program`], and [`place_part`]
+//! ([`PlaceRequest`] → [`PlacedCell`]) when a cell refuses a part where it
+//! stands.
 //!
 //! ```no_run
 //! use waam_slicer::{Cell, Part, PlanOptions, ProgramFormat};
@@ -104,6 +106,9 @@ pub mod robot;
 pub mod toolaxis;
 pub mod util;
 
+// Stage 8, after the stages it searches over (see the table above).
+pub mod place;
+
 #[cfg(feature = "python")]
 mod python;
 
@@ -114,6 +119,8 @@ pub use error::{Error, ErrorKind};
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
 pub use pipeline::{
-    check_program, plan_part, slice_part, slice_part_with, Cell, Control, Part, PlanOptions,
-    PlannedPart, ProgramFormat, RzLaw, SliceOverrides, SlicedPart,
+    check_program, place_part, plan_part, slice_part, slice_part_with, Cell, Control, Part,
+    PlaceRequest, PlacedCell, PlanOptions, PlannedPart, ProgramFormat, RzLaw, SliceOverrides,
+    SlicedPart,
 };
+pub use place::PlaceOptions;

@@ -6,8 +6,8 @@
 use crate::args::PlaceArgs;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use waam_slicer::pipeline::{place_part, PlaceRequest};
-use waam_slicer::{Cell, Part};
+use waam_slicer::place::Binding;
+use waam_slicer::{place_part, Cell, Part, PlaceRequest};
 
 /// Runs the command; prints errors itself and returns the exit code.
 pub fn run(a: &PlaceArgs, quiet: bool) -> ExitCode {
@@ -31,7 +31,7 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
         ));
     }
     let mut req = PlaceRequest {
-        half_box_mm: a.half_box,
+        half_box_mm: Some(a.half_box),
         ..PlaceRequest::default()
     };
     req.search.samples = a.samples;
@@ -52,7 +52,7 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
             .bounds
             .variables
             .iter()
-            .zip(&p.values)
+            .zip(p.values.in_table_order(&p.cell))
             .filter(|(v, _)| v.is_free() || v.current != 0.0)
             .map(|(v, x)| {
                 if v.angle {
@@ -87,17 +87,20 @@ fn place(a: &PlaceArgs, quiet: bool) -> Result<bool, String> {
     }
     if !p.feasible {
         let why = match &p.binding {
-            Some((c, share)) if c.contains("(on the full path)") => {
-                let (head, tail) = c.split_once("(on the full path)").unwrap_or((c, ""));
+            Some(b @ Binding::FullPath { limit, refused, .. }) => {
+                let also = refused
+                    .as_ref()
+                    .map(|r| format!("; another candidate was refused by the program check: {r}"))
+                    .unwrap_or_default();
                 format!(
-                    "{head}(on the full path): feasible on the subsample, it binds {:.0} % of the layers checked of the best candidate{tail}",
-                    100.0 * share
+                    "{limit} (on the full path): feasible on the subsample, it binds {:.0} % of the layers checked of the best candidate{also}",
+                    100.0 * b.share()
                 )
             }
-            Some((c, _)) if c.ends_with("(program check)") => {
-                format!("every candidate feasible on the full path was refused: {c}")
+            Some(b @ Binding::ProgramCheck { .. }) => {
+                format!("every candidate feasible on the full path was refused: {b}")
             }
-            Some((c, share)) => format!("{c} bound {:.0} % of the candidates", 100.0 * share),
+            Some(b) => format!("{b} bound {:.0} % of the candidates", 100.0 * b.share()),
             None => "no candidate was feasible".into(),
         };
         eprintln!(

@@ -586,3 +586,191 @@ fn program_settings(
         abb,
     })
 }
+
+/// A placed cell file's text: `text` (the cell file as read, `file` naming
+/// it) with the placement's values written into its `[part_carried]` or
+/// `[torch_carried]` table (FANUC `[X, Y, Z, W, P, R]`, mm and deg, 6
+/// decimals), the bounds searched as its `[placement]` table (relative to
+/// the mount written, so that placing again from the file searches the same
+/// box), and a header comment giving the margins achieved. The original's
+/// comments, key order and layout are kept (toml_edit); a header from an
+/// earlier placement is replaced.
+///
+/// # Errors
+/// [`CellFileError::Syntax`] naming `file` when `text` is not TOML or lacks
+/// the table of the placed cell's kind.
+pub fn placed_cell_file(
+    text: &str,
+    file: &str,
+    p: &crate::place::Placement,
+    bounds: &crate::place::PlacementBounds,
+) -> Result<String, CellFileError> {
+    use toml_edit::{DocumentMut, Item, Table};
+    let syntax = |message: String| CellFileError::Syntax {
+        path: file.to_string(),
+        message,
+    };
+    let mut doc: DocumentMut = text
+        .parse()
+        .map_err(|e: toml_edit::TomlError| syntax(e.to_string()))?;
+    let table = |doc: &DocumentMut, name: &str| -> Result<Table, CellFileError> {
+        match doc.get(name).and_then(Item::as_table) {
+            Some(t) => Ok(t.clone()),
+            None => Err(syntax(format!("no [{name}] table"))),
+        }
+    };
+    let v = &p.values;
+    match &p.cell {
+        Cell::PartCarried(c) => {
+            let mut t = table(&doc, "part_carried")?;
+            t["deposition_point_mm"] = toml_floats(c.deposition_point_mm.coords.as_slice());
+            let mount_moved = [v.rotation, v.tilt_x, v.tilt_y, v.offset_mm]
+                .iter()
+                .any(|x| *x != 0.0);
+            if mount_moved || t.contains_key("flange_from_part_xyzwpr") {
+                let pose = FanucPose::from_isometry(&c.flange_from_part).to_xyzwpr_deg();
+                t["flange_from_part_xyzwpr"] = toml_floats(&pose);
+            }
+            doc["part_carried"] = Item::Table(t);
+        }
+        Cell::TorchCarried(c) => {
+            let mut t = table(&doc, "torch_carried")?;
+            let pose = FanucPose::from_isometry(&c.base_from_positioner).to_xyzwpr_deg();
+            t["positioner_pose_xyzwpr"] = toml_floats(&pose);
+            if v.tilt_x != 0.0 || v.tilt_y != 0.0 || t.contains_key("table_from_part_xyzwpr") {
+                let pose = FanucPose::from_isometry(&c.table_from_part).to_xyzwpr_deg();
+                t["table_from_part_xyzwpr"] = toml_floats(&pose);
+            }
+            if v.torch_rotation != 0.0 {
+                let pose = FanucPose::from_isometry(&c.flange_from_tcp).to_xyzwpr_deg();
+                t["tool_xyzwpr"] = toml_floats(&pose);
+            }
+            doc["torch_carried"] = Item::Table(t);
+        }
+    }
+    // An existing [placement] table keeps its place and comments; its keys
+    // are replaced.
+    let mut spec = doc
+        .get("placement")
+        .and_then(Item::as_table)
+        .cloned()
+        .unwrap_or_default();
+    spec.clear();
+    placement_table(&mut spec, p, bounds);
+    doc["placement"] = Item::Table(spec);
+    let body = doc.to_string();
+    // A file placed before starts with our header: not repeated.
+    let body = strip_placed_header(&body);
+    let m = &p.margins;
+    let b = &p.margins_before;
+    Ok(format!(
+        "# Placed by waam place from {} ({}).\n\
+         # Worst-layer margins after: {:.2} deg from a joint stop, speed headroom {:.1} %, dexterity {:.4}, {:.1} mm inside the arm's reach, {} infeasible layer(s).\n\
+         # Before (on the search's subsample of layers and points): {:.2} deg, {:.1} %, {:.4}, {:.1} mm, {} infeasible layer(s).\n\
+         # Candidates {}, feasible on the subsample {:.0} %, certified on the full path {}, {:.1} s.\n{body}",
+        file,
+        if p.feasible { "feasible" } else { "NOT feasible" },
+        m.joint_limit_deg,
+        100.0 * m.speed_headroom,
+        m.dexterity,
+        m.reach_mm,
+        m.infeasible_layers,
+        b.joint_limit_deg,
+        100.0 * b.speed_headroom,
+        b.dexterity,
+        b.reach_mm,
+        b.infeasible_layers,
+        p.candidates,
+        100.0 * p.feasible_fraction,
+        p.certified,
+        p.time_s,
+    ))
+}
+
+/// Fills the `[placement]` table `spec` with the bounds searched, around
+/// the placement found: the box of the deposition point (positioner) as
+/// searched; the rotation, fixture and torch-mount ranges relative to the
+/// mount written (exact for one free tilt axis; with both, placing again
+/// searches a slightly different box about the found mount); the fixed
+/// variables; the keep-out box.
+fn placement_table(
+    spec: &mut toml_edit::Table,
+    p: &crate::place::Placement,
+    bounds: &crate::place::PlacementBounds,
+) {
+    use std::f64::consts::PI;
+    let v = &bounds.variables;
+    let found = &p.values;
+    spec["min_mm"] = toml_floats(&[v[0].lower, v[1].lower, v[2].lower]);
+    spec["max_mm"] = toml_floats(&[v[0].upper, v[1].upper, v[2].upper]);
+    let (lo, hi) = (v[3].lower - found.rotation, v[3].upper - found.rotation);
+    let span = (hi - lo).min(2.0 * PI);
+    spec["rotation_deg"] = toml_floats(&[lo.to_degrees(), (lo + span).to_degrees()]);
+    let mount = match p.cell {
+        Cell::PartCarried(_) => ("offset_mm", found.offset_mm, false),
+        Cell::TorchCarried(_) => ("torch_rotation_deg", found.torch_rotation, true),
+    };
+    let extra = [
+        (&v[4], ("tilt_x_deg", found.tilt_x, true)),
+        (&v[5], ("tilt_y_deg", found.tilt_y, true)),
+        (&v[6], mount),
+    ];
+    for (var, (key, x, degrees)) in extra {
+        if var.is_free() {
+            let (lo, hi) = (var.lower - x, var.upper - x);
+            let r = if degrees {
+                [lo.to_degrees(), hi.to_degrees()]
+            } else {
+                [lo, hi]
+            };
+            spec[key] = toml_floats(&r);
+        }
+    }
+    let fixed: toml_edit::Array = ["x", "y", "z", "rotation"]
+        .iter()
+        .zip(v)
+        .filter(|(_, var)| var.lower == var.upper)
+        .map(|(n, _)| *n)
+        .collect();
+    if !fixed.is_empty() {
+        spec["fixed"] = toml_edit::value(fixed);
+    }
+    if let Some((lo, hi)) = bounds.keep_out {
+        spec["keep_out_min_mm"] = toml_floats(&lo);
+        spec["keep_out_max_mm"] = toml_floats(&hi);
+    }
+}
+
+/// A TOML array of `xs` rounded to 6 decimals (no `-0`).
+fn toml_floats(xs: &[f64]) -> toml_edit::Item {
+    let round6 = |x: f64| {
+        let r = (x * 1e6).round() / 1e6;
+        if r == 0.0 {
+            0.0
+        } else {
+            r
+        }
+    };
+    let mut a: toml_edit::Array = xs.iter().map(|x| round6(*x)).collect();
+    a.fmt();
+    toml_edit::value(a)
+}
+
+/// The first lines of the comment [`placed_cell_file`] puts at the top.
+const PLACED_HEADER: [&str; 4] = [
+    "# Placed by waam place ",
+    "# Worst-layer margins after: ",
+    "# Before (on the search's subsample",
+    "# Candidates ",
+];
+
+/// `text` without the header [`placed_cell_file`] puts first (a cell file
+/// placed again keeps one header, the new one, and the original's own
+/// comments).
+fn strip_placed_header(text: &str) -> &str {
+    let mut rest = text;
+    while PLACED_HEADER.iter().any(|h| rest.starts_with(h)) {
+        rest = rest.split_once('\n').map_or("", |(_, r)| r);
+    }
+    rest
+}

@@ -112,7 +112,6 @@ mod degree;
 pub mod options;
 pub mod outcome;
 pub mod parameterisation;
-pub mod place;
 mod point_by_point;
 pub mod positioner;
 mod problem;

@@ -56,7 +56,7 @@ pub enum OptimiseError {
         layers: usize,
     },
     /// A placement bound or setting is invalid (see
-    /// [`place`](crate::optimise::place::place)).
+    /// [`place`](crate::place::place)).
     #[error("placement: `{field}`: {reason}")]
     InvalidPlacement {
         /// The variable or setting, as in the cell file's `[placement]` table.

@@ -38,7 +38,7 @@ pub use options::DEFAULT_MAX_POINTS;
 pub use options::{
     AxisOverrides, ParseOptionError, PlanOptions, ProgramFormat, RzLaw, SliceOverrides,
 };
-pub use place::{place_part, placement_bounds, PlaceRequest, PlacedCell};
+pub use place::{place_part, placement_bounds, PlaceRequest, PlacedCell, DEFAULT_HALF_BOX_MM};
 pub use planned::{plan_part, program_name, PlanTimes, PlannedPart};
 pub use sliced::{slice_part, slice_part_with, SliceTimes, SlicedPart};
 

@@ -1,4 +1,4 @@
-//! **Stage 8 — robot programs.** Takes a planned [`JointTrajectory`] (joints
+//! **Stage 7 — robot programs.** Takes a planned [`JointTrajectory`] (joints
 //! per path point, rad), the path points it was computed for
 //! ([`PathPointInput`]: layer structure, part-frame positions (mm), tool axes,
 //! `R_Z`), the [`Cell`] and the travel speeds (mm/s), checks that the plan is
@@ -76,6 +76,10 @@ pub enum ProgramError {
         count: usize,
         /// The first one, with its layer, point and joint.
         first: String,
+        /// The layers the first one concerns (its own, and the next layer's
+        /// for an arc-off move into it), so that a host (the placement
+        /// search) reads them without parsing `first`.
+        layers: Vec<usize>,
     },
     /// A layer of the plan is infeasible or has lost points: no program is
     /// written, so that no layer can silently vanish from it.
@@ -192,6 +196,21 @@ impl std::fmt::Display for LayerRefusal {
             LayerRefusal::NoJointSolution { point } => {
                 write!(f, "point {point} has no joint solution")
             }
+        }
+    }
+}
+
+impl ProgramError {
+    /// The layers (their [`LayerPoints::layer`](crate::optimise::LayerPoints::layer)
+    /// numbers) the error names, from its typed fields: the first infeasible
+    /// layer, or the layers of a program check's refusal (a violation's
+    /// layer, an arc-off move's two layers); empty for errors about no
+    /// layer. The placement search brings them into its subsample.
+    pub fn layers(&self) -> Vec<usize> {
+        match self {
+            ProgramError::InfeasibleLayer { layer, .. } => vec![*layer],
+            ProgramError::Infeasible { layers, .. } => layers.clone(),
+            _ => Vec::new(),
         }
     }
 }
@@ -820,6 +839,7 @@ pub fn build_program_with(
         return Err(ProgramError::Infeasible {
             count: trajectory.report.violations.len(),
             first: v.to_string(),
+            layers: vec![v.layer],
         });
     }
     let robot = cell.robot();
@@ -838,6 +858,7 @@ pub fn build_program_with(
             return Err(ProgramError::Infeasible {
                 count: 1,
                 first: format!("layer {}, point {}: no joint solution", p.layer, p.point),
+                layers: vec![p.layer],
             });
         };
         let first = i == 0 || points[i - 1].layer != p.layer;
@@ -869,6 +890,7 @@ pub fn build_program_with(
                         p.point,
                         points[i - 1].point
                     ),
+                    layers: vec![p.layer],
                 });
             }
             if d > 0.0 {
@@ -887,6 +909,7 @@ pub fn build_program_with(
                                 speeds[i],
                                 robot.max_speed_rad_s[j].to_degrees()
                             ),
+                            layers: vec![p.layer],
                         });
                     }
                 }
@@ -1020,6 +1043,7 @@ fn unwind_turns(
                     stroke.lower_rad.to_degrees(),
                     stroke.upper_rad.to_degrees()
                 ),
+                layers: vec![points[b.start].layer],
             });
         }
         let k = ((at - start) / TAU).round().clamp(k_min, k_max);
@@ -1151,6 +1175,7 @@ fn safe_transits(
         .map_err(|e| ProgramError::Infeasible {
             count: 1,
             first: format!("layer {}: transit check: {e}", from.layer),
+            layers: vec![from.layer],
         })
     };
     let first: Vec<Result<transit::TransitClearance, ProgramError>> =
@@ -1161,14 +1186,14 @@ fn safe_transits(
             continue;
         }
         let layer = program.points[blocks[k].end].layer;
-        let to_what = if k + 1 < n {
-            format!(
-                "layer {}'s approach",
-                program.points[blocks[k + 1].start].layer
-            )
-        } else {
-            "home".to_string()
+        let next_layer = (k + 1 < n).then(|| program.points[blocks[k + 1].start].layer);
+        let to_what = match next_layer {
+            Some(l) => format!("layer {l}'s approach"),
+            None => "home".to_string(),
         };
+        let layers: Vec<usize> = std::iter::once(layer)
+            .chain(next_layer.filter(|&l| l != layer))
+            .collect();
         let refuse = |why: String| ProgramError::Infeasible {
             count: 1,
             first: format!(
@@ -1181,6 +1206,7 @@ fn safe_transits(
                 r.tip_mm.y,
                 r.tip_mm.z
             ),
+            layers: layers.clone(),
         };
         let has_retract = program.points[blocks[k].last].arc == ArcFlag::Retract;
         let next_approach = (k + 1 < n)
@@ -1291,6 +1317,7 @@ fn clearance_point(
             "layer {}, {what} point ({} mm from point {} along the tool axis): {msg}",
             p.layer, clearance_mm, p.point
         ),
+        layers: vec![p.layer],
     };
     let position_mm = p.position_mm + p.tool_axis.into_inner() * clearance_mm;
     let cp = CellPoint {

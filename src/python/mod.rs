@@ -12,6 +12,7 @@
 //! repository root.
 
 mod arrays;
+mod cell;
 mod control;
 mod part;
 mod placed;
@@ -61,7 +62,7 @@ pub(crate) fn json_to_py<'py>(
 fn check_program<'py>(
     py: Python<'py>,
     path: PathBuf,
-    cell: &part::PyCell,
+    cell: &cell::PyCell,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let report = py
         .detach(|| crate::pipeline::check_program(&path, &cell.cell))
@@ -88,7 +89,7 @@ fn waam_slicer(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("WaamError", py.get_type::<WaamError>())?;
     m.add("InfeasiblePlan", py.get_type::<InfeasiblePlan>())?;
     m.add_class::<part::PyPart>()?;
-    m.add_class::<part::PyCell>()?;
+    m.add_class::<cell::PyCell>()?;
     m.add_class::<sliced::PySlicedPart>()?;
     m.add_class::<planned::PyPlannedPart>()?;
     m.add_class::<placed::PyPlacedCell>()?;

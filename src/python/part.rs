@@ -1,16 +1,17 @@
-//! `Part` and `Cell`: a part file and a cell file, read and validated once,
-//! and the two long calls on a part (`slice`, `plan`).
+//! `Part`: a part file, read and validated once, and the long calls on a
+//! part (`slice`, `plan`, `place`).
 
 use std::path::PathBuf;
 
 use pyo3::prelude::*;
 
+use super::cell::PyCell;
 use super::control::{HostControl, SliceKeywords};
 use super::placed::PyPlacedCell;
 use super::planned::PyPlannedPart;
 use super::sliced::PySlicedPart;
 use super::waam_error;
-use crate::pipeline::{Cell, Part, PlaceRequest, PlanOptions, RzLaw};
+use crate::pipeline::{Part, PlaceRequest, PlanOptions, RzLaw};
 
 /// A tube to build: geometry, substrate and the part file's slicing,
 /// tool-axis and process settings. Part frame, mm.
@@ -198,70 +199,9 @@ impl PyPart {
                     "half_box_mm = {h}: must be positive and finite"
                 )));
             }
-            req.half_box_mm = h;
+            req.half_box_mm = Some(h);
         }
         let result = py.detach(|| crate::pipeline::place_part(&self.part, &cell.cell, &req));
         PyPlacedCell::new(py, result.map_err(waam_error)?)
-    }
-}
-
-/// A robot cell: the robot and its layout (part carried under a fixed
-/// torch, or torch carried over a positioner). Robot base frame, mm.
-#[pyclass(frozen, name = "Cell", module = "waam_slicer")]
-pub(crate) struct PyCell {
-    pub cell: Cell,
-}
-
-#[pymethods]
-impl PyCell {
-    /// Reads and validates a cell file (TOML).
-    #[staticmethod]
-    fn read(path: PathBuf) -> PyResult<Self> {
-        Ok(Self {
-            cell: Cell::read(&path).map_err(waam_error)?,
-        })
-    }
-
-    /// Parses cell-file text; `name` stands for the file in messages.
-    #[staticmethod]
-    #[pyo3(signature = (text, name = "<string>"))]
-    fn from_toml(text: &str, name: &str) -> PyResult<Self> {
-        Ok(Self {
-            cell: Cell::from_toml_str(text, name).map_err(waam_error)?,
-        })
-    }
-
-    /// The cell's name (the file's `name`).
-    #[getter]
-    fn name(&self) -> &str {
-        &self.cell.name
-    }
-
-    /// The file it was read from, as given.
-    #[getter]
-    fn file(&self) -> &str {
-        &self.cell.file
-    }
-
-    /// The program format of the robot's controller: `fanuc`, `kuka` or `abb`.
-    #[getter]
-    fn vendor(&self) -> &'static str {
-        self.cell.native_format().name()
-    }
-
-    /// `True` when the torch is carried over a positioner: planned joints
-    /// then have 8 columns.
-    #[getter]
-    fn has_positioner(&self) -> bool {
-        matches!(self.cell.layout, crate::robot::Cell::TorchCarried(_))
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "Cell({:?}, file={:?}, vendor={:?})",
-            self.cell.name,
-            self.cell.file,
-            self.vendor()
-        )
     }
 }

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::part::PyCell;
+use super::cell::PyCell;
 use super::{json_to_py, waam_error};
 use crate::pipeline::PlacedCell;
 
@@ -62,7 +62,7 @@ impl PyPlacedCell {
             .placement
             .binding
             .as_ref()
-            .map(|(c, share)| format!("{c} ({:.0} %)", 100.0 * share))
+            .map(|b| format!("{b} ({:.0} %)", 100.0 * b.share()))
     }
 
     /// The placement variables: name → value found, in mm or degrees (the
@@ -70,14 +70,15 @@ impl PyPlacedCell {
     #[getter]
     fn values<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
+        let p = &self.placed.placement;
         for (v, x) in self
             .placed
             .bounds
             .variables
             .iter()
-            .zip(&self.placed.placement.values)
+            .zip(p.values.in_table_order(&p.cell))
         {
-            d.set_item(v.name, if v.angle { x.to_degrees() } else { *x })?;
+            d.set_item(v.name, if v.angle { x.to_degrees() } else { x })?;
         }
         Ok(d)
     }

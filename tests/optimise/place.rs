@@ -272,3 +272,89 @@ fn the_s_bent_tube_at_its_own_grid_plans_after_placement() {
     assert_eq!(planned.plan.layers.len(), 213);
     assert_eq!(fk_check(&placed.toml, &planned), 213 * 400);
 }
+
+/// A refused placement names its binding constraint as data: the S-bend,
+/// refused where `parts/cells/robowam_part_carried.toml` puts it at J5's
+/// travel (the cell file restricts J5 to ±135°, "to avoid substrate/robot
+/// collisions"), with every placement variable fixed so that the search can
+/// only judge the cell as given: the binding is a joint limit named by its
+/// joint (J5), the same constraint `plan_part` reports for the cell's
+/// infeasible layers; a share in (0, 1]; and its words are those of
+/// `placement.json`. Coarse grid (Delta 5 mm, 48 points) as in the S-bend
+/// test above.
+#[test]
+fn a_refused_placement_names_the_joint_limit_as_a_typed_binding() {
+    use waam_slicer::optimise::{Constraint, LayerStatus};
+    use waam_slicer::place::{Binding, Limit, PlaceOptions};
+    let part = Part::read(part_path("s-bend.toml")).unwrap();
+    let text = std::fs::read_to_string(part_path("cells/robowam_part_carried.toml")).unwrap();
+    let text = text + "\n[placement]\nfixed = [\"x\", \"y\", \"z\", \"rotation\"]\n";
+    let cell = Cell::from_toml_str(&text, "fixed.toml").unwrap();
+    let coarse = SliceOverrides {
+        delta_mm: Some(5.0),
+        discretisation: Some(waam_slicer::path::Discretisation::Points(48)),
+        ..SliceOverrides::default()
+    };
+    // The cell's own verdict, layer by layer: J5's travel binds.
+    let opts = PlanOptions {
+        slice: coarse.clone(),
+        ..PlanOptions::default()
+    };
+    let before = plan_part(&part, &cell, &opts).unwrap();
+    let planned_limits: Vec<Constraint> = before
+        .plan
+        .infeasible_layers()
+        .filter_map(|l| match &l.status {
+            LayerStatus::Infeasible { binding } | LayerStatus::FixedViolates { binding } => {
+                Some(binding.constraint)
+            }
+            _ => None,
+        })
+        .collect();
+    let j5 = Constraint::JointLimit { joint: 5 };
+    assert!(planned_limits.contains(&j5), "{planned_limits:?}");
+
+    let req = waam_slicer::PlaceRequest {
+        slice: coarse,
+        search: PlaceOptions {
+            samples: 2,
+            rounds: 1,
+            ..PlaceOptions::default()
+        },
+        ..waam_slicer::PlaceRequest::default()
+    };
+    let placed = waam_slicer::place_part(&part, &cell, &req).unwrap();
+    let p = &placed.placement;
+    assert!(!p.feasible, "{:#}", placed.summary());
+    let binding = p.binding.as_ref().expect("a refused placement names why");
+    assert_eq!(binding.limit(), Some(&Limit::Layer(j5)), "{binding:?}");
+    assert!(
+        matches!(
+            binding,
+            Binding::Subsample { .. } | Binding::FullPath { .. }
+        ),
+        "{binding:?}"
+    );
+    assert!(binding.share() > 0.0 && binding.share() <= 1.0);
+    assert_eq!(
+        placed.summary()["binding"]["constraint"],
+        binding.to_string().as_str()
+    );
+    assert!(binding.to_string().starts_with("J5 travel"), "{binding}");
+}
+
+/// The request's half box is an `Option`: a value given must be positive
+/// and finite, and the error names the field.
+#[test]
+fn a_bad_half_box_names_its_field() {
+    let part = Part::read(part_path("hemisphere.toml")).unwrap();
+    let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
+    for h in [0.0, -1.0, f64::NAN] {
+        let req = waam_slicer::PlaceRequest {
+            half_box_mm: Some(h),
+            ..waam_slicer::PlaceRequest::default()
+        };
+        let e = waam_slicer::place_part(&part, &cell, &req).unwrap_err();
+        assert!(e.to_string().contains("half_box_mm"), "{h}: {e}");
+    }
+}

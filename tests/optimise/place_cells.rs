@@ -15,8 +15,8 @@
 //! attainable (only that the search is consistent with itself).
 
 use crate::common::{part_path, SAMPLE_PARTS};
-use waam_slicer::optimise::place::PlaceOptions;
 use waam_slicer::pipeline::{place_part, PlaceRequest};
+use waam_slicer::place::PlaceOptions;
 use waam_slicer::{plan_part, Cell, Part, PlanOptions, SliceOverrides};
 
 fn coarse() -> SliceOverrides {
@@ -106,7 +106,8 @@ fn every_sample_part_in_every_sample_cell_plans_after_placement_or_names_its_bin
             } else {
                 let (binding, share) = p
                     .binding
-                    .clone()
+                    .as_ref()
+                    .map(|b| (b.to_string(), b.share()))
                     .unwrap_or_else(|| panic!("{part_name} in {cell_name}: no binding named"));
                 assert!(
                     CONSTRAINTS.iter().any(|c| binding.contains(c)) && share > 0.0,

@@ -133,7 +133,11 @@ fn another_vendors_format_is_refused_before_planning() {
 fn errors_name_the_file_and_field() {
     let e = Part::read(part_path("no-such-part.toml")).unwrap_err();
     assert!(e.to_string().contains("no-such-part.toml"), "{e}");
-    assert_eq!(Error::from(e.clone()).kind(), ErrorKind::Io, "a missing file: {e}");
+    assert_eq!(
+        Error::from(e.clone()).kind(),
+        ErrorKind::Io,
+        "a missing file: {e}"
+    );
     // A robot-only cell file is not a cell.
     let e = Cell::read(part_path("cells/kuka_kr16_2.toml")).unwrap_err();
     assert!(e.to_string().contains("kuka_kr16_2.toml"), "{e}");
