@@ -175,7 +175,9 @@ fn group_of(
 ///
 /// # Errors
 /// [`ProgramError::OverBudget`] naming the field, the layer and the
-/// numbers when one bead alone does not fit; the errors of `size`.
+/// numbers when one bead alone does not fit; [`ProgramError::Mismatch`]
+/// when `program.bead_setup` is neither empty nor one per bead; the errors
+/// of `size`.
 pub fn layer_groups(
     program: &Program,
     budget: &Budget,
@@ -186,6 +188,17 @@ pub fn layer_groups(
     if n == 0 || size(program)? <= budget.limit {
         #[allow(clippy::single_range_in_vec_init)] // one group: every bead
         return Ok(vec![0..n]);
+    }
+    // a set-up list that does not fit the beads: a group must not drop it
+    // silently (the emitters refuse it when they measure the whole)
+    if !program.bead_setup.is_empty() && program.bead_setup.len() != n {
+        return Err(ProgramError::Mismatch {
+            index: program.points.len(),
+            reason: format!(
+                "{} bead_setup entries for {n} beads",
+                program.bead_setup.len()
+            ),
+        });
     }
     let planned = planned_ranges(program, &blocks);
     let mut fits = |beads: Range<usize>| -> Result<(bool, usize), ProgramError> {

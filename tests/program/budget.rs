@@ -362,8 +362,8 @@ fn abb_main_module_loads_runs_and_unloads_each_part_in_order() {
     );
 }
 
-/// A group missing from the set is an error naming it; a group over the
-/// budget read back is a problem.
+/// A group missing from the set is an error naming it; a group that does
+/// not end at home, or is over the budget, read back is a problem.
 #[test]
 fn a_missing_or_oversized_group_is_reported() {
     let (cell, prog, planned, mut settings) = build(KUKA_CELLS[0]);
@@ -379,6 +379,19 @@ fn a_missing_or_oversized_group_is_reported() {
     assert!(
         e.to_string().contains("HEMI_P01") && e.to_string().contains("missing"),
         "{e}"
+    );
+    // group 1 without its last home move: group 2 would not start where
+    // group 1 ended
+    let mut cut = files.clone();
+    let src = cut.iter_mut().find(|f| f.name == "HEMI_P01.src").unwrap();
+    let at = src.text.rfind("  PTP PHOME\n").unwrap();
+    src.text.replace_range(at..at + "  PTP PHOME\n".len(), "");
+    let r = check_files(Vendor::Kuka, &cut, &cell, &settings, Some(&planned)).unwrap();
+    assert!(
+        r.problems.iter().any(|p| p.kind == ProblemKind::Setup
+            && p.file == "HEMI_P01.src"
+            && p.message.contains("the last motion")),
+        "{r}"
     );
     let mut tight = settings.clone();
     tight.kuka.max_file_bytes = whole / 4;

@@ -1,6 +1,7 @@
 //! ABB RAPID module (`.mod`) [SPEC §8]: [`abb_files`] takes a [`Program`]
 //! (joints rad, positions mm, speeds mm/s) and [`AbbOptions`] and gives one
-//! module `<name>.mod` that a task loads next to its own modules.
+//! module `<name>.mod` that a task loads next to its own modules (over the
+//! memory budget: a main module and the part modules it loads in turn).
 //!
 //! * **Names: one entry routine, everything else `LOCAL`.** The module is
 //!   `MODULE MOD_<name>` ([`module_name`]) and holds one global routine,
@@ -39,6 +40,15 @@
 //!   axes `eax_a`, `eax_b` (deg; [`AbbOptions::positioner_axes`]), the
 //!   others `9E+09`.
 //! * `ConfL \On` so that the controller keeps our branch on linear moves.
+//! * **Memory budget** ([`AbbOptions::max_file_bytes`], default 2 MB): a
+//!   build whose module is larger is cut between layers into part modules
+//!   `<name>_P01.mod`, `<name>_P02.mod`, … (each a complete module as
+//!   above, entry routine `<name>_P01`, from home to home), and
+//!   `<name>.mod` becomes the main module whose entry routine `<name>()`
+//!   loads each in turn from [`AbbOptions::load_path`] (`StartLoad
+//!   \Dynamic`, `WaitLoad`), calls it late-bound (`%"<name>_P01"%;`) and
+//!   unloads it (`UnLoad`), so one part module is resident at a time
+//!   ([`loader`]).
 //! * **Every identifier the module uses is declared in it** (`LOCAL`),
 //!   except the controller data named in [`AbbOptions`] (the interpass
 //!   input signal [`AbbOptions::interpass_signal`], the positioner's

@@ -87,6 +87,12 @@
 //!   payload (`$LOAD.M` kg, `$LOAD.CM` mm in the flange frame, `$LOAD.J`
 //!   of a point mass), dwell (`WAIT SEC`) and interpass wait (`WAIT FOR
 //!   $IN[n]`).
+//! * **Memory budget** ([`KukaOptions::max_file_bytes`], default 2 MB for
+//!   the `.src` and `.dat` together): a larger build is cut between layers
+//!   into several complete programs, `NAME_P01.src`/`.dat`,
+//!   `NAME_P02.src`/`.dat`, … (each from home to home, with its own
+//!   declarations, interrupt and set-up), which the cell selects and runs
+//!   in turn ([`split`](crate::program::split)).
 //! * **Part-carried cell: external TCP.** `$VEL.CP` is the speed of the TCP;
 //!   the planned speed is the torch's relative to the part. In the
 //!   part-carried cell the emitter switches to KUKA's fixed-tool mode,
