@@ -788,8 +788,7 @@ pub struct TpProgram {
     /// `/PROG` name.
     pub name: String,
     /// `/ATTR COMMENT` (at most [`COMMENT_MAX`] characters: `waam-slicer`,
-    /// `waam: 3 parts` for a main program, `waam: 1 of 3` for a
-    /// sub-program).
+    /// or `waam: 1 of 3` for group 1 of a build cut to the memory budget).
     pub comment: String,
     /// Motion groups in use (1 or 2).
     pub groups: usize,
