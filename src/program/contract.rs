@@ -6,6 +6,11 @@
 //! FANUC, KUKA and ABB each implement [`Controller`] in their own folder;
 //! [`with_controller`] is the one place that turns a [`Vendor`] into its
 //! implementation, so nothing else spells out the vendor list.
+//!
+//! Each controller states its memory budget ([`Controller::budget`]); a
+//! build over it is emitted as groups the cell runs in turn
+//! ([`crate::program::split`]), and [`check_files`] reads such a set back
+//! and checks it as one build ([`validate_build`]).
 
 use std::path::Path;
 
