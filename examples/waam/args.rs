@@ -37,7 +37,9 @@ pub enum Command {
     /// Slice a part: writes path.csv and summary.json in --out.
     Slice(SliceArgs),
     /// Check a robot program against a cell — FANUC .ls (following its CALLs), KUKA .src + .dat,
-    /// ABB .mod: limits, speeds, reachability, configuration, beads. Exit 0 valid, 2 problems, 1 unreadable.
+    /// ABB .mod (and the part modules it loads; any group NAME_P01.. of a build cut to the memory
+    /// budget brings all its groups): limits, speeds, reachability, configuration, beads, budget.
+    /// Exit 0 valid, 2 problems, 1 unreadable.
     Check(CheckArgs),
     /// Plan a part in a cell: slice, tool axes, R_Z optimisation, joints;
     /// writes joints.csv and summary.json in --out (exit 2 if infeasible).

@@ -85,14 +85,21 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     // The robot program, only for a feasible plan; the program stage checks
     // again and refuses (exit 2) if the trajectory it rebuilds breaks a limit.
     let t = Instant::now();
+    let mut written: Vec<serde_json::Value> = Vec::new();
     let feasible = if planned.plan.is_feasible() {
         match planned.write_programs(&dir, planned.format) {
             Ok(files) => {
+                // the files in the order the cell loads them (the main
+                // first; a build cut to the memory budget: its groups in turn)
+                let names: Vec<String> = files
+                    .iter()
+                    .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+                    .collect();
+                for (f, name) in files.iter().zip(&names) {
+                    let bytes = std::fs::metadata(f).map_or(0, |m| m.len());
+                    written.push(serde_json::json!({ "file": name, "bytes": bytes }));
+                }
                 if !quiet {
-                    let names: Vec<String> = files
-                        .iter()
-                        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
-                        .collect();
                     println!("  program: {}", names.join(", "));
                 }
                 true
@@ -115,6 +122,8 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     times["pictures"] = t_plots.into();
     times["report_html"] = t_report.into();
     times["program_files"] = t_programs.into();
+    // the program files in the order the cell loads them, with their sizes
+    summary["program_files"] = written.into();
     let sj = dir.join("summary.json");
     write_atomic(&sj, |w| {
         serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;

@@ -1,7 +1,8 @@
 //! Checking a program file against a cell in one call: the program's
 //! vendor from the extension, its files read from disk as that vendor's
 //! [`Controller`](crate::program::contract::Controller) says (a FANUC main
-//! program's `CALL`s followed, a KUKA `.src` with its `.dat`), then
+//! program's `CALL`s followed, a KUKA `.src` with its `.dat`, the groups
+//! of a build cut to the memory budget in order), then
 //! validated for joint limits, speeds, reachability, configuration and
 //! beads (SPEC §8).
 
@@ -16,7 +17,10 @@ use crate::Error;
 
 /// Reads the program at `path` — a FANUC `.ls` main program (the
 /// sub-programs it calls are read from the same folder), a KUKA `.src` or
-/// `.dat` (its pair beside it) or an ABB `.mod` — and validates it against
+/// `.dat` (its pair beside it) or an ABB `.mod` (with the part modules a
+/// main module loads); for a build cut to the controller's memory budget,
+/// any of its groups `NAME_P01`, `NAME_P02`, … (or `NAME` itself) brings
+/// all of them, checked as one build — and validates it against
 /// `cell`, with the emitter options and set-up (home, dwell, interpass
 /// wait, payload, transit) of the cell file's `[program]` table. Problems
 /// found are data: the report lists each with its `file:line`.

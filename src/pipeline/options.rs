@@ -141,11 +141,13 @@ impl SliceOverrides {
 /// A robot program format: the vendor whose controller runs it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ProgramFormat {
-    /// FANUC TP ASCII `.ls` (split into sub-programs of whole beads).
+    /// FANUC TP ASCII `.ls` (over `max_positions`: groups of whole
+    /// beads the cell loads in turn).
     Fanuc,
-    /// KUKA KRL `.src` + `.dat`.
+    /// KUKA KRL `.src` + `.dat` (over `max_file_bytes`: several programs).
     Kuka,
-    /// ABB RAPID `.mod`.
+    /// ABB RAPID `.mod` (over `max_file_bytes`: a main module loading part
+    /// modules in turn).
     Abb,
 }
 

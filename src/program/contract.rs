@@ -6,6 +6,11 @@
 //! FANUC, KUKA and ABB each implement [`Controller`] in their own folder;
 //! [`with_controller`] is the one place that turns a [`Vendor`] into its
 //! implementation, so nothing else spells out the vendor list.
+//!
+//! Each controller states its memory budget ([`Controller::budget`]); a
+//! build over it is emitted as groups the cell runs in turn
+//! ([`crate::program::split`]), and [`check_files`] reads such a set back
+//! and checks it as one build ([`validate_build`]).
 
 use std::path::Path;
 
@@ -13,7 +18,10 @@ use crate::math::Point3;
 pub use crate::program::abb::Abb;
 pub use crate::program::fanuc::Fanuc;
 pub use crate::program::kuka::Kuka;
-use crate::program::validate::{check_steps, vendor_matches, Step, ValidationReport};
+use crate::program::split::{parse_group_name, Budget};
+use crate::program::validate::{
+    check_home_ends, check_steps, push, vendor_matches, ProblemKind, Step, ValidationReport,
+};
 use crate::program::{EmittedFile, Program, ProgramError, ProgramOptions, ProgramSettings};
 use crate::robot::{Cell, Vendor};
 
@@ -51,6 +59,45 @@ pub trait Controller {
 
     /// The vendor-neutral set-up inside the options.
     fn common(opts: &Self::Options) -> &ProgramOptions;
+
+    /// The controller's memory budget for the programs resident at once
+    /// (one group of a build cut into groups, [`crate::program::split`]).
+    fn budget(opts: &Self::Options) -> Budget;
+
+    /// What a set of files read back (`files`, read as `read`) occupies
+    /// against [`Controller::budget`], in its unit.
+    fn occupied(files: &[EmittedFile], read: &Self::Read) -> usize;
+
+    /// The groups a build's files make, in the order the cell runs them
+    /// (each a complete program); one group for a build in one piece.
+    /// By default the files named `NAME_P01`, `NAME_P02`, … (any
+    /// extension) make the groups ([`groups_by_name`]); a vendor whose
+    /// build has a loader (ABB's main module) checks it here, adding its
+    /// problems to `report`.
+    ///
+    /// # Errors
+    /// [`ProgramError::Read`] naming a file that belongs to no group or a
+    /// missing group.
+    fn groups(
+        files: &[EmittedFile],
+        report: &mut ValidationReport,
+    ) -> Result<Vec<Vec<EmittedFile>>, ProgramError> {
+        let _ = report;
+        let (rest, groups) = groups_by_name(files)?;
+        if let (Some(f), false) = (rest.first(), groups.is_empty()) {
+            return Err(ProgramError::Read {
+                file: f.name.clone(),
+                line: 0,
+                reason: "not one of the build's groups (NAME_P01, NAME_P02, ...) read with it"
+                    .into(),
+            });
+        }
+        Ok(if groups.is_empty() {
+            vec![rest]
+        } else {
+            groups
+        })
+    }
 
     /// The program's files, the main (entry) file first.
     ///
@@ -123,6 +170,124 @@ pub(crate) fn validate_decoded<C: Controller>(
         check_steps(&steps, cell, planned, C::common(opts), &mut report);
     }
     report
+}
+
+/// The stem of a file name (no folder, no extension).
+pub fn file_stem(name: &str) -> &str {
+    Path::new(name)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or(name)
+}
+
+/// The files of a build sorted into its groups by name
+/// ([`parse_group_name`]): the files of no group, then the groups in
+/// order (empty when no file is a group's).
+///
+/// # Errors
+/// [`ProgramError::Read`] when the groups are of two builds, or a group
+/// between the first and the last is missing.
+pub fn groups_by_name(
+    files: &[EmittedFile],
+) -> Result<(Vec<EmittedFile>, Vec<Vec<EmittedFile>>), ProgramError> {
+    let mut rest = Vec::new();
+    let mut groups: Vec<Vec<EmittedFile>> = Vec::new();
+    let mut base: Option<String> = None;
+    for f in files {
+        let Some((b, k)) = parse_group_name(file_stem(&f.name)) else {
+            rest.push(f.clone());
+            continue;
+        };
+        match &base {
+            Some(x) if !x.eq_ignore_ascii_case(b) => {
+                return Err(ProgramError::Read {
+                    file: f.name.clone(),
+                    line: 0,
+                    reason: format!("a group of build `{b}`, read with the groups of `{x}`"),
+                })
+            }
+            _ => base = Some(b.to_string()),
+        }
+        if groups.len() < k {
+            groups.resize(k, Vec::new());
+        }
+        groups[k - 1].push(f.clone());
+    }
+    if let Some(k) = groups.iter().position(Vec::is_empty) {
+        return Err(ProgramError::Read {
+            file: crate::program::split::group_name(base.as_deref().unwrap_or(""), k + 1),
+            line: 0,
+            reason: format!(
+                "group {} of {} is missing: every group of the build is needed, in order",
+                k + 1,
+                groups.len()
+            ),
+        });
+    }
+    Ok((rest, groups))
+}
+
+/// Reads and validates the files of a whole build with controller `C`:
+/// its groups ([`Controller::groups`]) decoded in order and checked as one
+/// run of steps ([`check_steps`]: the deposition points against `planned`
+/// over every group, the set-up carried across), each group within the
+/// budget ([`Controller::occupied`]) and, in a build of several groups,
+/// each starting and ending at home.
+///
+/// # Errors
+/// [`ProgramError::Read`] naming the file and line that cannot be read.
+pub fn validate_build<C: Controller>(
+    files: &[EmittedFile],
+    cell: &Cell,
+    opts: &C::Options,
+    planned: Option<&[Point3]>,
+) -> Result<ValidationReport, ProgramError> {
+    let mut report = ValidationReport::default();
+    let groups = C::groups(files, &mut report)?;
+    let budget = C::budget(opts);
+    let mut steps: Vec<Step> = Vec::new();
+    let mut ranges = Vec::with_capacity(groups.len());
+    for g in &groups {
+        let read = C::read(g)?;
+        let main = C::main_file(&read).to_string();
+        if !vendor_matches(cell, C::VENDOR, C::EMITTER, &main, &mut report) {
+            return Ok(report);
+        }
+        let used = C::occupied(g, &read);
+        if used > budget.limit {
+            push(
+                &mut report,
+                ProblemKind::Budget,
+                &main,
+                0,
+                format!(
+                    "{used} {unit} resident at once, more than `{}` = {} {unit}: the controller cannot hold it",
+                    budget.field,
+                    budget.limit,
+                    unit = budget.unit
+                ),
+            );
+        }
+        let Some(s) = C::steps(&read, cell, opts, &mut report) else {
+            return Ok(report);
+        };
+        ranges.push(steps.len()..steps.len() + s.len());
+        steps.extend(s);
+    }
+    check_steps(&steps, cell, planned, C::common(opts), &mut report);
+    let n = ranges.len();
+    if n > 1 {
+        for (k, r) in ranges.into_iter().enumerate() {
+            check_home_ends(
+                &steps[r],
+                cell,
+                C::common(opts),
+                [k > 0, k + 1 < n],
+                &mut report,
+            );
+        }
+    }
+    Ok(report)
 }
 
 /// Something done with one controller's implementation, chosen at run time
@@ -229,7 +394,8 @@ pub fn emit(
     with_controller(program.cell.robot().vendor, Emit(program, settings))
 }
 
-/// Reads `files` as a program of `vendor`'s format and validates it against
+/// Reads `files` as a program of `vendor`'s format — one program, or a
+/// build cut into groups ([`validate_build`]) — and validates it against
 /// `cell` with the options of `settings`.
 ///
 /// # Errors
@@ -250,13 +416,12 @@ pub fn check_files(
     impl ControllerTask for Check<'_> {
         type Output = Result<ValidationReport, ProgramError>;
         fn run<C: Controller>(self) -> Self::Output {
-            let read = C::read(self.files)?;
-            Ok(C::validate(
-                &read,
+            validate_build::<C>(
+                self.files,
                 self.cell,
                 &C::options(self.settings),
                 self.planned,
-            ))
+            )
         }
     }
     with_controller(
@@ -293,7 +458,36 @@ pub fn files_on_disk(path: &Path) -> Result<(Vendor, Vec<EmittedFile>), ProgramE
             ext.to_ascii_lowercase()
         ),
     })?;
-    Ok((vendor, with_controller(vendor, OnDisk(path))?))
+    // a build cut into groups: `NAME.ext` stands for its groups when only
+    // they are on disk; any group brings its siblings, in order
+    let first_group = |p: &Path| {
+        let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+        p.with_file_name(format!(
+            "{}.{ext}",
+            crate::program::split::group_name(stem, 1)
+        ))
+    };
+    let path = if !path.exists() && first_group(path).exists() {
+        first_group(path)
+    } else {
+        path.to_path_buf()
+    };
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+    let Some((base, _)) = parse_group_name(stem) else {
+        return Ok((vendor, with_controller(vendor, OnDisk(&path))?));
+    };
+    let mut files = Vec::new();
+    for k in 1.. {
+        let p = path.with_file_name(format!(
+            "{}.{ext}",
+            crate::program::split::group_name(base, k)
+        ));
+        if !p.exists() {
+            break;
+        }
+        files.extend(with_controller(vendor, OnDisk(&p))?);
+    }
+    Ok((vendor, files))
 }
 
 /// Reads the text of `path` as an [`EmittedFile`] named by its file name.

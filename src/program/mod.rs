@@ -16,7 +16,7 @@
 //! | KUKA KRL `.src` + `.dat` | [`kuka`] | [`kuka::Kuka`], [`kuka::kuka_files`], [`kuka::parse_krl`], [`kuka::validate_kuka`] |
 //! | ABB RAPID `.mod` | [`abb`] | [`abb::Abb`], [`abb::abb_files`], [`abb::parse_mod`], [`abb::validate_abb`] |
 //! | vendor-neutral words: move kinds, position modes | [`kinds`] | [`MoveKind`], [`PositionMode`] |
-//! | splitting at a point limit | [`split`] | [`split::chunks`] |
+//! | cutting a build into groups within a memory budget | [`split`] | [`split::split_to_budget`], [`split::Budget`] |
 //! | CSV of every point | [`csv`] | [`csv::write_csv`] |
 //! | the one checker of decoded steps (file + cell) | [`validate`] | [`validate::check_steps`], [`validate::Step`] |
 //! | approach and retract points | this module | [`build_program_with`], [`ProgramOptions`] |
@@ -117,6 +117,23 @@ pub enum ProgramError {
         value: String,
         /// Why it is rejected.
         reason: &'static str,
+    },
+    /// One layer's bead alone does not fit the controller's memory budget:
+    /// a build is cut between beads only ([`split`]), never inside one.
+    #[error(
+        "layer {layer} alone needs {size} {unit} in one program, more than `{field}` = {limit}: raise `{field}` if the controller holds more, or coarsen the layer (path_tolerance_mm, fewer points)"
+    )]
+    OverBudget {
+        /// The cell-file key stating the budget, e.g. `[program.fanuc] max_positions`.
+        field: &'static str,
+        /// The budget, in `unit`.
+        limit: usize,
+        /// What is counted (`positions`, `bytes`).
+        unit: &'static str,
+        /// The layer whose bead does not fit.
+        layer: usize,
+        /// What its group alone needs, in `unit`.
+        size: usize,
     },
     /// A file could not be written.
     #[error("{path}: cannot write: {source}")]

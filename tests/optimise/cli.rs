@@ -130,8 +130,9 @@ fn every_sample_part_plans_in_the_part_carried_cell() {
             .unwrap();
         let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
         assert_eq!(status.code(), Some(0), "{part}: {summary}");
-        // The main program: the shortest .ls name (NAME.ls before its
-        // NAME_001.ls, NAME_002.ls sub-programs when the plan was split).
+        // The program: the shortest .ls name (NAME.ls; a build cut to the
+        // memory budget is NAME_P01.ls, NAME_P02.ls, …, any of which brings
+        // the others to `check`).
         let program = std::fs::read_dir(&out)
             .unwrap()
             .map(|e| e.unwrap().path())

@@ -245,38 +245,78 @@ fn setup_golden_reads_back_into_the_right_steps() {
     assert_eq!(r.beads, 2);
 }
 
-/// Split at a point limit: the home moves are the main program's first and
-/// last motion, the set-up sits in the sub-programs before each bead.
+/// Cut to the memory budget (`max_positions`): each group is a complete
+/// program whose first and last motions are the home move (the cell loads
+/// the next one with the arm at home), with the set-up before its bead;
+/// the second group sets the payload in effect again, then dwells and
+/// waits as the second bead of the build; read as one build they validate.
 #[test]
-fn split_programs_keep_home_in_the_main_program() {
+fn groups_start_and_end_at_home_with_their_setup() {
     let cell = part_carried();
-    let (prog, planned) = with_setup(&cell);
+    let (mut prog, planned) = with_setup(&cell);
+    // no payload update before bead 1: the group must carry bead 0's
+    prog.bead_setup[1].payload = None;
+    let mut opts = setup_opts(&prog, false);
+    opts.common.payload_every_layers = 2;
+    // each bead with its approach and retract, plus the home record
+    let largest = waam_slicer::program::split::bead_blocks(&prog)
+        .iter()
+        .map(|b| b.len())
+        .max()
+        .unwrap()
+        + 1;
     let opts = FanucOptions {
-        point_limit: 10,
-        ..setup_opts(&prog, false)
+        max_positions: largest,
+        ..opts
     };
     let files = fanuc_files(&prog, &opts).unwrap();
-    assert_eq!(files.len(), 3);
+    let names: Vec<&str> = files.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["HEMI_P01.ls", "HEMI_P02.ls"]);
     let tps = read_all(&files);
-    let main: Vec<&Op> = tps[0].instructions.iter().map(|i| &i.op).collect();
-    let moves: Vec<usize> = main
-        .iter()
-        .enumerate()
-        .filter(|(_, o)| matches!(o, Op::Move { .. }))
-        .map(|(i, _)| i)
-        .collect();
-    let calls: Vec<usize> = main
-        .iter()
-        .enumerate()
-        .filter(|(_, o)| matches!(o, Op::Call(_)))
-        .map(|(i, _)| i)
-        .collect();
-    assert_eq!(moves.len(), 2);
-    assert!(moves[0] < calls[0] && moves[1] > calls[1], "{main:?}");
-    let steps = steps_of(&tps, &cell, &opts);
-    assert_eq!(setup_steps(&steps).len(), 4);
-    let r = validate_fanuc(&tps, &cell, &opts, Some(&planned));
+    for tp in &tps {
+        assert!(tp.positions.len() <= largest);
+        let moves: Vec<usize> = tp
+            .instructions
+            .iter()
+            .filter_map(|i| match i.op {
+                Op::Move { position, .. } => Some(position),
+                _ => None,
+            })
+            .collect();
+        let home = tp.positions.len();
+        assert_eq!(
+            (moves[0], *moves.last().unwrap()),
+            (home, home),
+            "{}",
+            tp.name
+        );
+    }
+    // group 2 alone: the payload of bead 0 set again, then the dwell and
+    // the interpass wait of bead 1
+    let second = setup_steps(&steps_of(&tps[1..], &cell, &opts));
+    assert_eq!(
+        second,
+        [
+            "payload 2.500 kg at (0.00, 0.00, 40.00) mm",
+            "dwell 30.00 s",
+            "wait DI[3]"
+        ]
+    );
+    let settings = waam_slicer::program::ProgramSettings {
+        common: opts.common,
+        fanuc: opts.clone(),
+        ..Default::default()
+    };
+    let r = waam_slicer::program::contract::check_files(
+        waam_slicer::robot::Vendor::Fanuc,
+        &files,
+        &cell,
+        &settings,
+        Some(&planned),
+    )
+    .unwrap();
     assert!(r.is_ok(), "{r}");
+    assert_eq!(r.beads, 2);
 }
 
 /// Torch-carried cell: the home move carries the positioner (GP2), every

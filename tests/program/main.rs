@@ -1,9 +1,11 @@
 //! Integration tests of the program stage (SPEC §8): golden files per
 //! emitter, read-back and validation of our FANUC output, corrupted files,
-//! splitting at a point limit, refusal of infeasible plans.
+//! cutting a build into groups within each controller's memory budget,
+//! refusal of infeasible plans.
 
 mod abb_controller;
 mod api;
+mod budget;
 mod cells;
 mod contract;
 mod fanuc_controller;

@@ -12,6 +12,7 @@
 //! routine_data = ( "PERS" | "VAR" | "CONST" ) ident ident [ ":=" expr ] ";"
 //! routine     = [ "LOCAL" ] "PROC" ident "(" ")" { routine_data } { statement } "ENDPROC"
 //! statement   = ident ":=" expr ";" | ident [ arguments ] ";"
+//!             | "%" expr "%" [ arguments ] ";"      (late binding: the procedure's name as a string)
 //! arguments   = argument { "," argument | optional }   (the first may be an optional)
 //! argument    = optional | [ ident ":=" ] expr
 //! optional    = "\" ident [ ":=" expr ]
@@ -201,6 +202,7 @@ fn lex(text: &str) -> Result<Vec<(Tok, usize)>, String> {
                     '-' => "-",
                     '*' => "*",
                     '/' => "/",
+                    '%' => "%",
                     _ => return Err(format!("line {n}: unexpected character `{ch}`")),
                 };
                 out.push((Tok::Punct(p), n));
@@ -378,6 +380,17 @@ impl Parser {
     }
 
     fn statement(&mut self) -> Result<(), String> {
+        // late binding (RAPID kernel, "Procedure call": the procedure name
+        // given as a string expression between `%`)
+        if self.is_punct("%") {
+            self.at += 1;
+            self.expr()?;
+            self.punct("%")?;
+            if !self.is_punct(";") {
+                self.arguments()?;
+            }
+            return self.punct(";");
+        }
         self.ident()?;
         if self.is_punct(":=") {
             self.at += 1;
@@ -569,6 +582,10 @@ fn the_recogniser_accepts_rapid_and_rejects_errors() {
     ArcL p1, v100, sm1, weld1\\Weave:=weave1, fine, tGun;
     WaitDI diReady, 1;
     TPWrite \"n = \"\\Num:=n;
+    StartLoad \\Dynamic, \"HOME:/PART.mod\", ld1;
+    WaitLoad ld1;
+    %\"PART\"%;
+    UnLoad \"HOME:/PART.mod\";
     Stop;
   ENDPROC
 ENDMODULE
@@ -602,6 +619,10 @@ ENDMODULE
         ),
         (good.replace("n := n", "n = n"), "`=` for `:=`"),
         (good.replace("Stop;", "Stop; # x"), "stray character"),
+        (
+            good.replace("%\"PART\"%;", "%\"PART\";"),
+            "late binding without its closing `%`",
+        ),
         (
             format!("{good}MODULE Two\nENDMODULE\n"),
             "text after ENDMODULE",

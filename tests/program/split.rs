@@ -1,24 +1,29 @@
-//! Splitting at N points: sub-programs of whole beads (at most N points
-//! each, filled greedily, so ceil(points / N) of them only when N is a
-//! multiple of the bead size), called in order by a main program, whose
-//! concatenated motions are the unsplit program's; a bead longer than N is
-//! refused.
+//! Cutting a FANUC build to the memory budget (`[program.fanuc]
+//! max_positions`, issue 32 item 3): groups of whole beads, each a complete
+//! program the cell loads in turn (`HEMI_P01`, `HEMI_P02`, …, no main
+//! program calling them: FANUC sub-programs called from a main are resident
+//! together, so a main would not save memory), filled greedily, so
+//! `ceil(positions / N)` groups only when N is a multiple of the bead size;
+//! their motions in order are the uncut program's; a bead longer than N is
+//! refused with the numbers.
 
+use waam_slicer::program::contract::check_files;
 use waam_slicer::program::fanuc::parse_ls;
-use waam_slicer::program::fanuc::validate_fanuc;
 use waam_slicer::program::fanuc::{fanuc_files, ArmPosition, FanucOptions, Op, TpProgram};
-use waam_slicer::program::MoveKind;
+use waam_slicer::program::{MoveKind, ProgramError, ProgramSettings};
+use waam_slicer::robot::Vendor;
 
 use crate::fixture::{part_carried, program};
 
-/// Motions and process instructions in execution order, positions resolved.
+/// Motions and process instructions of the programs run one after the
+/// other, positions resolved.
 fn flatten(files: &[TpProgram]) -> Vec<String> {
     let mut out = Vec::new();
-    fn walk(tp: &TpProgram, all: &[TpProgram], out: &mut Vec<String>) {
+    for tp in files {
         for ins in &tp.instructions {
             match &ins.op {
-                Op::Call(n) => walk(all.iter().find(|p| &p.name == n).unwrap(), all, out),
                 Op::UFrame(_) | Op::UTool(_) | Op::Remark(_) => {}
+                Op::Call(n) => panic!("a group calls `{n}`: groups are complete programs"),
                 Op::Move {
                     kind,
                     position,
@@ -37,30 +42,29 @@ fn flatten(files: &[TpProgram]) -> Vec<String> {
             }
         }
     }
-    walk(&files[0], files, &mut out);
     out
 }
 
 #[test]
-fn split_at_n_points_concatenates_to_the_unsplit_program() {
+fn groups_at_n_positions_concatenate_to_the_uncut_program() {
     let cell = part_carried();
     let (prog, path) = program(&cell, 0..3, 10);
     let planned: Vec<_> = path.iter().map(|p| p.position_mm).collect();
-    let read = |opts: &FanucOptions| -> Vec<TpProgram> {
-        fanuc_files(&prog, opts)
-            .unwrap()
+    let read = |opts: &FanucOptions| -> (Vec<TpProgram>, Vec<_>) {
+        let files = fanuc_files(&prog, opts).unwrap();
+        let tps = files
             .iter()
             .map(|f| parse_ls(&f.text, &f.name).unwrap_or_else(|e| panic!("{e}")))
-            .collect()
+            .collect();
+        (tps, files)
     };
-    let whole = read(&FanucOptions::default());
+    let (whole, _) = read(&FanucOptions::default());
     assert_eq!(whole.len(), 1);
+    assert_eq!(whole[0].name, "HEMI");
     // 30 bead points and an approach and a retract point per bead: three
-    // beads of 12 points
+    // beads of 12 positions (no home in this program)
     assert_eq!(prog.points.len(), 36);
-    // Sub-programs hold whole beads, filled greedily: ceil(points / N) only
-    // when N is a multiple of the bead size; a bead is never cut
-    for (n, subs) in [
+    for (n, groups) in [
         (12usize, 3usize),
         (13, 3),
         (23, 3),
@@ -70,32 +74,24 @@ fn split_at_n_points_concatenates_to_the_unsplit_program() {
         (37, 1),
     ] {
         let opts = FanucOptions {
-            point_limit: n,
+            max_positions: n,
             ..Default::default()
         };
-        let parts = read(&opts);
-        if subs == 1 {
-            assert_eq!(parts.len(), 1);
-        } else {
-            assert_eq!(parts.len(), subs + 1, "N = {n}");
-            let calls: Vec<_> = parts[0].instructions.iter().map(|i| i.op.clone()).collect();
-            let want: Vec<_> = (1..=subs)
-                .map(|k| Op::Call(format!("HEMI_{k:03}")))
-                .collect();
-            assert_eq!(calls, want);
-            for (k, sub) in parts[1..].iter().enumerate() {
-                assert_eq!(sub.name, format!("HEMI_{:03}", k + 1));
-                assert!(sub.positions.len() <= n);
-                // whole beads: as many arc starts as ends, the first motion
-                // a joint move to an approach point
-                let count =
-                    |f: fn(&Op) -> bool| sub.instructions.iter().filter(|i| f(&i.op)).count();
+        let (parts, files) = read(&opts);
+        assert_eq!(parts.len(), groups, "N = {n}");
+        if groups > 1 {
+            for (k, g) in parts.iter().enumerate() {
+                assert_eq!(g.name, format!("HEMI_P{:02}", k + 1));
+                // each group alone is within the budget: it is all the
+                // controller holds while it runs
+                assert!(g.positions.len() <= n, "N = {n}");
+                let count = |f: fn(&Op) -> bool| g.instructions.iter().filter(|i| f(&i.op)).count();
                 let starts = count(|o| matches!(o, Op::ArcStart(_)));
                 assert!(
                     starts >= 1 && starts == count(|o| matches!(o, Op::ArcEnd(_))),
                     "N = {n}"
                 );
-                let first_move = sub
+                let first_move = g
                     .instructions
                     .iter()
                     .find_map(|i| match &i.op {
@@ -104,31 +100,48 @@ fn split_at_n_points_concatenates_to_the_unsplit_program() {
                     })
                     .unwrap();
                 assert_eq!(first_move, MoveKind::Joint, "N = {n}");
+                assert_eq!(g.comment, format!("waam: {} of {groups}", k + 1));
             }
         }
         assert_eq!(flatten(&parts), flatten(&whole), "N = {n}");
-        // `/ATTR COMMENT` takes at most 16 characters
-        for tp in &parts {
-            assert!(tp.comment.chars().count() <= 16, "{:?}", tp.comment);
-        }
-        let report = validate_fanuc(&parts, &cell, &opts, Some(&planned));
+        // the whole build read back as one: every planned point in order
+        let settings = ProgramSettings {
+            fanuc: opts.clone(),
+            ..Default::default()
+        };
+        let report = check_files(Vendor::Fanuc, &files, &cell, &settings, Some(&planned)).unwrap();
         assert!(report.is_ok(), "N = {n}: {report}");
         assert_eq!(report.beads, 3);
     }
 }
 
-/// A bead longer than the limit is refused, naming `point_limit` and the
-/// layer, rather than split with the arc on across two programs.
+/// A bead longer than the budget is refused, naming `max_positions`, the
+/// layer and the numbers, rather than cut with the arc on across two
+/// programs.
 #[test]
-fn a_bead_longer_than_the_limit_is_refused() {
+fn a_bead_longer_than_the_budget_is_refused() {
     let (prog, _) = program(&part_carried(), 0..3, 10);
     let opts = FanucOptions {
-        point_limit: 11,
+        max_positions: 11,
         ..Default::default()
     };
-    let e = fanuc_files(&prog, &opts).unwrap_err().to_string();
+    let e = fanuc_files(&prog, &opts).unwrap_err();
     assert!(
-        e.contains("`point_limit`") && e.contains("layer 0 has 12 points"),
+        matches!(
+            e,
+            ProgramError::OverBudget {
+                layer: 0,
+                size: 12,
+                limit: 11,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = e.to_string();
+    assert!(
+        e.contains("`[program.fanuc] max_positions` = 11")
+            && e.contains("layer 0 alone needs 12 positions"),
         "{e}"
     );
 }

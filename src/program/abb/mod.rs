@@ -1,6 +1,7 @@
 //! ABB RAPID module (`.mod`) [SPEC §8]: [`abb_files`] takes a [`Program`]
 //! (joints rad, positions mm, speeds mm/s) and [`AbbOptions`] and gives one
-//! module `<name>.mod` that a task loads next to its own modules.
+//! module `<name>.mod` that a task loads next to its own modules (over the
+//! memory budget: a main module and the part modules it loads in turn).
 //!
 //! * **Names: one entry routine, everything else `LOCAL`.** The module is
 //!   `MODULE MOD_<name>` ([`module_name`]) and holds one global routine,
@@ -39,6 +40,15 @@
 //!   axes `eax_a`, `eax_b` (deg; [`AbbOptions::positioner_axes`]), the
 //!   others `9E+09`.
 //! * `ConfL \On` so that the controller keeps our branch on linear moves.
+//! * **Memory budget** ([`AbbOptions::max_file_bytes`], default 2 MB): a
+//!   build whose module is larger is cut between layers into part modules
+//!   `<name>_P01.mod`, `<name>_P02.mod`, … (each a complete module as
+//!   above, entry routine `<name>_P01`, from home to home), and
+//!   `<name>.mod` becomes the main module whose entry routine `<name>()`
+//!   loads each in turn from [`AbbOptions::load_path`] (`StartLoad
+//!   \Dynamic`, `WaitLoad`), calls it late-bound (`%"<name>_P01"%;`) and
+//!   unloads it (`UnLoad`), so one part module is resident at a time
+//!   ([`loader`]).
 //! * **Every identifier the module uses is declared in it** (`LOCAL`),
 //!   except the controller data named in [`AbbOptions`] (the interpass
 //!   input signal [`AbbOptions::interpass_signal`], the positioner's
@@ -125,10 +135,13 @@
 pub mod decode;
 pub mod read;
 
+pub mod loader;
+
 pub use decode::validate_abb;
 pub use read::parse_mod;
 
-use crate::program::contract::{read_file, Controller};
+use crate::program::contract::{groups_by_name, read_file, Controller};
+use crate::program::split::{split_to_budget, Budget};
 use crate::program::validate::{Step, ValidationReport};
 use crate::program::{ProgramOptions, ProgramSettings};
 use std::path::Path;
@@ -181,6 +194,12 @@ pub const DEFAULT_PREFLOW_TIME_S: f64 = 0.3;
 /// Default [`AbbOptions::postflow_time_s`] (s): in the 1–2 s usual for
 /// GMAW/CMT on steel (reactive alloys need more). Take the qualified value.
 pub const DEFAULT_POSTFLOW_TIME_S: f64 = 1.5;
+
+/// Default [`AbbOptions::max_file_bytes`]: 2 MB, RoboDK's IRC5 post's
+/// 20 000 lines a module (its ABB post: "5000 recommended for S4, 20000
+/// recommended for IRC5") at the ~100 bytes a line our modules measure
+/// (tests/program/golden/abb_*.mod). ABB publishes no module size limit.
+pub const DEFAULT_MAX_FILE_BYTES: usize = 2_000_000;
 
 /// The prefix of the module's name: `MODULE MOD_<name>` holds `PROC
 /// <name>()`, since a routine and its module may not share a name (RAPID
@@ -290,6 +309,11 @@ const USED_NAMES: &[&str] = &[
     "wWaam",
     "seamWaam",
     "jHome",
+    "loadsession",
+    "StartLoad",
+    "WaitLoad",
+    "UnLoad",
+    "ldWaam",
 ];
 const NUMBERED_NAMES: &[&str] = &["p", "j", "weldWaam", "loadWaam", "z"];
 
@@ -422,6 +446,17 @@ pub struct AbbOptions {
     /// Gas post-flow after the arc ends, shielding the cooling crater (s,
     /// finite, ≥ 0): `seamdata.postflow_time`. Default 1.5 s.
     pub postflow_time_s: f64,
+    /// Most bytes of one module the controller is given at once. A build
+    /// with more is cut between layers into part modules
+    /// (`NAME_P01.mod`, `NAME_P02.mod`, …, [`split`](crate::program::split)),
+    /// each within it, and `NAME.mod` becomes the main module whose entry
+    /// routine loads, runs and unloads them in turn ([`loader`]); a layer
+    /// that does not fit alone is refused. Default
+    /// [`DEFAULT_MAX_FILE_BYTES`].
+    pub max_file_bytes: usize,
+    /// The controller folder the part modules are loaded from (a RAPID
+    /// path, e.g. `HOME:` or `HOME:/waam`). Default `"HOME:"`.
+    pub load_path: String,
     /// The vendor-independent options (home, dwell, interpass wait,
     /// payload, transit, coordination) the validator checks the file
     /// against; not a key of `[program.<vendor>]` (set from `[program]` by
@@ -447,6 +482,8 @@ impl Default for AbbOptions {
             purge_time_s: DEFAULT_PURGE_TIME_S,
             preflow_time_s: DEFAULT_PREFLOW_TIME_S,
             postflow_time_s: DEFAULT_POSTFLOW_TIME_S,
+            max_file_bytes: DEFAULT_MAX_FILE_BYTES,
+            load_path: "HOME:".into(),
             common: Default::default(),
         }
     }
@@ -503,6 +540,21 @@ impl AbbOptions {
                 reason,
             })
         };
+        if self.max_file_bytes == 0 {
+            return bad("max_file_bytes", "0".into(), "must be >= 1");
+        }
+        if self.load_path.is_empty()
+            || !self
+                .load_path
+                .chars()
+                .all(|c| c.is_ascii_graphic() && c != '"' && c != '\\')
+        {
+            return bad(
+                "load_path",
+                self.load_path.clone(),
+                "must be a non-empty controller path of printable ASCII without `\"` or `\\`",
+            );
+        }
         if !(self.approach_speed_mm_s.is_finite() && self.approach_speed_mm_s > 0.0) {
             return bad(
                 "approach_speed_mm_s",
@@ -1078,25 +1130,47 @@ fn check_setup(program: &Program) -> Result<(), ProgramError> {
     Ok(())
 }
 
-/// The `.mod` file of `program`: `<name>.mod`, holding `MODULE
-/// MOD_<name>` with the entry routine `PROC <name>()` (module doc).
+/// The `.mod` files of `program`: `<name>.mod`, holding `MODULE
+/// MOD_<name>` with the entry routine `PROC <name>()` (module doc), when
+/// it fits [`AbbOptions::max_file_bytes`]; else the main module
+/// `<name>.mod` that loads, runs and unloads the part modules in turn
+/// ([`loader`]), then the part modules `<name>_P01.mod`, … (groups of
+/// whole beads, [`split::split_to_budget`](crate::program::split::split_to_budget)),
+/// each a complete module within the budget.
 ///
 /// # Errors
 /// [`ProgramError::InvalidOptions`] for bad options (naming the field) or
-/// a name that cannot name the entry routine ([`check_entry_name`]);
+/// a name that cannot name the entry routine ([`check_entry_name`], group
+/// suffix included); [`ProgramError::OverBudget`] for a bead whose module
+/// alone does not fit `max_file_bytes`;
 /// [`ProgramError::VendorMismatch`] when the cell's robot is not an ABB arm;
 /// [`ProgramError::Mismatch`] for a bead set-up list that does not fit the
 /// beads or holds non-finite values.
 pub fn abb_files(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+    let size = |g: &Program| -> Result<usize, ProgramError> { Ok(abb_module(g, opts)?.text.len()) };
+    let parts = split_to_budget(program, &Abb::budget(opts), size)?;
+    if parts.len() == 1 {
+        return Ok(vec![abb_module(program, opts)?]);
+    }
+    let names: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();
+    let mut out = vec![loader::loader_file(&program.name, &names, opts)?];
+    for part in &parts {
+        out.push(abb_module(part, opts)?);
+    }
+    Ok(out)
+}
+
+/// The one module of `program`.
+fn abb_module(program: &Program, opts: &AbbOptions) -> Result<EmittedFile, ProgramError> {
     check_vendor(&program.cell, Vendor::Abb, EMITTER)?;
     program.check_finite()?;
     check_setup(program)?;
     opts.validate()?;
     check_entry_name(&program.name, opts)?;
-    Ok(vec![EmittedFile {
+    Ok(EmittedFile {
         name: format!("{}.mod", program.name),
         text: render(|w| write_mod(w, program, opts))?,
-    }])
+    })
 }
 
 /// ABB RAPID `.mod` modules: the [`Controller`] implementation.
@@ -1119,6 +1193,72 @@ impl Controller for Abb {
         &opts.common
     }
 
+    fn budget(opts: &AbbOptions) -> Budget {
+        Budget {
+            field: "[program.abb] max_file_bytes",
+            limit: opts.max_file_bytes,
+            unit: "bytes",
+        }
+    }
+
+    /// The bytes of the module (a part module of a build is resident alone
+    /// beside the small main module).
+    fn occupied(files: &[EmittedFile], _read: &read::RapidModule) -> usize {
+        files.iter().map(|f| f.text.len()).sum()
+    }
+
+    /// The part modules in the order the main module loads them, that
+    /// order checked ([`loader::read_loader`]): every part loaded, run and
+    /// unloaded once, in the order of their numbers.
+    fn groups(
+        files: &[EmittedFile],
+        report: &mut ValidationReport,
+    ) -> Result<Vec<Vec<EmittedFile>>, ProgramError> {
+        let (rest, groups) = groups_by_name(files)?;
+        if groups.is_empty() {
+            return Ok(vec![rest]);
+        }
+        let loaders: Vec<&EmittedFile> =
+            rest.iter().filter(|f| loader::is_loader(&f.text)).collect();
+        if let Some(f) = rest.iter().find(|f| !loader::is_loader(&f.text)) {
+            return Err(ProgramError::Read {
+                file: f.name.clone(),
+                line: 0,
+                reason: "neither a part module (NAME_P01, ...) nor the main module loading them"
+                    .into(),
+            });
+        }
+        if let Some(main) = loaders.first() {
+            let loaded = loader::read_loader(main, report);
+            let want: Vec<String> = groups
+                .iter()
+                .map(|g| crate::program::contract::file_stem(&g[0].name).to_string())
+                .collect();
+            let got: Vec<String> = loaded.iter().map(|p| p.routine.clone()).collect();
+            let files: Vec<String> = loaded
+                .iter()
+                .map(|p| {
+                    crate::program::contract::file_stem(loader::path_file(&p.path)).to_string()
+                })
+                .collect();
+            let same = |a: &[String]| {
+                a.len() == want.len() && a.iter().zip(&want).all(|(x, y)| x.eq_ignore_ascii_case(y))
+            };
+            if !(same(&got) && same(&files)) {
+                crate::program::validate::push(
+                    report,
+                    crate::program::validate::ProblemKind::Call,
+                    &main.name,
+                    loaded.first().map_or(0, |p| p.line),
+                    format!(
+                        "the main module loads and calls {got:?} (files {files:?}); the build's part modules are {want:?}, in that order"
+                    ),
+                );
+            }
+        }
+        Ok(groups)
+    }
+
     fn emit(program: &Program, opts: &AbbOptions) -> Result<Vec<EmittedFile>, ProgramError> {
         abb_files(program, opts)
     }
@@ -1132,8 +1272,20 @@ impl Controller for Abb {
         parse_mod(&main.text, &main.name)
     }
 
+    /// The module at `path`; for a main module of part modules, the part
+    /// modules it loads too, read from the same folder by their file names.
     fn files_on_disk(path: &Path) -> Result<Vec<EmittedFile>, ProgramError> {
-        Ok(vec![read_file(path)?])
+        let main = read_file(path)?;
+        if !loader::is_loader(&main.text) {
+            return Ok(vec![main]);
+        }
+        let mut scratch = ValidationReport::default();
+        let parts = loader::read_loader(&main, &mut scratch);
+        let mut out = vec![main];
+        for p in parts {
+            out.push(read_file(&path.with_file_name(loader::path_file(&p.path)))?);
+        }
+        Ok(out)
     }
 
     fn main_file(read: &read::RapidModule) -> &str {

@@ -17,10 +17,15 @@
 //!   switching points are not moved, `Arc End[s]` (or the user's end line).
 //! * The torch-carried cell's positioner is motion group 2 (`GP2`, `J1 J2` =
 //!   `q7 q8` in degrees), `DEFAULT_GROUP = 1,1,*,*,*`.
-//! * Over [`FanucOptions::point_limit`] positions the program is split into
-//!   numbered sub-programs and a main program calling them in order
-//!   ([`split`](crate::program::split)); cuts fall between beads only, so
-//!   every sub-program holds whole beads (arc start and end together).
+//! * **Memory budget.** Sub-programs called from a main program are
+//!   resident together, so the budget counts every position of every
+//!   program resident at once ([`FanucOptions::max_positions`], default
+//!   15 000, the R-30iB's standard program space). A build with more is
+//!   cut between layers into groups, each a complete program the cell
+//!   loads and runs in turn — `NAME_P01.ls`, `NAME_P02.ls`, … (frames,
+//!   home → its beads with their set-up → home) — and no main program
+//!   ([`split`](crate::program::split)); a layer that does not fit alone
+//!   is refused with the numbers.
 //!
 //! * With approach and retract points ([`ArcFlag::Approach`],
 //!   [`ArcFlag::Retract`]) a bead is `J P[a] 10% FINE` (approach point, arc
@@ -123,7 +128,7 @@ use crate::math::Isometry3;
 use crate::program::fmt::{ascii_comment, ceil_to, floor_to, FanucDeg, FanucMm, Fixed};
 use crate::program::frames::{fixed_torch_at, held_tool};
 use crate::program::kinds::{MoveKind, PositionMode};
-use crate::program::split::{chunks, sub_name, DEFAULT_POINT_LIMIT};
+use crate::program::split::{split_to_budget, Budget, DEFAULT_MAX_POSITIONS};
 use crate::program::{
     check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
     ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
@@ -225,10 +230,15 @@ pub struct FanucOptions {
     /// Payload schedule (`PAYLOAD[n]`, `$PLST_GRP1[n]`, 1–10) the program
     /// rewrites and selects at each payload update. Default 1.
     pub payload_schedule: u8,
-    /// Most positions in one program; more are split into sub-programs of
-    /// whole beads, so it must be at least the longest bead's point count
-    /// (approach and retract included). Default 15 000 (R-30iB Plus).
-    pub point_limit: usize,
+    /// The controller's TP program space: the most positions (`P[]`
+    /// records, home included) of every program resident at once. A build
+    /// with more is cut between layers into groups the cell loads in turn
+    /// (`NAME_P01.ls`, `NAME_P02.ls`, …, [`split`](crate::program::split)),
+    /// each within it; a layer that does not fit alone is refused. Default
+    /// 15 000: the standard program space of a one-group R-30iB (more
+    /// needs the R709 TP DRAM/FILE storage option; FANUC R-30iB operator's
+    /// manual, optional functions, B-83284EN-2/05 ch. 29).
+    pub max_positions: usize,
     /// The vendor-independent options (home, dwell, interpass wait,
     /// payload, transit, coordination) the validator checks the file
     /// against; not a key of `[program.<vendor>]` (set from `[program]` by
@@ -254,7 +264,7 @@ impl Default for FanucOptions {
             remote_tcp_frame: 1,
             base_from_torch: None,
             payload_schedule: 1,
-            point_limit: DEFAULT_POINT_LIMIT,
+            max_positions: DEFAULT_MAX_POSITIONS,
             // remote TCP off by default (module doc, "Remote TCP")
             common: crate::program::ProgramOptions {
                 remote_tcp: false,
@@ -299,8 +309,12 @@ impl FanucOptions {
                 "must be in 1..=10",
             ));
         }
-        if self.point_limit == 0 {
-            return Err(bad("point_limit", "0".into(), "must be >= 1"));
+        if self.max_positions < 2 {
+            return Err(bad(
+                "max_positions",
+                self.max_positions.to_string(),
+                "must be >= 2 (a bead has at least two positions)",
+            ));
         }
         if !(1..=9).contains(&self.remote_tcp_frame) {
             return Err(bad(
@@ -774,8 +788,7 @@ pub struct TpProgram {
     /// `/PROG` name.
     pub name: String,
     /// `/ATTR COMMENT` (at most [`COMMENT_MAX`] characters: `waam-slicer`,
-    /// `waam: 3 parts` for a main program, `waam: 1 of 3` for a
-    /// sub-program).
+    /// or `waam: 1 of 3` for group 1 of a build cut to the memory budget).
     pub comment: String,
     /// Motion groups in use (1 or 2).
     pub groups: usize,
@@ -792,24 +805,25 @@ pub struct TpProgram {
     pub positions: Vec<Position>,
 }
 
-/// The FANUC programs of `program`: one program when it has at most
-/// `opts.point_limit` points, else the main program (first, named
-/// `program.name`) and its sub-programs `NAME_001`, `NAME_002`, ... of
-/// whole beads ([`split::chunks`](crate::program::split::chunks)).
+/// The FANUC programs of `program`: one program when its positions (home
+/// included) fit `opts.max_positions`, else the groups of whole beads the
+/// cell loads in turn, `NAME_P01`, `NAME_P02`, … each within it
+/// ([`split::split_to_budget`](crate::program::split::split_to_budget)).
 ///
 /// Every program opens with remarks stating its frames ([`frame_remarks`],
 /// [`FanucOptions::frames`]), then `UFRAME_NUM`/`UTOOL_NUM`. With
 /// `program.home`, the first and the last motion (of the main program when
-/// split) are a joint move to the home joints. Before each bead's first
+/// of each group) are a joint move to the home joints. Before each bead's first
 /// motion come its [`BeadSetup`](crate::program::BeadSetup) instructions:
 /// payload (`$PLST_GRP1[n]` mass and CoG in kg and cm, then `PAYLOAD[n]`),
 /// dwell (`WAIT x.xx(sec)`, rounded up to 0.01 s), interpass wait (`WAIT
 /// DI[n]=ON`).
 ///
 /// # Errors
-/// [`ProgramError::InvalidOptions`] for bad options, a name too long for
-/// the sub-program suffix, or a bead longer than the point limit (field
-/// `point_limit`, naming the layer); [`ProgramError::VendorMismatch`] when the
+/// [`ProgramError::InvalidOptions`] for bad options or a name too long for
+/// the group suffix; [`ProgramError::OverBudget`] for a bead that does not
+/// fit `max_positions` alone (naming the layer and the numbers);
+/// [`ProgramError::VendorMismatch`] when the
 /// cell's robot is not a FANUC arm; [`ProgramError::Mismatch`] when
 /// `program.bead_setup` is not one per bead, or a home or set-up value is
 /// not finite.
@@ -825,6 +839,35 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             reason: "remote TCP (`remote_tcp`) in the part-carried cell needs joint positions: the Cartesian representation of FANUC RTCP programs (RX..RR) is not documented",
         });
     }
+    // every program resident at once within the budget: one program, or
+    // groups of whole beads the cell loads in turn (module doc)
+    let home_positions = usize::from(program.home.is_some());
+    let parts = split_to_budget(program, &Fanuc::budget(opts), |g| {
+        Ok(g.points.len() + home_positions)
+    })?;
+    let n = parts.len();
+    parts
+        .iter()
+        .enumerate()
+        .map(|(k, part)| {
+            check_name(&part.name)?;
+            let comment = if n == 1 {
+                "waam-slicer".to_string()
+            } else {
+                format!("waam: {} of {n}", k + 1)
+            };
+            tp_program(part, opts, &comment)
+        })
+        .collect()
+}
+
+/// One TP program of [`tp_programs`]: `program` whole, named
+/// `program.name`, with `/ATTR COMMENT` `comment`.
+fn tp_program(
+    program: &Program,
+    opts: &FanucOptions,
+    comment: &str,
+) -> Result<TpProgram, ProgramError> {
     let robot = program.cell.robot();
     let frames = opts.frames(&program.cell);
     let user_from_base = frames.base_from_user.inverse();
@@ -893,167 +936,113 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             group2_line: 0,
         })
     };
-    let arcs: Vec<ArcFlag> = program.points.iter().map(|p| p.arc).collect();
-    let ranges = chunks(&arcs, opts.point_limit).map_err(|b| ProgramError::InvalidOptions {
-        field: "point_limit",
-        value: format!(
-            "{} (the bead of layer {} has {} points with its approach and retract)",
-            opts.point_limit, program.points[b.first].layer, b.len
-        ),
-        reason: "a sub-program holds whole beads: the limit must be at least the longest bead's point count",
-    })?;
-    let split = ranges.len() > 1;
-    let mut out = Vec::new();
-    if split {
-        let names: Vec<String> = (1..=ranges.len())
-            .map(|k| sub_name(&program.name, k))
-            .collect();
-        check_name(names.last().expect("at least two chunks"))?;
-        let mut ins = Vec::new();
-        let mut positions = Vec::new();
-        if let Some(h) = home_record(1) {
-            ins.extend(frame_header(program, opts, &frames));
-            positions.push(h);
-            ins.push(joint_move(1));
-        }
-        ins.extend(names.into_iter().map(|n| Instruction {
+    let range = 0..program.points.len();
+    let mut ins = frame_header(program, opts, &frames);
+    if range
+        .clone()
+        .any(|i| !joint_move_target(program, i) && opts.segment_time_based(program, i))
+    {
+        ins.push(Instruction {
             line: 0,
-            op: Op::Call(n),
-        }));
-        if home.is_some() {
-            ins.push(joint_move(1));
-        }
-        out.push(TpProgram {
-            name: program.name.clone(),
-            comment: attr_comment(&format!("waam: {} parts", ranges.len())),
-            groups,
-            arc_welding,
-            arc_enabled: arc_welding,
-            remote_tcp: false,
-            instructions: ins,
-            positions,
+            op: Op::Remark(TIME_BASED_REMARK.into()),
         });
     }
-    for (k, range) in ranges.iter().enumerate() {
-        let mut ins = frame_header(program, opts, &frames);
-        if range
-            .clone()
-            .any(|i| !joint_move_target(program, i) && opts.segment_time_based(program, i))
-        {
-            ins.push(Instruction {
-                line: 0,
-                op: Op::Remark(TIME_BASED_REMARK.into()),
-            });
-        }
-        let mut positions = Vec::with_capacity(range.len() + 1);
-        // the home record follows the points, so that P[n] is point n
-        let home_index = range.len() + 1;
-        if !split && home.is_some() {
-            ins.push(joint_move(home_index));
-        }
-        for (local, p) in program.points[range.clone()].iter().enumerate() {
-            let index = local + 1;
-            let global = range.start + local;
-            let prev = global.checked_sub(1).map(|g| &program.points[g]);
-            let arm = match opts.positions {
-                PositionMode::Cartesian if !near_turn_edge(&p.joints) => {
-                    let pose =
-                        user_from_base * robot.flange_pose(&p.joints) * frames.flange_from_tool;
-                    ArmPosition::Cartesian {
-                        xyzwpr: FanucPose::from_isometry(&pose).to_xyzwpr_deg(),
-                        config: robot.fanuc_config(&p.joints).to_string(),
-                    }
-                }
-                _ => ArmPosition::Joint(p.joints.map(f64::to_degrees)),
-            };
-            positions.push(Position {
-                index,
-                uf_ut: (frames.user_frame, frames.tool_frame),
-                arm,
-                group2: p.positioner.map(|q| q.map(f64::to_degrees)),
-                line: 0,
-                value_lines: [0; 6],
-                group2_line: 0,
-            });
-            if let Some(b) = bead_of[global] {
-                if let Some(setup) = program.bead_setup.get(b) {
-                    ins.extend(
-                        setup_ops(setup, opts)
-                            .into_iter()
-                            .map(|op| Instruction { line: 0, op }),
-                    );
+    let mut positions = Vec::with_capacity(range.len() + 1);
+    // the home record follows the points, so that P[n] is point n
+    let home_index = range.len() + 1;
+    if home.is_some() {
+        ins.push(joint_move(home_index));
+    }
+    for (local, p) in program.points[range.clone()].iter().enumerate() {
+        let index = local + 1;
+        let global = range.start + local;
+        let prev = global.checked_sub(1).map(|g| &program.points[g]);
+        let arm = match opts.positions {
+            PositionMode::Cartesian if !near_turn_edge(&p.joints) => {
+                let pose = user_from_base * robot.flange_pose(&p.joints) * frames.flange_from_tool;
+                ArmPosition::Cartesian {
+                    xyzwpr: FanucPose::from_isometry(&pose).to_xyzwpr_deg(),
+                    config: robot.fanuc_config(&p.joints).to_string(),
                 }
             }
-            let linear = |speed, term| Instruction {
-                line: 0,
-                op: Op::Move {
-                    kind: MoveKind::Linear,
-                    position: index,
-                    speed,
-                    term,
-                    options,
-                },
-            };
-            match p.arc {
-                ArcFlag::Approach => ins.push(joint_move(index)),
-                ArcFlag::Start => {
-                    ins.push(match prev {
-                        Some(a) if a.arc == ArcFlag::Approach => {
-                            linear(linear_speed(global, a.speed_mm_s), Termination::Fine)
-                        }
-                        _ => joint_move(index),
-                    });
-                    ins.push(Instruction {
-                        line: 0,
-                        op: start_op.clone(),
-                    });
-                }
-                ArcFlag::On => ins.push(linear(
-                    linear_speed(global, p.speed_mm_s),
-                    Termination::Cnt(opts.cnt),
-                )),
-                ArcFlag::End => {
-                    ins.push(linear(
-                        linear_speed(global, p.speed_mm_s),
-                        Termination::Fine,
-                    ));
-                    ins.push(Instruction {
-                        line: 0,
-                        op: end_op.clone(),
-                    });
-                }
-                ArcFlag::Retract => ins.push(linear(
+            _ => ArmPosition::Joint(p.joints.map(f64::to_degrees)),
+        };
+        positions.push(Position {
+            index,
+            uf_ut: (frames.user_frame, frames.tool_frame),
+            arm,
+            group2: p.positioner.map(|q| q.map(f64::to_degrees)),
+            line: 0,
+            value_lines: [0; 6],
+            group2_line: 0,
+        });
+        if let Some(b) = bead_of[global] {
+            if let Some(setup) = program.bead_setup.get(b) {
+                ins.extend(
+                    setup_ops(setup, opts)
+                        .into_iter()
+                        .map(|op| Instruction { line: 0, op }),
+                );
+            }
+        }
+        let linear = |speed, term| Instruction {
+            line: 0,
+            op: Op::Move {
+                kind: MoveKind::Linear,
+                position: index,
+                speed,
+                term,
+                options,
+            },
+        };
+        match p.arc {
+            ArcFlag::Approach => ins.push(joint_move(index)),
+            ArcFlag::Start => {
+                ins.push(match prev {
+                    Some(a) if a.arc == ArcFlag::Approach => {
+                        linear(linear_speed(global, a.speed_mm_s), Termination::Fine)
+                    }
+                    _ => joint_move(index),
+                });
+                ins.push(Instruction {
+                    line: 0,
+                    op: start_op.clone(),
+                });
+            }
+            ArcFlag::On => ins.push(linear(
+                linear_speed(global, p.speed_mm_s),
+                Termination::Cnt(opts.cnt),
+            )),
+            ArcFlag::End => {
+                ins.push(linear(
                     linear_speed(global, p.speed_mm_s),
                     Termination::Fine,
-                )),
+                ));
+                ins.push(Instruction {
+                    line: 0,
+                    op: end_op.clone(),
+                });
             }
+            ArcFlag::Retract => ins.push(linear(
+                linear_speed(global, p.speed_mm_s),
+                Termination::Fine,
+            )),
         }
-        if !split {
-            if let Some(h) = home_record(home_index) {
-                positions.push(h);
-                ins.push(joint_move(home_index));
-            }
-        }
-        out.push(TpProgram {
-            name: if split {
-                sub_name(&program.name, k + 1)
-            } else {
-                program.name.clone()
-            },
-            comment: attr_comment(&if split {
-                format!("waam: {} of {}", k + 1, ranges.len())
-            } else {
-                "waam-slicer".into()
-            }),
-            groups,
-            arc_welding,
-            arc_enabled: arc_welding,
-            remote_tcp: options.rtcp,
-            instructions: ins,
-            positions,
-        });
     }
-    Ok(out)
+    if let Some(h) = home_record(home_index) {
+        positions.push(h);
+        ins.push(joint_move(home_index));
+    }
+    Ok(TpProgram {
+        name: program.name.clone(),
+        comment: attr_comment(comment),
+        groups,
+        arc_welding,
+        arc_enabled: arc_welding,
+        remote_tcp: options.rtcp,
+        instructions: ins,
+        positions,
+    })
 }
 
 /// Fraction of a joint's (or positioner axis's) maximum speed above which
@@ -1359,7 +1348,8 @@ pub fn write_ls(w: &mut dyn Write, tp: &TpProgram) -> std::io::Result<()> {
     Ok(())
 }
 
-/// The `.ls` files of `program` (main program first when split).
+/// The `.ls` files of `program`: one, or its groups in the order the cell
+/// runs them ([`tp_programs`]).
 ///
 /// # Errors
 /// As [`tp_programs`].
@@ -1395,6 +1385,20 @@ impl Controller for Fanuc {
 
     fn common(opts: &FanucOptions) -> &ProgramOptions {
         &opts.common
+    }
+
+    fn budget(opts: &FanucOptions) -> Budget {
+        Budget {
+            field: "[program.fanuc] max_positions",
+            limit: opts.max_positions,
+            unit: "positions",
+        }
+    }
+
+    /// Every `P[]` record of the programs read together (a main program
+    /// and what it calls are resident at once).
+    fn occupied(_files: &[EmittedFile], read: &Vec<TpProgram>) -> usize {
+        read.iter().map(|p| p.positions.len()).sum()
     }
 
     fn emit(program: &Program, opts: &FanucOptions) -> Result<Vec<EmittedFile>, ProgramError> {

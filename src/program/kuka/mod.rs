@@ -87,6 +87,12 @@
 //!   payload (`$LOAD.M` kg, `$LOAD.CM` mm in the flange frame, `$LOAD.J`
 //!   of a point mass), dwell (`WAIT SEC`) and interpass wait (`WAIT FOR
 //!   $IN[n]`).
+//! * **Memory budget** ([`KukaOptions::max_file_bytes`], default 2 MB for
+//!   the `.src` and `.dat` together): a larger build is cut between layers
+//!   into several complete programs, `NAME_P01.src`/`.dat`,
+//!   `NAME_P02.src`/`.dat`, … (each from home to home, with its own
+//!   declarations, interrupt and set-up), which the cell selects and runs
+//!   in turn ([`split`](crate::program::split)).
 //! * **Part-carried cell: external TCP.** `$VEL.CP` is the speed of the TCP;
 //!   the planned speed is the torch's relative to the part. In the
 //!   part-carried cell the emitter switches to KUKA's fixed-tool mode,
@@ -128,6 +134,7 @@ pub use decode::validate_kuka;
 pub use read::parse_krl;
 
 use crate::program::contract::{read_file, Controller};
+use crate::program::split::{split_to_budget, Budget};
 use crate::program::validate::{Step, ValidationReport};
 use crate::program::{ProgramOptions, ProgramSettings};
 use std::path::Path;
@@ -150,6 +157,14 @@ use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel, Vendor};
 
 /// The emitter's name in [`ProgramError::VendorMismatch`].
 pub const EMITTER: &str = "KUKA KRL";
+
+/// Default [`KukaOptions::max_file_bytes`]: 2 MB, half of the lower end
+/// of the 4–8 MB of programs in total that KR C4 users report
+/// (robot-forum field reports; KUKA publishes no figure), leaving the rest
+/// for the cell's own programs and the system's; far above RoboDK's KUKA
+/// posts' 1 400 (KR C2) to 2 500 lines a program, which no KR C4 limit
+/// requires.
+pub const DEFAULT_MAX_FILE_BYTES: usize = 2_000_000;
 
 /// Longest KRL name (`DEF`, `DEFDAT`, characters).
 pub const KRL_NAME_MAX: usize = 24;
@@ -221,6 +236,13 @@ pub struct KukaOptions {
     /// 1, 2, 4–39 or 81–128 (1 the highest; 3 and 40–80 are the system's).
     /// Default 20 (our choice, inside 4–39 and clear of ArcTech's 3).
     pub arc_loss_interrupt: u8,
+    /// Most bytes of one program (its `.src` and `.dat` together) the
+    /// controller is given at once. A build with more is cut between
+    /// layers into groups, each a complete program the cell selects and
+    /// runs in turn (`NAME_P01.src`/`.dat`, `NAME_P02.src`/`.dat`, …,
+    /// [`split`](crate::program::split)); a layer that does not fit alone
+    /// is refused. Default [`DEFAULT_MAX_FILE_BYTES`].
+    pub max_file_bytes: usize,
     /// The vendor-independent options (home, dwell, interpass wait,
     /// payload, transit, coordination) the validator checks the file
     /// against; not a key of `[program.<vendor>]` (set from `[program]` by
@@ -250,6 +272,7 @@ impl Default for KukaOptions {
             ek_machine: 2,
             arc_loss: ArcLoss::Abort,
             arc_loss_interrupt: 20,
+            max_file_bytes: DEFAULT_MAX_FILE_BYTES,
             common: Default::default(),
         }
     }
@@ -331,6 +354,9 @@ impl KukaOptions {
             value,
             reason,
         };
+        if self.max_file_bytes == 0 {
+            return Err(bad("max_file_bytes", "0".into(), "must be >= 1"));
+        }
         if !(self.cdis_mm.is_finite() && self.cdis_mm > 0.0) {
             return Err(bad(
                 "cdis_mm",
@@ -1143,13 +1169,31 @@ pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     Ok(())
 }
 
-/// The `.src` and `.dat` files of `program`.
+/// The `.src` and `.dat` files of `program`: one pair when its bytes fit
+/// [`KukaOptions::max_file_bytes`], else one pair per group of whole beads,
+/// `NAME_P01`, `NAME_P02`, … in the order the cell runs them
+/// ([`split::split_to_budget`](crate::program::split::split_to_budget)).
 ///
 /// # Errors
 /// [`ProgramError::InvalidOptions`] for bad options or a bad name (or one
-/// longer than [`KRL_NAME_MAX`]); [`ProgramError::VendorMismatch`] when the
-/// cell's robot is not a KUKA arm.
+/// longer than [`KRL_NAME_MAX`], group suffix included);
+/// [`ProgramError::OverBudget`] for a bead whose program alone does not
+/// fit `max_file_bytes`; [`ProgramError::VendorMismatch`] when the cell's
+/// robot is not a KUKA arm.
 pub fn kuka_files(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFile>, ProgramError> {
+    let size = |g: &Program| -> Result<usize, ProgramError> {
+        Ok(kuka_pair(g, opts)?.iter().map(|f| f.text.len()).sum())
+    };
+    let parts = split_to_budget(program, &Kuka::budget(opts), size)?;
+    let mut out = Vec::with_capacity(2 * parts.len());
+    for part in &parts {
+        out.extend(kuka_pair(part, opts)?);
+    }
+    Ok(out)
+}
+
+/// The `.src` and `.dat` of `program` as one KRL program.
+fn kuka_pair(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFile>, ProgramError> {
     check_vendor(&program.cell, Vendor::Kuka, EMITTER)?;
     program.check_finite()?;
     opts.validate()?;
@@ -1210,6 +1254,19 @@ impl Controller for Kuka {
 
     fn common(opts: &KukaOptions) -> &ProgramOptions {
         &opts.common
+    }
+
+    fn budget(opts: &KukaOptions) -> Budget {
+        Budget {
+            field: "[program.kuka] max_file_bytes",
+            limit: opts.max_file_bytes,
+            unit: "bytes",
+        }
+    }
+
+    /// The bytes of the `.src` and `.dat` read together.
+    fn occupied(files: &[EmittedFile], _read: &read::KrlProgram) -> usize {
+        files.iter().map(|f| f.text.len()).sum()
     }
 
     fn emit(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFile>, ProgramError> {

@@ -376,71 +376,7 @@ fn check_setup(
     bead: &[bool],
     report: &mut ValidationReport,
 ) {
-    let motions: Vec<(usize, &Motion)> = steps
-        .iter()
-        .enumerate()
-        .filter_map(|(i, s)| match s {
-            Step::Motion(m) => Some((i, m.as_ref())),
-            _ => None,
-        })
-        .collect();
-    if let Some(h) = common.home(cell) {
-        // an endless turn written modulo 360° is home at any whole turn
-        let modulo = crate::program::contract::turn_modulo(cell);
-        let turn_difference = |n: usize, d: f64| {
-            if modulo && n == 1 {
-                crate::robot::ik::wrap_pi(d)
-            } else {
-                d
-            }
-        };
-        let is_home =
-            |m: &Motion| {
-                m.kind == MoveKind::Joint
-                    && m.joints.is_some_and(|q| {
-                        q.iter()
-                            .zip(h.joints)
-                            .all(|(a, b)| (a - b).abs() <= HOME_TOLERANCE_RAD)
-                    })
-                    && match (h.positioner, m.positioner) {
-                        (Some(a), Some(b)) => a.iter().zip(b).enumerate().all(|(n, (x, y))| {
-                            turn_difference(n, x - y).abs() <= HOME_TOLERANCE_RAD
-                        }),
-                        (None, _) => true,
-                        (Some(_), None) => false,
-                    }
-            };
-        let home_deg = |h: &crate::program::HomePosition| {
-            h.joints
-                .iter()
-                .map(|v| format!("{:.3}", v.to_degrees()))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        for (which, m) in [("first", motions.first()), ("last", motions.last())] {
-            match m {
-                Some((_, m)) if !is_home(m) => push(
-                    report,
-                    ProblemKind::Setup,
-                    &m.file,
-                    m.line,
-                    format!(
-                        "the {which} motion ({}) is not a joint move to the cell's home [{}] deg",
-                        m.label,
-                        home_deg(&h)
-                    ),
-                ),
-                None => push(
-                    report,
-                    ProblemKind::Setup,
-                    "",
-                    0,
-                    "no motion: the cell's home position is never reached".into(),
-                ),
-                _ => {}
-            }
-        }
-    }
+    check_home_ends(steps, cell, common, [true, true], report);
     // what happens before each bead: from the end of the previous bead (or
     // the program start) to the bead's process-on
     let part_carried = matches!(cell, Cell::PartCarried(_));
@@ -567,6 +503,90 @@ fn check_setup(
     }
     if common.transit_check {
         check_transits(steps, cell, common, bead, report);
+    }
+}
+
+/// Checks that the first (`ends[0]`) and the last (`ends[1]`) motion of
+/// `steps` are joint moves to the cell's home, when `common` has one: a
+/// whole program's, or those of one group of a build cut to the memory
+/// budget (each group starts and ends at home).
+pub(crate) fn check_home_ends(
+    steps: &[Step],
+    cell: &Cell,
+    common: &ProgramOptions,
+    ends: [bool; 2],
+    report: &mut ValidationReport,
+) {
+    let motions: Vec<(usize, &Motion)> = steps
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| match s {
+            Step::Motion(m) => Some((i, m.as_ref())),
+            _ => None,
+        })
+        .collect();
+    if let Some(h) = common.home(cell) {
+        // an endless turn written modulo 360° is home at any whole turn
+        let modulo = crate::program::contract::turn_modulo(cell);
+        let turn_difference = |n: usize, d: f64| {
+            if modulo && n == 1 {
+                crate::robot::ik::wrap_pi(d)
+            } else {
+                d
+            }
+        };
+        let is_home =
+            |m: &Motion| {
+                m.kind == MoveKind::Joint
+                    && m.joints.is_some_and(|q| {
+                        q.iter()
+                            .zip(h.joints)
+                            .all(|(a, b)| (a - b).abs() <= HOME_TOLERANCE_RAD)
+                    })
+                    && match (h.positioner, m.positioner) {
+                        (Some(a), Some(b)) => a.iter().zip(b).enumerate().all(|(n, (x, y))| {
+                            turn_difference(n, x - y).abs() <= HOME_TOLERANCE_RAD
+                        }),
+                        (None, _) => true,
+                        (Some(_), None) => false,
+                    }
+            };
+        let home_deg = |h: &crate::program::HomePosition| {
+            h.joints
+                .iter()
+                .map(|v| format!("{:.3}", v.to_degrees()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        for ((which, m), check) in [("first", motions.first()), ("last", motions.last())]
+            .into_iter()
+            .zip(ends)
+        {
+            if !check {
+                continue;
+            }
+            match m {
+                Some((_, m)) if !is_home(m) => push(
+                    report,
+                    ProblemKind::Setup,
+                    &m.file,
+                    m.line,
+                    format!(
+                        "the {which} motion ({}) is not a joint move to the cell's home [{}] deg",
+                        m.label,
+                        home_deg(&h)
+                    ),
+                ),
+                None => push(
+                    report,
+                    ProblemKind::Setup,
+                    "",
+                    0,
+                    "no motion: the cell's home position is never reached".into(),
+                ),
+                _ => {}
+            }
+        }
     }
 }
 

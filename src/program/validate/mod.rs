@@ -22,6 +22,7 @@
 mod between;
 mod check;
 
+pub(crate) use check::check_home_ends;
 pub use check::check_steps;
 
 use std::fmt;
@@ -92,6 +93,9 @@ pub enum ProblemKind {
     Setup,
     /// An arc-off joint move sweeps the torch through the deposited wall.
     Collision,
+    /// A program (or a group of a build) larger than the controller's
+    /// memory budget (`max_positions`, `max_file_bytes`).
+    Budget,
 }
 
 impl ProblemKind {
@@ -114,6 +118,7 @@ impl ProblemKind {
             Self::Format => "format",
             Self::Setup => "setup",
             Self::Collision => "collision",
+            Self::Budget => "budget",
         }
     }
 }
