@@ -19,17 +19,47 @@ pub type Isometry3 = nalgebra::Isometry3<f64>;
 /// A 3-D translation (mm).
 pub type Translation3 = nalgebra::Translation3<f64>;
 
-/// Named tolerances. Lengths in mm, angles in rad.
+/// Named tolerances shared by more than one stage, each with what it guards.
+///
+/// Lengths in mm, angles in rad; "relative" ones multiply a scale the call
+/// site names. A tolerance used by one module only is a named `const` at the
+/// top of that module instead. The values are the ones the code has always
+/// used: changing one changes output.
 pub mod tol {
-    /// Two points closer than this are the same point (mm).
+    /// Two points closer than this are the same point (mm): coincident spline
+    /// control points, a start point already on the substrate.
     pub const LENGTH_MM: f64 = 1e-9;
-    /// Angular tolerance for parallel / perpendicular tests (rad).
+    /// Angular tolerance for parallel / perpendicular tests (rad, or the sine
+    /// or cosine of the angle between unit vectors): a unit vector with a
+    /// direction projected out that is shorter than this is parallel to that
+    /// direction; two unit directions whose dot product is below it are
+    /// perpendicular.
     pub const ANGLE_RAD: f64 = 1e-9;
     /// Relative tolerance used when a vector is normalised: below this norm
-    /// (relative to the scale of the problem) it is treated as zero.
+    /// (relative to the scale of the problem) it is treated as zero. Also the
+    /// norm below which `Unit::try_new` refuses a direction read from input.
     pub const DEGENERATE: f64 = 1e-12;
-    /// Tolerance on a curve parameter `t` found by root finding (parameter units).
+    /// Tolerance on a curve parameter `t` found by root finding, relative to
+    /// `1 + |t|` (parameter units): the constant-distance layer step.
     pub const PARAM: f64 = 1e-12;
+    /// The finer tolerance on a curve parameter `t` found by Brent's method
+    /// (parameter units; relative to `1 + |t|` in the layer strategies,
+    /// absolute where the first layer meets a mesh substrate): iso-parametric,
+    /// planar and spiral steps, substrate hits.
+    pub const PARAM_FINE: f64 = 1e-13;
+    /// Distance between two consecutive path points (mm) below which they are
+    /// treated as one: no chord direction or rate per mm is taken over it.
+    pub const ZERO_LENGTH_MM: f64 = 1e-12;
+    /// Angle (rad) a tool axis must have turned by to count as changed by a
+    /// rule (rate bound, collision avoidance) in the point counts reported.
+    pub const AXIS_MOVED_RAD: f64 = 1e-12;
+    /// Floor of a divisor that may be exactly zero (same unit as the divisor):
+    /// keeps a ratio finite without changing any divisor of real size.
+    pub const DIV_FLOOR: f64 = 1e-300;
+    /// Floor of an objective value used as a scale (the objective's units):
+    /// relative gains of a layer's optimisation are measured against at least
+    /// this, so a seed already at zero does not divide by zero.
+    pub const OBJECTIVE_SCALE_FLOOR: f64 = 1e-6;
 }
 
 /// Outcome of a bracketed 1-D root find.

@@ -4,8 +4,12 @@
 
 use super::guide::GuideCurve;
 use super::GeometryError;
-use crate::math::{any_perpendicular, Vector3};
+use crate::math::{any_perpendicular, tol, Vector3};
 use serde::{Deserialize, Serialize};
+
+/// Curvature (1/mm) below which the Frenet frame is undefined: the principal
+/// normal of a straight stretch is rounding noise.
+const FRENET_MIN_CURVATURE_PER_MM: f64 = 1e-9;
 
 /// How the profile's `v = 0` direction is carried along the guide.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -95,7 +99,7 @@ impl FrameField {
                 let r0 = match reference {
                     Some(r) => {
                         let p = r - t0 * t0.dot(&r);
-                        if !(p.norm() > 1e-9 * r.norm()) {
+                        if !(p.norm() > tol::ANGLE_RAD * r.norm()) {
                             return Err(GeometryError::InvalidField {
                                 field: "frame.reference".into(),
                                 reason: "is parallel to the guide tangent at t_min".into(),
@@ -266,14 +270,17 @@ fn unit(v: Vector3) -> Vector3 {
     }
 }
 
-/// Frenet frame at `t`, `None` where the curvature is below 1e-9 /mm.
+/// Frenet frame at `t`, `None` where the curvature is below [`FRENET_MIN_CURVATURE_PER_MM`].
 fn frenet(curve: &dyn GuideCurve, t: f64) -> Option<Frame> {
     let d1 = curve.d1(t);
     let d2 = curve.d2(t);
     let speed = d1.norm();
     let c = d1.cross(&d2);
     let cn = c.norm();
-    if !(speed > 0.0) || !(cn / (speed * speed * speed) > 1e-9) || !cn.is_finite() {
+    if !(speed > 0.0)
+        || !(cn / (speed * speed * speed) > FRENET_MIN_CURVATURE_PER_MM)
+        || !cn.is_finite()
+    {
         return None;
     }
     let tan = d1 / speed;
@@ -310,7 +317,7 @@ fn reflect_step(curve: &dyn GuideCurve, ta: f64, tb: f64, r: Vector3) -> Vector3
     let t_l = tan_a - v1 * (2.0 / c1 * v1.dot(&tan_a));
     let v2 = tan_b - t_l;
     let c2 = v2.norm_squared();
-    if !(c2 > 1e-300) {
+    if !(c2 > tol::DIV_FLOOR) {
         return r_l;
     }
     r_l - v2 * (2.0 / c2 * v2.dot(&r_l))

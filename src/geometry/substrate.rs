@@ -5,10 +5,15 @@
 
 use super::tube::Tube;
 use super::GeometryError;
-use crate::math::{self, Point3, UnitVector3, Vector3};
+use crate::math::{self, tol, Point3, UnitVector3, Vector3};
 use parry3d_f64::query::{Ray, RayCast};
 use parry3d_f64::shape::TriMesh;
 use std::f64::consts::TAU;
+
+/// Signed distance (mm) at which a point scanned along an iso-v line is on
+/// an analytic substrate: the scan stops there, and Brent's method stops at a
+/// residual this small.
+const ON_SUBSTRATE_MM: f64 = 1e-12;
 
 /// Largest STL file accepted (bytes): 256 MiB, about 5 million triangles.
 pub const MAX_STL_BYTES: u64 = 256 * 1024 * 1024;
@@ -294,7 +299,7 @@ impl Substrate {
                         let hp = ray.point_at(hit.time_of_impact);
                         let n = hit.normal;
                         let g = |t: f64| (tube.point(t, v) - hp).dot(&n);
-                        return Ok(match math::brent(g, ta, tb, 1e-13, 0.0) {
+                        return Ok(match math::brent(g, ta, tb, tol::PARAM_FINE, 0.0) {
                             Ok(r) => r.x,
                             Err(_) => ta + hit.time_of_impact * dt,
                         });
@@ -311,7 +316,7 @@ impl Substrate {
                 if !f0.is_finite() {
                     return Err(miss("signed distance is not finite"));
                 }
-                if f0.abs() <= 1e-9 {
+                if f0.abs() <= tol::LENGTH_MM {
                     return Ok(lo);
                 }
                 let mut ta = lo;
@@ -319,11 +324,11 @@ impl Substrate {
                 for k in 1..=steps {
                     let tb = lo + k as f64 * dt;
                     let fb = f(tb);
-                    if fb.abs() <= 1e-12 {
+                    if fb.abs() <= ON_SUBSTRATE_MM {
                         return Ok(tb);
                     }
                     if fa * fb < 0.0 {
-                        return math::brent(f, ta, tb, 1e-13, 1e-12)
+                        return math::brent(f, ta, tb, tol::PARAM_FINE, ON_SUBSTRATE_MM)
                             .map(|r| r.x)
                             .map_err(|_| miss("root finding failed"));
                     }

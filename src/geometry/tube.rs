@@ -9,6 +9,13 @@ use super::GeometryError;
 use crate::math::{self, Point3, UnitVector3, Vector3};
 use std::sync::Arc;
 
+/// A guide whose speed times the parameter span is below this fraction of
+/// its size (relative) has a zero derivative there: no frame can be built.
+const ZERO_SPEED_REL: f64 = 1e-9;
+/// Newton on the arc length ([`Tube::t_at_arc_length`]) stops when its step is
+/// below this fraction of `1 + |t|` (relative, parameter units).
+const ARC_STEP_REL_TOL: f64 = 1e-14;
+
 /// Number of samples of the validity check along the guide (plus the range ends).
 const VALIDITY_SAMPLES: usize = 4096;
 
@@ -130,7 +137,7 @@ impl Tube {
                     t,
                 });
             }
-            if d1.norm() * (hi - lo) <= 1e-9 * span {
+            if d1.norm() * (hi - lo) <= ZERO_SPEED_REL * span {
                 return Err(GeometryError::ZeroDerivative { t });
             }
             let a = profile.radius(t);
@@ -286,7 +293,7 @@ impl Tube {
             let f = self.arc_from_eval_min(t) - target;
             let step = f / self.guide.d1(t).norm();
             t -= step;
-            if step.abs() < 1e-14 * (1.0 + t.abs()) {
+            if step.abs() < ARC_STEP_REL_TOL * (1.0 + t.abs()) {
                 break;
             }
         }

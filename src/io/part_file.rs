@@ -10,7 +10,7 @@ pub use crate::geometry::Plane;
 use crate::geometry::{
     FrameMethod, GeometryError, MeshSubstrate, ProfileLaw, ProfilePiece, Substrate, Tube, TubeRange,
 };
-use crate::math::{Point3, UnitVector3, Vector3};
+use crate::math::{tol, Point3, UnitVector3, Vector3};
 pub use crate::path::{Discretisation, Strategy};
 use crate::path::{EndRule, SliceOptions};
 use crate::process::{ProcessParameters, ProcessPreset};
@@ -614,7 +614,7 @@ impl Ctx<'_> {
 
     fn unit(&self, field: &str, v: &Vec3Field) -> Result<UnitVector3, PartFileError> {
         let x = self.vec3(field, v)?;
-        UnitVector3::try_new(x, 1e-12)
+        UnitVector3::try_new(x, tol::DEGENERATE)
             .ok_or_else(|| self.field(field, "must be a non-zero direction"))
     }
 
@@ -636,7 +636,7 @@ impl Ctx<'_> {
             } => {
                 let e1 = self.unit("guide.radial0", radial0)?;
                 let e2 = self.unit("guide.tangent0", tangent0)?;
-                if e1.dot(&e2).abs() > 1e-9 {
+                if e1.dot(&e2).abs() > tol::ANGLE_RAD {
                     return Err(
                         self.field("guide.tangent0", "must be perpendicular to guide.radial0")
                     );
@@ -657,7 +657,7 @@ impl Ctx<'_> {
             } => {
                 let a = self.unit("guide.axis", axis)?;
                 let e1 = self.unit("guide.radial0", radial0)?;
-                if a.dot(&e1).abs() > 1e-9 {
+                if a.dot(&e1).abs() > tol::ANGLE_RAD {
                     return Err(self.field("guide.radial0", "must be perpendicular to guide.axis"));
                 }
                 Arc::new(Helix {

@@ -16,6 +16,7 @@ use super::{
     ConfigurationChoice, ConfigurationChoiceReport, LayerPlan, LayerQuality, LayerStatus,
     ObjectiveReport, OptimiseOptions, Parameterisation, PlannedPoint, RzLaw, SolverReport,
 };
+use crate::math::tol;
 use crate::robot::cell::Cell;
 use crate::robot::ik::Configuration;
 
@@ -306,7 +307,9 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
 /// Objective scale of a layer: its value at the seed (bounded below).
 fn scale_of(problem: &LayerProblem, r: &[f64], smoothness: f64) -> f64 {
     match problem.evaluate(r) {
-        Ok(e) => problem.objective(&e, smoothness).max(1e-6),
+        Ok(e) => problem
+            .objective(&e, smoothness)
+            .max(tol::OBJECTIVE_SCALE_FLOOR),
         Err(_) => 1.0,
     }
 }

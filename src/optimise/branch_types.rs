@@ -8,6 +8,7 @@
 use super::parameterisation::Basis;
 use super::problem::{Evaluation, PointFailure};
 use super::{sqp, RzLaw};
+use crate::math::tol;
 use crate::robot::ik::Configuration;
 use crate::robot::Joints;
 
@@ -95,7 +96,7 @@ fn improves(new: (f64, f64), best: Option<(f64, f64)>) -> bool {
 /// feasible; infinite otherwise (keep raising).
 fn relative_gain(new: (f64, f64), best: Option<(f64, f64)>) -> f64 {
     match best {
-        Some((bv, bf)) if bv <= 0.0 && new.0 <= 0.0 => (bf - new.1) / bf.abs().max(1e-300),
+        Some((bv, bf)) if bv <= 0.0 && new.0 <= 0.0 => (bf - new.1) / bf.abs().max(tol::DIV_FLOOR),
         _ => f64::INFINITY,
     }
 }

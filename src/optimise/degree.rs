@@ -8,6 +8,12 @@ use super::parameterisation::Basis;
 use super::problem::{Evaluation, LayerProblem, PointFailure};
 use super::setup::LayerSetup;
 use super::{sqp, RzLaw, SqpOptions};
+use crate::math::tol;
+
+/// Floor of the model step (rad) within whose reach constraints are looked
+/// for before skipping a degree raise: a zero step still sees the constraints
+/// at the edge.
+const MIN_REACH_STEP_RAD: f64 = 1e-6;
 
 /// Records `best` (with the objective of every degree solved, `history`)
 /// as `outcome`'s law and evaluation.
@@ -44,7 +50,7 @@ pub(super) fn degree_loop(
 ) -> Result<(Best, Vec<(usize, f64)>), PointFailure> {
     let e0 = problem.evaluate(&basis.eval(&c)).ok();
     let scale = match &e0 {
-        Some(e) => problem.objective(e, 0.0).max(1e-6),
+        Some(e) => problem.objective(e, 0.0).max(tol::OBJECTIVE_SCALE_FLOOR),
         None => 1.0,
     };
     let mut history = Vec::new();
@@ -160,6 +166,6 @@ pub(super) fn skip_raise(
     };
     gain < RAISE_MODEL_FRACTION * threshold
         && problem
-            .constraint_rows(e, raised, step.max(1e-6))
+            .constraint_rows(e, raised, step.max(MIN_REACH_STEP_RAD))
             .is_empty()
 }

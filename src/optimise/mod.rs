@@ -126,7 +126,7 @@ mod tests;
 
 pub use options::{
     Abscissa, ConfigurationChoice, DexterityFloor, Objective, OptimiseOptions, Parameterisation,
-    SqpOptions,
+    SqpOptions, DEFAULT_STOP_RELATIVE_GAIN,
 };
 pub use outcome::{
     Binding, ConfigurationChoiceReport, Constraint, LayerPlan, LayerQuality, LayerStatus,

@@ -6,6 +6,19 @@ use serde::{Deserialize, Serialize};
 use crate::optimise::OptimiseError;
 use crate::robot::trajectory::TrajectoryOptions;
 
+/// Default `stop_relative_gain` of [`Parameterisation::Polynomial`]
+/// (relative objective gain): raising the degree stops when it gains less
+/// than 0.1 %.
+pub const DEFAULT_STOP_RELATIVE_GAIN: f64 = 1e-3;
+/// Default [`SqpOptions::min_trust_rad`] (rad).
+const DEFAULT_MIN_TRUST_RAD: f64 = 1e-9;
+/// Default [`SqpOptions::step_tolerance_rad`] (rad).
+const DEFAULT_STEP_TOLERANCE_RAD: f64 = 1e-7;
+/// Default [`SqpOptions::relative_tolerance`] (relative merit gain).
+const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-9;
+/// Default [`OptimiseOptions::centring_weight`] (unitless).
+const DEFAULT_CENTRING_WEIGHT: f64 = 1e-3;
+
 /// Abscissa of the polynomial `R_Z` of a layer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -67,7 +80,7 @@ impl Default for Parameterisation {
         Self::Polynomial {
             max_degree: 4,
             abscissa: Abscissa::Auto,
-            stop_relative_gain: 1e-3,
+            stop_relative_gain: DEFAULT_STOP_RELATIVE_GAIN,
         }
     }
 }
@@ -153,9 +166,9 @@ impl Default for SqpOptions {
         Self {
             max_iterations: 60,
             initial_trust_rad: 0.5,
-            min_trust_rad: 1e-9,
-            step_tolerance_rad: 1e-7,
-            relative_tolerance: 1e-9,
+            min_trust_rad: DEFAULT_MIN_TRUST_RAD,
+            step_tolerance_rad: DEFAULT_STEP_TOLERANCE_RAD,
+            relative_tolerance: DEFAULT_RELATIVE_TOLERANCE,
             penalty: 1e3,
         }
     }
@@ -221,7 +234,7 @@ impl Default for OptimiseOptions {
             dexterity_floor: DexterityFloor::default(),
             configuration: ConfigurationChoice::default(),
             joint_limit_margin_rad: 0.5f64.to_radians(),
-            centring_weight: 1e-3,
+            centring_weight: DEFAULT_CENTRING_WEIGHT,
             seeds: 12,
             seed_points: 12,
             sqp: SqpOptions::default(),

@@ -5,7 +5,12 @@
 
 use std::f64::consts::TAU;
 
-use crate::math::Point3;
+use crate::math::{tol, Point3};
+
+/// Ridge added to the spline fit's normal equations, relative to their mean
+/// diagonal: a span without points takes its coefficient from its
+/// neighbours instead of making the system singular (relative).
+const RIDGE_REL: f64 = 1e-14;
 
 /// Cylindrical angle of each point about the part Z axis (rad), unwrapped
 /// along the layer (continuous, starting in `(-π, π]`).
@@ -312,7 +317,7 @@ impl Basis {
                 // coefficient to its neighbours
                 let (mut ata, atb) = self.normal_equations(r, 0.0);
                 let k = self.len();
-                let ridge = 1e-14 * (ata.trace() / k as f64).max(1e-300);
+                let ridge = RIDGE_REL * (ata.trace() / k as f64).max(tol::DIV_FLOOR);
                 for i in 0..k {
                     ata[(i, i)] += ridge;
                 }

@@ -7,6 +7,9 @@ use std::f64::consts::PI;
 use super::problem::{Evaluation, LayerProblem, PointFailure};
 use crate::robot::model::Joints;
 
+/// Bracket width (rad) at which the one-point `R_Z` line search stops.
+const LINE_SEARCH_TOL_RAD: f64 = 1e-7;
+
 /// Point by point: every constraint is penalised from `PBP_MARGIN` inside
 /// its bound (rad, rad per step, or relative for the dexterity), so that the
 /// 1-D search's tolerance (1e-7 rad) cannot leave a point a hair outside.
@@ -67,7 +70,7 @@ pub(super) fn point_by_point(
         };
         let x = match held {
             Some(h) if m == 0 => h,
-            _ => minimise_1d(&f, start, 0.02, 1e-7),
+            _ => minimise_1d(&f, start, 0.02, LINE_SEARCH_TOL_RAD),
         };
         r[m] = x;
         let (q, pose) = problem

@@ -45,12 +45,41 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::math::{Matrix3, Point3, UnitVector3, Vector3};
+use crate::math::{tol, Matrix3, Point3, UnitVector3, Vector3};
 use crate::optimise::parameterisation::{cylindrical_angles, turns_about_z, Basis};
 use crate::optimise::problem::Row;
 use crate::optimise::sqp::solve_qp;
 use crate::robot::cell::{CellPoint, TorchCarriedCell};
 use crate::robot::positioner::{Positioner, PositionerJoints};
+
+/// Ridge added to the positioner SQP's Gauss–Newton matrix, relative to its
+/// mean diagonal (relative).
+const RIDGE_REL: f64 = 1e-9;
+/// Floor of the mean diagonal the ridge scales with (units of `JᵀJ`).
+const RIDGE_TRACE_FLOOR: f64 = 1e-12;
+/// Trust bound on the positioner joints' coefficients (rad) below which the
+/// SQP stops.
+const MIN_TRUST_RAD: f64 = 1e-9;
+/// Largest coefficient change (rad) of a refused step below which the SQP
+/// stops: shrinking the trust region further changes nothing.
+const MIN_STEP_RAD: f64 = 1e-10;
+/// A trial is accepted when it lowers the merit by more than this fraction of
+/// it (relative): more than rounding.
+const ACCEPT_GAIN_REL: f64 = 1e-14;
+/// An accepted gain below this fraction of the merit (relative) is flat: the
+/// SQP stops.
+const FLAT_GAIN_REL: f64 = 1e-9;
+/// Floor of the merit the two relative gains above scale with (merit units).
+const MERIT_FLOOR: f64 = 1e-12;
+/// The sum of the build directions (unit vectors) shorter than this has no
+/// mean direction: no hold seed (unitless).
+const MIN_BUILD_SUM: f64 = 1e-9;
+/// A feasible seed whose objective is at most this (objective units) cannot
+/// be beaten: the remaining seeds are skipped.
+const ZERO_OBJECTIVE: f64 = 1e-14;
+/// A violation left on the samples above this (constraint units) means
+/// the SQP is stuck: more samples cannot help.
+const STUCK_VIOLATION: f64 = 1e-9;
 
 /// How the torch-carried cell's positioner moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -558,11 +587,11 @@ fn sqp(pb: &LawProblem, basis: &Basis, idx: &[usize], x0: Vec<f64>) -> (Vec<f64>
         }
         let trace: f64 = (0..n).map(|i| p[i * n + i]).sum::<f64>() / n as f64;
         for i in 0..n {
-            p[i * n + i] += 1e-9 * trace.max(1e-12);
+            p[i * n + i] += RIDGE_REL * trace.max(RIDGE_TRACE_FLOOR);
         }
         let Some(qp) = solve_qp(n, &p, &g, &model.rows, rho, bound) else {
             bound *= 0.25;
-            if bound < 1e-9 {
+            if bound < MIN_TRUST_RAD {
                 break;
             }
             continue;
@@ -571,7 +600,7 @@ fn sqp(pb: &LawProblem, basis: &Basis, idx: &[usize], x0: Vec<f64>) -> (Vec<f64>
         let tm = build_model(pb, basis, idx, &trial);
         let new = merit(&tm, rho);
         let step = qp.x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        if new.is_finite() && new < cur - 1e-14 * cur.abs().max(1e-12) {
+        if new.is_finite() && new < cur - ACCEPT_GAIN_REL * cur.abs().max(MERIT_FLOOR) {
             let gain = cur - new;
             x = trial;
             model = tm;
@@ -581,12 +610,12 @@ fn sqp(pb: &LawProblem, basis: &Basis, idx: &[usize], x0: Vec<f64>) -> (Vec<f64>
             }
             // flat: a relative gain this small moves no axis by a
             // measurable amount (feasible or at the least violation)
-            if gain < 1e-9 * cur.abs().max(1e-12) {
+            if gain < FLAT_GAIN_REL * cur.abs().max(MERIT_FLOOR) {
                 break;
             }
         } else {
             bound *= 0.25;
-            if bound < 1e-9 || step < 1e-10 {
+            if bound < MIN_TRUST_RAD || step < MIN_STEP_RAD {
                 break;
             }
         }
@@ -720,7 +749,7 @@ fn lazy_joints(
             let h = b_w.xy().normalize();
             let target = Vector3::new(h.x * hold_rad.sin(), h.y * hold_rad.sin(), hold_rad.cos());
             let up = UnitVector3::new_normalize(r0t * target);
-            let b = UnitVector3::try_new(pb.b[m], 1e-12)?;
+            let b = UnitVector3::try_new(pb.b[m], tol::DEGENERATE)?;
             q = pb
                 .cell
                 .positioner
@@ -933,7 +962,7 @@ pub fn positioner_law(
     let basis = Basis::spline(&abscissa, opts.spans.min(n / 4).max(1));
     // the hold seed: the pose turning the mean b vertical
     let mean_b = pb.b.iter().fold(Vector3::zeros(), |a, b| a + b);
-    let hold = UnitVector3::try_new(mean_b, 1e-9)
+    let hold = UnitVector3::try_new(mean_b, MIN_BUILD_SUM)
         .and_then(|b| {
             let up = cell.base_from_positioner.rotation.inverse() * Vector3::z_axis();
             pos.angles_for_vertical(&b, &up, q8_hint, std::f64::consts::PI)
@@ -969,7 +998,7 @@ pub fn positioner_law(
     for (seed, x0) in seeds {
         if best
             .as_ref()
-            .is_some_and(|(feasible, _, objective, ..)| *feasible && *objective <= 1e-14)
+            .is_some_and(|(feasible, _, objective, ..)| *feasible && *objective <= ZERO_OBJECTIVE)
         {
             break;
         }
@@ -991,7 +1020,7 @@ pub fn positioner_law(
             iterations += it;
             x = xs;
             // violated on the samples already: more samples cannot help
-            let stuck = left > 1e-9;
+            let stuck = left > STUCK_VIOLATION;
             let (c7, c8) = x.split_at(k);
             let (q7, q8) = (basis.eval(c7), basis.eval(c8));
             joints = q7.into_iter().zip(q8).map(|(a, b)| [a, b]).collect();

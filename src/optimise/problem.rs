@@ -14,20 +14,20 @@ use crate::robot::ik::Configuration;
 use crate::robot::indices::{
     dexterity, dexterity_warm, positioning_uncertainty, SvdWarmStart, UncertaintyFormula,
 };
-use crate::robot::model::{Joints, RobotModel};
+use crate::robot::model::{Joints, RobotModel, ARCMATE_120IC_ENCODER_SIGMA_DEG};
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::RobotError;
 
-/// Encoder resolutions of the ArcMate 120iC [table 4.2] (deg), used when the
-/// robot model has none.
-const ARCMATE_SIGMA_DEG: [f64; 6] = [3.63e-8, 3.63e-8, 3.81e-8, 16.45e-8, 14.12e-8, 63.18e-8];
+/// Relative amount shaved off the dexterity lower bound so that rounding
+/// keeps it below the true value (relative).
+const ROUNDING_SHAVE_REL: f64 = 1e-12;
 
 /// The joint resolutions of eq. 4.13 (rad): the robot model's encoder
 /// resolutions, or the ArcMate 120iC's [table 4.2] when it has none.
 pub(crate) fn encoder_sigma_rad(robot: &RobotModel) -> [f64; 6] {
     robot
         .encoder_sigma_rad
-        .unwrap_or(ARCMATE_SIGMA_DEG.map(f64::to_radians))
+        .unwrap_or(ARCMATE_120IC_ENCODER_SIGMA_DEG.map(f64::to_radians))
 }
 
 /// Where the dexterity bound is at least this multiple of the floor, the
@@ -218,7 +218,7 @@ impl<'a> LayerProblem<'a> {
         let b = 1.0 / (nj * ni).sqrt();
         if b.is_finite() {
             // shave rounding so that the bound stays below the true value
-            b * (1.0 - 1e-12)
+            b * (1.0 - ROUNDING_SHAVE_REL)
         } else {
             0.0
         }

@@ -14,6 +14,13 @@ use crate::robot::cell::Cell;
 use crate::robot::model::Joints;
 use crate::robot::trajectory::{joint_trajectory, PathPointInput, ViolationKind};
 
+/// A constraint violated by more than this (its own units, as
+/// [`LayerProblem::binding`] takes them) is reported as binding.
+const BINDING_VIOLATION: f64 = 1e-9;
+/// A joint step (rad) smaller than this has no direction: it neither starts
+/// nor ends a reversal in the counts.
+const REVERSAL_MIN_STEP_RAD: f64 = 1e-7;
+
 /// Smallest distance to a stop over the limited joints (rad) and its joint (1-based).
 pub(super) fn limit_distance(robot: &crate::robot::RobotModel, q: &Joints) -> (f64, usize) {
     let mut best = (f64::INFINITY, 0);
@@ -77,7 +84,7 @@ pub(super) fn finish(
         Err(_) => Vec::new(),
     };
     problem.exact_dexterity(&mut e);
-    let binding = problem.binding(&e, 1e-9).or_else(|| {
+    let binding = problem.binding(&e, BINDING_VIOLATION).or_else(|| {
         violations.first().map(|v| {
             // the amount in the units of `Binding::violation`: rad past a
             // bound, rad over one step for a speed, relative for dexterity
@@ -195,7 +202,7 @@ fn quality(problem: &LayerProblem, e: &Evaluation) -> LayerQuality {
             let dq = q[j] - e.q[m - 1][j];
             out.joint_travel_rad[j] += dq.abs();
             out.peak_speed_rad_s[j] = out.peak_speed_rad_s[j].max(v[j].abs());
-            if dq.abs() > 1e-7 {
+            if dq.abs() > REVERSAL_MIN_STEP_RAD {
                 let dir = if dq > 0.0 { 1 } else { -1 };
                 if last_dir[j] != 0 && dir != last_dir[j] {
                     out.direction_reversals[j] += 1;

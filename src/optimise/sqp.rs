@@ -18,6 +18,18 @@ use crate::optimise::options::SqpOptions;
 use crate::optimise::parameterisation::Basis;
 use crate::optimise::problem::{Evaluation, LayerProblem, PointFailure};
 
+/// A row `a·x ≤ b` counts as violated when `a·x - t` exceeds `b` by more
+/// than this fraction of `1 + |b|` (relative).
+const ROW_SLACK_REL: f64 = 1e-10;
+/// A step is accepted when the merit falls by at least this fraction of the
+/// model's predicted decrease (unitless, the trust-region ratio).
+const ACCEPT_RATIO: f64 = 1e-4;
+/// The polish takes Gauss–Newton steps of at most this (rad of `R_Z`) and
+/// stops where a constraint is within reach of such a step.
+const POLISH_MAX_STEP_RAD: f64 = 1e-3;
+/// The polish stops after a step below this (rad of `R_Z`).
+const POLISH_MIN_STEP_RAD: f64 = 1e-12;
+
 /// The polish stops when the Gauss–Newton model predicts a relative
 /// decrease of the objective below this: it is flat there, and such steps
 /// (of at most ~1e-4 rad of `R_Z` on the sample parts) are refused about
@@ -62,7 +74,7 @@ pub(crate) fn solve_qp(
 ) -> Option<Qp> {
     let violated_by = |x: &[f64], t: f64, r: &crate::optimise::problem::Row| {
         let ax: f64 = r.a.iter().map(|&(i, v)| v * x[i]).sum();
-        ax - t > r.b + 1e-10 * (1.0 + r.b.abs())
+        ax - t > r.b + ROW_SLACK_REL * (1.0 + r.b.abs())
     };
     let mut work: Vec<usize> = Vec::new();
     if let Some(x) = unconstrained(k, p_dense, g) {
@@ -301,7 +313,7 @@ pub(crate) fn solve(
                     &mut p_new,
                     &mut grad_new,
                 );
-                let ok = ratio >= 1e-4;
+                let ok = ratio >= ACCEPT_RATIO;
                 if secant {
                     let p_ref = if ok { &p_new } else { &p_dense };
                     psb_update(k, &mut corr, p_ref, dc, &grad, &grad_new);
@@ -361,7 +373,9 @@ pub(crate) fn solve(
             // the model's decrease of f = Σr², `gᵀP⁻¹g` here: below this
             // fraction of f the step is not worth an evaluation
             if -gv.dot(&dc) < POLISH_MIN_GAIN * f
-                || !problem.constraint_rows(&e, basis, 1e-3).is_empty()
+                || !problem
+                    .constraint_rows(&e, basis, POLISH_MAX_STEP_RAD)
+                    .is_empty()
             {
                 break;
             }
@@ -373,7 +387,7 @@ pub(crate) fn solve(
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
             // a step below the convergence tolerance is not worth an evaluation
-            if step > 1e-3 || step < opts.step_tolerance_rad {
+            if step > POLISH_MAX_STEP_RAD || step < opts.step_tolerance_rad {
                 break;
             }
             let Ok(e_new) = problem.evaluate(&r_new) else {
@@ -387,7 +401,7 @@ pub(crate) fn solve(
             c = c_new;
             e = e_new;
             f = f_new;
-            if step < 1e-12 {
+            if step < POLISH_MIN_STEP_RAD {
                 break;
             }
         }

@@ -29,7 +29,15 @@ use super::parameterisation::Basis;
 use super::problem::{LayerProblem, SOLVER_MARGIN};
 use super::setup::LayerSetup;
 use super::sqp;
+use crate::math::tol;
 use crate::robot::cell::CellPoint;
+
+/// A layer whose tool axis and build direction turn by less than this in
+/// total (rad) has samples spread by point count alone.
+const MIN_TOTAL_TURN_RAD: f64 = 1e-9;
+/// Slack on the sample quantile test (unitless, in `[0, 1]`): rounding does
+/// not push a sample one point further.
+const QUANTILE_SLACK: f64 = 1e-12;
 
 /// Refinements of the samples before a layer goes back to the whole-layer
 /// optimisation.
@@ -126,7 +134,7 @@ fn degree_loop(
         let e0 = sub
             .evaluate(&full_basis.restricted(&samples.idx)?.eval(&c))
             .ok()?;
-        sub.objective(&e0, 0.0).max(1e-6)
+        sub.objective(&e0, 0.0).max(tol::OBJECTIVE_SCALE_FLOOR)
     };
     let mut history = Vec::new();
     let mut best: Option<Best> = None;
@@ -360,7 +368,7 @@ pub(super) fn initial_samples(points: &[CellPoint], n: usize) -> Vec<usize> {
     let total = turn[p - 1];
     let last = (p - 1) as f64;
     let u = |m: usize| {
-        if total > 1e-9 {
+        if total > MIN_TOTAL_TURN_RAD {
             0.5 * m as f64 / last + 0.5 * turn[m] / total
         } else {
             m as f64 / last
@@ -370,7 +378,7 @@ pub(super) fn initial_samples(points: &[CellPoint], n: usize) -> Vec<usize> {
     let mut m = 0;
     for k in 0..n {
         let target = k as f64 / (n - 1) as f64;
-        while m < p - 1 && u(m) < target - 1e-12 {
+        while m < p - 1 && u(m) < target - QUANTILE_SLACK {
             m += 1;
         }
         if idx.last() != Some(&m) {

@@ -17,6 +17,11 @@
 
 use crate::math::Point3;
 
+/// Relative widening of a group's bounding sphere (of its scale, and of the
+/// reach tested against it) so that rounding never skips a group holding a
+/// chunk the chunk test would accept (relative).
+const GROUP_ROUNDING_REL: f64 = 1e-9;
+
 /// Consecutive segments per bounding sphere.
 pub const CHUNK: usize = 8;
 /// Consecutive chunks (or groups) per group sphere.
@@ -105,7 +110,7 @@ fn group_level(below: &[(Point3, f64)]) -> Vec<Group> {
             let scale = radius + centre.coords.amax() + 1.0;
             Group {
                 centre,
-                radius: radius + 1e-9 * scale,
+                radius: radius + GROUP_ROUNDING_REL * scale,
             }
         })
         .collect()
@@ -291,7 +296,7 @@ impl SegmentIndex {
         let group = &self.levels[level][g];
         // Widened by a relative 1e-9 over the chunk test: a group is skipped
         // only when every chunk in it would be, rounding included.
-        let reach = (group.radius + *distance) * (1.0 + 1e-9);
+        let reach = (group.radius + *distance) * (1.0 + GROUP_ROUNDING_REL);
         if (p - group.centre).norm_squared() >= reach * reach {
             return;
         }

@@ -16,6 +16,10 @@ use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
+/// Central-difference step of the distance's derivative in `t`, relative to
+/// `1 + |t|` (parameter units).
+const FD_STEP_REL: f64 = 1e-6;
+
 /// Smoothing settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Smoothing {
@@ -104,7 +108,7 @@ pub fn smooth_layer(
         let delta0: Vec<f64> = (0..n).map(|i| dist(i, cur[i])).collect();
         let g: Vec<f64> = (0..n)
             .map(|i| {
-                let h = 1e-6 * (1.0 + cur[i].abs());
+                let h = FD_STEP_REL * (1.0 + cur[i].abs());
                 (dist(i, cur[i] + h) - dist(i, cur[i] - h)) / (2.0 * h)
             })
             .collect();

@@ -5,7 +5,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use crate::optimise::{Abscissa, Parameterisation};
+use crate::optimise::{Abscissa, Parameterisation, DEFAULT_STOP_RELATIVE_GAIN};
 use crate::path::smooth::Smoothing;
 use crate::path::{Discretisation, SliceOptions, Strategy};
 use crate::process::ProcessParameters;
@@ -232,7 +232,7 @@ impl Default for RzLaw {
         Self(Parameterisation::Polynomial {
             max_degree: 4,
             abscissa: Abscissa::Auto,
-            stop_relative_gain: 1e-3,
+            stop_relative_gain: DEFAULT_STOP_RELATIVE_GAIN,
         })
     }
 }
@@ -262,7 +262,7 @@ impl FromStr for RzLaw {
                 Parameterisation::Polynomial {
                     max_degree: n,
                     abscissa: Abscissa::Auto,
-                    stop_relative_gain: 1e-3,
+                    stop_relative_gain: DEFAULT_STOP_RELATIVE_GAIN,
                 }
             }
             None if s == "spline" => Parameterisation::SmoothingSpline { smoothness: 1.0 },

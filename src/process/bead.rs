@@ -4,6 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Slack on the ends of a process window (the window's own unit: m/min, V,
+/// mm): a value at the end up to rounding is inside.
+const WINDOW_SLACK: f64 = 1e-12;
+
 /// mm/s in one m/min.
 pub const MM_S_PER_M_MIN: f64 = 1000.0 / 60.0;
 /// mm/s in one cm/min.
@@ -90,7 +94,8 @@ impl XiongRange {
         voltage_v: f64,
         stick_out_mm: f64,
     ) -> bool {
-        let inside = |x: f64, (lo, hi): (f64, f64)| x >= lo - 1e-12 && x <= hi + 1e-12;
+        let inside =
+            |x: f64, (lo, hi): (f64, f64)| x >= lo - WINDOW_SLACK && x <= hi + WINDOW_SLACK;
         inside(wfs_m_min, self.wfs_m_min)
             && inside(ts_cm_min, self.ts_cm_min)
             && inside(voltage_v, self.voltage_v)

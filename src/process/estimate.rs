@@ -3,6 +3,10 @@
 
 use crate::path::Path;
 
+/// Unit conversion: a volume in mm³ times a density in kg/m³ gives
+/// `× G_PER_MM3_PER_KG_M3` grams (1 mm³ = 1e-9 m³, 1 kg = 1e3 g).
+const G_PER_MM3_PER_KG_M3: f64 = 1e-6;
+
 /// What a deposition costs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimates {
@@ -45,7 +49,7 @@ pub(crate) fn estimate(
         wire_length_mm,
         wire_volume_mm3,
         // 1 mm³ = 1e-9 m³; kg -> g: × 1e3.
-        deposited_mass_g: wire_volume_mm3 * density_kg_m3 * 1e-6,
+        deposited_mass_g: wire_volume_mm3 * density_kg_m3 * G_PER_MM3_PER_KG_M3,
     }
 }
 

@@ -17,6 +17,16 @@ use crate::robot::kinematics::{rot_y, rot_z};
 use crate::robot::model::{Joints, RobotModel};
 use crate::robot::RobotError;
 
+/// Default of [`CalibrationOptions::step_tolerance_mm`] (mm).
+const DEFAULT_STEP_TOLERANCE_MM: f64 = 1e-10;
+/// The identification Jacobian is rank deficient (a length is not
+/// observable from the measurements) when its smallest singular value is
+/// below this fraction of its largest (relative).
+const RANK_REL_TOL: f64 = 1e-10;
+/// Singular values below this are treated as zero by the least-squares step
+/// (units of the Jacobian, mm per mm).
+const SVD_SOLVE_EPS: f64 = 1e-14;
+
 /// One measurement: joint readings and the measured flange position.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CalibrationMeasurement {
@@ -40,7 +50,7 @@ impl Default for CalibrationOptions {
     fn default() -> Self {
         Self {
             max_iterations: 20,
-            step_tolerance_mm: 1e-10,
+            step_tolerance_mm: DEFAULT_STEP_TOLERANCE_MM,
         }
     }
 }
@@ -132,13 +142,13 @@ pub fn calibrate_lengths(
         let svd = jac.clone().svd(true, true);
         let smax = svd.singular_values.max();
         let smin = svd.singular_values.min();
-        if smin.is_nan() || smin <= 1e-10 * smax {
+        if smin.is_nan() || smin <= RANK_REL_TOL * smax {
             return Err(err(
                 "the measurements do not determine all five lengths (rank-deficient)",
             ));
         }
         let step = svd
-            .solve(&res, 1e-14)
+            .solve(&res, SVD_SOLVE_EPS)
             .map_err(|_| err("least-squares solve failed"))?;
         let mut l = model.geometry.segment_lengths();
         for k in 0..5 {

@@ -19,6 +19,20 @@ use crate::robot::orientation::Bryant;
 use crate::robot::positioner::{Positioner, PositionerJoints};
 use crate::robot::RobotError;
 
+/// Slack on the shoulder-circle reach test, as a fraction of the arm's
+/// longest reach (relative): rounding of the FK/IK chain.
+const REACH_SLACK_REL: f64 = 1e-6;
+/// `t_z² + u²` below this (unitless, a squared sine) means `R_X = ±90°`: the
+/// rate of the pose in `R_Z` is undefined.
+const MIN_TILT_DEN: f64 = 1e-14;
+/// Dexterity at 1000 mm (unitless) below which the Jacobian is singular and
+/// its LU solution meaningless.
+const SINGULAR_DEXTERITY: f64 = 1e-12;
+/// Dexterity bound (unitless) 100 times [`SINGULAR_DEXTERITY`]: a pose whose
+/// already known dexterity, rescaled to 1000 mm, is above it skips the
+/// singularity test (it would pass).
+const REGULAR_DEXTERITY: f64 = 1e-10;
+
 /// One path point as the cells see it (part frame).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CellPoint {
@@ -154,7 +168,7 @@ fn check_anchor_reach(
     let arm_max = g.upper_arm_mm + k;
     let arm_min = (g.upper_arm_mm - k).abs();
     // rounding of the FK/IK chain; the test is a bound, not a decision at the edge
-    let slack = 1e-6 * arm_max;
+    let slack = REACH_SLACK_REL * arm_max;
     let (near, far) = shoulder_circle_distances(robot, anchor);
     let max_reach = arm_max + allowance_mm + slack;
     let min_reach = (arm_min - allowance_mm - slack).max(0.0);
@@ -289,7 +303,7 @@ impl PartCarriedCell {
         let (s, c) = r_z.sin_cos();
         let u = t.x * c - t.y * s;
         let den = t.z * t.z + u * u;
-        if den.is_nan() || den <= 1e-14 {
+        if den.is_nan() || den <= MIN_TILT_DEN {
             return Err(RobotError::DegenerateToolAxis {
                 tx: t.x,
                 ty: t.y,
@@ -602,10 +616,10 @@ impl Cell {
         // rounding (~10⁻¹⁵ in dexterity) far behind: the test would pass.
         let regular = dexterity_at.is_some_and(|(dex, s)| {
             let k = s / 1000.0;
-            dex * k.min(1.0 / k) > 1e-10
+            dex * k.min(1.0 / k) > REGULAR_DEXTERITY
         });
         // a near-exact singularity can leave a finite but meaningless LU solution
-        if !regular && crate::robot::indices::dexterity(j, 1000.0) < 1e-12 {
+        if !regular && crate::robot::indices::dexterity(j, 1000.0) < SINGULAR_DEXTERITY {
             return Err(RobotError::SingularJacobian {
                 manipulability: crate::robot::indices::manipulability(j),
             });

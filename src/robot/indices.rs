@@ -6,6 +6,10 @@ use nalgebra::{Matrix3, Matrix6};
 
 use crate::robot::model::{JointLimit, Joints};
 
+/// A column left shorter than this by Gram–Schmidt (its norm before was 1;
+/// unitless) is dependent on the previous ones: the basis is degenerate.
+const MIN_GRAM_SCHMIDT_NORM: f64 = 1e-3;
+
 /// Manipulability `sqrt(det(J Jᵀ))` [eq. 1.7] of a 6×6 Jacobian (units of J
 /// multiplied: mm³ for a Jacobian in mm/rad and rad/rad). 0 at a singularity.
 pub fn manipulability(j: &Matrix6<f64>) -> f64 {
@@ -138,7 +142,7 @@ fn orthonormalise(v: &mut [[f64; 6]; 6]) -> bool {
             }
         }
         let n = v[i].iter().map(|x| x * x).sum::<f64>().sqrt();
-        if !(n > 1e-3 && n.is_finite()) {
+        if !(n > MIN_GRAM_SCHMIDT_NORM && n.is_finite()) {
             return false;
         }
         for x in v[i].iter_mut() {

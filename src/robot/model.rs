@@ -34,6 +34,15 @@ use serde::{Deserialize, Serialize};
 use crate::math::{Matrix3, Rotation3};
 use crate::robot::RobotError;
 
+/// Encoder resolutions of the ArcMate 120iC [thesis table 4.2] (deg, joints
+/// 1–6): measured data, not a tolerance. The nominal model carries them; the
+/// optimiser falls back on them for a model without its own.
+pub(crate) const ARCMATE_120IC_ENCODER_SIGMA_DEG: [f64; 6] =
+    [3.63e-8, 3.63e-8, 3.81e-8, 16.45e-8, 14.12e-8, 63.18e-8];
+/// `wrist_from_flange` is a rotation when `MᵀM - I` and `det M - 1` are both
+/// below this (unitless, per entry).
+const ROTATION_TOL: f64 = 1e-9;
+
 /// Six joint values in controller convention (rad), J1 first.
 pub type Joints = [f64; 6];
 
@@ -289,9 +298,7 @@ impl RobotModel {
                 JointLimit::UNLIMITED,
             ],
             max_speed_rad_s: deg6([195.0, 175.0, 180.0, 360.0, 360.0, 550.0]),
-            encoder_sigma_rad: Some(deg6([
-                3.63e-8, 3.63e-8, 3.81e-8, 16.45e-8, 14.12e-8, 63.18e-8,
-            ])),
+            encoder_sigma_rad: Some(deg6(ARCMATE_120IC_ENCODER_SIGMA_DEG)),
             twist_deviation_rad: [0.0; 6],
         }
     }
@@ -460,7 +467,7 @@ impl RobotModel {
         }
         let m = &self.convention.wrist_from_flange;
         let err = (m.transpose() * m - Matrix3::identity()).abs().max();
-        if !(err < 1e-9 && (m.determinant() - 1.0).abs() < 1e-9) {
+        if !(err < ROTATION_TOL && (m.determinant() - 1.0).abs() < ROTATION_TOL) {
             return Err(bad(
                 "wrist_from_flange",
                 err,

@@ -15,12 +15,16 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::math::{Isometry3, Rotation3, Translation3, UnitQuaternion, UnitVector3, Vector3};
+use crate::math::{tol, Isometry3, Rotation3, Translation3, UnitQuaternion, UnitVector3, Vector3};
 use crate::robot::ik::wrap_pi;
 use crate::robot::kinematics::{rot_y, rot_z};
 use crate::robot::model::JointLimit;
 use crate::robot::RobotError;
 use std::f64::consts::TAU;
+
+/// Floor of the accepted build-direction error (rad): an exact solution is
+/// not refused for rounding when the cell asks for zero error.
+const MIN_ERROR_RAD: f64 = 1e-12;
 
 /// A two-axis tilt-and-turn positioner, as data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -196,7 +200,7 @@ impl Positioner {
             // one inside the travel nearest the hint (the previous point's),
             // so that a layer going round a part of revolution turns the
             // table continuously instead of jumping back by 360°.
-            let q8 = if b_xy > 1e-12 {
+            let q8 = if b_xy > tol::DEGENERATE {
                 let a = wrap_pi(w.y.atan2(w.x) - b.y.atan2(b.x));
                 let k = ((q8_hint - a) / TAU).round();
                 [k, k - 1.0, k + 1.0]
@@ -211,7 +215,7 @@ impl Positioner {
             let cand = [q7, q8];
             let reached = self.positioner_from_table(&cand).rotation * b.into_inner();
             let error = reached.cross(up).norm().atan2(reached.dot(up));
-            if error.is_nan() || error > max_error_rad.max(1e-12) {
+            if error.is_nan() || error > max_error_rad.max(MIN_ERROR_RAD) {
                 continue;
             }
             let inside = self.limits[0].contains(q7) && self.limits[1].contains(q8);

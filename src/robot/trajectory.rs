@@ -21,6 +21,10 @@ use crate::robot::model::Joints;
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::RobotError;
 
+/// Slack on the torch-carried build tilt bound (rad): rounding of the chain
+/// of rotations.
+const BUILD_TILT_ROUNDING_RAD: f64 = 1e-9;
+
 /// One path point, as the trajectory stage needs it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PathPointInput {
@@ -494,8 +498,8 @@ fn trajectory(
         }
         if let (Cell::TorchCarried(c), Some(qp)) = (cell, pose.positioner) {
             let tilt = c.build_tilt(&cp, &qp);
-            // rounding of the chain of rotations: 1e-9 rad
-            if tilt > c.max_vertical_error_rad + 1e-9 {
+            // rounding of the chain of rotations: [`BUILD_TILT_ROUNDING_RAD`]
+            if tilt > c.max_vertical_error_rad + BUILD_TILT_ROUNDING_RAD {
                 violation(ViolationKind::BuildTilt {
                     tilt_rad: tilt,
                     max_rad: c.max_vertical_error_rad,

@@ -6,11 +6,15 @@
 
 use super::{LocalFrame, ToolAxisError};
 use crate::geometry::{Substrate, Tube};
-use crate::math::{Point3, Vector3};
+use crate::math::{tol, Point3, Vector3};
 use crate::path::index::SegmentIndex;
 use crate::path::{Layer, Path};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+
+/// The sum of the adjacent facets' unit normals (at most two) shorter than
+/// this has no direction: the facets face opposite ways (unitless).
+const MIN_NORMAL_SUM: f64 = 1e-9;
 
 /// Where surface normals come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -72,7 +76,7 @@ fn analytic_layer(layer: &Layer, tube: &Tube, li: usize) -> Result<Vec<LocalFram
             // Tangent in the surface's tangent plane.
             let c = chord - normal * chord.dot(&normal);
             let scale = chord.norm().max(1.0);
-            let tangent = if c.norm() > 1e-12 * scale {
+            let tangent = if c.norm() > tol::DEGENERATE * scale {
                 c.normalize()
             } else if li == usize::MAX {
                 sp.d_dv.normalize()
@@ -167,7 +171,7 @@ fn numeric_layer(
         let m = pos(i);
         let c = pos(next) - pos(prev);
         let c_len = c.norm();
-        if !(c_len > 1e-12) {
+        if !(c_len > tol::ZERO_LENGTH_MM) {
             return Err(ToolAxisError::DegenerateTangent {
                 layer: li,
                 point: i,
@@ -184,7 +188,7 @@ fn numeric_layer(
             let up = (q - m) * sign;
             let facet = c.cross(&(q - pos(prev)));
             let f_len = facet.norm();
-            if !(f_len > 1e-12 * c_len * (q - pos(prev)).norm().max(1e-300)) {
+            if !(f_len > tol::DEGENERATE * c_len * (q - pos(prev)).norm().max(tol::DIV_FLOOR)) {
                 continue;
             }
             let mut f = facet / f_len;
@@ -195,7 +199,7 @@ fn numeric_layer(
             sum += f;
         }
         let s_len = sum.norm();
-        if !(s_len > 1e-9) {
+        if !(s_len > MIN_NORMAL_SUM) {
             return Err(ToolAxisError::DegenerateNormal {
                 layer: li,
                 point: i,
@@ -265,7 +269,7 @@ pub(crate) fn orient_away_from_substrate(
             for (p, f) in l.points.iter().zip(fl.iter_mut()) {
                 if let Some(o) = substrate.outward(&p.position) {
                     let b = o - f.tangent * o.dot(&f.tangent);
-                    if b.norm() > 1e-9 {
+                    if b.norm() > tol::ANGLE_RAD {
                         f.build = b.normalize();
                         f.tool = f.build;
                     }

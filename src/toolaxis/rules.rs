@@ -5,9 +5,28 @@
 
 use super::lead_tilt::tool_axis;
 use super::{LocalFrame, ToolAxisError};
-use crate::math::{self, Point3, Vector3};
+use crate::math::{self, tol, Point3, Vector3};
 use crate::path::Path;
 use serde::{Deserialize, Serialize};
+
+/// Slack on the cosine test of the cone rule (unitless): an axis this close
+/// to the cone's edge is inside and left unchanged.
+const CONE_COS_SLACK: f64 = 1e-15;
+/// The lean rule's angle is clamped this far inside ±π/2 (rad) so that its
+/// tangent stays finite.
+const TAN_CLAMP_MARGIN_RAD: f64 = 1e-6;
+/// Two unit axes closer than this (rad) are the same: [`slerp`] returns the
+/// target unchanged.
+const SAME_DIRECTION_RAD: f64 = 1e-15;
+/// A lead or tilt angle changed by more than this (rad) by the envelope
+/// smoothing counts as moved.
+const LEAD_TILT_MOVED_RAD: f64 = 1e-15;
+/// Relative slack on the axis-rate bound: a rate within `1 + RATE_SLACK_REL`
+/// times the bound meets it (rounding of the angle and length).
+const RATE_SLACK_REL: f64 = 1e-9;
+/// The rate relaxation aims this fraction below the bound (relative), so a
+/// corrected pair lands inside it despite rounding.
+const RATE_TARGET_MARGIN_REL: f64 = 1e-6;
 
 /// How the lead/tilt angles of each point are chosen.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -142,7 +161,7 @@ impl AxisRule {
                 let a = Vector3::from(*axis).normalize();
                 let t0 = tool_axis(frame, lead_rad, tilt_rad);
                 let cos_max = max_angle_rad.cos();
-                if t0.dot(&a) >= cos_max - 1e-15 {
+                if t0.dot(&a) >= cos_max - CONE_COS_SLACK {
                     return unchanged;
                 }
                 match tilt_into_cone(frame, lead_rad, tilt_rad, &a, cos_max) {
@@ -183,7 +202,7 @@ fn tilt_into_cone(
     let (au, an) = (axis.dot(&uh), axis.dot(&frame.normal));
     let rho = au.hypot(an);
     let phi = an.atan2(au);
-    let lim = std::f64::consts::FRAC_PI_2 - 1e-6;
+    let lim = std::f64::consts::FRAC_PI_2 - TAN_CLAMP_MARGIN_RAD;
     let to_tilt = |psi: f64| (l * psi.clamp(-lim, lim).tan()).atan();
     if rho < cos_max {
         return Err(to_tilt(phi));
@@ -232,18 +251,18 @@ pub(crate) fn check_shape(
 pub(crate) fn project_build(frames: &mut [Vec<LocalFrame>], p: &Vector3) {
     for f in frames.iter_mut().flatten() {
         let b = f.build - p * f.build.dot(p);
-        if b.norm() < 1e-9 {
+        if b.norm() < tol::ANGLE_RAD {
             continue;
         }
         let b = b.normalize();
         let t = f.tangent - b * f.tangent.dot(&b);
-        let t = if t.norm() > 1e-9 {
+        let t = if t.norm() > tol::ANGLE_RAD {
             t.normalize()
         } else {
             math::any_perpendicular(&b)
         };
         let n = f.normal - b * f.normal.dot(&b) - t * f.normal.dot(&t);
-        let n = if n.norm() > 1e-9 {
+        let n = if n.norm() > tol::ANGLE_RAD {
             n.normalize()
         } else {
             b.cross(&t)
@@ -265,11 +284,11 @@ pub(crate) fn angle(a: &Vector3, b: &Vector3) -> f64 {
 /// Rotates unit `a` toward unit `b` by `fraction` of the angle between them.
 pub(crate) fn slerp(a: &Vector3, b: &Vector3, fraction: f64) -> Vector3 {
     let theta = angle(a, b);
-    if theta < 1e-15 {
+    if theta < SAME_DIRECTION_RAD {
         return *b;
     }
     let mut k = a.cross(b);
-    if k.norm() < 1e-12 {
+    if k.norm() < tol::DEGENERATE {
         k = math::any_perpendicular(a);
     }
     let k = k.normalize();
@@ -338,7 +357,7 @@ pub fn smooth_angles(
     let (lead, tilt) = (envelope(&lead), envelope(&tilt));
     let mut moved = 0;
     for (a, (ln, tn)) in angles.iter_mut().zip(lead.into_iter().zip(tilt)) {
-        if (a.0 - ln).abs() > 1e-15 || (a.1 - tn).abs() > 1e-15 {
+        if (a.0 - ln).abs() > LEAD_TILT_MOVED_RAD || (a.1 - tn).abs() > LEAD_TILT_MOVED_RAD {
             moved += 1;
         }
         *a = (ln, tn);
@@ -367,7 +386,7 @@ fn max_pair_rate(positions: &[Point3], closed: bool, change: impl Fn(usize, usiz
         .filter_map(|i| {
             let j = (i + 1) % n;
             let d = (positions[j] - positions[i]).norm();
-            (d > 1e-12).then(|| change(i, j) / d)
+            (d > tol::ZERO_LENGTH_MM).then(|| change(i, j) / d)
         })
         .fold(0.0, f64::max)
 }
@@ -416,11 +435,11 @@ pub fn smooth_layer(
     let pairs = if closed && n > 2 { n } else { n - 1 };
     for _ in 0..n {
         let mut worst = None;
-        let mut worst_excess = 1.0 + 1e-9;
+        let mut worst_excess = 1.0 + RATE_SLACK_REL;
         for i in 0..pairs {
             let j = (i + 1) % n;
             let d = (positions[j] - positions[i]).norm();
-            if d > 1e-12 {
+            if d > tol::ZERO_LENGTH_MM {
                 let excess = angle(&axes[i], &axes[j]) / (max_rate_rad_per_mm * d);
                 if excess > worst_excess {
                     worst_excess = excess;
@@ -459,13 +478,13 @@ pub fn smooth_layer(
         }
     }
     for _ in 0..2000 {
-        if max_rate(positions, axes, closed) <= max_rate_rad_per_mm * (1.0 + 1e-9) {
+        if max_rate(positions, axes, closed) <= max_rate_rad_per_mm * (1.0 + RATE_SLACK_REL) {
             break;
         }
         for i in 0..pairs {
             let j = (i + 1) % n;
             let d = (positions[j] - positions[i]).norm();
-            let target = max_rate_rad_per_mm * d * (1.0 - 1e-6);
+            let target = max_rate_rad_per_mm * d * (1.0 - RATE_TARGET_MARGIN_REL);
             let a = angle(&axes[i], &axes[j]);
             if a > target && a > 0.0 {
                 let (ai, aj) = (axes[i], axes[j]);
@@ -477,6 +496,6 @@ pub fn smooth_layer(
     }
     axes.iter()
         .zip(&original)
-        .filter(|(a, o)| angle(a, o) > 1e-12)
+        .filter(|(a, o)| angle(a, o) > tol::AXIS_MOVED_RAD)
         .count()
 }

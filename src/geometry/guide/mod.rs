@@ -21,6 +21,10 @@ pub use spline::CubicSpline;
 
 use crate::math::{self, Point3, Vector3};
 
+/// Newton on the arc length stops when `|arc_length - s|` is below this
+/// fraction of `max(|s|, 1 mm)` (relative).
+const ARC_LENGTH_REL_TOL: f64 = 1e-12;
+
 /// A regular parametric curve `Mg(t)` in the part frame (mm), the spine of a tube.
 ///
 /// `t` is the curve's own parameter (mm for lines, splines and pipe runs, rad
@@ -83,7 +87,7 @@ fn default_param_at_arc_length<C: GuideCurve + ?Sized>(c: &C, t0: f64, s: f64) -
     let mut t = 0.5 * (lo + hi);
     for _ in 0..100 {
         let f = c.arc_length(t0, t) - s;
-        if f.abs() < 1e-12 * s.abs().max(1.0) {
+        if f.abs() < ARC_LENGTH_REL_TOL * s.abs().max(1.0) {
             break;
         }
         if (f * dir) < 0.0 {

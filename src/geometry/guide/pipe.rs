@@ -4,7 +4,7 @@
 
 use super::GuideCurve;
 use crate::geometry::GeometryError;
-use crate::math::{Point3, UnitVector3, Vector3};
+use crate::math::{tol, Point3, UnitVector3, Vector3};
 
 /// One piece of a [`PipeRun`], as given by the user.
 #[derive(Debug, Clone, PartialEq)]
@@ -100,7 +100,7 @@ impl PipeRun {
                         return Err(bad("bend angle must be in (0, 360) degrees"));
                     }
                     let perp = toward - d * d.dot(&toward);
-                    if !(perp.norm() > 1e-9 * toward.norm().max(1.0))
+                    if !(perp.norm() > tol::ANGLE_RAD * toward.norm().max(1.0))
                         || !perp.iter().all(|c| c.is_finite())
                     {
                         return Err(bad(

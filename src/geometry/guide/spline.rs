@@ -8,7 +8,7 @@
 
 use super::GuideCurve;
 use crate::geometry::GeometryError;
-use crate::math::{Point3, Vector3};
+use crate::math::{tol, Point3, Vector3};
 
 /// Natural cubic spline through the given points (part frame, mm), parameter
 /// `t` = cumulative chord length (mm) in `[0, total chord]`. Outside that range
@@ -44,7 +44,7 @@ impl CubicSpline {
                 });
             }
             let d = (w[1] - w[0]).norm();
-            if d <= 1e-9 {
+            if d <= tol::LENGTH_MM {
                 return Err(GeometryError::Spline {
                     index: i + 1,
                     reason: "coincides with the previous point".into(),

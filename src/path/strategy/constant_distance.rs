@@ -5,8 +5,19 @@
 
 use super::{forward_root, Step};
 use crate::geometry::Tube;
-use crate::math::{Point3, RootFailure};
+use crate::math::{tol, Point3, RootFailure};
 use crate::path::index::{SegmentId, SegmentIndex};
+
+/// Floor of the across-layer part of the surface's `t` derivative, as a
+/// fraction of the whole (relative): keeps the first step finite where the
+/// column runs along the layer below.
+const MIN_ACROSS_FRACTION: f64 = 1e-3;
+/// Residual at which Brent's method stops, relative to Delta (× `delta_mm`
+/// gives mm).
+const BRENT_RESIDUAL_REL: f64 = 1e-10;
+/// A point whose exact distance to the layer below is within this fraction
+/// of Delta is accepted without the fallback search (relative).
+const ACCEPT_RESIDUAL_REL: f64 = 1e-9;
 
 /// Next `t` of the column at profile angle `v` whose point on the layer below
 /// is at `t_below`; `hint` is a segment of the layer below next to that point
@@ -33,7 +44,7 @@ pub fn next_t(
             let along = below.segment_direction(hint);
             let across = (d_dt - along * d_dt.dot(&along))
                 .norm()
-                .max(1e-3 * d_dt.norm());
+                .max(MIN_ACROSS_FRACTION * d_dt.norm());
             0.999 * delta_mm / across
         }
     };
@@ -55,7 +66,7 @@ pub fn next_t(
             .nearest_hinted(p, Some(foot.get()))
             .map_or(f64::INFINITY, |n| n.distance)
     };
-    let x_tol = 1e-12 * (1.0 + t_below.abs());
+    let x_tol = tol::PARAM * (1.0 + t_below.abs());
     let solve = |dist: &dyn Fn(&Point3) -> f64| {
         forward_root(
             |t| dist(&tube.point(t, v)) - delta_mm,
@@ -64,14 +75,14 @@ pub fn next_t(
             step0,
             t_hi,
             x_tol,
-            1e-10 * delta_mm,
+            BRENT_RESIDUAL_REL * delta_mm,
         )
     };
     let Some((t, evaluations, _)) = solve(&local)? else {
         return Ok(Step::End);
     };
     let residual = (exact(&tube.point(t, v)) - delta_mm).abs();
-    if residual <= 1e-9 * delta_mm {
+    if residual <= ACCEPT_RESIDUAL_REL * delta_mm {
         return Ok(Step::Point {
             t,
             evaluations,

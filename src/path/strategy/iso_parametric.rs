@@ -4,9 +4,9 @@
 //! line); on the sphere and the torus it reproduces the closed forms of the
 //! thesis (checked in the integration tests).
 
-use super::{forward_root, Step};
+use super::{forward_root, Step, RESIDUAL_REL};
 use crate::geometry::Tube;
-use crate::math::RootFailure;
+use crate::math::{tol, RootFailure};
 
 /// Next `t` of the column `v`: the first `t > t_below` with
 /// `|M(t, v) − M(t_below, v)| = Delta`.
@@ -19,7 +19,7 @@ pub fn next_t(
 ) -> Result<Step, RootFailure> {
     let p0 = tube.point(t_below, v);
     let speed = tube.surface(t_below, v).d_dt.norm();
-    let x_tol = 1e-13 * (1.0 + t_below.abs());
+    let x_tol = tol::PARAM_FINE * (1.0 + t_below.abs());
     match forward_root(
         |t| (tube.point(t, v) - p0).norm() - delta_mm,
         t_below,
@@ -27,7 +27,7 @@ pub fn next_t(
         0.9 * delta_mm / speed,
         t_hi,
         x_tol,
-        1e-11 * delta_mm,
+        RESIDUAL_REL * delta_mm,
     )? {
         Some((t, evaluations, residual)) => Ok(Step::Point {
             t,

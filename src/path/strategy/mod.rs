@@ -2,6 +2,14 @@
 //! (fixed profile angle `v`) and where it stands on the layer below, the `t`
 //! of its next point. The layer loop that drives them is in `path::march`.
 
+/// The secant guess of [`forward_root`] is pushed past the root by this
+/// fraction of the first step (relative), so that a root exactly at the guess
+/// is still bracketed.
+const SECANT_NUDGE_REL: f64 = 1e-9;
+/// Residual tolerance of the iso-parametric and spiral steps' Brent search,
+/// relative to Delta (`× delta_mm` gives mm).
+pub(crate) const RESIDUAL_REL: f64 = 1e-11;
+
 pub mod constant_distance;
 pub mod iso_parametric;
 pub mod normal_to_guide;
@@ -62,7 +70,7 @@ pub(crate) fn forward_root(
         // next point brackets it; at least ×1.6 growth when far off.
         let slope = (gb - ga) / (tb - ta);
         let secant = if slope > 0.0 {
-            -gb / slope * 1.02 + 1e-9 * step0
+            -gb / slope * 1.02 + SECANT_NUDGE_REL * step0
         } else {
             f64::INFINITY
         };

@@ -3,7 +3,13 @@
 
 use super::{forward_root, Step};
 use crate::geometry::Tube;
-use crate::math::RootFailure;
+use crate::math::{tol, RootFailure};
+
+/// Floor of the first step in `t` (parameter units): a column already at the
+/// slice height still moves forward.
+const MIN_FIRST_STEP: f64 = 1e-9;
+/// Residual (mm of height) at which Brent's method stops on the slice plane.
+const Z_RESIDUAL_MM: f64 = 1e-11;
 
 /// Next `t` of the column `v` on the plane `Z = z` (mm): the first crossing
 /// above `t_below`. A column already above `z` is skipped (it meets a later
@@ -16,8 +22,8 @@ pub fn next_t(tube: &Tube, v: f64, t_below: f64, z: f64, t_hi: f64) -> Result<St
     let speed = tube.surface(t_below, v).d_dt.norm();
     // First step: half the height still to climb (in arc length), so that a
     // column turning down again is not jumped over.
-    let step = ((z - z0) / speed).max(1e-9) * 0.5;
-    let x_tol = 1e-13 * (1.0 + t_below.abs());
+    let step = ((z - z0) / speed).max(MIN_FIRST_STEP) * 0.5;
+    let x_tol = tol::PARAM_FINE * (1.0 + t_below.abs());
     match forward_root(
         |t| tube.point(t, v).z - z,
         t_below,
@@ -25,7 +31,7 @@ pub fn next_t(tube: &Tube, v: f64, t_below: f64, z: f64, t_hi: f64) -> Result<St
         step,
         t_hi,
         x_tol,
-        1e-11,
+        Z_RESIDUAL_MM,
     )? {
         Some((t, evaluations, residual)) => Ok(Step::Point {
             t,

@@ -12,9 +12,9 @@
 //! Points are computed in batches of half a turn, in parallel within a batch
 //! (a point only depends on points at least half a turn earlier).
 
-use super::forward_root;
+use super::{forward_root, RESIDUAL_REL};
 use crate::geometry::{CurvePoint, Tube};
-use crate::math::{Point3, RootFailure};
+use crate::math::{tol, Point3, RootFailure};
 use crate::path::index::SegmentIndex;
 use rayon::prelude::*;
 
@@ -203,7 +203,7 @@ fn compute_batch(
             let d0 = dist(t_below);
             let speed = tube.surface(t_below, v).d_dt.norm();
             let step0 = 0.9 * (goal - d0).max(0.05 * delta_mm) / speed;
-            let x_tol = 1e-13 * (1.0 + t_below.abs());
+            let x_tol = tol::PARAM_FINE * (1.0 + t_below.abs());
             if d0 >= goal {
                 // Already far enough (only on the ramp): stay on the point below.
                 let position = tube.point(t_below, v);
@@ -225,7 +225,7 @@ fn compute_batch(
                 step0,
                 t_hi,
                 x_tol,
-                1e-11 * delta_mm,
+                RESIDUAL_REL * delta_mm,
             ) {
                 Ok(Some((t, ev, res))) => {
                     let position = tube.point(t, v);

@@ -6,7 +6,7 @@ use super::clearance::{check_shape, layer_clearances, substrate_shape, summarise
 use super::torch::Torch;
 use super::{CollisionOptions, CollisionReport, LayerClearance};
 use crate::geometry::Substrate;
-use crate::math::{Point3, Vector3};
+use crate::math::{tol, Point3, Vector3};
 use crate::path::Path;
 use crate::toolaxis::rules::{angle, smooth_angles};
 use crate::toolaxis::{LocalFrame, ToolAxisError};
@@ -109,7 +109,7 @@ pub struct AvoidanceReport {
 /// Unit basis `(e1, e2)` perpendicular to `tool`, `e1` along the tangent.
 fn cone_basis(f: &LocalFrame, tool: &Vector3) -> (Vector3, Vector3) {
     let e1 = f.tangent - tool * f.tangent.dot(tool);
-    let e1 = if e1.norm() > 1e-9 {
+    let e1 = if e1.norm() > tol::ANGLE_RAD {
         e1.normalize()
     } else {
         crate::math::any_perpendicular(tool)
@@ -359,7 +359,7 @@ pub fn avoid_collisions(
             let mut max_corr: f64 = 0.0;
             for (f, a) in out_frames.iter_mut().zip(&axes) {
                 let d = angle(&f.tool, a);
-                if d > 1e-12 {
+                if d > tol::AXIS_MOVED_RAD {
                     corrected_count += 1;
                 }
                 max_corr = max_corr.max(d);
