@@ -18,12 +18,22 @@ _PathLike = Union[str, "os.PathLike[str]"]
 
 __version__: str
 
-class WaamError(ValueError):
-    """Bad input or a failed stage; the message names the file, field,
-    keyword, layer or point."""
+class WaamError(Exception):
+    """Any error of the library; the message names the file, field,
+    keyword, layer or point. Raised as one of its subclasses, by kind."""
+
+class InputError(WaamError, ValueError):
+    """Bad input: a part or cell file's field, a keyword, a program file."""
 
 class InfeasiblePlan(WaamError):
-    """A program was asked of a plan with an infeasible layer."""
+    """A program was asked of a plan with an infeasible layer (an answer
+    about the part in the cell, not bad input)."""
+
+class Cancelled(WaamError):
+    """The host stopped the run (cancel flag or progress callback)."""
+
+class WaamIOError(WaamError, OSError):
+    """A file could not be read or written (missing, permissions, disk)."""
 
 class Part:
     """A tube to build: geometry, substrate and the part file's slicing,

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use pyo3::prelude::*;
 
-use super::waam_error;
+use super::stage_error;
 use crate::pipeline::Cell;
 
 /// A robot cell: the robot and its layout (part carried under a fixed
@@ -21,7 +21,7 @@ impl PyCell {
     #[staticmethod]
     fn read(path: PathBuf) -> PyResult<Self> {
         Ok(Self {
-            cell: Cell::read(&path).map_err(waam_error)?,
+            cell: Cell::read(&path).map_err(stage_error)?,
         })
     }
 
@@ -30,7 +30,7 @@ impl PyCell {
     #[pyo3(signature = (text, name = "<string>"))]
     fn from_toml(text: &str, name: &str) -> PyResult<Self> {
         Ok(Self {
-            cell: Cell::from_toml_str(text, name).map_err(waam_error)?,
+            cell: Cell::from_toml_str(text, name).map_err(stage_error)?,
         })
     }
 

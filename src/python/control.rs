@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 
 use pyo3::prelude::*;
 
-use super::waam_error;
+use super::{stage_error, waam_error};
 use crate::path::{Discretisation, Strategy};
 use crate::pipeline::{Control, SliceOverrides};
 
@@ -117,7 +117,7 @@ impl HostControl {
         let raised = self.raised.lock().unwrap_or_else(|p| p.into_inner()).take();
         match (raised, result) {
             (Some(e), _) => Err(e),
-            (None, r) => r.map_err(waam_error),
+            (None, r) => r.map_err(stage_error),
         }
     }
 }

@@ -10,7 +10,7 @@ use super::control::{HostControl, SliceKeywords};
 use super::placed::PyPlacedCell;
 use super::planned::PyPlannedPart;
 use super::sliced::PySlicedPart;
-use super::waam_error;
+use super::{stage_error, waam_error};
 use crate::pipeline::{Part, PlaceRequest, PlanOptions, RzLaw};
 
 /// A tube to build: geometry, substrate and the part file's slicing,
@@ -26,7 +26,7 @@ impl PyPart {
     #[staticmethod]
     fn read(path: PathBuf) -> PyResult<Self> {
         Ok(Self {
-            part: Part::read(&path).map_err(waam_error)?,
+            part: Part::read(&path).map_err(stage_error)?,
         })
     }
 
@@ -36,7 +36,7 @@ impl PyPart {
     #[pyo3(signature = (text, name = "<string>"))]
     fn from_toml(text: &str, name: &str) -> PyResult<Self> {
         Ok(Self {
-            part: Part::from_toml_str(text, name).map_err(waam_error)?,
+            part: Part::from_toml_str(text, name).map_err(stage_error)?,
         })
     }
 
@@ -202,6 +202,6 @@ impl PyPart {
             req.half_box_mm = Some(h);
         }
         let result = py.detach(|| crate::pipeline::place_part(&self.part, &cell.cell, &req));
-        PyPlacedCell::new(py, result.map_err(waam_error)?)
+        PyPlacedCell::new(py, result.map_err(stage_error)?)
     }
 }

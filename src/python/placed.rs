@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use super::cell::PyCell;
-use super::{json_to_py, waam_error};
+use super::{io_error, json_to_py};
 use crate::pipeline::PlacedCell;
 
 /// A part placed in a cell (or the search's account of why it cannot be).
@@ -92,7 +92,7 @@ impl PyPlacedCell {
     /// Writes `placement.json` and, when a placement was found, `cell.toml`
     /// into `dir` (created if missing), each atomically; returns the paths.
     fn write(&self, py: Python<'_>, dir: PathBuf) -> PyResult<Vec<PathBuf>> {
-        py.detach(|| self.placed.write(&dir)).map_err(waam_error)
+        py.detach(|| self.placed.write(&dir)).map_err(io_error)
     }
 
     fn __repr__(&self) -> String {

@@ -7,7 +7,7 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::{arrays, json_to_py, waam_error, InfeasiblePlan};
+use super::{arrays, json_to_py, stage_error, waam_error, InfeasiblePlan};
 use crate::pipeline::{PlannedPart, ProgramFormat};
 use crate::robot::trajectory::{SingularityKind, Violation, ViolationKind};
 
@@ -224,7 +224,7 @@ impl PyPlannedPart {
             )));
         }
         py.detach(|| self.planned.write_programs(&dir, format))
-            .map_err(waam_error)
+            .map_err(stage_error)
     }
 
     fn __len__(&self) -> usize {

@@ -14,13 +14,20 @@ def torus():
     return ws.Part.read(PARTS / "quarter-torus.toml")
 
 
-def test_waam_error_is_a_value_error():
-    assert issubclass(ws.WaamError, ValueError)
+def test_errors_are_raised_by_kind():
+    # one base, a subclass per kind (the library's ErrorKind); bad input is
+    # still a ValueError, an unreadable file an OSError
+    for kind in (ws.InputError, ws.InfeasiblePlan, ws.Cancelled, ws.WaamIOError):
+        assert issubclass(kind, ws.WaamError)
+    assert issubclass(ws.InputError, ValueError)
+    assert issubclass(ws.WaamIOError, OSError)
+    assert not issubclass(ws.WaamIOError, ValueError)
+    assert not issubclass(ws.InfeasiblePlan, ValueError)
 
 
 def test_a_missing_part_file_is_named(tmp_path):
     missing = tmp_path / "nope.toml"
-    with pytest.raises(ws.WaamError, match="nope.toml"):
+    with pytest.raises(ws.WaamIOError, match="nope.toml"):
         ws.Part.read(missing)
 
 
@@ -28,7 +35,7 @@ def test_a_bad_field_names_the_file_and_field():
     text = (PARTS / "quarter-torus.toml").read_text()
     bad = text.replace('radius = "r"', 'radius = "-r"')
     assert bad != text
-    with pytest.raises(ws.WaamError, match=r"my-torus\.toml: field `profile\.radius`"):
+    with pytest.raises(ws.InputError, match=r"my-torus\.toml: field `profile\.radius`"):
         ws.Part.from_toml(bad, name="my-torus.toml")
     with pytest.raises(ws.WaamError, match="my-torus.toml"):
         ws.Part.from_toml(text.replace("delta_mm = 5.0", 'delta_mm = "five"'), name="my-torus.toml")
@@ -56,7 +63,7 @@ def test_from_toml_reads_the_same_part_as_read():
     ],
 )
 def test_bad_keywords_name_the_keyword(torus, keywords, message):
-    with pytest.raises(ws.WaamError, match=message):
+    with pytest.raises(ws.InputError, match=message):
         torus.slice(**keywords)
 
 
@@ -69,7 +76,7 @@ def test_bad_plan_keywords(torus):
 
 
 def test_a_robot_file_is_not_a_cell():
-    with pytest.raises(ws.WaamError, match=r"kuka_kr16_2\.toml.*a robot, not a cell"):
+    with pytest.raises(ws.InputError, match=r"kuka_kr16_2\.toml.*a robot, not a cell"):
         ws.Cell.read(CELLS / "kuka_kr16_2.toml")
 
 

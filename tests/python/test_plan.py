@@ -91,6 +91,15 @@ def test_infeasible_plan_refuses_to_write(hemisphere, part_carried, tmp_path):
     assert issubclass(ws.InfeasiblePlan, ws.WaamError)
 
 
+def test_a_folder_that_cannot_be_made_is_an_io_error(feasible, tmp_path):
+    """Writing under a regular file fails in the OS, not in the input."""
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    with pytest.raises(ws.WaamIOError, match="a-file") as raised:
+        feasible.write_program(blocker / "prog")
+    assert isinstance(raised.value, OSError)
+
+
 def test_check_program_round_trip(feasible, part_carried, tmp_path):
     files = feasible.write_program(tmp_path / "prog")
     assert files and files[0].name == "HEMISPHERE.ls"
