@@ -89,6 +89,7 @@ class Part:
         max_layers: Optional[int] = None,
         progress: Optional[Callable[[float], Any]] = None,
         positioner: Optional[str] = None,
+        format: Optional[str] = None,
     ) -> "PlannedPart":
         """Plans the part in `cell`: slice, tool axes, layer-by-layer R_Z
         optimisation, joint trajectory, program model. An infeasible layer
@@ -98,7 +99,9 @@ class Part:
             "spline" or "point". positioner (torch-carried cells):
             "optimised" (default: tilt and turn laws within the cell's cone
             of the vertical) or "vertical" (the build direction exactly
-            vertical, as in the thesis). Other keywords as in `slice`.
+            vertical, as in the thesis). format: "fanuc", "kuka", "abb" or
+            None (the cell robot's vendor's; another vendor's raises
+            InputError before any work). Other keywords as in `slice`.
             Progress is reported at stage boundaries (slicing, optimising,
             program).
         """
@@ -225,12 +228,12 @@ class PlannedPart:
         """The program format written by default (the cell vendor's)."""
     def summary(self) -> Dict[str, Any]:
         """The content of summary.json as `waam plan` writes it."""
-    def write_program(self, dir: _PathLike, format: Optional[str] = None) -> List[Path]:
+    def write_program(self, dir: _PathLike) -> List[Path]:
         """Writes the robot program into `dir` (created if missing), each
-        file atomically; returns the written paths, the main program first.
-        format: "fanuc", "kuka", "abb" or None for the cell vendor's; another
-        vendor's is refused (WaamError). Raises InfeasiblePlan when a layer
-        is infeasible."""
+        file atomically, in the plan's format (`Part.plan(format=...)`);
+        returns the written paths in the order the cell runs them. Raises
+        InfeasiblePlan when a layer is infeasible, WaamIOError when a file
+        cannot be written."""
     def __len__(self) -> int:
         """Number of planned points."""
 

@@ -31,7 +31,7 @@ fn main() -> Result<(), waam_slicer::Error> {
         }
         std::process::exit(2);
     }
-    let files = planned.write_programs(&out, cell.native_format())?;
+    let files = planned.write_programs(&out)?;
     let report = waam_slicer::check_program(&files[0], &cell)?;
     println!(
         "{}: {} motions, {} problem(s)",

@@ -77,7 +77,7 @@ fn main() -> Result<(), waam_slicer::Error> {
                 continue;
             }
             let dir = out.join(cell_name).join(part_name);
-            let files = planned.write_programs(&dir, cell_used.native_format())?;
+            let files = planned.write_programs(&dir)?;
             let report = check_program(&files[0], &cell_used)?;
             let points: usize = planned.layers.iter().map(|l| l.points.len()).sum();
             let names: Vec<String> = files

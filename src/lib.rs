@@ -59,13 +59,13 @@
 //! stands.
 //!
 //! ```no_run
-//! use waam_slicer::{Cell, Part, PlanOptions, ProgramFormat};
+//! use waam_slicer::{Cell, Part, PlanOptions};
 //! # fn main() -> Result<(), waam_slicer::Error> {
 //! let part = Part::read("parts/hemisphere.toml")?;
 //! let cell = Cell::read("parts/cells/robowam_part_carried.toml")?;
 //! let planned = waam_slicer::plan_part(&part, &cell, &PlanOptions::default())?;
 //! if planned.is_feasible() {
-//!     planned.write_programs("out/hemisphere", ProgramFormat::Fanuc)?;
+//!     planned.write_programs("out/hemisphere")?;
 //! }
 //! # Ok(()) }
 //! ```
@@ -119,8 +119,8 @@ pub use error::{Error, ErrorKind};
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
 pub use pipeline::{
-    check_program, place_part, plan_part, slice_part, slice_part_with, Cell, Control, Part,
-    PlaceRequest, PlacedCell, PlanOptions, PlannedPart, ProgramFormat, RzLaw, SliceOverrides,
-    SlicedPart,
+    check_program, place_part, plan_part, plan_part_with, slice_part, slice_part_with, Cell,
+    Control, Part, PlaceRequest, PlacedCell, PlanOptions, PlannedPart, ProgramFormat, RzLaw,
+    SliceOverrides, SlicedPart,
 };
 pub use place::PlaceOptions;

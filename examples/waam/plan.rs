@@ -11,7 +11,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 use waam_slicer::program::ProgramError;
 use waam_slicer::util::atomic::write_atomic;
-use waam_slicer::{plan_part, Cell, Error, Part, PlanOptions, PlannedPart, ProgramFormat};
+use waam_slicer::{plan_part_with, Cell, Error, Part, PlanOptions, PlannedPart, ProgramFormat};
 
 /// Runs the command; prints errors itself and returns the exit code.
 pub fn run(a: &PlanArgs, quiet: bool) -> ExitCode {
@@ -53,8 +53,8 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     a.axes.apply(&mut opts.slice);
     let t_read = t0.elapsed().as_secs_f64();
     let spinner = crate::progress::Stage::start(quiet, "slicing");
-    opts.control = spinner.control();
-    let planned = match plan_part(&part, &cell, &opts) {
+
+    let planned = match plan_part_with(&part, &cell, &opts, &spinner.control()) {
         Ok(p) => p,
         Err(Error::Program(e @ ProgramError::VendorMismatch { .. })) => {
             let name = format.map(ProgramFormat::name).unwrap_or_default();
@@ -87,7 +87,7 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     let t = Instant::now();
     let mut written: Vec<serde_json::Value> = Vec::new();
     let feasible = if planned.plan.is_feasible() {
-        match planned.write_programs(&dir, planned.format) {
+        match planned.write_programs(&dir) {
             Ok(files) => {
                 // the files in the order the cell loads them (the main
                 // first; a build cut to the memory budget: its groups in turn)

@@ -11,13 +11,13 @@
 //! need one step.
 //!
 //! ```no_run
-//! use waam_slicer::{Cell, Part, PlanOptions, ProgramFormat};
+//! use waam_slicer::{Cell, Part, PlanOptions};
 //! # fn main() -> Result<(), waam_slicer::Error> {
 //! let part = Part::read("parts/hemisphere.toml")?;
 //! let cell = Cell::read("parts/cells/robowam_part_carried.toml")?;
 //! let planned = waam_slicer::plan_part(&part, &cell, &PlanOptions::default())?;
 //! assert!(planned.is_feasible());
-//! let files = planned.write_programs("out/hemisphere", ProgramFormat::Fanuc)?;
+//! let files = planned.write_programs("out/hemisphere")?;
 //! let report = waam_slicer::check_program(&files[0], &cell)?;
 //! assert!(report.problems.is_empty());
 //! # Ok(()) }
@@ -39,7 +39,7 @@ pub use options::{
     AxisOverrides, ParseOptionError, PlanOptions, ProgramFormat, RzLaw, SliceOverrides,
 };
 pub use place::{place_part, placement_bounds, PlaceRequest, PlacedCell, DEFAULT_HALF_BOX_MM};
-pub use planned::{plan_part, program_name, PlanTimes, PlannedPart};
+pub use planned::{plan_part, plan_part_with, program_name, PlanTimes, PlannedPart};
 pub use sliced::{slice_part, slice_part_with, SliceTimes, SlicedPart};
 
 use crate::io::cell_file::{parse_cell_file, CellFile, CellFileError};

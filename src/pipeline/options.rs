@@ -285,8 +285,11 @@ impl fmt::Display for RzLaw {
 }
 
 /// Options of [`plan_part`](crate::plan_part): the slicing overrides, the
-/// `R_Z` law and the program format. Plain data; `Default` plans with the
-/// part file's settings, `poly:4` and the cell robot's vendor's format.
+/// `R_Z` law, the positioner's mode and the program format. Plain data (a
+/// host's progress callback and cancel flag go to
+/// [`plan_part_with`](crate::plan_part_with) as a [`Control`](super::Control));
+/// `Default` plans with the part file's settings, `poly:4` and the cell
+/// robot's vendor's format.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PlanOptions {
     /// Overrides of the part file's slicing, tool-axis and process settings
@@ -294,11 +297,12 @@ pub struct PlanOptions {
     pub slice: SliceOverrides,
     /// How `R_Z` varies along a layer.
     pub rz: RzLaw,
-    /// Program format; `None`: the cell robot's vendor's.
+    /// Program format; `None`: the cell robot's vendor's. The one place a
+    /// format is asked: checked against the cell's robot before any work
+    /// (another vendor's is refused), kept as [`PlannedPart::format`](crate::PlannedPart::format)
+    /// and written by [`PlannedPart::write_programs`](crate::PlannedPart::write_programs).
     pub format: Option<ProgramFormat>,
     /// The torch-carried cell's positioner: optimised laws within the cell's
     /// cone of the vertical (default) or the thesis's exact vertical.
     pub positioner: crate::optimise::positioner::PositionerOptions,
-    /// Progress reports and cancellation for a host program.
-    pub control: super::Control,
 }

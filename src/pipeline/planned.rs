@@ -10,7 +10,7 @@ use serde::Serialize;
 use serde_json::{json, Value};
 
 use super::sliced::merge;
-use super::{slice_part_with, Cell, Part, PlanOptions, ProgramFormat, RzLaw, SlicedPart};
+use super::{slice_part_with, Cell, Control, Part, PlanOptions, ProgramFormat, RzLaw, SlicedPart};
 use crate::optimise::{
     layer_points, optimise_with, trajectory_inputs, ConfigurationChoice, LayerPoints,
     OptimiseOptions, Plan,
@@ -54,7 +54,8 @@ pub struct PlannedPart {
     pub optimise: OptimiseOptions,
     /// The `R_Z` law asked for.
     pub rz: RzLaw,
-    /// The program format the plan writes by default.
+    /// The program format the plan writes: [`PlanOptions::format`], else the
+    /// cell robot's vendor's.
     pub format: ProgramFormat,
     /// The optimised plan, one entry per layer.
     pub plan: Plan,
@@ -102,9 +103,23 @@ pub fn program_name(part_name: &str) -> String {
 /// the cell's robot cannot run ([`ProgramError::VendorMismatch`], checked
 /// before any work); [`Error::Cancelled`].
 pub fn plan_part(part: &Part, cell: &Cell, opts: &PlanOptions) -> Result<PlannedPart, Error> {
+    plan_part_with(part, cell, opts, &Control::default())
+}
+
+/// [`plan_part`] with a host's progress reports and cancellation
+/// ([`Control`]: progress from 0 to 1 through slicing, optimising and the
+/// program; a cancel request is seen between layers).
+///
+/// # Errors
+/// As [`plan_part`].
+pub fn plan_part_with(
+    part: &Part,
+    cell: &Cell,
+    opts: &PlanOptions,
+    control: &Control,
+) -> Result<PlannedPart, Error> {
     let format = opts.format.unwrap_or_else(|| cell.native_format());
     check_vendor(&cell.layout, format.vendor(), format.emitter())?;
-    let control = &opts.control;
     let t = Instant::now();
     // Slicing is the first tenth of a plan's progress.
     let sliced = slice_part_with(part, &opts.slice, &control.within(0.0, 0.1))?;
@@ -291,16 +306,15 @@ impl PlannedPart {
         crate::io::joints_csv::write_joints_csv(w, &self.layers, &self.plan, self.has_positioner())
     }
 
-    /// The emitted program files in `format`, not written.
+    /// The emitted program files in the plan's [`PlannedPart::format`], not
+    /// written.
     ///
     /// # Errors
     /// [`ProgramError::InfeasibleLayer`] naming the first infeasible layer,
-    /// [`ProgramError::Infeasible`] when the program stage refused the
-    /// trajectory, [`ProgramError::VendorMismatch`] for another vendor's format.
-    pub fn program_files(
-        &self,
-        format: ProgramFormat,
-    ) -> Result<Vec<crate::program::EmittedFile>, Error> {
+    /// the program stage's refusal of the trajectory
+    /// ([`PlannedPart::program`]'s error).
+    pub fn program_files(&self) -> Result<Vec<crate::program::EmittedFile>, Error> {
+        let format = self.format;
         check_vendor(&self.cell.layout, format.vendor(), format.emitter())?;
         check_every_layer(&self.layers, &self.plan)?;
         let program = self.program.as_ref().map_err(Clone::clone)?;
@@ -308,17 +322,14 @@ impl PlannedPart {
         Ok(crate::program::contract::emit(program, settings)?)
     }
 
-    /// Writes the robot program in `format` into `dir` (created if missing),
-    /// each file atomically; returns the written paths, the main program first.
+    /// Writes the robot program in the plan's [`PlannedPart::format`] into
+    /// `dir` (created if missing), each file atomically; returns the written
+    /// paths, the main program first.
     ///
     /// # Errors
     /// As [`PlannedPart::program_files`]; [`ProgramError::Io`] naming the file.
-    pub fn write_programs(
-        &self,
-        dir: impl AsRef<FsPath>,
-        format: ProgramFormat,
-    ) -> Result<Vec<PathBuf>, Error> {
-        let files = self.program_files(format)?;
+    pub fn write_programs(&self, dir: impl AsRef<FsPath>) -> Result<Vec<PathBuf>, Error> {
+        let files = self.program_files()?;
         let dir = dir.as_ref();
         std::fs::create_dir_all(dir).map_err(|source| ProgramError::Io {
             path: dir.display().to_string(),

@@ -94,7 +94,8 @@ impl PyPart {
     /// `positioner`: `"optimised"` (default) or `"vertical"` (the thesis's
     /// exact vertical), torch-carried cells.
     #[pyo3(signature = (cell, *, delta_mm = None, points = None, chord_mm = None, strategy = None,
-        rz = None, travel_speed_mm_s = None, max_layers = None, progress = None, positioner = None))]
+        rz = None, travel_speed_mm_s = None, max_layers = None, progress = None, positioner = None,
+        format = None))]
     #[allow(clippy::too_many_arguments)]
     fn plan(
         &self,
@@ -109,6 +110,7 @@ impl PyPart {
         max_layers: Option<i64>,
         progress: Option<Py<PyAny>>,
         positioner: Option<&str>,
+        format: Option<&str>,
     ) -> PyResult<PyPlannedPart> {
         use crate::optimise::positioner::{PositionerMode, PositionerOptions};
         let mode = match positioner {
@@ -135,18 +137,26 @@ impl PyPart {
                 .parse()
                 .map_err(|e| waam_error(format!("rz = {s:?}: {e}")))?,
         };
+        let format = match format {
+            None => None,
+            Some(s) => Some(
+                s.parse::<crate::pipeline::ProgramFormat>()
+                    .map_err(|e| waam_error(format!("format = {s:?}: {e}")))?,
+            ),
+        };
         let host = HostControl::new(progress);
         let opts = PlanOptions {
             slice,
             rz,
-            format: None,
+            format,
             positioner: PositionerOptions {
                 mode,
                 ..PositionerOptions::default()
             },
-            control: host.control.clone(),
         };
-        let result = py.detach(|| crate::pipeline::plan_part(&self.part, &cell.cell, &opts));
+        let result = py.detach(|| {
+            crate::pipeline::plan_part_with(&self.part, &cell.cell, &opts, &host.control)
+        });
         PyPlannedPart::new(py, host.finish(result)?)
     }
 

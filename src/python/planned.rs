@@ -7,8 +7,8 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::{arrays, json_to_py, stage_error, waam_error, InfeasiblePlan};
-use crate::pipeline::{PlannedPart, ProgramFormat};
+use super::{arrays, json_to_py, stage_error, InfeasiblePlan};
+use crate::pipeline::PlannedPart;
 use crate::robot::trajectory::{SingularityKind, Violation, ViolationKind};
 
 /// A part planned in a cell: every planned point in deposition order.
@@ -201,29 +201,18 @@ impl PyPlannedPart {
     }
 
     /// Writes the robot program into `dir` (created if missing), each file
-    /// atomically; returns the written paths, the main program first.
-    /// `format`: `fanuc`, `kuka`, `abb` or None for the cell vendor's.
-    /// Raises `InfeasiblePlan` when a layer is infeasible.
-    #[pyo3(signature = (dir, format = None))]
-    fn write_program(
-        &self,
-        py: Python<'_>,
-        dir: PathBuf,
-        format: Option<&str>,
-    ) -> PyResult<Vec<PathBuf>> {
-        let format = match format {
-            None => self.planned.format,
-            Some(s) => s
-                .parse::<ProgramFormat>()
-                .map_err(|e| waam_error(format!("format = {s:?}: {e}")))?,
-        };
+    /// atomically, in the plan's format (`Part.plan(format=...)`, else the
+    /// cell vendor's); returns the written paths, in the order the cell
+    /// runs them. Raises `InfeasiblePlan` when a layer is infeasible.
+    #[pyo3(signature = (dir,))]
+    fn write_program(&self, py: Python<'_>, dir: PathBuf) -> PyResult<Vec<PathBuf>> {
         if let Some(why) = self.refusal() {
             return Err(InfeasiblePlan::new_err(format!(
                 "{}: no program written: {why}",
                 self.planned.sliced.part_file
             )));
         }
-        py.detach(|| self.planned.write_programs(&dir, format))
+        py.detach(|| self.planned.write_programs(&dir))
             .map_err(stage_error)
     }
 

@@ -12,8 +12,8 @@ use waam_slicer::io::joints_csv::read_joints_csv;
 use waam_slicer::optimise::{Constraint, LayerStatus};
 use waam_slicer::program::{LayerRefusal, ProgramError};
 use waam_slicer::{
-    check_program, plan_part, slice_part, Cell, Control, Error, ErrorKind, Part, PlanOptions,
-    ProgramFormat, SliceOverrides,
+    check_program, plan_part, plan_part_with, slice_part, Cell, Control, Error, ErrorKind, Part,
+    PlanOptions, ProgramFormat, SliceOverrides,
 };
 
 fn small(points: usize) -> PlanOptions {
@@ -38,9 +38,7 @@ fn one_call_plan_writes_a_program_that_reads_back_clean() {
     assert!(planned.is_feasible(), "{:?}", planned.refusal());
     assert_eq!(planned.format, ProgramFormat::Fanuc);
     let dir = tempfile::tempdir().unwrap();
-    let files = planned
-        .write_programs(dir.path(), ProgramFormat::Fanuc)
-        .unwrap();
+    let files = planned.write_programs(dir.path()).unwrap();
     assert_eq!(files[0], dir.path().join("HEMISPHERE.ls"));
     let report = check_program(&files[0], &cell).unwrap();
     assert!(report.problems.is_empty(), "{:?}", report.problems);
@@ -69,7 +67,7 @@ fn an_infeasible_plan_cannot_write_a_program_and_names_its_layer() {
     assert!(!planned.is_feasible());
     let first = planned.plan.infeasible_layers().next().unwrap().layer;
     let dir = tempfile::tempdir().unwrap();
-    let written = planned.write_programs(dir.path(), ProgramFormat::Fanuc);
+    let written = planned.write_programs(dir.path());
     // an answer about the part in the cell, not bad input
     assert_eq!(
         written.as_ref().map_err(Error::kind).err(),
@@ -108,7 +106,7 @@ fn a_layer_lost_between_plan_and_program_is_refused() {
     // A host that drops a layer's plan (or an optimiser that returned none).
     planned.plan.layers.pop();
     let last = planned.layers.last().unwrap().layer;
-    match planned.program_files(ProgramFormat::Fanuc) {
+    match planned.program_files() {
         Err(Error::Program(ProgramError::InfeasibleLayer { layer, .. })) => assert_eq!(layer, last),
         other => panic!("expected InfeasibleLayer, got {other:?}"),
     }
@@ -225,13 +223,10 @@ fn a_cancel_flag_stops_the_run() {
     let flag = Arc::new(AtomicBool::new(true));
     let seen = Arc::new(std::sync::Mutex::new(Vec::new()));
     let s2 = seen.clone();
-    let opts = PlanOptions {
-        control: Control::default()
-            .with_cancel(flag)
-            .with_progress(move |stage, f| s2.lock().unwrap().push((stage.to_string(), f))),
-        ..small(60)
-    };
-    let e = plan_part(&part, &cell, &opts).unwrap_err();
+    let control = Control::default()
+        .with_cancel(flag)
+        .with_progress(move |stage, f| s2.lock().unwrap().push((stage.to_string(), f)));
+    let e = plan_part_with(&part, &cell, &small(60), &control).unwrap_err();
     assert!(matches!(e, Error::Cancelled { .. }), "{e}");
     assert_eq!(e.kind(), ErrorKind::Cancelled);
     assert!(seen.lock().unwrap().is_empty());
@@ -245,13 +240,13 @@ fn a_plans_progress_rises_from_0_to_1() {
     let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
     let seen = Arc::new(std::sync::Mutex::new(Vec::new()));
     let s2 = seen.clone();
+    let control = Control::default()
+        .with_progress(move |stage, f| s2.lock().unwrap().push((stage.to_string(), f)));
     let opts = PlanOptions {
-        control: Control::default()
-            .with_progress(move |stage, f| s2.lock().unwrap().push((stage.to_string(), f))),
         rz: "fixed:90".parse().unwrap(),
         ..small(40)
     };
-    plan_part(&part, &cell, &opts).unwrap();
+    plan_part_with(&part, &cell, &opts, &control).unwrap();
     let seen = seen.lock().unwrap();
     let fractions: Vec<f64> = seen.iter().map(|s| s.1).collect();
     assert!(fractions.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
@@ -304,18 +299,15 @@ fn a_cancel_during_optimisation_stops_between_layers() {
     let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
     let flag = Arc::new(AtomicBool::new(false));
     let f2 = flag.clone();
-    let opts = PlanOptions {
-        control: Control::default()
-            .with_cancel(flag)
-            .with_progress(move |stage, f| {
-                // the host presses "stop" once a layer is done
-                if stage == "optimising" && f > 0.1 {
-                    f2.store(true, std::sync::atomic::Ordering::Relaxed);
-                }
-            }),
-        ..small(60)
-    };
-    let e = plan_part(&part, &cell, &opts).unwrap_err();
+    let control = Control::default()
+        .with_cancel(flag)
+        .with_progress(move |stage, f| {
+            // the host presses "stop" once a layer is done
+            if stage == "optimising" && f > 0.1 {
+                f2.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+        });
+    let e = plan_part_with(&part, &cell, &small(60), &control).unwrap_err();
     assert!(
         matches!(
             e,

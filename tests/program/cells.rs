@@ -55,7 +55,7 @@ fn every_sample_cell_writes_programs_with_home_dwell_transit_and_payload_that_ch
         }
         let dir = tmp.join(file.trim_end_matches(".toml"));
         let files = planned
-            .write_programs(&dir, cell.native_format())
+            .write_programs(&dir)
             .unwrap_or_else(|e| panic!("{file}: {e}"));
         let report = check_program(&files[0], &cell).unwrap();
         assert!(report.is_ok(), "{file}:\n{report}");

@@ -126,11 +126,13 @@ def test_check_program_round_trip(feasible, part_carried, tmp_path):
     assert all({"file", "line", "kind", "message"} <= p.keys() for p in problems)
 
 
-def test_write_program_in_another_vendors_format_is_refused(feasible, tmp_path):
-    with pytest.raises(ws.WaamError, match="(?i)kuka|vendor|fanuc"):
-        feasible.write_program(tmp_path, format="kuka")
-    with pytest.raises(ws.WaamError, match="format"):
-        feasible.write_program(tmp_path, format="gcode")
+def test_another_vendors_format_is_refused_before_planning(hemisphere, part_carried):
+    # the format is asked once, when planning (Rust PlanOptions::format)
+    with pytest.raises(ws.InputError, match="(?i)kuka|vendor|fanuc"):
+        hemisphere.plan(part_carried, points=POINTS, format="kuka")
+    with pytest.raises(ws.InputError, match="format"):
+        hemisphere.plan(part_carried, points=POINTS, format="gcode")
+    assert hemisphere.plan(part_carried, points=POINTS, format="fanuc").format == "fanuc"
 
 
 def test_progress_reports_fractions_and_can_stop_the_plan(hemisphere, part_carried):
