@@ -5,6 +5,7 @@
 mod abb_controller;
 mod api;
 mod cells;
+mod circular;
 mod contract;
 mod fanuc_controller;
 mod fixture;

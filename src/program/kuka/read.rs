@@ -21,6 +21,16 @@ pub enum KrlOp {
         /// Blended (`C_DIS`).
         blended: bool,
     },
+    /// `CIRC aux, name [C_DIS]`: circular move through the auxiliary
+    /// point `aux` to `target`.
+    Circ {
+        /// Auxiliary (via) point name.
+        aux: String,
+        /// Target name.
+        target: String,
+        /// Blended (`C_DIS`).
+        blended: bool,
+    },
     /// `$VEL.CP = v` (m/s).
     VelCp(f64),
     /// `TRIGGER WHEN DISTANCE=d DELAY=0 DO action [PRIO=p]`.
@@ -421,6 +431,26 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
                     blended: true,
                 }),
                 _ => Err(format!("expected `LIN name [C_DIS]`, got `{l}`")),
+            };
+        }
+        Some("CIRC") => {
+            let circ = |aux: &str, t: &str, blended| {
+                Ok(KrlOp::Circ {
+                    aux: aux.to_string(),
+                    target: t.to_string(),
+                    blended,
+                })
+            };
+            let args: Vec<&str> = l["CIRC".len()..].split(',').map(str::trim).collect();
+            return match args.as_slice() {
+                [aux, rest] if !aux.is_empty() => {
+                    match rest.split_whitespace().collect::<Vec<_>>().as_slice() {
+                        [t] => circ(aux, t, false),
+                        [t, "C_DIS"] => circ(aux, t, true),
+                        _ => Err(format!("expected `CIRC aux, name [C_DIS]`, got `{l}`")),
+                    }
+                }
+                _ => Err(format!("expected `CIRC aux, name [C_DIS]`, got `{l}`")),
             };
         }
         Some("TRIGGER") => {
