@@ -70,3 +70,152 @@ fn circular_beads_round_trip_in_every_vendor() {
         assert!(r.is_ok(), "{file}:\n{r}");
     }
 }
+
+/// `[program] circular_moves = false` in a cell file turns them off: the
+/// same bead is then written with linear moves only, and needs more
+/// positions.
+#[test]
+fn a_cell_file_can_turn_circular_moves_off() {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("parts/cells/kuka_kr16_2_torch_carried.toml");
+    let text = std::fs::read_to_string(&p).unwrap();
+    let on = waam_slicer::io::cell_file::parse_cell_file(&text, "on").unwrap();
+    assert!(on.program.common.circular_moves, "default on");
+    let off_text = if text.contains("\n[program]\n") {
+        text.replace("\n[program]\n", "\n[program]\ncircular_moves = false\n")
+    } else {
+        format!("{text}\n[program]\ncircular_moves = false\n")
+    };
+    let off = waam_slicer::io::cell_file::parse_cell_file(&off_text, "off").unwrap();
+    assert!(!off.program.common.circular_moves);
+    let c = cell("kuka_kr16_2_torch_carried.toml");
+    let path = hemisphere(0..2, 240, law(&c));
+    let tr = trajectory(&c, &path);
+    let build = |common: &waam_slicer::program::ProgramOptions| {
+        waam_slicer::program::build_program_with(
+            "HEMI",
+            &c,
+            &path,
+            &tr,
+            &waam_slicer::program::TravelSpeed::Constant(TS_MM_S),
+            common,
+        )
+        .unwrap()
+    };
+    let with = build(&on.program.common);
+    let without = build(&off.program.common);
+    assert!(with.points.iter().any(|p| p.via));
+    assert!(!without.points.iter().any(|p| p.via));
+    assert!(
+        with.bead_points().count() < without.bead_points().count(),
+        "{} positions with circles, {} without",
+        with.bead_points().count(),
+        without.bead_points().count()
+    );
+}
+
+/// Closed form: points on an exact circle (radius 40 mm, 1° apart, tool
+/// axis constant) compress to at most two circular moves per 180° of arc,
+/// and every programmed circle, sampled with the controller model
+/// (`interpolate`), stays within the path tolerance of the true circle:
+/// `| |p - centre| - r |` and the height off its plane.
+#[test]
+fn points_on_a_circle_compress_to_few_circular_moves() {
+    use waam_slicer::math::{Point3, UnitQuaternion, Vector3};
+    use waam_slicer::program::compress::{
+        compress, interpolate, tool_z_map, CompressOptions, ControllerPose, Move,
+    };
+    let (r, centre) = (40.0, Point3::new(100.0, -20.0, 5.0));
+    for sweep_deg in [90usize, 180, 300, 360] {
+        let poses: Vec<ControllerPose> = (0..=sweep_deg)
+            .map(|k| {
+                let a = (k as f64).to_radians();
+                let p = centre + Vector3::new(r * a.cos(), r * a.sin(), 0.0);
+                ControllerPose::new(p, UnitQuaternion::identity(), Vec::new())
+            })
+            .collect();
+        let opts = CompressOptions::default();
+        let c = compress(&poses, &[], &tool_z_map, &opts).unwrap();
+        let halves = sweep_deg.div_ceil(180);
+        assert!(
+            c.moves.len() <= 2 * halves && c.moves.iter().all(|m| m.via().is_some()),
+            "{sweep_deg}°: {:?}",
+            c.moves
+        );
+        assert!(c.max_path_error_mm < opts.path_tolerance_mm, "{c:?}");
+        let mut from = 0;
+        for m in &c.moves {
+            let Move::Circular { via, to } = *m else {
+                unreachable!()
+            };
+            for k in 0..=100 {
+                let x = interpolate(
+                    &poses[from],
+                    Some(&poses[via]),
+                    &poses[to],
+                    k as f64 / 100.0,
+                )
+                .p;
+                let radial = ((x - centre).xy().norm() - r).abs();
+                let height = (x.z - centre.z).abs();
+                assert!(
+                    radial.max(height) < opts.path_tolerance_mm,
+                    "{radial} {height}"
+                );
+            }
+            from = to;
+        }
+    }
+}
+
+/// The checker samples the circle the controller would run: a KUKA
+/// program whose first `CIRC` auxiliary point is moved by 1 mm (its `X` in
+/// the `.dat`) is refused, with a deviation between the moves on the
+/// `CIRC` line (KRL: the circle runs through the auxiliary point, so moving
+/// it moves the whole arc).
+#[test]
+fn a_via_moved_by_1_mm_is_refused() {
+    let c = cell("kuka_kr16_2_torch_carried.toml");
+    let prog = thinned_hemisphere(&c, 0..1);
+    let settings = ProgramSettings::default();
+    let mut files = emit(&prog, &settings).unwrap();
+    let ok = check_files(c.robot().vendor, &files, &c, &settings, Some(&prog.planned)).unwrap();
+    assert!(ok.is_ok(), "{ok}");
+    let src = files.iter().find(|f| f.name.ends_with(".src")).unwrap();
+    let (circ_line, circ) = src
+        .text
+        .lines()
+        .enumerate()
+        .find(|(_, l)| l.trim_start().starts_with("CIRC "))
+        .expect("a CIRC");
+    let aux = circ.trim()["CIRC ".len()..]
+        .split(',')
+        .next()
+        .unwrap()
+        .trim()
+        .to_string();
+    let dat = files.iter_mut().find(|f| f.name.ends_with(".dat")).unwrap();
+    let decl = format!("DECL E6POS {aux}={{X ");
+    let text: Vec<String> = dat
+        .text
+        .lines()
+        .map(|l| match l.find(&decl) {
+            Some(at) => {
+                let start = at + decl.len();
+                let end = start + l[start..].find(',').unwrap();
+                let x: f64 = l[start..end].parse().unwrap();
+                format!("{}{:.4}{}", &l[..start], x + 1.0, &l[end..])
+            }
+            None => l.to_string(),
+        })
+        .collect();
+    assert_ne!(text.join("\n"), dat.text.trim_end(), "{aux} not found");
+    dat.text = text.join("\n") + "\n";
+    let r = check_files(c.robot().vendor, &files, &c, &settings, Some(&prog.planned)).unwrap();
+    let between = r.problems.iter().find(|p| {
+        p.kind == waam_slicer::program::validate::ProblemKind::Deviation
+            && p.line == circ_line + 1
+            && p.message.contains("between the moves")
+    });
+    assert!(between.is_some(), "line {}: {r}", circ_line + 1);
+}
