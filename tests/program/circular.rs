@@ -219,3 +219,36 @@ fn a_via_moved_by_1_mm_is_refused() {
     });
     assert!(between.is_some(), "line {}: {r}", circ_line + 1);
 }
+
+/// A FANUC `C P[v]` line whose end line `:  P[n] …` is missing is refused
+/// by the reader, naming the file and the `C` line (TP: a circular motion
+/// is one program line written on two text lines).
+#[test]
+fn a_fanuc_circular_move_without_its_end_line_is_refused() {
+    let c = cell("robowam_torch_carried.toml");
+    let prog = thinned_hemisphere(&c, 0..1);
+    let files = emit(&prog, &ProgramSettings::default()).unwrap();
+    let ls = &files[0];
+    let lines: Vec<&str> = ls.text.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.contains(":C P["))
+        .expect("a circular move");
+    assert!(
+        lines[at + 1].trim_start().starts_with(":  P["),
+        "{}",
+        lines[at + 1]
+    );
+    let cut: Vec<&str> = lines
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| *k != at + 1)
+        .map(|(_, l)| *l)
+        .collect();
+    let err = waam_slicer::program::fanuc::parse_ls(&cut.join("\n"), &ls.name).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains(&ls.name) && msg.contains(&format!("{}", at + 1)),
+        "{msg}"
+    );
+}
