@@ -252,3 +252,34 @@ fn a_fanuc_circular_move_without_its_end_line_is_refused() {
         "{msg}"
     );
 }
+
+/// A KRL program with `CIRC` moves states the orientation control the
+/// checker models (`$ORI_TYPE = #VAR`, `$CIRC_TYPE = #BASE`: orientation
+/// from start to end relative to the base, the auxiliary point's
+/// orientation ignored — KUKA system software, "Orientation control for
+/// CIRC"); without it the first `CIRC` is a frame problem.
+#[test]
+fn krl_circ_needs_its_orientation_control_stated() {
+    let c = cell("kuka_kr16_2_torch_carried.toml");
+    let prog = thinned_hemisphere(&c, 0..1);
+    let settings = ProgramSettings::default();
+    let mut files = emit(&prog, &settings).unwrap();
+    let src = files.iter_mut().find(|f| f.name.ends_with(".src")).unwrap();
+    assert!(src
+        .text
+        .contains("\n  $ORI_TYPE = #VAR\n  $CIRC_TYPE = #BASE\n"));
+    src.text = src.text.replace("  $ORI_TYPE = #VAR\n", "");
+    let circ_line = src
+        .text
+        .lines()
+        .position(|l| l.trim_start().starts_with("CIRC "))
+        .unwrap()
+        + 1;
+    let r = check_files(c.robot().vendor, &files, &c, &settings, Some(&prog.planned)).unwrap();
+    assert!(
+        r.problems.iter().any(
+            |p| p.kind == waam_slicer::program::validate::ProblemKind::Frame && p.line == circ_line
+        ),
+        "{r}"
+    );
+}

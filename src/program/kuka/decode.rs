@@ -16,6 +16,7 @@ use crate::program::kuka::read::{
     falling_input, InterruptAction, KrlOp, KrlProgram, KrlRoutine, KrlStatement,
 };
 use crate::program::kuka::{ArcLoss, KukaOptions, StatedBase, ARC_LOST_HANDLER};
+use crate::program::kuka::{CIRC_CIRC_TYPE, CIRC_ORI_TYPE};
 use crate::program::MoveKind;
 use crate::robot::{Cell, Configuration, Joints};
 
@@ -97,6 +98,8 @@ pub(crate) fn kuka_steps(
         push(report, ProblemKind::Frame, src, line, msg)
     };
     let stmts = &program.statements;
+    // `$ORI_TYPE = #VAR`, `$CIRC_TYPE = #BASE` stated before a `CIRC`
+    let mut circ_stated = [false; 2];
     let mut next = 0;
     while let Some(st) = stmts.get(next) {
         next += 1;
@@ -129,6 +132,18 @@ pub(crate) fn kuka_steps(
         let (targets, linear) = match &st.op {
             KrlOp::Ptp(t) => (vec![(t, MoveKind::Joint)], false),
             KrlOp::Lin { target, .. } => (vec![(target, MoveKind::Linear)], true),
+            KrlOp::Circ { aux, target, .. } if circ_stated != [true; 2] => {
+                frame_problem(
+                    &mut report,
+                    line,
+                    format!("CIRC before the program states $ORI_TYPE = {CIRC_ORI_TYPE} and $CIRC_TYPE = {CIRC_CIRC_TYPE}: the controller's orientation on the circle would be its default, not the checked one"),
+                );
+                circ_stated = [true; 2];
+                (
+                    vec![(aux, MoveKind::Via), (target, MoveKind::Circular)],
+                    true,
+                )
+            }
             KrlOp::Circ { aux, target, .. } => (
                 vec![(aux, MoveKind::Via), (target, MoveKind::Circular)],
                 true,
@@ -177,6 +192,22 @@ pub(crate) fn kuka_steps(
                     );
                 }
                 pending.push((*distance, action.clone(), line));
+                continue;
+            }
+            KrlOp::OriType(v) | KrlOp::CircType(v) => {
+                let (name, want) = match st.op {
+                    KrlOp::OriType(_) => ("$ORI_TYPE", CIRC_ORI_TYPE),
+                    _ => ("$CIRC_TYPE", CIRC_CIRC_TYPE),
+                };
+                if v == want {
+                    circ_stated[usize::from(name == "$CIRC_TYPE")] = true;
+                } else {
+                    frame_problem(
+                        &mut report,
+                        line,
+                        format!("{name} = {v}: the checker models {want} (orientation by slerp from start to end)"),
+                    );
+                }
                 continue;
             }
             KrlOp::IpoTcp(tcp) => {

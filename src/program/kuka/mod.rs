@@ -637,6 +637,16 @@ pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<
     })
 }
 
+/// `$ORI_TYPE` written before the first `CIRC`: the orientation changes
+/// continuously from the start to the end orientation (KUKA system
+/// software, "Orientation control"), the slerp of
+/// [`interpolate`](crate::program::compress::interpolate).
+pub const CIRC_ORI_TYPE: &str = "#VAR";
+/// `$CIRC_TYPE` written before the first `CIRC`: orientation control
+/// relative to the base (`#PATH` would turn it with the circle's tangent),
+/// the auxiliary point's orientation ignored.
+pub const CIRC_CIRC_TYPE: &str = "#BASE";
+
 /// Name of the home position in the `.dat` (an `E6AXIS`).
 pub const HOME_NAME: &str = "PHOME";
 
@@ -707,6 +717,12 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
         writeln!(w, "  $IPO_MODE = #TCP")?;
     } else {
         writeln!(w, "  $IPO_MODE = #BASE")?;
+    }
+    if program.points.iter().any(|p| p.via) {
+        // the orientation on a circle: from start to end, the auxiliary
+        // point's ignored, relative to the base (the checker's model)
+        writeln!(w, "  $ORI_TYPE = {CIRC_ORI_TYPE}")?;
+        writeln!(w, "  $CIRC_TYPE = {CIRC_CIRC_TYPE}")?;
     }
     writeln!(w, "  $APO.CDIS = {}", Mm(opts.cdis_mm))?;
     writeln!(w, "  BAS (#VEL_PTP,{} )", opts.ptp_percent)?;

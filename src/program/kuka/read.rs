@@ -127,6 +127,10 @@ pub enum KrlOp {
     Resume,
     /// `$IPO_MODE = #TCP` (`true`) or `#BASE` (`false`).
     IpoTcp(bool),
+    /// `$ORI_TYPE = v`: orientation control of CP moves (`#VAR` written).
+    OriType(String),
+    /// `$CIRC_TYPE = v`: orientation reference of `CIRC` (`#BASE` written).
+    CircType(String),
     /// `$VEL_EXTAX[n] = p`: external axis `n` (1-based) at `p` % of its
     /// maximum speed in path motions.
     VelExtax {
@@ -612,6 +616,8 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
                 };
                 return Ok(KrlOp::TimerStop { timer, stop });
             }
+            "$ORI_TYPE" => return Ok(KrlOp::OriType(v.to_string())),
+            "$CIRC_TYPE" => return Ok(KrlOp::CircType(v.to_string())),
             "$IPO_MODE" => {
                 return match v {
                     "#TCP" => Ok(KrlOp::IpoTcp(true)),
