@@ -24,8 +24,10 @@
 //! planned axis interpolated there. From each kept point the search gallops
 //! and then bisects for the farthest acceptable linear and circular end
 //! (acceptability is not monotone in `j`, so the result may be slightly
-//! short of the true optimum), takes the farther (linear on a tie), and never
-//! passes a must-keep point. A check costs O(points + samples of the move)
+//! short of the true optimum), counts positions — a circular move writes
+//! two (via and end), a linear one one — and takes the circular move only
+//! where it reaches farther than two linear moves would, and never passes
+//! a must-keep point. A check costs O(points + samples of the move)
 //! thanks to nearest-point queries that follow the path and skip segments
 //! by distance bounds; 100 000 points take a few tenths of a second in a
 //! release build.
@@ -449,6 +451,17 @@ pub fn circular_move_allowed(
             && arc.radius <= opts.max_radius_mm
             && arc.sweep <= opts.max_arc_angle_deg.to_radians() + ARC_SWEEP_SLACK_RAD
     })
+}
+
+/// Length (mm) of the controller's path from `a` through `via` to `b`: the
+/// circle arc through the three points, or the two chords `a → via → b`
+/// where they are (nearly) collinear or `via` is not between them on the
+/// circle. The same circle as [`interpolate`].
+pub fn arc_length(a: &Point3<f64>, via: &Point3<f64>, b: &Point3<f64>) -> f64 {
+    match Arc3::through(a, via, b) {
+        Some(arc) => arc.radius * arc.sweep,
+        None => (via - a).norm() + (b - via).norm(),
+    }
 }
 
 /// Measures one move from pose `from` to `mv.to()` as [`compress`] does, in
@@ -1055,12 +1068,26 @@ where
         } else {
             None
         };
+        // a circular move writes two positions (via and end): it must reach
+        // farther than two linear moves would
         let mv = match circular.map(|j| (j, self.circular_via(i, j))) {
-            Some((to, Some(via))) if to > linear => Move::Circular { via, to },
+            Some((to, Some(via)))
+                if to > linear && to > self.two_linear_reach(linear, limit)? =>
+            {
+                Move::Circular { via, to }
+            }
             _ => Move::Linear { to: linear },
         };
         let dev = self.evaluate(i, mv.to(), mv.via())?;
         Ok((mv, dev))
+    }
+
+    /// Where a second linear move from `linear` (ending at most at `limit`)
+    /// reaches: what two linear moves from the same start cover.
+    fn two_linear_reach(&mut self, linear: usize, limit: usize) -> Result<usize, CompressError> {
+        Ok(self
+            .farthest(linear, limit, Kind::Linear)?
+            .unwrap_or(linear))
     }
 
     /// Farthest acceptable end of a `kind` move from `i`: a galloping search

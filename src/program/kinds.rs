@@ -18,12 +18,21 @@ pub enum PositionMode {
 }
 
 /// How the controller moves to a position: a joint move (FANUC `J`, KUKA
-/// `PTP`, ABB `MoveAbsJ`/`MoveJ`) or a linear one (FANUC `L`, KUKA `LIN`,
-/// ABB `MoveL`/`ArcL`).
+/// `PTP`, ABB `MoveAbsJ`/`MoveJ`), a linear one (FANUC `L`, KUKA `LIN`,
+/// ABB `MoveL`/`ArcL`) or a circular one (FANUC `C`, KUKA `CIRC`, ABB
+/// `MoveC`/`ArcC`), whose via position comes first as a [`MoveKind::Via`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MoveKind {
     /// Joint interpolation.
     Joint,
     /// Linear interpolation of the tool point, orientation interpolated.
     Linear,
+    /// The via (auxiliary, circle) point of a circular move: not a move of
+    /// its own; the controller passes through this position on its way to
+    /// the next one, which is the [`MoveKind::Circular`] end.
+    Via,
+    /// Circular interpolation of the tool point from the previous position
+    /// through the via to this one, orientation interpolated from start to
+    /// end ([`interpolate`](crate::program::compress::interpolate)).
+    Circular,
 }

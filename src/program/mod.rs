@@ -293,6 +293,14 @@ pub struct ProgramPoint {
     pub speed_mm_s: f64,
     /// Arc flag.
     pub arc: ArcFlag,
+    /// This bead point is the via (circle) point of a circular move (FANUC
+    /// `C`, KUKA `CIRC`, ABB `ArcC`/`MoveC`): the controller passes through
+    /// its position on the circle from the previous point to the next one,
+    /// which the move ends at and whose speed it carries
+    /// ([`moves::thin_beads`]). Always an [`ArcFlag::On`] point between two
+    /// bead points; `false` for every point of an unthinned program.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub via: bool,
 }
 
 /// A buildable program: points in path order, one bead per layer.
@@ -583,6 +591,11 @@ pub struct ProgramOptions {
     /// Largest angle between the interpolated and the planned torch axis
     /// (deg, > 0) when beads are thinned. Default 0.5°.
     pub orientation_tolerance_deg: f64,
+    /// Thinned beads may use circular moves (FANUC `C`, KUKA `CIRC`, ABB
+    /// `ArcC`) where a stretch is a circle arc within the tolerances and
+    /// that takes fewer positions than linear moves (a circular move writes
+    /// two: its via and its end). Default on.
+    pub circular_moves: bool,
 }
 
 impl Default for ProgramOptions {
@@ -604,6 +617,7 @@ impl Default for ProgramOptions {
             remote_tcp: false,
             path_tolerance_mm: 0.05,
             orientation_tolerance_deg: 0.5,
+            circular_moves: true,
         }
     }
 }
@@ -952,6 +966,7 @@ pub fn build_program_with(
             } else {
                 ArcFlag::On
             },
+            via: false,
         });
     }
     if opts.clearance_mm > 0.0 {
@@ -1381,6 +1396,7 @@ fn clearance_point(
         positioner: pose.positioner,
         speed_mm_s: opts.approach_speed_mm_s,
         arc: flag,
+        via: false,
         ..*p
     })
 }
@@ -1432,7 +1448,7 @@ pub const POSITIONER_STILL_DEG: f64 = 0.01;
 /// part (the part turns under a nearly still torch), so a TCP speed would
 /// not give the planned travel speed.
 pub fn positioner_moves(program: &Program, i: usize) -> bool {
-    let Some(prev) = i.checked_sub(1).map(|k| &program.points[k]) else {
+    let Some(prev) = move_start(program, i).map(|k| &program.points[k]) else {
         return false;
     };
     match (program.points[i].positioner, prev.positioner) {
@@ -1443,12 +1459,32 @@ pub fn positioner_moves(program: &Program, i: usize) -> bool {
     }
 }
 
-/// Length of the segment into point `i` of `program`, the deposition point's
-/// travel over the part (part frame, mm); 0 for `i = 0`.
+/// Length of the move into point `i` of `program`, the deposition point's
+/// travel over the part (part frame, mm): the chord from the previous
+/// point, or for a circular move the arc from [`move_start`] through the via
+/// ([`compress::arc_length`]); 0 for `i = 0`.
 pub fn segment_length_mm(program: &Program, i: usize) -> f64 {
-    match i.checked_sub(1) {
-        Some(k) => (program.points[i].position_mm - program.points[k].position_mm).norm(),
-        None => 0.0,
+    let Some(k) = move_start(program, i) else {
+        return 0.0;
+    };
+    let end = &program.points[i].position_mm;
+    let start = &program.points[k].position_mm;
+    if k + 2 == i {
+        let via = &program.points[k + 1].position_mm;
+        crate::program::compress::arc_length(start, via, end)
+    } else {
+        (end - start).norm()
+    }
+}
+
+/// Where the move into point `i` of `program` starts: the point before it,
+/// or the one before the via when point `i` ends a circular move
+/// ([`ProgramPoint::via`]); `None` for `i = 0`.
+pub fn move_start(program: &Program, i: usize) -> Option<usize> {
+    let k = i.checked_sub(1)?;
+    match (k.checked_sub(1), program.points[k].via) {
+        (Some(before), true) => Some(before),
+        _ => Some(k),
     }
 }
 

@@ -1,11 +1,21 @@
 //! Stage 7, the moves a controller is given: each bead of a [`Program`]
-//! thinned to the fewest linear moves whose interpolated path stays within
+//! thinned to the fewest positions whose interpolated path stays within
 //! [`ProgramOptions::path_tolerance_mm`] and
 //! [`ProgramOptions::orientation_tolerance_deg`] of every planned point
-//! ([`compress`]). The controller's
-//! model of a linear move is the one the emitters ask for: the tool centre
-//! point moves on a straight line and its orientation turns by slerp in the
-//! frame the move is programmed in, extra axes (the positioner) linearly —
+//! ([`compress`]), with linear moves and, where a stretch is a circle arc
+//! within the tolerances and [`ProgramOptions::circular_moves`] is on,
+//! circular ones (FANUC `C`, KUKA `CIRC`, ABB `ArcC`; the via is marked
+//! [`ProgramPoint::via`]). The controller's model of a move is the one the
+//! emitters ask for and the checker samples
+//! ([`interpolate`](crate::program::compress::interpolate)): the tool
+//! centre point moves on a straight line or on the circle through the via,
+//! its orientation turns by slerp from the start to the end over the
+//! path's length (the via's orientation is not used: KUKA `$ORI_TYPE =
+//! #VAR` with `$CIRC_TYPE = #BASE`, ABB `MoveC`/`ArcC`, FANUC `C`; the
+//! via's planned orientation is within the orientation tolerance of that
+//! slerp, so a controller that passes through it stays within it too) in
+//! the frame the move is programmed in, extra axes (the positioner)
+//! linearly —
 //! the part frame where the part is the moving frame (remote/fixed tool in
 //! the part-carried cell, coordinated motion in the torch-carried one),
 //! else the robot base frame with the positioner turning the part under it.
@@ -13,9 +23,10 @@
 //! changes and every point outside beads are kept.
 
 use crate::math::Isometry3;
-use crate::program::compress::{compress, CompressOptions, ControllerPose, Move};
+use crate::program::compress::{arc_length, compress, CompressOptions, ControllerPose, Move};
 use crate::program::contract::moves_in_part_frame;
 use crate::program::frames::fixed_torch_at;
+use crate::program::validate::between::{check_between, InterpolatedMove};
 use crate::program::{ArcFlag, Program, ProgramError, ProgramOptions, ProgramPoint};
 use crate::robot::Cell;
 
@@ -24,8 +35,11 @@ use crate::robot::Cell;
 pub struct Thinning {
     /// Bead points before (one per planned point).
     pub bead_points_before: usize,
-    /// Bead points kept (one move each).
+    /// Bead positions kept: one per linear move, two per circular move
+    /// (its via and its end), plus each bead's first point.
     pub bead_points_after: usize,
+    /// Circular moves among them ([`ProgramOptions::circular_moves`]).
+    pub circular_moves: usize,
     /// Largest distance between the interpolated path and the planned
     /// points or polyline, over the part (mm).
     pub max_path_error_mm: f64,
@@ -44,6 +58,11 @@ const SPEED_CHANGE: f64 = 1e-9;
 /// a move stops where the planned joints have turned this much, so that
 /// the controller's joints cannot take the other way round.
 const MAX_JOINT_TURN_PER_MOVE_RAD: f64 = std::f64::consts::FRAC_PI_4;
+
+/// Largest sweep of a circular move in a thinned bead (deg): a whole layer
+/// is three circular moves (six positions) rather than two whose
+/// orientation turns half a turn each (see [`thin_beads`]).
+pub const MAX_ARC_SWEEP_DEG: f64 = 120.0;
 
 /// The bead points every thinned move must stop at: where the speed
 /// changes (a move carries one), and where the joints have turned
@@ -131,6 +150,27 @@ pub(crate) fn flange_of(cell: &Cell, pose: &ControllerPose, in_part: bool) -> Is
     }
 }
 
+/// `true` when the circular move from `a` through `via` to `b` runs as the
+/// checker samples it ([`check_between`]): every joint within its travel,
+/// no jump, no joint above its maximum speed at the planned travel speed.
+fn circle_runs(
+    cell: &Cell,
+    opts: &ProgramOptions,
+    a: &ProgramPoint,
+    via: &ProgramPoint,
+    b: &ProgramPoint,
+) -> bool {
+    let length = arc_length(&a.position_mm, &via.position_mm, &b.position_mm);
+    let mv = InterpolatedMove {
+        from: (&a.joints, a.positioner),
+        via: Some((&via.joints, via.positioner)),
+        to: (&b.joints, b.positioner),
+        duration_s: length / b.speed_mm_s,
+        planned: None,
+    };
+    check_between(cell, opts, &mv).is_empty()
+}
+
 /// Thins every bead of `program` (module doc); `None` when
 /// `opts.path_tolerance_mm` is 0 (every point kept).
 ///
@@ -148,7 +188,12 @@ pub fn thin_beads(
     let copts = CompressOptions {
         path_tolerance_mm: opts.path_tolerance_mm,
         orientation_tolerance_deg: opts.orientation_tolerance_deg,
-        allow_circular: false,
+        allow_circular: opts.circular_moves,
+        // where the part frame moves with the positioner, the torch turns
+        // over the part as much as the arc sweeps: at 180° the slerp's
+        // shortest way round is undefined and the rounding of the written
+        // positions picks it; MAX_ARC_SWEEP_DEG keeps it well away
+        max_arc_angle_deg: MAX_ARC_SWEEP_DEG,
         // the joints follow the whole rotation, R_Z included
         rotation_tolerance_deg: Some(opts.orientation_tolerance_deg),
         ..CompressOptions::default()
@@ -198,6 +243,45 @@ pub fn thin_beads(
             index: i,
             reason: format!("layer {}: move compression: {e}", bead[0].layer),
         })?;
+        // a circular move whose joints leave their travel, jump or outrun
+        // their speed between the positions (sampled as the checker does)
+        // is written with linear moves instead
+        let mut c = c;
+        let mut moves = Vec::with_capacity(c.moves.len());
+        let mut start = 0;
+        for m in &c.moves {
+            match *m {
+                Move::Circular { via, to }
+                    if !circle_runs(&cell, opts, &bead[start], &bead[via], &bead[to]) =>
+                {
+                    let sub = compress(
+                        &poses[start..=to],
+                        &keep[start..=to],
+                        &map,
+                        &CompressOptions {
+                            allow_circular: false,
+                            ..copts.clone()
+                        },
+                    )
+                    .map_err(|e| ProgramError::Mismatch {
+                        index: i,
+                        reason: format!("layer {}: move compression: {e}", bead[0].layer),
+                    })?;
+                    c.max_path_error_mm = c.max_path_error_mm.max(sub.max_path_error_mm);
+                    c.max_orientation_error_deg = c
+                        .max_orientation_error_deg
+                        .max(sub.max_orientation_error_deg);
+                    moves.extend(
+                        sub.moves
+                            .iter()
+                            .map(|s| Move::Linear { to: start + s.to() }),
+                    );
+                }
+                m => moves.push(m),
+            }
+            start = m.to();
+        }
+        c.moves = moves;
         report.bead_points_before += bead.len();
         report.max_path_error_mm = report.max_path_error_mm.max(c.max_path_error_mm);
         report.max_orientation_error_deg = report
@@ -205,12 +289,16 @@ pub fn thin_beads(
             .max(c.max_orientation_error_deg);
         kept.push(bead[0]);
         for m in &c.moves {
-            let to = match *m {
-                Move::Linear { to } | Move::Circular { to, .. } => to,
-            };
-            kept.push(bead[to]);
+            if let Move::Circular { via, .. } = *m {
+                kept.push(ProgramPoint {
+                    via: true,
+                    ..bead[via]
+                });
+                report.circular_moves += 1;
+            }
+            kept.push(bead[m.to()]);
         }
-        report.bead_points_after += 1 + c.moves.len();
+        report.bead_points_after += c.programmed_indices().len();
         i = end + 1;
     }
     program.points = kept;

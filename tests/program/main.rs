@@ -7,6 +7,7 @@ mod abb_controller;
 mod api;
 mod budget;
 mod cells;
+mod circular;
 mod contract;
 mod fanuc_controller;
 mod fixture;

@@ -555,7 +555,7 @@ pub(crate) fn abb_steps(
             seconds,
             input,
         };
-        let (target, speed, kind, event, v_reax_time) = match &ins.op {
+        let motion = match &ins.op {
             RapidOp::ConfL(on) => {
                 conf_l = *on;
                 continue;
@@ -647,10 +647,11 @@ pub(crate) fn abb_steps(
             }
             RapidOp::MoveAbsJ { target, zone, tool } => {
                 check_motion_args(module, &decls, zone, tool, line, report);
-                (target, None, MoveKind::Joint, None, None)
+                (vec![(target, MoveKind::Joint)], None, None, None)
             }
             RapidOp::Linear {
                 instruction,
+                via,
                 target,
                 speed_mm_s,
                 v_reax_deg_s,
@@ -661,7 +662,7 @@ pub(crate) fn abb_steps(
                 tool,
             } => {
                 check_motion_args(module, &decls, zone, tool, line, report);
-                let arc = instruction != "MoveL";
+                let arc = !instruction.starts_with("Move");
                 let mut v = *speed_mm_s;
                 if arc {
                     if start.is_some() {
@@ -713,7 +714,7 @@ pub(crate) fn abb_steps(
                 }
                 let event = match instruction.as_str() {
                     "ArcLStart" => Some(true),
-                    "ArcLEnd" => Some(false),
+                    "ArcLEnd" | "ArcCEnd" => Some(false),
                     _ => None,
                 };
                 let speed = match (time_s, &frames) {
@@ -743,47 +744,56 @@ pub(crate) fn abb_steps(
                     // is the torch's speed over the part
                     (None, _) => MotionSpeed::Linear(v),
                 };
+                // a circular move's circle point first, as its own step
+                let moves_to = match via {
+                    Some(c) => vec![(c, MoveKind::Via), (target, MoveKind::Circular)],
+                    None => vec![(target, MoveKind::Linear)],
+                };
                 (
-                    target,
+                    moves_to,
                     Some(speed),
-                    MoveKind::Linear,
                     event,
                     time_s.map(|t| (t, *v_reax_deg_s)),
                 )
             }
         };
-        if kind == MoveKind::Linear && !conf_l {
-            push(
-                report,
-                ProblemKind::Configuration,
-                file,
-                line,
-                "linear move without `ConfL \\On`: the controller may change the configuration"
-                    .into(),
-            );
-        }
-        let Some(t) = targets.get(target.as_str()).copied() else {
-            push(
-                report,
-                ProblemKind::Declaration,
-                file,
-                line,
-                format!("{target} is not declared"),
-            );
-            prev_positioner = None;
-            continue;
-        };
-        let positioner = match (t.external[slots[0]], t.external[slots[1]]) {
-            (Some(a), Some(b)) => Some([a.to_radians(), b.to_radians()]),
-            _ => None,
-        };
-        if let (Some((time, v_reax)), Some(a), Some(b)) = (v_reax_time, positioner, prev_positioner)
-        {
-            // a controller running the move at weld_speed instead of \T
-            // is held back by v_reax only
-            let turn = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).to_degrees();
-            if turn / v_reax < time - 1e-3 {
+        let (moves_to, speed, event, v_reax_time) = motion;
+        for (target, kind) in moves_to {
+            if kind == MoveKind::Linear && !conf_l {
                 push(
+                    report,
+                    ProblemKind::Configuration,
+                    file,
+                    line,
+                    "linear move without `ConfL \\On`: the controller may change the configuration"
+                        .into(),
+                );
+            }
+            let Some(t) = targets.get(target.as_str()).copied() else {
+                push(
+                    report,
+                    ProblemKind::Declaration,
+                    file,
+                    line,
+                    format!("{target} is not declared"),
+                );
+                prev_positioner = None;
+                continue;
+            };
+            let positioner = match (t.external[slots[0]], t.external[slots[1]]) {
+                (Some(a), Some(b)) => Some([a.to_radians(), b.to_radians()]),
+                _ => None,
+            };
+            // checked over the whole move, at its end (not at a circle point)
+            let v_reax_time = v_reax_time.filter(|_| kind != MoveKind::Via);
+            if let (Some((time, v_reax)), Some(a), Some(b)) =
+                (v_reax_time, positioner, prev_positioner)
+            {
+                // a controller running the move at weld_speed instead of \T
+                // is held back by v_reax only
+                let turn = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).to_degrees();
+                if turn / v_reax < time - 1e-3 {
+                    push(
                     report,
                     ProblemKind::Timing,
                     file,
@@ -793,22 +803,29 @@ pub(crate) fn abb_steps(
                         turn / v_reax
                     ),
                 );
+                }
             }
-        }
-        prev_positioner = positioner;
-        let (joints, from_cartesian) = match (&t.value, kind) {
-            (RapidTargetValue::Joint(a), MoveKind::Joint) => (Some(a.map(f64::to_radians)), false),
-            (RapidTargetValue::Rob { pose, conf }, MoveKind::Linear) => {
-                // cfx bit 2: wrist centre behind axis 1; bit 1: behind the
-                // lower arm, the elbow joint test (abb::confdata)
-                let (side, elbow) = arm_of(conf[3] & 4 != 0, conf[3] & 2 == 0);
-                let cfg = Configuration {
-                    wrist: wrist_of_j5(robot, conf[3] & 1 == 0),
-                    elbow,
-                    side,
-                };
-                if !(0..8).contains(&conf[3]) || cfg != cell.configuration() {
-                    push(
+            if kind != MoveKind::Via {
+                prev_positioner = positioner;
+            }
+            let (joints, from_cartesian) = match (&t.value, kind) {
+                (RapidTargetValue::Joint(a), MoveKind::Joint) => {
+                    (Some(a.map(f64::to_radians)), false)
+                }
+                (
+                    RapidTargetValue::Rob { pose, conf },
+                    MoveKind::Linear | MoveKind::Via | MoveKind::Circular,
+                ) => {
+                    // cfx bit 2: wrist centre behind axis 1; bit 1: behind the
+                    // lower arm, the elbow joint test (abb::confdata)
+                    let (side, elbow) = arm_of(conf[3] & 4 != 0, conf[3] & 2 == 0);
+                    let cfg = Configuration {
+                        wrist: wrist_of_j5(robot, conf[3] & 1 == 0),
+                        elbow,
+                        side,
+                    };
+                    if !(0..8).contains(&conf[3]) || cfg != cell.configuration() {
+                        push(
                         report, ProblemKind::Configuration,
                         file,
                         t.line,
@@ -819,68 +836,69 @@ pub(crate) fn abb_steps(
                             cell.configuration()
                         ),
                     );
-                }
-                let f = frames.and_then(|f| {
-                    let at = f.at(cell, positioner);
-                    if at.is_none() {
-                        push(
-                            report,
-                            ProblemKind::Format,
+                    }
+                    let f = frames.and_then(|f| {
+                        let at = f.at(cell, positioner);
+                        if at.is_none() {
+                            push(
+                                report,
+                                ProblemKind::Format,
+                                file,
+                                t.line,
+                                format!(
+                                    "{}: no positioner values for the coordinated work object",
+                                    t.name
+                                ),
+                            );
+                        }
+                        at
+                    });
+                    let q = f.and_then(|f| {
+                        decode_pose(
+                            robot,
+                            &f.flange(pose),
+                            cfg,
+                            |j, q| {
+                                let cf = match j {
+                                    0 => conf[0],
+                                    3 => conf[1],
+                                    _ => conf[2],
+                                };
+                                abb_quadrant(q, cf)
+                            },
+                            &t.name,
                             file,
                             t.line,
-                            format!(
-                                "{}: no positioner values for the coordinated work object",
-                                t.name
-                            ),
-                        );
-                    }
-                    at
-                });
-                let q = f.and_then(|f| {
-                    decode_pose(
-                        robot,
-                        &f.flange(pose),
-                        cfg,
-                        |j, q| {
-                            let cf = match j {
-                                0 => conf[0],
-                                3 => conf[1],
-                                _ => conf[2],
-                            };
-                            abb_quadrant(q, cf)
-                        },
-                        &t.name,
-                        file,
-                        t.line,
+                            report,
+                        )
+                    });
+                    (q, true)
+                }
+                _ => {
+                    push(
                         report,
-                    )
-                });
-                (q, true)
-            }
-            _ => {
-                push(
-                    report,
-                    ProblemKind::Declaration,
-                    file,
-                    line,
-                    format!("{target}: wrong target type for this instruction"),
-                );
-                continue;
-            }
-        };
-        steps.push(Step::Motion(Box::new(Motion {
-            file: file.clone(),
-            line,
-            label: t.name.clone(),
-            record_file: file.clone(),
-            record_line: t.line,
-            value_lines: [t.line; 6],
-            joints,
-            from_cartesian,
-            positioner,
-            kind,
-            speed: speed.unwrap_or(MotionSpeed::Joint),
-        })));
+                        ProblemKind::Declaration,
+                        file,
+                        line,
+                        format!("{target}: wrong target type for this instruction"),
+                    );
+                    continue;
+                }
+            };
+            steps.push(Step::Motion(Box::new(Motion {
+                file: file.clone(),
+                line,
+                label: t.name.clone(),
+                record_file: file.clone(),
+                record_line: t.line,
+                value_lines: [t.line; 6],
+                joints,
+                from_cartesian,
+                positioner,
+                kind,
+                speed: speed.unwrap_or(MotionSpeed::Joint),
+            })));
+        }
         match event {
             Some(true) => steps.push(Step::ProcessOn {
                 file: file.clone(),

@@ -154,8 +154,8 @@ use crate::math::Isometry3;
 use crate::program::fmt::{ascii_comment, ceil_to, floor_to, Deg, Fixed, Mm, Unitless};
 use crate::program::frames::ToolFrames;
 use crate::program::{
-    check_name, check_vendor, opens_bead, positioner_moves, render, segment_length_mm, ArcFlag,
-    EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, move_start, opens_bead, positioner_moves, render, segment_length_mm,
+    ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::abb_quaternion;
 use crate::robot::{Cell, Joints, RobotModel, Vendor};
@@ -296,6 +296,9 @@ const USED_NAMES: &[&str] = &[
     "ArcLStart",
     "ArcL",
     "ArcLEnd",
+    "MoveC",
+    "ArcC",
+    "ArcCEnd",
     "WaitTime",
     "WaitDI",
     "GripLoad",
@@ -1008,9 +1011,10 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             let t = ceil_to(t, 3).max(0.001);
             // and bound the positioner to its planned rate (°/s), for a
             // controller that runs the move at weld_speed instead of \T
+            let start = move_start(program, i).map(|k| &program.points[k]);
             let (a, b) = (
                 p.positioner.unwrap_or([0.0; 2]),
-                prev.and_then(|q| q.positioner).unwrap_or([0.0; 2]),
+                start.and_then(|q| q.positioner).unwrap_or([0.0; 2]),
             );
             let turn_deg = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).to_degrees();
             let v_reax = floor_to(turn_deg / t, 4).max(1e-4);
@@ -1021,7 +1025,18 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             );
         }
         let weld = |v: f64| format!("seamWaam, weldWaam{}", weld_of(v));
+        // the circle point of a circular move into this point (`ArcC`,
+        // `ArcCEnd`, `MoveC`: RAPID reference, "CirPoint, ToPoint"), written
+        // just before it
+        let circle = prev.filter(|a| a.via).map(|_| format!("p{}, ", k - 1));
+        let (arc_on, arc_end, move_on) = match &circle {
+            Some(_) => ("ArcC", "ArcCEnd", "MoveC"),
+            None => ("ArcL", "ArcLEnd", "MoveL"),
+        };
+        let c = circle.as_deref().unwrap_or("");
         match (&opts.process, p.arc) {
+            // written with the circular move it is the circle point of
+            (_, ArcFlag::On) if p.via => {}
             (_, ArcFlag::Approach) => {
                 writeln!(w, "    ! bead {} (layer {}): approach", p.layer, p.layer)?;
                 abs_j(w, k)?;
@@ -1054,19 +1069,19 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             }
             (ProcessControl::Arc { .. }, ArcFlag::On) => writeln!(
                 w,
-                "    ArcL p{k}, {v}, {}, {zone}, {tw};",
+                "    {arc_on} {c}p{k}, {v}, {}, {zone}, {tw};",
                 weld(p.speed_mm_s)
             )?,
             (ProcessControl::Arc { .. }, ArcFlag::End) => writeln!(
                 w,
-                "    ArcLEnd p{k}, {v}, {}, fine, {tw};",
+                "    {arc_end} {c}p{k}, {v}, {}, fine, {tw};",
                 weld(p.speed_mm_s)
             )?,
             (ProcessControl::Custom { .. }, ArcFlag::On) => {
-                writeln!(w, "    MoveL p{k}, {v}, {zone}, {tw};")?
+                writeln!(w, "    {move_on} {c}p{k}, {v}, {zone}, {tw};")?
             }
             (ProcessControl::Custom { end, .. }, ArcFlag::End) => {
-                writeln!(w, "    MoveL p{k}, {v}, fine, {tw};")?;
+                writeln!(w, "    {move_on} {c}p{k}, {v}, fine, {tw};")?;
                 writeln!(w, "    {end};")?;
             }
         }

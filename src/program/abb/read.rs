@@ -315,11 +315,15 @@ pub enum RapidOp {
         /// Tool and work object.
         tool: ToolArg,
     },
-    /// `MoveL`, `ArcLStart`, `ArcL`, `ArcLEnd`: instruction name, target and
+    /// `MoveL`, `ArcLStart`, `ArcL`, `ArcLEnd`, or the circular `MoveC`,
+    /// `ArcC`, `ArcCEnd` (circle point first): instruction name, target and
     /// `v_tcp` (mm/s).
     Linear {
-        /// `MoveL`, `ArcLStart`, `ArcL` or `ArcLEnd`.
+        /// `MoveL`, `ArcLStart`, `ArcL`, `ArcLEnd`, `MoveC`, `ArcC` or
+        /// `ArcCEnd`.
         instruction: String,
+        /// The circle point (`CirPoint`) of a circular instruction.
+        via: Option<String>,
         /// Target.
         target: String,
         /// `v_tcp` of the speeddata (mm/s).
@@ -735,8 +739,12 @@ fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
                 tool: tool_arg(&args[3])?,
             })
         }
-        "MoveL" | "ArcLStart" | "ArcL" | "ArcLEnd" => {
-            let arc = name != "MoveL";
+        "MoveL" | "ArcLStart" | "ArcL" | "ArcLEnd" | "MoveC" | "ArcC" | "ArcCEnd" => {
+            let arc = !name.starts_with("Move");
+            // `MoveC CirPoint, ToPoint, …`: one argument more, first
+            let circular = matches!(name, "MoveC" | "ArcC" | "ArcCEnd");
+            let via = circular.then(|| args.first().cloned()).flatten();
+            let args = &args[usize::from(circular).min(args.len())..];
             let want = if arc { 6 } else { 4 };
             if args.len() != want {
                 return Err(format!(
@@ -767,6 +775,7 @@ fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
             }
             Ok(RapidOp::Linear {
                 instruction: name.to_string(),
+                via,
                 target: args[0].clone(),
                 speed_mm_s: speed[0],
                 v_reax_deg_s: speed[3],

@@ -334,27 +334,31 @@ impl Decoder<'_> {
                 Op::Move {
                     kind,
                     position,
+                    via,
                     speed,
                     options,
                     ..
                 } => {
-                    let Some(pos) = tp.positions.iter().find(|p| p.index == *position) else {
-                        push(
-                            report,
-                            ProblemKind::Declaration,
-                            file,
-                            line,
-                            format!("P[{position}] has no record"),
-                        );
-                        continue;
-                    };
-                    let label = format!("P[{}]", pos.index);
-                    let linear = *kind == MoveKind::Linear;
-                    for (name, present, want) in [
-                        ("COORD", options.coord, want_coord && linear),
-                        ("RTCP", options.rtcp, want_rtcp && linear),
-                    ] {
-                        let why = match (present, want) {
+                    // a circular move's via first, as its own step
+                    let via = via.map(|v| (v, MoveKind::Via));
+                    for (position, kind) in via.into_iter().chain([(*position, *kind)]) {
+                        let Some(pos) = tp.positions.iter().find(|p| p.index == position) else {
+                            push(
+                                report,
+                                ProblemKind::Declaration,
+                                file,
+                                line,
+                                format!("P[{position}] has no record"),
+                            );
+                            continue;
+                        };
+                        let label = format!("P[{}]", pos.index);
+                        let linear = kind != MoveKind::Joint;
+                        for (name, present, want) in [
+                            ("COORD", options.coord, want_coord && linear),
+                            ("RTCP", options.rtcp, want_rtcp && linear),
+                        ] {
+                            let why = match (present, want) {
                             (false, true) if name == "COORD" => Some(
                                 "linear move without COORD: its speed would be the TCP's in the world frame, not the travel speed over the part on the positioner",
                             ),
@@ -365,54 +369,56 @@ impl Decoder<'_> {
                             (true, false) => Some("not expected: the options and cell do not use it"),
                             _ => None,
                         };
-                        if let Some(why) = why {
+                            if let Some(why) = why {
+                                push(
+                                    report,
+                                    ProblemKind::Frame,
+                                    file,
+                                    line,
+                                    format!("{label}: {name}: {why}"),
+                                );
+                            }
+                        }
+                        if options.coord && tp.groups < 2 {
                             push(
                                 report,
                                 ProblemKind::Frame,
                                 file,
                                 line,
-                                format!("{label}: {name}: {why}"),
+                                format!(
+                                    "{label}: COORD in a program of one motion group (no leader)"
+                                ),
                             );
                         }
-                    }
-                    if options.coord && tp.groups < 2 {
-                        push(
-                            report,
-                            ProblemKind::Frame,
-                            file,
-                            line,
-                            format!("{label}: COORD in a program of one motion group (no leader)"),
-                        );
-                    }
-                    let (joints, from_cartesian) = match &pos.arm {
-                        ArmPosition::Joint(d) => (Some(d.map(f64::to_radians)), false),
-                        ArmPosition::Cartesian { .. } if tp.remote_tcp => {
-                            push(
+                        let (joints, from_cartesian) = match &pos.arm {
+                            ArmPosition::Joint(d) => (Some(d.map(f64::to_radians)), false),
+                            ArmPosition::Cartesian { .. } if tp.remote_tcp => {
+                                push(
                                 report,
                                 ProblemKind::Format,
                                 file,
                                 pos.line,
                                 format!("{label}: Cartesian position in a remote TCP program: its representation (RX..RR) is not documented, write joint positions"),
                             );
-                            (None, true)
-                        }
-                        ArmPosition::Cartesian { xyzwpr, config } => {
-                            let cfg_line = pos.line + 2;
-                            let q = if pos.uf_ut != (frames.user_frame, frames.tool_frame) {
-                                push(
-                                    report,
-                                    ProblemKind::Frame,
-                                    file,
-                                    pos.line,
-                                    format!(
+                                (None, true)
+                            }
+                            ArmPosition::Cartesian { xyzwpr, config } => {
+                                let cfg_line = pos.line + 2;
+                                let q = if pos.uf_ut != (frames.user_frame, frames.tool_frame) {
+                                    push(
+                                        report,
+                                        ProblemKind::Frame,
+                                        file,
+                                        pos.line,
+                                        format!(
                                         "{label}: UF {}, UT {} are not the frames of the options",
                                         pos.uf_ut.0, pos.uf_ut.1
                                     ),
-                                );
-                                None
-                            } else if let Some((cfg, turns)) = parse_config(config) {
-                                if cfg != cell.configuration() {
-                                    push(
+                                    );
+                                    None
+                                } else if let Some((cfg, turns)) = parse_config(config) {
+                                    if cfg != cell.configuration() {
+                                        push(
                                         report, ProblemKind::Configuration,
                                         file,
                                         cfg_line,
@@ -421,67 +427,70 @@ impl Decoder<'_> {
                                             cell.configuration()
                                         ),
                                     );
+                                    }
+                                    let user_from_tool =
+                                        FanucPose::from_xyzwpr_deg(*xyzwpr).to_isometry();
+                                    let base_from_flange =
+                                        frames.base_from_user * user_from_tool * tool.inverse();
+                                    decode_pose(
+                                        robot,
+                                        &base_from_flange,
+                                        cfg,
+                                        |j, q| {
+                                            let t = match j {
+                                                0 => turns[0],
+                                                3 => turns[1],
+                                                _ => turns[2],
+                                            };
+                                            Some(q + TAU * t as f64)
+                                        },
+                                        &label,
+                                        file,
+                                        pos.value_lines[0],
+                                        report,
+                                    )
+                                } else {
+                                    push(
+                                        report,
+                                        ProblemKind::Configuration,
+                                        file,
+                                        cfg_line,
+                                        format!("{label}: bad CONFIG '{config}'"),
+                                    );
+                                    None
+                                };
+                                (q, true)
+                            }
+                        };
+                        steps.push(Step::Motion(Box::new(Motion {
+                            file: file.clone(),
+                            line,
+                            label,
+                            record_file: file.clone(),
+                            record_line: pos.line,
+                            value_lines: pos.value_lines,
+                            joints,
+                            from_cartesian,
+                            positioner: pos.group2.map(|g| g.map(f64::to_radians)),
+                            kind,
+                            speed: match (speed.mm_s(), speed.time_s()) {
+                                // COORD: relative to the leader (the positioner
+                                // carrying the part); RTCP: relative speed of
+                                // the workpiece and the fixed torch. Both are
+                                // the deposition point's speed over the part.
+                                (Some(v), _) if options.coord || options.rtcp => {
+                                    MotionSpeed::Linear(v)
                                 }
-                                let user_from_tool =
-                                    FanucPose::from_xyzwpr_deg(*xyzwpr).to_isometry();
-                                let base_from_flange =
-                                    frames.base_from_user * user_from_tool * tool.inverse();
-                                decode_pose(
-                                    robot,
-                                    &base_from_flange,
-                                    cfg,
-                                    |j, q| {
-                                        let t = match j {
-                                            0 => turns[0],
-                                            3 => turns[1],
-                                            _ => turns[2],
-                                        };
-                                        Some(q + TAU * t as f64)
-                                    },
-                                    &label,
-                                    file,
-                                    pos.value_lines[0],
-                                    report,
-                                )
-                            } else {
-                                push(
-                                    report,
-                                    ProblemKind::Configuration,
-                                    file,
-                                    cfg_line,
-                                    format!("{label}: bad CONFIG '{config}'"),
-                                );
-                                None
-                            };
-                            (q, true)
-                        }
-                    };
-                    steps.push(Step::Motion(Box::new(Motion {
-                        file: file.clone(),
-                        line,
-                        label,
-                        record_file: file.clone(),
-                        record_line: pos.line,
-                        value_lines: pos.value_lines,
-                        joints,
-                        from_cartesian,
-                        positioner: pos.group2.map(|g| g.map(f64::to_radians)),
-                        kind: *kind,
-                        speed: match (speed.mm_s(), speed.time_s()) {
-                            // COORD: relative to the leader (the positioner
-                            // carrying the part); RTCP: relative speed of
-                            // the workpiece and the fixed torch. Both are
-                            // the deposition point's speed over the part.
-                            (Some(v), _) if options.coord || options.rtcp => MotionSpeed::Linear(v),
-                            (Some(v), _) => MotionSpeed::Tcp {
-                                mm_s: v,
-                                flange_from_tcp: tool,
-                                extax_fraction: [1.0; 2],
+                                (Some(v), _) => MotionSpeed::Tcp {
+                                    mm_s: v,
+                                    flange_from_tcp: tool,
+                                    extax_fraction: [1.0; 2],
+                                },
+                                (None, Some(t)) => MotionSpeed::Time(t),
+                                _ => MotionSpeed::Joint,
                             },
-                            (None, Some(t)) => MotionSpeed::Time(t),
-                            _ => MotionSpeed::Joint,
-                        },
-                    })));
+                        })));
+                    }
                 }
             }
         }

@@ -130,8 +130,8 @@ use crate::program::frames::{fixed_torch_at, held_tool};
 use crate::program::kinds::{MoveKind, PositionMode};
 use crate::program::split::{split_to_budget, Budget, DEFAULT_MAX_POSITIONS};
 use crate::program::{
-    check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
-    ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, joint_move_target, move_start, positioner_moves, render,
+    segment_length_mm, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::FanucPose;
 use crate::robot::{Cell, Joints, Vendor};
@@ -633,12 +633,18 @@ pub enum Op {
     UFrame(u8),
     /// `UTOOL_NUM=n`.
     UTool(u8),
-    /// `J P[n] ...` / `L P[n] ...`; `position` is the `P[]` index in this program.
+    /// `J P[n] ...` / `L P[n] ...`, or a circular move written on two
+    /// lines, `C P[v]` then `:  P[n] ...` (FANUC TP, "Circular motion": the
+    /// via point on the `C` line, the end point, speed, termination and
+    /// options on the continuation line); `position` is the `P[]` index in
+    /// this program.
     Move {
-        /// J or L.
+        /// J, L or C ([`MoveKind::Circular`]).
         kind: MoveKind,
         /// `P[]` index (1-based) in this program.
         position: usize,
+        /// The via point's `P[]` index of a circular move (`None` otherwise).
+        via: Option<usize>,
         /// Speed.
         speed: Speed,
         /// Termination.
@@ -697,15 +703,17 @@ impl std::fmt::Display for Op {
             Op::Move {
                 kind,
                 position,
+                via,
                 speed,
                 term,
                 options,
             } => {
-                let k = match kind {
-                    MoveKind::Joint => 'J',
-                    MoveKind::Linear => 'L',
-                };
-                write!(f, "{k} P[{position}] {speed} {term}")?;
+                match (kind, via) {
+                    (MoveKind::Joint, _) => write!(f, "J ")?,
+                    (MoveKind::Circular, Some(v)) => write!(f, "C P[{v}]    \n    :  ")?,
+                    _ => write!(f, "L ")?,
+                }
+                write!(f, "P[{position}] {speed} {term}")?;
                 if options.coord {
                     write!(f, " COORD")?;
                 }
@@ -920,6 +928,7 @@ fn tp_program(
         op: Op::Move {
             kind: MoveKind::Joint,
             position,
+            via: None,
             speed: Speed::Percent(opts.approach_percent as u32),
             term: Termination::Fine,
             options: MotionOptions::default(),
@@ -985,11 +994,19 @@ fn tp_program(
                 );
             }
         }
+        // the move into this point: circular through the point before it
+        // when that one is a via
+        let circular = prev.is_some_and(|a| a.via) && local > 0;
         let linear = |speed, term| Instruction {
             line: 0,
             op: Op::Move {
-                kind: MoveKind::Linear,
+                kind: if circular {
+                    MoveKind::Circular
+                } else {
+                    MoveKind::Linear
+                },
                 position: index,
+                via: circular.then(|| index - 1),
                 speed,
                 term,
                 options,
@@ -1009,6 +1026,8 @@ fn tp_program(
                     op: start_op.clone(),
                 });
             }
+            // a via is written with the move it is the via of
+            ArcFlag::On if p.via => {}
             ArcFlag::On => ins.push(linear(
                 linear_speed(global, p.speed_mm_s),
                 Termination::Cnt(opts.cnt),
@@ -1055,7 +1074,7 @@ pub const JOINT_SPEED_MARGIN: f64 = 0.98;
 /// (0 for a zero-length segment or `i = 0`).
 pub fn joint_speed_ratio(program: &Program, i: usize, v: f64) -> f64 {
     let d = segment_length_mm(program, i);
-    let Some(prev) = i.checked_sub(1).map(|k| &program.points[k]) else {
+    let Some(prev) = move_start(program, i).map(|k| &program.points[k]) else {
         return 0.0;
     };
     if d <= 0.0 || v <= 0.0 {

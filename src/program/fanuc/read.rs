@@ -63,6 +63,8 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
     let mut mn_line = 0;
     let mut current: Option<Partial> = None;
     let mut last_line = 0;
+    // a `C P[v]` line waiting for its `:  P[n] ...` continuation
+    let mut pending_circular: Option<(usize, String)> = None;
     for (i, raw) in text.lines().enumerate() {
         let n = i + 1;
         last_line = n;
@@ -99,6 +101,12 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
                 continue;
             }
             "/POS" => {
+                if let Some((start, _)) = &pending_circular {
+                    return Err(err(
+                        *start,
+                        "circular move without its end line `:  P[n] ...`".into(),
+                    ));
+                }
                 if section != Section::Mn {
                     return Err(err(n, "/POS before /MN".into()));
                 }
@@ -147,6 +155,23 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
                 }
             }
             Section::Mn => {
+                // the continuation line of a circular move: `:  P[n] ... ;`
+                if let Some((start, head)) = pending_circular.take() {
+                    let rest = l.strip_prefix(':').ok_or_else(|| {
+                        err(
+                            n,
+                            format!("expected the end line `:  P[n] <speed> <FINE|CNTn> ;` of the circular move of line {start}"),
+                        )
+                    })?;
+                    let body = rest
+                        .trim_end()
+                        .strip_suffix(';')
+                        .ok_or_else(|| err(n, "instruction without `;`".into()))?
+                        .trim();
+                    let op = parse_op(&format!("{head} {body}")).map_err(|r| err(start, r))?;
+                    tp.instructions.push(Instruction { line: start, op });
+                    continue;
+                }
                 let (num, body) = l
                     .split_once(':')
                     .ok_or_else(|| err(n, format!("expected `<n>:<instruction> ;`, got `{l}`")))?;
@@ -163,8 +188,12 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
                         ),
                     ));
                 }
+                let body = body.trim();
+                if body.starts_with("C ") && !body.ends_with(';') {
+                    pending_circular = Some((n, body.to_string()));
+                    continue;
+                }
                 let body = body
-                    .trim_end()
                     .strip_suffix(';')
                     .ok_or_else(|| err(n, "instruction without `;`".into()))?
                     .trim();
@@ -313,9 +342,11 @@ pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
         }
     }
     for ins in &tp.instructions {
-        if let Op::Move { position, .. } = ins.op {
-            if !tp.positions.iter().any(|p| p.index == position) {
-                return Err(err(ins.line, format!("P[{position}] has no /POS record")));
+        if let Op::Move { position, via, .. } = ins.op {
+            for position in via.into_iter().chain([position]) {
+                if !tp.positions.iter().any(|p| p.index == position) {
+                    return Err(err(ins.line, format!("P[{position}] has no /POS record")));
+                }
             }
         }
     }
@@ -329,15 +360,27 @@ fn attr_value<'a>(l: &'a str, key: &str) -> Option<&'a str> {
 }
 
 fn parse_op(body: &str) -> Result<Op, String> {
-    let tokens: Vec<&str> = body.split_whitespace().collect();
+    let mut tokens: Vec<&str> = body.split_whitespace().collect();
     if let Some(kind) = match tokens.first() {
         Some(&"J") => Some(MoveKind::Joint),
         Some(&"L") => Some(MoveKind::Linear),
+        Some(&"C") => Some(MoveKind::Circular),
         _ => None,
     } {
+        let index = |t: &str| {
+            t.strip_prefix("P[")
+                .and_then(|s| s.strip_suffix(']'))
+                .and_then(|s| s.parse::<usize>().ok())
+                .ok_or_else(|| format!("bad position `{t}`"))
+        };
+        // `C P[v] P[n] ...`: the via, then what a linear move has
+        let via = match kind {
+            MoveKind::Circular if tokens.len() >= 2 => Some(index(tokens.remove(1))?),
+            _ => None,
+        };
         if tokens.len() < 4 {
             return Err(format!(
-                "expected `J|L P[n] <speed> <FINE|CNTn> [COORD] [RTCP]`, got `{body}`"
+                "expected `J|L P[n] <speed> <FINE|CNTn> [COORD] [RTCP]` or `C P[v]` then `:  P[n] <speed> <FINE|CNTn> ...`, got `{body}`"
             ));
         }
         let mut options = MotionOptions::default();
@@ -352,11 +395,7 @@ fn parse_op(body: &str) -> Result<Op, String> {
             }
             *flag = true;
         }
-        let position = tokens[1]
-            .strip_prefix("P[")
-            .and_then(|s| s.strip_suffix(']'))
-            .and_then(|s| s.parse::<usize>().ok())
-            .ok_or_else(|| format!("bad position `{}`", tokens[1]))?;
+        let position = index(tokens[1])?;
         let s = tokens[2];
         let num = |t: &str| t.parse::<u32>().map_err(|_| format!("bad speed `{s}`"));
         let speed = if let Some(v) = s.strip_suffix('%') {
@@ -387,6 +426,7 @@ fn parse_op(body: &str) -> Result<Op, String> {
         return Ok(Op::Move {
             kind,
             position,
+            via,
             speed,
             term,
             options,

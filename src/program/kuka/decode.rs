@@ -16,6 +16,7 @@ use crate::program::kuka::read::{
     falling_input, InterruptAction, KrlOp, KrlProgram, KrlRoutine, KrlStatement,
 };
 use crate::program::kuka::{ArcLoss, KukaOptions, StatedBase, ARC_LOST_HANDLER};
+use crate::program::kuka::{CIRC_CIRC_TYPE, CIRC_ORI_TYPE};
 use crate::program::MoveKind;
 use crate::robot::{Cell, Configuration, Joints};
 
@@ -97,6 +98,8 @@ pub(crate) fn kuka_steps(
         push(report, ProblemKind::Frame, src, line, msg)
     };
     let stmts = &program.statements;
+    // `$ORI_TYPE = #VAR`, `$CIRC_TYPE = #BASE` stated before a `CIRC`
+    let mut circ_stated = [false; 2];
     let mut next = 0;
     while let Some(st) = stmts.get(next) {
         next += 1;
@@ -113,7 +116,7 @@ pub(crate) fn kuka_steps(
             // inside a stray `IF NOT $IN[n] THEN … ENDIF` (reported)
             match &st.op {
                 KrlOp::EndIf => in_if = None,
-                KrlOp::Ptp(_) | KrlOp::Lin { .. } => push(
+                KrlOp::Ptp(_) | KrlOp::Lin { .. } | KrlOp::Circ { .. } => push(
                     &mut report,
                     ProblemKind::Instruction,
                     src,
@@ -124,9 +127,27 @@ pub(crate) fn kuka_steps(
             }
             continue;
         }
-        let (target, linear) = match &st.op {
-            KrlOp::Ptp(t) => (t, false),
-            KrlOp::Lin { target, .. } => (target, true),
+        // the positions a motion statement moves to, with how: a `CIRC`'s
+        // auxiliary point first, as its own step
+        let (targets, linear) = match &st.op {
+            KrlOp::Ptp(t) => (vec![(t, MoveKind::Joint)], false),
+            KrlOp::Lin { target, .. } => (vec![(target, MoveKind::Linear)], true),
+            KrlOp::Circ { aux, target, .. } if circ_stated != [true; 2] => {
+                frame_problem(
+                    &mut report,
+                    line,
+                    format!("CIRC before the program states $ORI_TYPE = {CIRC_ORI_TYPE} and $CIRC_TYPE = {CIRC_CIRC_TYPE}: the controller's orientation on the circle would be its default, not the checked one"),
+                );
+                circ_stated = [true; 2];
+                (
+                    vec![(aux, MoveKind::Via), (target, MoveKind::Circular)],
+                    true,
+                )
+            }
+            KrlOp::Circ { aux, target, .. } => (
+                vec![(aux, MoveKind::Via), (target, MoveKind::Circular)],
+                true,
+            ),
             KrlOp::VelCp(v) => {
                 vel = Some(v * 1000.0);
                 continue;
@@ -171,6 +192,22 @@ pub(crate) fn kuka_steps(
                     );
                 }
                 pending.push((*distance, action.clone(), line));
+                continue;
+            }
+            KrlOp::OriType(v) | KrlOp::CircType(v) => {
+                let (name, want) = match st.op {
+                    KrlOp::OriType(_) => ("$ORI_TYPE", CIRC_ORI_TYPE),
+                    _ => ("$CIRC_TYPE", CIRC_CIRC_TYPE),
+                };
+                if v == want {
+                    circ_stated[usize::from(name == "$CIRC_TYPE")] = true;
+                } else {
+                    frame_problem(
+                        &mut report,
+                        line,
+                        format!("{name} = {v}: the checker models {want} (orientation by slerp from start to end)"),
+                    );
+                }
                 continue;
             }
             KrlOp::IpoTcp(tcp) => {
@@ -472,7 +509,11 @@ pub(crate) fn kuka_steps(
             }
         }
         if arc && arc_is_on {
-            let what = format!("{} {target}", if linear { "LIN" } else { "PTP" });
+            let what = match targets.as_slice() {
+                [(aux, _), (target, _)] => format!("CIRC {aux}, {target}"),
+                [(target, _), ..] => format!("{} {target}", if linear { "LIN" } else { "PTP" }),
+                [] => String::new(),
+            };
             sup.motion(line, &what, opts, src, &mut report);
         }
         if let Some((_, l)) = mass.take() {
@@ -512,50 +553,51 @@ pub(crate) fn kuka_steps(
                 after.push(step);
             }
         }
-        let Some(pos) = program.positions.iter().find(|p| &p.name == target) else {
-            push(
-                &mut report,
-                ProblemKind::Declaration,
-                src,
-                line,
-                format!("{target} has no DECL in {dat}"),
-            );
-            continue;
-        };
-        let speed = if linear {
-            match vel {
-                Some(v) => MotionSpeed::Linear(v),
-                None => {
-                    push(
-                        &mut report,
-                        ProblemKind::Timing,
-                        src,
-                        line,
-                        "LIN before any $VEL.CP".into(),
-                    );
-                    MotionSpeed::Joint
-                }
-            }
-        } else {
-            MotionSpeed::Joint
-        };
-        if linear && matches!(pos.value, KrlValue::Axis(_)) {
-            push(
-                &mut report,
-                ProblemKind::Declaration,
-                src,
-                line,
-                format!(
-                    "LIN to {}, an E6AXIS ({dat}:{}): a LIN target must be an E6POS",
-                    pos.name, pos.line
-                ),
-            );
-        }
-        let mut positioner =
-            matches!(cell, Cell::TorchCarried(_)).then(|| pos.external.map(f64::to_radians));
-        if let (true, Some(qp)) = (modulo, positioner.as_mut()) {
-            if qp[1].abs() > std::f64::consts::PI + 1e-9 {
+        for (target, kind) in targets {
+            let Some(pos) = program.positions.iter().find(|p| &p.name == target) else {
                 push(
+                    &mut report,
+                    ProblemKind::Declaration,
+                    src,
+                    line,
+                    format!("{target} has no DECL in {dat}"),
+                );
+                continue;
+            };
+            let speed = if linear {
+                match vel {
+                    Some(v) => MotionSpeed::Linear(v),
+                    None => {
+                        push(
+                            &mut report,
+                            ProblemKind::Timing,
+                            src,
+                            line,
+                            "LIN before any $VEL.CP".into(),
+                        );
+                        MotionSpeed::Joint
+                    }
+                }
+            } else {
+                MotionSpeed::Joint
+            };
+            if linear && matches!(pos.value, KrlValue::Axis(_)) {
+                push(
+                    &mut report,
+                    ProblemKind::Declaration,
+                    src,
+                    line,
+                    format!(
+                        "LIN to {}, an E6AXIS ({dat}:{}): a LIN target must be an E6POS",
+                        pos.name, pos.line
+                    ),
+                );
+            }
+            let mut positioner =
+                matches!(cell, Cell::TorchCarried(_)).then(|| pos.external.map(f64::to_radians));
+            if let (true, Some(qp)) = (modulo, positioner.as_mut()) {
+                if qp[1].abs() > std::f64::consts::PI + 1e-9 {
+                    push(
                     report_out,
                     ProblemKind::JointLimit,
                     dat,
@@ -566,25 +608,25 @@ pub(crate) fn kuka_steps(
                         qp[1].to_degrees()
                     ),
                 );
+                }
+                qp[1] = turn_at + crate::robot::ik::wrap_pi(qp[1] - turn_at);
+                turn_at = qp[1];
             }
-            qp[1] = turn_at + crate::robot::ik::wrap_pi(qp[1] - turn_at);
-            turn_at = qp[1];
-        }
-        let (joints, from_cartesian) = match &pos.value {
-            KrlValue::Axis(a) => (Some(a.map(f64::to_radians)), false),
-            KrlValue::Pos {
-                xyzabc,
-                status,
-                turn,
-            } => {
-                let (side, elbow) = arm_of(status & 1 != 0, status & 2 != 0);
-                let cfg = Configuration {
-                    wrist: wrist_of_j5(robot, status & 4 == 0),
-                    elbow,
-                    side,
-                };
-                if cfg != cell.configuration() {
-                    push(
+            let (joints, from_cartesian) = match &pos.value {
+                KrlValue::Axis(a) => (Some(a.map(f64::to_radians)), false),
+                KrlValue::Pos {
+                    xyzabc,
+                    status,
+                    turn,
+                } => {
+                    let (side, elbow) = arm_of(status & 1 != 0, status & 2 != 0);
+                    let cfg = Configuration {
+                        wrist: wrist_of_j5(robot, status & 4 == 0),
+                        elbow,
+                        side,
+                    };
+                    if cfg != cell.configuration() {
+                        push(
                         &mut report, ProblemKind::Configuration,
                         dat,
                         pos.line,
@@ -594,73 +636,70 @@ pub(crate) fn kuka_steps(
                             cell.configuration()
                         ),
                     );
+                    }
+                    let rot = KukaAbc::from_degrees(xyzabc[3], xyzabc[4], xyzabc[5]).to_rotation();
+                    let pose = Isometry3::from_parts(
+                        nalgebra::Translation3::new(xyzabc[0], xyzabc[1], xyzabc[2]),
+                        nalgebra::UnitQuaternion::from_rotation_matrix(&rot),
+                    );
+                    // with a coupled base, the base at this position's E1, E2
+                    let base = opts.base_at(cell, positioner);
+                    let base_from_flange = base * pose * tool.inverse();
+                    let q = decode_pose(
+                        robot,
+                        &base_from_flange,
+                        cfg,
+                        |j, q| match (&prev_q, linear) {
+                            (Some(p), true) => Some(crate::robot::ik::unwrap_near(q, p[j])),
+                            _ => {
+                                let negative = turn & (1 << j) != 0;
+                                (-2..=2)
+                                    .map(|k| q + TAU * k as f64)
+                                    .filter(|v| {
+                                        // a joint at zero may be written with either sign
+                                        ((*v < 0.0) == negative || v.abs() < 1e-6)
+                                            && robot.limits[j].contains(*v)
+                                    })
+                                    .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+                            }
+                        },
+                        &pos.name,
+                        dat,
+                        pos.line,
+                        &mut report,
+                    );
+                    (q, true)
                 }
-                let rot = KukaAbc::from_degrees(xyzabc[3], xyzabc[4], xyzabc[5]).to_rotation();
-                let pose = Isometry3::from_parts(
-                    nalgebra::Translation3::new(xyzabc[0], xyzabc[1], xyzabc[2]),
-                    nalgebra::UnitQuaternion::from_rotation_matrix(&rot),
-                );
-                // with a coupled base, the base at this position's E1, E2
-                let base = opts.base_at(cell, positioner);
-                let base_from_flange = base * pose * tool.inverse();
-                let q = decode_pose(
-                    robot,
-                    &base_from_flange,
-                    cfg,
-                    |j, q| match (&prev_q, linear) {
-                        (Some(p), true) => Some(crate::robot::ik::unwrap_near(q, p[j])),
-                        _ => {
-                            let negative = turn & (1 << j) != 0;
-                            (-2..=2)
-                                .map(|k| q + TAU * k as f64)
-                                .filter(|v| {
-                                    // a joint at zero may be written with either sign
-                                    ((*v < 0.0) == negative || v.abs() < 1e-6)
-                                        && robot.limits[j].contains(*v)
-                                })
-                                .min_by(|a, b| a.abs().total_cmp(&b.abs()))
-                        }
-                    },
-                    &pos.name,
-                    dat,
-                    pos.line,
-                    &mut report,
-                );
-                (q, true)
-            }
-        };
-        // Outside the fixed-tool mode and without a coupled base $VEL.CP is
-        // the TCP's speed in the robot frame, and external axes move with
-        // the path at $VEL_EXTAX. (In the fixed-tool mode $VEL.CP is the
-        // torch's speed over the part; with the base coupled to the
-        // positioner it is the TCP's speed relative to the moving base, the
-        // part: both the planned meaning.)
-        let speed = match speed {
-            MotionSpeed::Linear(v) if !external_tcp && !coordinated => MotionSpeed::Tcp {
-                mm_s: v,
-                flange_from_tcp: tool,
-                extax_fraction: [vel_extax[0] / 100.0, vel_extax[1] / 100.0],
-            },
-            speed => speed,
-        };
-        prev_q = joints.or(prev_q);
-        steps.push(Step::Motion(Box::new(Motion {
-            file: src.clone(),
-            line,
-            label: pos.name.clone(),
-            record_file: dat.clone(),
-            record_line: pos.line,
-            value_lines: [pos.line; 6],
-            joints,
-            from_cartesian,
-            positioner,
-            kind: if linear {
-                MoveKind::Linear
-            } else {
-                MoveKind::Joint
-            },
-            speed,
-        })));
+            };
+            // Outside the fixed-tool mode and without a coupled base $VEL.CP is
+            // the TCP's speed in the robot frame, and external axes move with
+            // the path at $VEL_EXTAX. (In the fixed-tool mode $VEL.CP is the
+            // torch's speed over the part; with the base coupled to the
+            // positioner it is the TCP's speed relative to the moving base, the
+            // part: both the planned meaning.)
+            let speed = match speed {
+                MotionSpeed::Linear(v) if !external_tcp && !coordinated => MotionSpeed::Tcp {
+                    mm_s: v,
+                    flange_from_tcp: tool,
+                    extax_fraction: [vel_extax[0] / 100.0, vel_extax[1] / 100.0],
+                },
+                speed => speed,
+            };
+            prev_q = joints.or(prev_q);
+            steps.push(Step::Motion(Box::new(Motion {
+                file: src.clone(),
+                line,
+                label: pos.name.clone(),
+                record_file: dat.clone(),
+                record_line: pos.line,
+                value_lines: [pos.line; 6],
+                joints,
+                from_cartesian,
+                positioner,
+                kind,
+                speed,
+            })));
+        }
         steps.extend(after);
     }
     for (_, action, l) in pending {
@@ -847,7 +886,7 @@ fn read_handshake(
                 "arc on in the failed-ignition branch".into(),
             ),
             KrlOp::Halt if exit_on.is_some() => halt = true,
-            KrlOp::Ptp(_) | KrlOp::Lin { .. } => problem(
+            KrlOp::Ptp(_) | KrlOp::Lin { .. } | KrlOp::Circ { .. } => problem(
                 ProblemKind::Instruction,
                 "motion inside the ignition loop".into(),
             ),
@@ -1193,7 +1232,7 @@ fn check_handler(
                     problem(format!("INTERRUPT ON {prio} in {name} before the arc is established again"));
                 }
             }
-            KrlOp::Ptp(_) | KrlOp::Lin { .. } => problem(format!("motion in the arc-loss handler {name}")),
+            KrlOp::Ptp(_) | KrlOp::Lin { .. } | KrlOp::Circ { .. } => problem(format!("motion in the arc-loss handler {name}")),
             KrlOp::Resume => problem(format!(
                 "RESUME in the arc-loss handler {name}: it abandons the rest of the bead, and the program goes on without it"
             )),

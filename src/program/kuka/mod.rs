@@ -149,8 +149,8 @@ pub use crate::program::frames::fixed_torch_at;
 use crate::program::frames::{held_tool, ToolFrames};
 use crate::program::PositionMode;
 use crate::program::{
-    check_name, check_vendor, joint_move_target, positioner_moves, render, segment_length_mm,
-    ArcFlag, BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, joint_move_target, move_start, positioner_moves, render,
+    segment_length_mm, ArcFlag, BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::KukaAbc;
 use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel, Vendor};
@@ -636,12 +636,20 @@ pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<
     {
         return None;
     }
-    let (p, a) = (&program.points[i], &program.points[i - 1]);
+    let start = move_start(program, i)?;
+    let (p, a) = (&program.points[i], &program.points[start]);
     let time_s = segment_length_mm(program, i) / p.speed_mm_s;
     let robot = &c.robot;
     let tool = held_tool(&program.cell, opts.flange_from_tool);
-    let tcp = |q: &Joints| (robot.flange_pose(q) * tool).translation.vector;
-    let tcp_mm = (tcp(&p.joints) - tcp(&a.joints)).norm();
+    let tcp =
+        |q: &Joints| crate::math::Point3::from((robot.flange_pose(q) * tool).translation.vector);
+    // a circular move's TCP runs on the arc through its via
+    let tcp_mm = if start + 2 == i {
+        let via = &program.points[i - 1].joints;
+        crate::program::compress::arc_length(&tcp(&a.joints), &tcp(via), &tcp(&p.joints))
+    } else {
+        (tcp(&p.joints) - tcp(&a.joints)).norm()
+    };
     let (qp, qa) = (p.positioner?, a.positioner?);
     let vel_extax_percent = std::array::from_fn(|n| {
         let max = c.positioner.max_speed_rad_s[n];
@@ -654,6 +662,16 @@ pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<
         vel_extax_percent,
     })
 }
+
+/// `$ORI_TYPE` written before the first `CIRC`: the orientation changes
+/// continuously from the start to the end orientation (KUKA system
+/// software, "Orientation control"), the slerp of
+/// [`interpolate`](crate::program::compress::interpolate).
+pub const CIRC_ORI_TYPE: &str = "#VAR";
+/// `$CIRC_TYPE` written before the first `CIRC`: orientation control
+/// relative to the base (`#PATH` would turn it with the circle's tangent),
+/// the auxiliary point's orientation ignored.
+pub const CIRC_CIRC_TYPE: &str = "#BASE";
 
 /// Name of the home position in the `.dat` (an `E6AXIS`).
 pub const HOME_NAME: &str = "PHOME";
@@ -725,6 +743,12 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
         writeln!(w, "  $IPO_MODE = #TCP")?;
     } else {
         writeln!(w, "  $IPO_MODE = #BASE")?;
+    }
+    if program.points.iter().any(|p| p.via) {
+        // the orientation on a circle: from start to end, the auxiliary
+        // point's ignored, relative to the base (the checker's model)
+        writeln!(w, "  $ORI_TYPE = {CIRC_ORI_TYPE}")?;
+        writeln!(w, "  $CIRC_TYPE = {CIRC_CIRC_TYPE}")?;
     }
     writeln!(w, "  $APO.CDIS = {}", Mm(opts.cdis_mm))?;
     writeln!(w, "  BAS (#VEL_PTP,{} )", opts.ptp_percent)?;
@@ -802,6 +826,8 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                     write_ignition(w, opts, &on, &off, p.layer)?;
                 }
             }
+            // a via is written with the circular move it is the via of
+            ArcFlag::On if p.via => continue,
             ArcFlag::On | ArcFlag::End => match timed_segment(program, opts, i) {
                 Some(t) => {
                     set_vel(w, t.vel_cp_mm_s)?;
@@ -826,19 +852,25 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
         match p.arc {
             ArcFlag::Approach | ArcFlag::Start => {}
             ArcFlag::On | ArcFlag::End => {
-                if !arc && prev.is_some_and(|q| q.arc == ArcFlag::Start) {
+                let start = move_start(program, i).map(|k| &program.points[k]);
+                if !arc && start.is_some_and(|q| q.arc == ArcFlag::Start) {
                     writeln!(w, "  {}", trigger_line(0, &on))?;
                 }
+                // `CIRC aux, end` through the via written just before
+                let mv = match prev {
+                    Some(v) if v.via => format!("CIRC P{}, {name}", i),
+                    _ => format!("LIN {name}"),
+                };
                 if p.arc == ArcFlag::End {
                     if !arc {
                         writeln!(w, "  {}", trigger_line(1, &off))?;
                     }
-                    writeln!(w, "  LIN {name}")?;
+                    writeln!(w, "  {mv}")?;
                     if arc {
                         write_arc_end(w, opts, &off)?;
                     }
                 } else {
-                    writeln!(w, "  LIN {name} C_DIS")?;
+                    writeln!(w, "  {mv} C_DIS")?;
                 }
             }
             ArcFlag::Retract => {

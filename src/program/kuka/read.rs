@@ -21,6 +21,16 @@ pub enum KrlOp {
         /// Blended (`C_DIS`).
         blended: bool,
     },
+    /// `CIRC aux, name [C_DIS]`: circular move through the auxiliary
+    /// point `aux` to `target`.
+    Circ {
+        /// Auxiliary (via) point name.
+        aux: String,
+        /// Target name.
+        target: String,
+        /// Blended (`C_DIS`).
+        blended: bool,
+    },
     /// `$VEL.CP = v` (m/s).
     VelCp(f64),
     /// `TRIGGER WHEN DISTANCE=d DELAY=0 DO action [PRIO=p]`.
@@ -117,6 +127,10 @@ pub enum KrlOp {
     Resume,
     /// `$IPO_MODE = #TCP` (`true`) or `#BASE` (`false`).
     IpoTcp(bool),
+    /// `$ORI_TYPE = v`: orientation control of CP moves (`#VAR` written).
+    OriType(String),
+    /// `$CIRC_TYPE = v`: orientation reference of `CIRC` (`#BASE` written).
+    CircType(String),
     /// `$VEL_EXTAX[n] = p`: external axis `n` (1-based) at `p` % of its
     /// maximum speed in path motions.
     VelExtax {
@@ -423,6 +437,26 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
                 _ => Err(format!("expected `LIN name [C_DIS]`, got `{l}`")),
             };
         }
+        Some("CIRC") => {
+            let circ = |aux: &str, t: &str, blended| {
+                Ok(KrlOp::Circ {
+                    aux: aux.to_string(),
+                    target: t.to_string(),
+                    blended,
+                })
+            };
+            let args: Vec<&str> = l["CIRC".len()..].split(',').map(str::trim).collect();
+            return match args.as_slice() {
+                [aux, rest] if !aux.is_empty() => {
+                    match rest.split_whitespace().collect::<Vec<_>>().as_slice() {
+                        [t] => circ(aux, t, false),
+                        [t, "C_DIS"] => circ(aux, t, true),
+                        _ => Err(format!("expected `CIRC aux, name [C_DIS]`, got `{l}`")),
+                    }
+                }
+                _ => Err(format!("expected `CIRC aux, name [C_DIS]`, got `{l}`")),
+            };
+        }
         Some("TRIGGER") => {
             let rest = l
                 .strip_prefix("TRIGGER WHEN DISTANCE=")
@@ -582,6 +616,8 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
                 };
                 return Ok(KrlOp::TimerStop { timer, stop });
             }
+            "$ORI_TYPE" => return Ok(KrlOp::OriType(v.to_string())),
+            "$CIRC_TYPE" => return Ok(KrlOp::CircType(v.to_string())),
             "$IPO_MODE" => {
                 return match v {
                     "#TCP" => Ok(KrlOp::IpoTcp(true)),

@@ -1,7 +1,9 @@
-//! Between the moves: a linear move sampled as the controller interpolates
-//! it ([`interpolate`](crate::program::compress::interpolate): the tool on
-//! a straight line, its orientation by slerp, the positioner linearly, in
-//! the frame the move is programmed in,
+//! Between the moves: a linear or circular move sampled as the controller
+//! interpolates it ([`interpolate`](crate::program::compress::interpolate),
+//! the model the compressor thinned the beads with: the tool on a straight
+//! line or on the circle through the via, its orientation by slerp from
+//! start to end, the positioner linearly, in the frame the move is
+//! programmed in,
 //! [`moves_in_part_frame`](crate::program::contract::moves_in_part_frame)),
 //! each sample's joints solved in the cell's branch nearest the previous
 //! sample's, and checked: joint travel, joint speeds over each sampled
@@ -29,10 +31,13 @@ const SAMPLES_PER_DEG: f64 = 2.0;
 /// Fewest and most samples of one move.
 const SAMPLES: (usize, usize) = (4, 400);
 
-/// One linear move, from the previous motion to this one.
-pub(crate) struct LinearMove<'a> {
+/// One linear or circular move, from the previous motion to this one.
+pub(crate) struct InterpolatedMove<'a> {
     /// Joints and positioner joints where the move starts (rad).
     pub from: (&'a Joints, Option<[f64; 2]>),
+    /// Joints and positioner joints of a circular move's via (rad); `None`
+    /// for a linear move.
+    pub via: Option<(&'a Joints, Option<[f64; 2]>)>,
     /// Joints and positioner joints where it ends (rad).
     pub to: (&'a Joints, Option<[f64; 2]>),
     /// How long it takes (s).
@@ -46,26 +51,42 @@ pub(crate) struct LinearMove<'a> {
 pub(crate) fn check_between(
     cell: &Cell,
     common: &ProgramOptions,
-    mv: &LinearMove<'_>,
+    mv: &InterpolatedMove<'_>,
 ) -> Vec<(ProblemKind, String)> {
     let robot = cell.robot();
     let in_part = moves_in_part_frame(cell, common);
     let a = controller_pose_at(cell, mv.from.0, mv.from.1, in_part);
     let b = controller_pose_at(cell, mv.to.0, mv.to.1, in_part);
-    let travel = match (
-        deposition_point(cell, mv.from.0, mv.from.1),
-        deposition_point(cell, mv.to.0, mv.to.1),
-    ) {
-        (Some(p), Some(q)) => (p - q).norm(),
-        _ => 0.0,
-    };
-    let turn = mv
-        .from
-        .0
-        .iter()
-        .zip(mv.to.0)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
+    let via = mv
+        .via
+        .map(|(q, qp)| controller_pose_at(cell, q, qp, in_part));
+    // the legs through the via: travel and joint turn are summed over them
+    let ends: Vec<(&Joints, Option<[f64; 2]>)> = [Some(mv.from), mv.via, Some(mv.to)]
+        .into_iter()
+        .flatten()
+        .collect();
+    let travel: f64 = ends
+        .windows(2)
+        .map(|w| {
+            match (
+                deposition_point(cell, w[0].0, w[0].1),
+                deposition_point(cell, w[1].0, w[1].1),
+            ) {
+                (Some(p), Some(q)) => (p - q).norm(),
+                _ => 0.0,
+            }
+        })
+        .sum();
+    let turn = ends
+        .windows(2)
+        .map(|w| {
+            w[0].0
+                .iter()
+                .zip(w[1].0)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max)
+        })
+        .sum::<f64>()
         .to_degrees();
     let n = ((travel * SAMPLES_PER_MM).max(turn * SAMPLES_PER_DEG).ceil() as usize)
         .clamp(SAMPLES.0, SAMPLES.1);
@@ -79,7 +100,7 @@ pub(crate) fn check_between(
     let tolerance = common.path_tolerance_mm + REACH_TOLERANCE_MM;
     for k in 1..n {
         let s = k as f64 / n as f64;
-        let pose = interpolate(&a, None, &b, s);
+        let pose = interpolate(&a, via.as_ref(), &b, s);
         let qp = (!pose.ext.is_empty()).then(|| [pose.ext[0], pose.ext[1]]);
         let flange = flange_of(cell, &pose, in_part);
         let q = match robot.inverse_near(&flange, cell.configuration(), &prev) {

@@ -5,13 +5,15 @@
 use std::f64::consts::PI;
 
 use crate::math::Point3;
+use crate::program::compress::{arc_length, interpolate, ControllerPose};
 use crate::program::transit::{joint_move_clearance, WallBeads};
 use crate::program::MoveKind;
 use crate::program::ProgramOptions;
 use crate::robot::{Cell, Joints};
 use crate::toolaxis::collision::Torch;
+use nalgebra::UnitQuaternion;
 
-use super::between::{check_between, LinearMove};
+use super::between::{check_between, InterpolatedMove};
 use super::ProblemKind;
 use super::{
     deposition_point, push, Motion, MotionSpeed, Step, ValidationReport, NAMES, REACH_TOLERANCE_MM,
@@ -54,6 +56,9 @@ pub fn check_steps(
     // the planned point each bead motion lands on, in order: thinned
     // programs skip planned points, none goes back
     let mut plan_cursor = 0;
+    // the via of the circular move the next motion ends (joints,
+    // positioner, deposition point)
+    let mut via: Option<(Joints, Option<[f64; 2]>, Option<Point3>)> = None;
     let mut prev_matched: Option<usize> = None;
     let mut bead_motions = 0;
     let mut first_file: Option<String> = None;
@@ -100,6 +105,30 @@ pub fn check_steps(
                 m.line,
                 "joint move with the arc on".into(),
             );
+        }
+        // a circular move's via comes first as its own motion; the move is
+        // checked at its end, the next motion
+        let circle_via = via.take();
+        match (m.kind, &circle_via) {
+            (MoveKind::Circular, None) => push(
+                report,
+                ProblemKind::Instruction,
+                &m.file,
+                m.line,
+                format!("{}: circular move without a via point", m.label),
+            ),
+            (MoveKind::Circular, Some(_)) => {}
+            (_, Some(_)) => push(
+                report,
+                ProblemKind::Instruction,
+                &m.file,
+                m.line,
+                format!(
+                    "{}: a via point not followed by the end of its circular move",
+                    m.label
+                ),
+            ),
+            _ => {}
         }
         let Some(q) = m.joints else {
             prev = None;
@@ -210,22 +239,42 @@ pub fn check_steps(
                 }
             }
         }
+        if m.kind == MoveKind::Via {
+            via = Some((q, qp, dep));
+            continue;
+        }
         if let Some((pq, pqp, pm)) = &prev {
             let mut msgs = Vec::new();
             let linear = m.speed != MotionSpeed::Joint;
-            // joint moves (between beads) may rewind J4/J6; linear moves may not jump
-            for j in (0..6).filter(|_| linear) {
-                if (q[j] - pq[j]).abs() >= PI {
+            // joint moves (between beads) may rewind J4/J6; linear and
+            // circular moves (each leg of these) may not jump
+            let legs: Vec<(&Joints, &Joints)> = match &circle_via {
+                Some((qv, _, _)) => vec![(pq, qv), (qv, &q)],
+                None => vec![(pq, &q)],
+            };
+            for (j, (a, b)) in (0..6)
+                .filter(|_| linear)
+                .flat_map(|j| legs.iter().map(move |leg| (j, *leg)))
+            {
+                if (b[j] - a[j]).abs() >= PI {
                     msgs.push((ProblemKind::Configuration, format!(
                         "{} jumps by {:.2}° from the previous position (turn or configuration change)",
                         NAMES[j],
-                        (q[j] - pq[j]).to_degrees()
+                        (b[j] - a[j]).to_degrees()
                     )));
                 }
             }
+            // the length of the path: the chord, or the arc through the via
+            let path_length = |a: &Point3, b: &Point3, via: Option<Point3>| match via {
+                Some(v) => arc_length(a, &v, b),
+                None => (b - a).norm(),
+            };
+            let via_dep = circle_via.as_ref().and_then(|(_, _, d)| *d);
             let dt = match (m.speed, dep, pm) {
-                (MotionSpeed::Linear(v), Some(a), Some(b)) => {
-                    let d = (a - b).norm();
+                (MotionSpeed::Linear(v), Some(a), Some(b))
+                    if circle_via.is_none() || via_dep.is_some() =>
+                {
+                    let d = path_length(b, &a, via_dep);
                     (d > 0.0).then(|| (d / v, format!("at {v:.3} mm/s")))
                 }
                 (
@@ -239,7 +288,9 @@ pub fn check_steps(
                 ) => {
                     let tcp =
                         |q: &Joints| (robot.flange_pose(q) * flange_from_tcp).translation.vector;
-                    let mut t = (tcp(&q) - tcp(pq)).norm() / mm_s;
+                    let via_tcp = circle_via.as_ref().map(|(qv, _, _)| Point3::from(tcp(qv)));
+                    let mut t =
+                        path_length(&Point3::from(tcp(pq)), &Point3::from(tcp(&q)), via_tcp) / mm_s;
                     if let (Cell::TorchCarried(c), Some(a), Some(b)) = (cell, qp, pqp) {
                         for n in 0..2 {
                             let max = c.positioner.max_speed_rad_s[n] * extax_fraction[n];
@@ -276,8 +327,9 @@ pub fn check_steps(
                 (Some(_), Some(j0), Some(j1)) => j1 > j0 + 1,
                 (Some(_), _, _) => false,
                 (None, _, _) => true,
-            };
-            if let (Some((duration_s, _)), MoveKind::Linear, true) = (&dt, m.kind, skips) {
+            } || m.kind == MoveKind::Circular;
+            let interpolated = matches!(m.kind, MoveKind::Linear | MoveKind::Circular);
+            if let (Some((duration_s, _)), true, true) = (&dt, interpolated, skips) {
                 let planned_between = match (planned, prev_matched, matched) {
                     // a move between neighbouring planned points is the
                     // plan's own discretisation: only moves that skip planned
@@ -290,8 +342,9 @@ pub fn check_steps(
                 msgs.extend(check_between(
                     cell,
                     common,
-                    &LinearMove {
+                    &InterpolatedMove {
                         from: (pq, *pqp),
+                        via: circle_via.as_ref().map(|(qv, qvp, _)| (qv, *qvp)),
                         to: (&q, qp),
                         duration_s: *duration_s,
                         planned: planned_between,
@@ -603,6 +656,7 @@ fn check_transits(
     };
     let mut beads = WallBeads::default();
     let mut current: Vec<Point3> = Vec::new();
+    let mut via_dep: Option<Point3> = None;
     let mut prev: Option<(Joints, Option<[f64; 2]>)> = None;
     for (i, s) in steps.iter().enumerate() {
         match s {
@@ -616,7 +670,15 @@ fn check_transits(
                 };
                 if bead[i] {
                     if let Some(d) = deposition_point(cell, &q, m.positioner) {
-                        current.push(d);
+                        match (m.kind, via_dep.take(), current.last()) {
+                            // the wall follows the arc, not the chords
+                            // through the via
+                            (MoveKind::Via, ..) => via_dep = Some(d),
+                            (MoveKind::Circular, Some(v), Some(a)) => {
+                                current.extend(arc_samples(a, &v, &d));
+                            }
+                            _ => current.push(d),
+                        }
                     }
                 }
                 if let (Some((pq, pp)), MoveKind::Joint) = (prev, m.kind) {
@@ -649,4 +711,19 @@ fn check_transits(
             _ => {}
         }
     }
+}
+
+/// Largest distance (mm) between the wall's points along a circular bead.
+const WALL_ARC_STEP_MM: f64 = 1.0;
+
+/// Points along the circle arc from `a` through `via` to `b` (part frame,
+/// mm; [`interpolate`]'s circle), every [`WALL_ARC_STEP_MM`] at most, `b`
+/// last and `a` left out.
+fn arc_samples(a: &Point3, via: &Point3, b: &Point3) -> Vec<Point3> {
+    let pose = |p: &Point3| ControllerPose::new(*p, UnitQuaternion::identity(), Vec::new());
+    let (pa, pv, pb) = (pose(a), pose(via), pose(b));
+    let n = ((arc_length(a, via, b) / WALL_ARC_STEP_MM).ceil() as usize).clamp(1, 10_000);
+    (1..=n)
+        .map(|k| interpolate(&pa, Some(&pv), &pb, k as f64 / n as f64).p)
+        .collect()
 }

@@ -19,7 +19,7 @@
 //! transitions) are checked for limits, configuration and speeds but not
 //! compared with the planned points.
 
-mod between;
+pub(crate) mod between;
 mod check;
 
 pub(crate) use check::check_home_ends;
