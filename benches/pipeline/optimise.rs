@@ -18,7 +18,7 @@ use waam_slicer::io::cell_file::read_cell_file;
 use waam_slicer::io::part_file::read_part_file;
 use waam_slicer::optimise::{layer_points, optimise, LayerPoints, OptimiseOptions};
 use waam_slicer::path::slice;
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 use waam_slicer::toolaxis::local_frames;
 
 fn parts_dir() -> PathBuf {
@@ -37,7 +37,7 @@ fn layers(part: &str, delta: f64) -> Vec<LayerPoints> {
 /// Whole-part optimisation (default options: branch choice, degrees raised
 /// from the seed's until no gain, layers in parallel).
 pub fn whole_parts(c: &mut Criterion) {
-    let cell: Cell = read_cell_file(parts_dir().join("cells/robowam_part_carried.toml"))
+    let cell: CellLayout = read_cell_file(parts_dir().join("cells/robowam_part_carried.toml"))
         .unwrap()
         .cell
         .unwrap();
@@ -114,7 +114,7 @@ pub fn plan_at_scale(c: &mut Criterion) {
 /// The layers are the same in both cells, so the ratio of the medians is the
 /// ratio per layer.
 pub fn torch_vs_part_carried(c: &mut Criterion) {
-    let cell = |f: &str| -> Cell {
+    let cell = |f: &str| -> CellLayout {
         read_cell_file(parts_dir().join("cells").join(f))
             .unwrap()
             .cell

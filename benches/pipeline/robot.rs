@@ -7,7 +7,7 @@ use std::hint::black_box;
 use criterion::{Criterion, Throughput};
 use waam_slicer::math::{Isometry3, Point3, UnitVector3, Vector3};
 use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
-use waam_slicer::robot::{Cell, Configuration, Joints, PartCarriedCell, RobotModel};
+use waam_slicer::robot::{CellLayout, Configuration, Joints, PartCarriedCell, RobotModel};
 
 /// 1024 reachable flange poses of the ArcMate 120iC (deterministic).
 fn poses(robot: &RobotModel) -> Vec<(Isometry3, Configuration, Joints)> {
@@ -71,7 +71,7 @@ pub fn kinematics(c: &mut Criterion) {
 /// The hemisphere R_s = 45, Delta = 5 (15 layers × 100 points) in the ROBOWAM
 /// part-carried cell, R_Z = -v: IK, unwrap, speeds, dexterity, dq/dR_Z, report.
 pub fn hemisphere_trajectory(c: &mut Criterion) {
-    let cell = Cell::PartCarried(PartCarriedCell {
+    let cell = CellLayout::PartCarried(PartCarriedCell {
         name: "ROBOWAM part carried".into(),
         robot: RobotModel::arcmate_120ic_nominal().with_j5_travel_deg(135.0),
         deposition_point_mm: Point3::new(1045.747, -630.155, 653.167),

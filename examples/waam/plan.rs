@@ -189,7 +189,7 @@ fn draw_joint_plots(
     let robot = planned.cell.robot();
     // J1-J6, then the positioner's J7 (tilt) and J8 (turn) when there is one
     let positioner = match &planned.cell.layout {
-        waam_slicer::robot::Cell::TorchCarried(c) => Some(&c.positioner),
+        waam_slicer::robot::CellLayout::TorchCarried(c) => Some(&c.positioner),
         _ => None,
     };
     let axes = if positioner.is_some() { 8 } else { 6 };

@@ -182,7 +182,7 @@ use waam_slicer::program::{abb::parse_mod, fanuc::parse_ls, kuka::parse_krl};
 use waam_slicer::program::abb::validate_abb;
 use waam_slicer::program::fanuc::validate_fanuc;
 use waam_slicer::program::kuka::validate_kuka;
-use waam_slicer::robot::{Cell, CellPoint};
+use waam_slicer::robot::{CellLayout, CellPoint};
 
 /// Cell-file target: text → `parse_cell_file`; errors must name the file.
 /// An accepted cell is asked for the joints of a few points near the part
@@ -240,8 +240,8 @@ pub fn cell_file(text: &str) {
 
 /// The sample cells programs are checked against: FANUC (ROBOWAM part and
 /// torch carried), KUKA KR 16-2 and ABB IRB 2600 (part and torch carried).
-fn sample_cells() -> &'static [Cell; 6] {
-    static CELLS: OnceLock<[Cell; 6]> = OnceLock::new();
+fn sample_cells() -> &'static [CellLayout; 6] {
+    static CELLS: OnceLock<[CellLayout; 6]> = OnceLock::new();
     CELLS.get_or_init(|| {
         let read = |text: &str, name: &str| {
             parse_cell_file(text, name)

@@ -26,14 +26,14 @@ use crate::math::{Isometry3, Point3};
 use crate::program::{ProgramOptions, ProgramSettings};
 use crate::robot::orientation::FanucPose;
 use crate::robot::{
-    ArmGeometry, Cell, Configuration, JointConvention, JointLimit, PartCarriedCell, Positioner,
-    RobotError, RobotModel, RobotPreset, TorchCarriedCell, Vendor,
+    ArmGeometry, CellLayout, Configuration, JointConvention, JointLimit, PartCarriedCell,
+    Positioner, RobotError, RobotModel, RobotPreset, TorchCarriedCell, Vendor,
 };
 
 /// Part size the cell-file reader allows for when it checks that the arm
 /// reaches the work (mm): a cell is refused only if no path point within
 /// 1 m of the part frame origin could be reached
-/// ([`Cell::check_reach`]). A cell file names no part; a plan checks again
+/// ([`CellLayout::check_reach`]). A cell file names no part; a plan checks again
 /// with its path's own extent.
 pub const CELL_FILE_PART_RADIUS_MM: f64 = 1000.0;
 
@@ -88,7 +88,7 @@ pub struct CellFile {
     /// The robot (also inside `cell` when there is one).
     pub robot: RobotModel,
     /// The cell, if the file describes one.
-    pub cell: Option<Cell>,
+    pub cell: Option<CellLayout>,
     /// The `[placement]` table: bounds for `waam place`, if given.
     pub placement: Option<PlacementSpec>,
     /// The `[program]` table (home, dwell, interpass wait, payload, transit,
@@ -360,7 +360,7 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
                     .map(|v| FanucPose::from_xyzwpr_deg(v).to_isometry())
                     .unwrap_or_else(Isometry3::identity),
             };
-            Some(Cell::PartCarried(c))
+            Some(CellLayout::PartCarried(c))
         }
         (None, Some(tc)) => {
             let configuration = parse_cfg("torch_carried.configuration", &tc.configuration)?;
@@ -422,7 +422,7 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
                 max_hose_torsion_rad: tc.max_hose_torsion_deg.to_radians(),
                 max_vertical_error_rad: tc.max_vertical_error_deg.to_radians(),
             };
-            Some(Cell::TorchCarried(c))
+            Some(CellLayout::TorchCarried(c))
         }
         (None, None) => None,
     };
@@ -448,7 +448,7 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
                 "give both keep_out_min_mm and keep_out_max_mm",
             ));
         }
-        let part_carried = matches!(cell, Some(Cell::PartCarried(_)));
+        let part_carried = matches!(cell, Some(CellLayout::PartCarried(_)));
         let ranges = [
             ("placement.tilt_x_deg", p.tilt_x_deg, 90.0, None),
             ("placement.tilt_y_deg", p.tilt_y_deg, 90.0, None),
@@ -504,7 +504,7 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
 fn program_settings(
     path: &str,
     mut table: toml::Table,
-    cell: Option<&Cell>,
+    cell: Option<&CellLayout>,
 ) -> Result<ProgramSettings, CellFileError> {
     fn sub<T: serde::de::DeserializeOwned + Default>(
         path: &str,
@@ -621,7 +621,7 @@ pub fn placed_cell_file(
     };
     let v = &p.values;
     match &p.cell {
-        Cell::PartCarried(c) => {
+        CellLayout::PartCarried(c) => {
             let mut t = table(&doc, "part_carried")?;
             t["deposition_point_mm"] = toml_floats(c.deposition_point_mm.coords.as_slice());
             let mount_moved = [v.rotation, v.tilt_x, v.tilt_y, v.offset_mm]
@@ -633,7 +633,7 @@ pub fn placed_cell_file(
             }
             doc["part_carried"] = Item::Table(t);
         }
-        Cell::TorchCarried(c) => {
+        CellLayout::TorchCarried(c) => {
             let mut t = table(&doc, "torch_carried")?;
             let pose = FanucPose::from_isometry(&c.base_from_positioner).to_xyzwpr_deg();
             t["positioner_pose_xyzwpr"] = toml_floats(&pose);
@@ -707,8 +707,8 @@ fn placement_table(
     let span = (hi - lo).min(2.0 * PI);
     spec["rotation_deg"] = toml_floats(&[lo.to_degrees(), (lo + span).to_degrees()]);
     let mount = match p.cell {
-        Cell::PartCarried(_) => ("offset_mm", found.offset_mm, false),
-        Cell::TorchCarried(_) => ("torch_rotation_deg", found.torch_rotation, true),
+        CellLayout::PartCarried(_) => ("offset_mm", found.offset_mm, false),
+        CellLayout::TorchCarried(_) => ("torch_rotation_deg", found.torch_rotation, true),
     };
     let extra = [
         (&v[4], ("tilt_x_deg", found.tilt_x, true)),

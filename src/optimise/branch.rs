@@ -17,13 +17,13 @@ use super::{
     ObjectiveReport, OptimiseOptions, Parameterisation, PlannedPoint, RzLaw, SolverReport,
 };
 use crate::math::tol;
-use crate::robot::cell::Cell;
+use crate::robot::cell::CellLayout;
 use crate::robot::ik::Configuration;
 
 /// One layer (or spiral turn, `anchor` given); also returns the dexterity
 /// floor at its last point (the next spiral turn starts from it).
 pub(super) fn optimise_layer(
-    cell: &Cell,
+    cell: &CellLayout,
     lp: &LayerPoints,
     opts: &OptimiseOptions,
     anchor: Option<Anchor>,

@@ -1,6 +1,6 @@
 //! **Stage 6 — layer-by-layer optimisation of the free rotation `R_Z`.**
 //! Takes the layers of a path as cell points (part frame: position mm, tool
-//! axis, build direction) and a [`Cell`], and returns a [`Plan`]: per layer
+//! axis, build direction) and a [`CellLayout`], and returns a [`Plan`]: per layer
 //! the IK branch (and why), the `R_Z` law (rad), joints per point (rad),
 //! a status naming the binding constraint when the layer cannot be built,
 //! and the trajectory quality at the programmed travel speed (mm/s).
@@ -44,7 +44,7 @@
 //!    current optimum bounds the next degree's gain far below that criterion
 //!    (the next degree is then not solved).
 //! 3. **SQP**: the joints are linearised with the analytic `dq/dR_Z`
-//!    ([`Cell::pose`]'s flange twist through `J⁻¹`), chained through the
+//!    ([`CellLayout::pose`]'s flange twist through `J⁻¹`), chained through the
 //!    basis; each QP (closed form when no row binds, clarabel on a working
 //!    set otherwise) has an l∞ elastic variable, so an infeasible layer ends
 //!    at the least violation with the binding constraint named. The
@@ -141,7 +141,7 @@ use rayon::prelude::*;
 
 use crate::math::UnitVector3;
 use crate::path::Path;
-use crate::robot::cell::{Cell, CellPoint};
+use crate::robot::cell::{CellLayout, CellPoint};
 use crate::robot::trajectory::PathPointInput;
 use crate::toolaxis::LocalFrame;
 
@@ -242,7 +242,7 @@ fn path_point(layer: usize, point: usize, cp: &CellPoint, r_z: f64) -> PathPoint
 /// [`OptimiseError::TooFewPoints`], [`OptimiseError::BadPoint`]. Layers that
 /// cannot be built are reported in the plan ([`LayerStatus`]).
 pub fn optimise(
-    cell: &Cell,
+    cell: &CellLayout,
     layers: &[LayerPoints],
     opts: &OptimiseOptions,
 ) -> Result<Plan, OptimiseError> {
@@ -258,7 +258,7 @@ pub fn optimise(
 /// # Errors
 /// As [`optimise`]; [`OptimiseError::Cancelled`].
 pub fn optimise_with(
-    cell: &Cell,
+    cell: &CellLayout,
     layers: &[LayerPoints],
     opts: &OptimiseOptions,
     on_layer: &(dyn Fn(usize, usize) -> bool + Sync),
@@ -276,7 +276,7 @@ pub fn optimise_with(
             return None;
         }
         let mut plan = optimise_layer(cell, l, opts, None).0;
-        if let (Cell::TorchCarried(c), Some(laws)) = (cell, &laws) {
+        if let (CellLayout::TorchCarried(c), Some(laws)) = (cell, &laws) {
             plan.positioner = Some(laws[i].clone());
             // the positioner's laws see the arm only through a proxy: where
             // the arm cannot follow them, the thesis's exact vertical (inside
@@ -320,7 +320,7 @@ pub fn optimise_with(
 /// the arm; with its law.
 fn vertical_alternative(
     c: &crate::robot::cell::TorchCarriedCell,
-    cell: &Cell,
+    cell: &CellLayout,
     layer: &LayerPoints,
     law: &positioner::PositionerLaw,
     opts: &OptimiseOptions,
@@ -352,14 +352,14 @@ fn vertical_alternative(
 /// layers with the joints filled in and the laws; `(None, None)` when there
 /// is nothing to plan.
 fn schedule_positioner(
-    cell: &Cell,
+    cell: &CellLayout,
     layers: &[LayerPoints],
     opts: &OptimiseOptions,
 ) -> (
     Option<Vec<LayerPoints>>,
     Option<Vec<positioner::PositionerLaw>>,
 ) {
-    let Cell::TorchCarried(c) = cell else {
+    let CellLayout::TorchCarried(c) = cell else {
         return (None, None);
     };
     if layers
@@ -411,7 +411,7 @@ fn schedule_positioner(
 }
 
 fn validate_input(
-    cell: &Cell,
+    cell: &CellLayout,
     layers: &[LayerPoints],
     opts: &OptimiseOptions,
 ) -> Result<(), OptimiseError> {
@@ -442,7 +442,7 @@ fn validate_input(
 }
 
 /// Arc-off moves between consecutive planned layers.
-pub(super) fn transitions(cell: &Cell, plans: &[LayerPlan]) -> Vec<Transition> {
+pub(super) fn transitions(cell: &CellLayout, plans: &[LayerPlan]) -> Vec<Transition> {
     let robot = cell.robot();
     plans
         .windows(2)

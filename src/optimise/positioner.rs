@@ -1234,7 +1234,7 @@ mod tests {
         .expect("sample cell")
         .cell
         {
-            Some(crate::robot::Cell::TorchCarried(c)) => c,
+            Some(crate::robot::CellLayout::TorchCarried(c)) => c,
             other => panic!("not a torch-carried sample cell: {other:?}"),
         };
         c.max_vertical_error_rad = cone_deg.to_radians();

@@ -9,7 +9,7 @@ use nalgebra::{Matrix6, Vector6};
 use crate::optimise::options::Objective;
 use crate::optimise::outcome::{Binding, Constraint};
 use crate::optimise::parameterisation::Basis;
-use crate::robot::cell::{Cell, CellPoint};
+use crate::robot::cell::{CellLayout, CellPoint};
 use crate::robot::ik::Configuration;
 use crate::robot::indices::{
     dexterity, dexterity_warm, positioning_uncertainty, SvdWarmStart, UncertaintyFormula,
@@ -50,7 +50,7 @@ const FD_STEP_RAD: f64 = 1e-6;
 /// Everything fixed about one layer in one branch.
 #[derive(Debug, Clone)]
 pub(crate) struct LayerProblem<'a> {
-    pub cell: &'a Cell,
+    pub cell: &'a CellLayout,
     pub configuration: Configuration,
     pub points: &'a [CellPoint],
     /// Time from point m−1 to m at the travel speed (s); `dt[0] = 0`.

@@ -10,7 +10,7 @@ use super::{
     path_point, Binding, ConfigurationChoiceReport, Constraint, LayerPlan, LayerQuality,
     LayerStatus, ObjectiveReport, PlannedPoint, RzLaw, SolverReport,
 };
-use crate::robot::cell::Cell;
+use crate::robot::cell::CellLayout;
 use crate::robot::model::Joints;
 use crate::robot::trajectory::{joint_trajectory, PathPointInput, ViolationKind};
 
@@ -57,8 +57,8 @@ pub(super) fn finish(
     // the trajectory stage's own check, in the chosen branch
     let mut cell = setup.cell.clone();
     match &mut cell {
-        Cell::PartCarried(c) => c.configuration = configuration.chosen,
-        Cell::TorchCarried(c) => c.configuration = configuration.chosen,
+        CellLayout::PartCarried(c) => c.configuration = configuration.chosen,
+        CellLayout::TorchCarried(c) => c.configuration = configuration.chosen,
     }
     let inputs: Vec<PathPointInput> = setup
         .points

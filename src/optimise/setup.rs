@@ -7,13 +7,13 @@ use super::branch_types::Anchor;
 use super::parameterisation::{cylindrical_angles, turns_about_z};
 use super::problem::{encoder_sigma_rad, LayerProblem};
 use super::{Abscissa, DexterityFloor, OptimiseOptions, Parameterisation};
-use crate::robot::cell::{Cell, CellPoint};
+use crate::robot::cell::{CellLayout, CellPoint};
 use crate::robot::ik::Configuration;
 use crate::robot::indices::{dexterity_warm, SvdWarmStart};
 
 /// One layer (or spiral turn) as every branch sees it.
 pub(super) struct LayerSetup<'a> {
-    pub(super) cell: &'a Cell,
+    pub(super) cell: &'a CellLayout,
     pub(super) opts: &'a OptimiseOptions,
     pub(super) points: &'a [CellPoint],
     pub(super) dt: Vec<f64>,
@@ -29,7 +29,7 @@ impl<'a> LayerSetup<'a> {
     /// angles, whether the layer turns about the part Z axis, and the
     /// polynomial abscissa the options ask for.
     pub(super) fn new(
-        cell: &'a Cell,
+        cell: &'a CellLayout,
         points: &'a [CellPoint],
         opts: &'a OptimiseOptions,
         anchor: Option<Anchor>,
@@ -85,8 +85,8 @@ impl<'a> LayerSetup<'a> {
             upper: std::array::from_fn(|j| robot.limits[j].upper_rad - margin),
             wrist_margin: self.opts.trajectory.wrist_singularity_margin_rad,
             hose: match self.cell {
-                Cell::TorchCarried(c) => Some(c.max_hose_torsion_rad),
-                Cell::PartCarried(_) => None,
+                CellLayout::TorchCarried(c) => Some(c.max_hose_torsion_rad),
+                CellLayout::PartCarried(_) => None,
             },
             max_speed: robot.max_speed_rad_s,
             centring: self.opts.centring_weight / self.points.len() as f64,

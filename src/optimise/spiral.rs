@@ -10,7 +10,7 @@ use super::{
     transitions, validate_input, LayerPlan, LayerPoints, LayerStatus, OptimiseError,
     OptimiseOptions, Plan,
 };
-use crate::robot::cell::Cell;
+use crate::robot::cell::CellLayout;
 
 /// Optimises a spiral path (one continuous layer, `per_turn` points a turn,
 /// as [`Path::spiral`](crate::path::Path) gives it) turn by turn [SPEC §7]:
@@ -30,7 +30,7 @@ use crate::robot::cell::Cell;
 /// # Errors
 /// As [`optimise`](super::optimise()); [`OptimiseError::InvalidOption`] when `per_turn < 2`.
 pub fn optimise_spiral(
-    cell: &Cell,
+    cell: &CellLayout,
     spiral: &LayerPoints,
     per_turn: usize,
     opts: &OptimiseOptions,

@@ -48,8 +48,8 @@ fn hemisphere_layers() -> Vec<LayerPoints> {
 }
 
 /// The cell of `parts/cells/robowam_part_carried.toml`.
-fn robowam() -> Cell {
-    Cell::PartCarried(PartCarriedCell {
+fn robowam() -> CellLayout {
+    CellLayout::PartCarried(PartCarriedCell {
         name: "ROBOWAM".into(),
         robot: RobotModel::arcmate_120ic_nominal().with_j5_travel_deg(135.0),
         deposition_point_mm: Point3::new(1045.747, -630.155, 653.167),
@@ -61,7 +61,7 @@ fn robowam() -> Cell {
 /// A mid-height layer of the hemisphere, the optimiser's `R_Z` for it (rad)
 /// and its branch.
 fn layer_at_its_optimum(
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &OptimiseOptions,
 ) -> (LayerPoints, Vec<f64>, Configuration) {
     let layers = hemisphere_layers();

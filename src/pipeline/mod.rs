@@ -86,7 +86,7 @@ pub struct Cell {
     pub file: String,
     /// The robot, the deposition point or positioner, the torch: what the
     /// optimiser, the trajectory and the program stages take.
-    pub layout: crate::robot::Cell,
+    pub layout: crate::robot::CellLayout,
     /// The file's `[placement]` table (bounds of [`place_part`]), if any.
     pub placement: Option<crate::io::cell_file::PlacementSpec>,
     /// The file's `[program]` table: home, interlayer dwell, interpass wait,

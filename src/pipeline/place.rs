@@ -87,7 +87,7 @@ pub fn placement_bounds(cell: &Cell, half_box_mm: f64) -> Result<PlacementBounds
     }
     // Fixture and torch mount: searched only when the table gives a range
     // (the cell file reader has checked them and their cell kind).
-    let part_carried = matches!(cell.layout, crate::robot::Cell::PartCarried(_));
+    let part_carried = matches!(cell.layout, crate::robot::CellLayout::PartCarried(_));
     let extra = [
         (4, spec.tilt_x_deg, true),
         (5, spec.tilt_y_deg, true),
@@ -138,7 +138,7 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
     // (the arc-off transits against the deposited wall, the set-up), as
     // `plan` will check it.
     let name = super::program_name(&part.name);
-    let accept = |layout: &crate::robot::Cell,
+    let accept = |layout: &crate::robot::CellLayout,
                   layers: &[crate::optimise::LayerPoints],
                   plan: &crate::optimise::Plan| {
         let c = Cell {

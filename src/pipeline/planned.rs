@@ -295,7 +295,7 @@ impl PlannedPart {
     /// `true` when the cell has a positioner (torch carried): the joints
     /// have two more values.
     pub fn has_positioner(&self) -> bool {
-        matches!(self.cell.layout, crate::robot::Cell::TorchCarried(_))
+        matches!(self.cell.layout, crate::robot::CellLayout::TorchCarried(_))
     }
 
     /// Writes `joints.csv` (see [`crate::io::joints_csv`]).

@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, UnitVector3, Vector3};
 use crate::optimise::OptimiseError;
-use crate::robot::Cell;
+use crate::robot::CellLayout;
 
 /// Number of placement variables (see the module doc's table).
 pub const VARIABLES: usize = 7;
@@ -63,7 +63,7 @@ impl PlacementBounds {
     /// rotation, the fixture and torch mount fixed as given, and the robot's
     /// base keep-out: a vertical cylinder's bounding box of half-width 250 mm
     /// about the base axis below the shoulder.
-    pub fn around(cell: &Cell, half_box_mm: f64) -> Self {
+    pub fn around(cell: &CellLayout, half_box_mm: f64) -> Self {
         let names_pc = [
             "deposition_point_mm.x",
             "deposition_point_mm.y",
@@ -83,8 +83,8 @@ impl PlacementBounds {
             "torch_rotation",
         ];
         let (p, names): (Point3, [&'static str; VARIABLES]) = match cell {
-            Cell::PartCarried(c) => (c.deposition_point_mm, names_pc),
-            Cell::TorchCarried(c) => (
+            CellLayout::PartCarried(c) => (c.deposition_point_mm, names_pc),
+            CellLayout::TorchCarried(c) => (
                 Point3::from(c.base_from_positioner.translation.vector),
                 names_tc,
             ),
@@ -114,7 +114,7 @@ impl PlacementBounds {
             },
             fixed(names[4], true),
             fixed(names[5], true),
-            fixed(names[6], matches!(cell, Cell::TorchCarried(_))),
+            fixed(names[6], matches!(cell, CellLayout::TorchCarried(_))),
         ];
         Self {
             variables,
@@ -210,8 +210,8 @@ pub struct PlacementValues {
 
 impl PlacementValues {
     /// The values of the search's point `x` in a cell of `cell`'s kind.
-    pub(crate) fn from_coords(cell: &Cell, x: &Coords) -> Self {
-        let torch = matches!(cell, Cell::TorchCarried(_));
+    pub(crate) fn from_coords(cell: &CellLayout, x: &Coords) -> Self {
+        let torch = matches!(cell, CellLayout::TorchCarried(_));
         Self {
             position_mm: Point3::new(x[0], x[1], x[2]),
             rotation: x[3],
@@ -225,10 +225,10 @@ impl PlacementValues {
     /// The values in the order of the module doc's table for a cell of
     /// `cell`'s kind (mm, rad), as [`PlacementBounds::variables`] lists
     /// them.
-    pub fn in_table_order(&self, cell: &Cell) -> [f64; VARIABLES] {
+    pub fn in_table_order(&self, cell: &CellLayout) -> [f64; VARIABLES] {
         let mount = match cell {
-            Cell::PartCarried(_) => self.offset_mm,
-            Cell::TorchCarried(_) => self.torch_rotation,
+            CellLayout::PartCarried(_) => self.offset_mm,
+            CellLayout::TorchCarried(_) => self.torch_rotation,
         };
         let p = &self.position_mm;
         [
@@ -245,13 +245,13 @@ impl PlacementValues {
     /// The cell with this placement: the deposition point (positioner
     /// origin) set; the rotation, tilts, offset and torch rotation composed
     /// onto the cell's own mounts.
-    pub fn apply(&self, cell: &Cell) -> Cell {
+    pub fn apply(&self, cell: &CellLayout) -> CellLayout {
         let rot = |axis: &UnitVector3, a: f64| UnitQuaternion::from_axis_angle(axis, a);
         let tilt = rot(&Vector3::x_axis(), self.tilt_x) * rot(&Vector3::y_axis(), self.tilt_y);
         let p = self.position_mm;
         let mut out = cell.clone();
         match &mut out {
-            Cell::PartCarried(c) => {
+            CellLayout::PartCarried(c) => {
                 c.deposition_point_mm = p;
                 let mount = Isometry3::from_parts(
                     Translation3::new(0.0, 0.0, self.offset_mm),
@@ -259,7 +259,7 @@ impl PlacementValues {
                 );
                 c.flange_from_part = mount * c.flange_from_part;
             }
-            Cell::TorchCarried(c) => {
+            CellLayout::TorchCarried(c) => {
                 c.base_from_positioner = Isometry3::from_parts(
                     Translation3::new(p.x, p.y, p.z),
                     rot(&Vector3::z_axis(), self.rotation) * c.base_from_positioner.rotation,
@@ -277,6 +277,6 @@ impl PlacementValues {
 }
 
 /// The cell with the search's point `x`.
-pub(crate) fn placed_cell(cell: &Cell, x: &Coords) -> Cell {
+pub(crate) fn placed_cell(cell: &CellLayout, x: &Coords) -> CellLayout {
     PlacementValues::from_coords(cell, x).apply(cell)
 }

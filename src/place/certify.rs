@@ -16,7 +16,7 @@ use super::Search;
 use crate::optimise::{
     optimise, transitions, LayerPlan, LayerPoints, OptimiseError, OptimiseOptions, Plan,
 };
-use crate::robot::Cell;
+use crate::robot::CellLayout;
 
 /// Layers certified together: certification stops after the first group
 /// of this many (in certification order) with an infeasible layer, whatever
@@ -75,7 +75,7 @@ fn certification_order(n: usize, hot: &[usize]) -> Vec<usize> {
 /// path order, with their indices in `layers`) and the infeasible ones'
 /// indices.
 fn certify(
-    cell: &Cell,
+    cell: &CellLayout,
     layers: &[LayerPoints],
     order: &[usize],
     serial: &OptimiseOptions,
@@ -121,7 +121,7 @@ fn certify(
 /// subsample make its score the full path's.
 fn weakest_layers(
     planned: &[(usize, LayerPlan)],
-    cell: &Cell,
+    cell: &CellLayout,
     known: &BTreeSet<usize>,
 ) -> Vec<usize> {
     let mut worst: [(f64, Option<usize>); 3] = [(f64::INFINITY, None); 3];
@@ -152,7 +152,7 @@ fn weakest_layers(
 /// A candidate's full plan: every layer it planned at certification, with
 /// the arc-off transitions between them.
 struct FullPlan {
-    cell: Cell,
+    cell: CellLayout,
     plan: Plan,
     /// Infeasible layers, by index in the path.
     failing: Vec<usize>,

@@ -1,6 +1,6 @@
 //! **Stage 8 — placement of the part in the cell** (beyond the thesis,
 //! which moved the deposition point by hand, §3.3 "second position"). An
-//! outer search over stages 6 and 7: takes a [`Cell`], the layers of a path
+//! outer search over stages 6 and 7: takes a [`CellLayout`], the layers of a path
 //! (part frame, mm) and [`PlacementBounds`] on the cell's placement
 //! variables (robot base frame; mm, rad), judges candidates with the `R_Z`
 //! optimisation ([`optimise`]) as its oracle and
@@ -86,7 +86,7 @@ use screen::{coarse_picks, most_frequent_binding, subsample, Judged};
 
 use crate::optimise::{optimise, LayerPoints, OptimiseError, OptimiseOptions, Plan};
 use crate::program::ProgramError;
-use crate::robot::Cell;
+use crate::robot::CellLayout;
 
 /// Settings of the search ([`place`]). Plain data; the optimiser's own
 /// options are [`place`]'s argument.
@@ -148,7 +148,8 @@ impl PlaceOptions {
 /// screening, every layer at certification). A refusal naming layers
 /// ([`ProgramError::layers`]) brings them into the subsample at full
 /// resolution.
-pub type Accept<'a> = &'a (dyn Fn(&Cell, &[LayerPoints], &Plan) -> Result<(), ProgramError> + Sync);
+pub type Accept<'a> =
+    &'a (dyn Fn(&CellLayout, &[LayerPoints], &Plan) -> Result<(), ProgramError> + Sync);
 
 /// Searches the placement of `layers` in `cell` within `bounds` [module
 /// doc], each candidate planned with `optimise` (run serially per layer;
@@ -160,7 +161,7 @@ pub type Accept<'a> = &'a (dyn Fn(&Cell, &[LayerPoints], &Plan) -> Result<(), Pr
 /// placement makes feasible is a [`Placement`] with `feasible == false` and
 /// the binding constraint named.
 pub fn place(
-    cell: &Cell,
+    cell: &CellLayout,
     layers: &[LayerPoints],
     bounds: &PlacementBounds,
     opts: &PlaceOptions,
@@ -176,7 +177,7 @@ pub fn place(
 /// # Errors
 /// As [`place`].
 pub fn place_with(
-    cell: &Cell,
+    cell: &CellLayout,
     layers: &[LayerPoints],
     bounds: &PlacementBounds,
     opts: &PlaceOptions,
@@ -211,7 +212,7 @@ pub fn place_with(
 
 /// The search's state across its phases.
 pub(crate) struct Search<'a> {
-    cell: &'a Cell,
+    cell: &'a CellLayout,
     layers: &'a [LayerPoints],
     bounds: &'a PlacementBounds,
     opts: &'a PlaceOptions,
@@ -249,10 +250,10 @@ pub(crate) struct Search<'a> {
     rounds: usize,
     feasible_fraction: f64,
     /// The placement found: candidate, cell, full plan.
-    chosen: Option<(Coords, Cell, Plan)>,
+    chosen: Option<(Coords, CellLayout, Plan)>,
     /// The first candidate that failed certification: candidate, cell,
     /// partial plan, share of the checked layers infeasible.
-    failed: Option<(Coords, Cell, Plan, f64)>,
+    failed: Option<(Coords, CellLayout, Plan, f64)>,
     /// The constraint every re-judged candidate shared, when the rounds
     /// stopped on it.
     stopped: Option<Limit>,
@@ -261,7 +262,7 @@ pub(crate) struct Search<'a> {
 
 impl<'a> Search<'a> {
     fn new(
-        cell: &'a Cell,
+        cell: &'a CellLayout,
         layers: &'a [LayerPoints],
         bounds: &'a PlacementBounds,
         opts: &'a PlaceOptions,

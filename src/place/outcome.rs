@@ -9,7 +9,7 @@ use std::sync::Arc;
 use super::bounds::PlacementValues;
 use crate::optimise::{Constraint, OptimiseError, Plan};
 use crate::program::ProgramError;
-use crate::robot::{Cell, RobotError};
+use crate::robot::{CellLayout, RobotError};
 
 /// The worst layer's margins of a plan.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
@@ -155,7 +155,7 @@ impl fmt::Display for Binding {
 pub struct Placement {
     /// The cell with the placement found (or the best tried when none is
     /// feasible).
-    pub cell: Cell,
+    pub cell: CellLayout,
     /// The placement's values (robot base frame; mm, rad).
     pub values: PlacementValues,
     /// `true` when the full plan in the placed cell is feasible (and passed

@@ -4,7 +4,7 @@
 
 use super::outcome::{Limit, Margins};
 use crate::optimise::{LayerStatus, Plan};
-use crate::robot::{Cell, Joints, RobotModel};
+use crate::robot::{CellLayout, Joints, RobotModel};
 
 /// The reach margin (mm) the score calls comfortable. The full path's
 /// layers and laws (each layer re-optimised on every point) take the wrist
@@ -25,7 +25,7 @@ pub(crate) const SPEED_COMFORT: f64 = 0.2;
 const DEXTERITY_SCALE: f64 = 2e-3;
 
 /// The worst layer's margins of `plan` in `cell`.
-pub fn margins(plan: &Plan, cell: &Cell) -> Margins {
+pub fn margins(plan: &Plan, cell: &CellLayout) -> Margins {
     let robot = cell.robot();
     let mut m = Margins {
         joint_limit_deg: f64::INFINITY,
@@ -95,7 +95,7 @@ pub(crate) fn scaled(m: &Margins) -> [f64; 3] {
 /// mixes mm and rad, its values are ~1e-3 on our arms, so it only breaks
 /// ties); for an infeasible plan minus the share of infeasible layers minus
 /// a bounded measure of the violations.
-pub(crate) fn score(plan: &Plan, cell: &Cell) -> f64 {
+pub(crate) fn score(plan: &Plan, cell: &CellLayout) -> f64 {
     let m = margins(plan, cell);
     if m.infeasible_layers == 0 {
         let [a, b, r] = scaled(&m).map(|v| v.min(1.0));

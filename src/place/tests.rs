@@ -172,7 +172,7 @@ fn placement_values_follow_the_table_for_both_cell_kinds() {
     use super::bounds::{placed_cell, PlacementValues};
     use crate::io::cell_file::parse_cell_file;
     use crate::math::Point3;
-    use crate::robot::Cell;
+    use crate::robot::CellLayout;
     let x = [1000.0, -200.0, 500.0, 0.5, 0.1, -0.2, 30.0];
     for file in [
         "parts/cells/robowam_part_carried.toml",
@@ -186,11 +186,11 @@ fn placement_values_follow_the_table_for_both_cell_kinds() {
         assert_eq!(v.position_mm, Point3::new(1000.0, -200.0, 500.0));
         let placed = placed_cell(&cell, &x);
         match (&cell, &placed) {
-            (Cell::PartCarried(_), Cell::PartCarried(c)) => {
+            (CellLayout::PartCarried(_), CellLayout::PartCarried(c)) => {
                 assert_eq!((v.offset_mm, v.torch_rotation), (30.0, 0.0));
                 assert_eq!(c.deposition_point_mm, v.position_mm);
             }
-            (Cell::TorchCarried(_), Cell::TorchCarried(c)) => {
+            (CellLayout::TorchCarried(_), CellLayout::TorchCarried(c)) => {
                 assert_eq!((v.offset_mm, v.torch_rotation), (0.0, 30.0));
                 assert_eq!(
                     Point3::from(c.base_from_positioner.translation.vector),

@@ -23,7 +23,7 @@ use crate::program::validate::{
     check_home_ends, check_steps, push, vendor_matches, ProblemKind, Step, ValidationReport,
 };
 use crate::program::{EmittedFile, Program, ProgramError, ProgramOptions, ProgramSettings};
-use crate::robot::{Cell, Vendor};
+use crate::robot::{CellLayout, Vendor};
 
 /// A robot controller's program format: options, emit, read, decode.
 ///
@@ -130,7 +130,7 @@ pub trait Controller {
     /// `report`).
     fn steps(
         read: &Self::Read,
-        cell: &Cell,
+        cell: &CellLayout,
         opts: &Self::Options,
         report: &mut ValidationReport,
     ) -> Option<Vec<Step>>;
@@ -140,7 +140,7 @@ pub trait Controller {
     /// deposition points of the bead motions (part frame, mm), when known.
     fn validate(
         read: &Self::Read,
-        cell: &Cell,
+        cell: &CellLayout,
         opts: &Self::Options,
         planned: Option<&[Point3]>,
     ) -> ValidationReport
@@ -156,7 +156,7 @@ pub trait Controller {
 /// [`Controller::validate`] with the decoding given: the vendor checked
 /// (against `main_file`, line 1), then `decode`'s steps checked.
 pub(crate) fn validate_decoded<C: Controller>(
-    cell: &Cell,
+    cell: &CellLayout,
     main_file: &str,
     opts: &C::Options,
     planned: Option<&[Point3]>,
@@ -238,7 +238,7 @@ pub fn groups_by_name(
 /// [`ProgramError::Read`] naming the file and line that cannot be read.
 pub fn validate_build<C: Controller>(
     files: &[EmittedFile],
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &C::Options,
     planned: Option<&[Point3]>,
 ) -> Result<ValidationReport, ProgramError> {
@@ -314,17 +314,17 @@ pub fn with_controller<T: ControllerTask>(vendor: Vendor, task: T) -> T::Output 
 /// with the controller's [`Controller::ENDLESS_TURN_MODULO`]); `None`
 /// without a positioner. `UNLIMITED` for an endless turn the controller
 /// writes modulo 360°.
-pub fn turn_stroke(cell: &Cell) -> Option<crate::robot::JointLimit> {
+pub fn turn_stroke(cell: &CellLayout) -> Option<crate::robot::JointLimit> {
     match cell {
-        Cell::TorchCarried(c) => Some(c.positioner.turn_stroke(turn_modulo(cell))),
-        Cell::PartCarried(_) => None,
+        CellLayout::TorchCarried(c) => Some(c.positioner.turn_stroke(turn_modulo(cell))),
+        CellLayout::PartCarried(_) => None,
     }
 }
 
 /// `true` when `cell`'s robot controller turns endless axes modulo 360°
 /// ([`Controller::ENDLESS_TURN_MODULO`]) and its positioner's turn is
 /// endless without a stated stroke: the turn is then written modulo 360°.
-pub fn turn_modulo(cell: &Cell) -> bool {
+pub fn turn_modulo(cell: &CellLayout) -> bool {
     struct Modulo;
     impl ControllerTask for Modulo {
         type Output = bool;
@@ -333,11 +333,11 @@ pub fn turn_modulo(cell: &Cell) -> bool {
         }
     }
     match cell {
-        Cell::TorchCarried(c) => {
+        CellLayout::TorchCarried(c) => {
             with_controller(c.robot.vendor, Modulo)
                 && c.positioner.turn_stroke(true) == crate::robot::JointLimit::UNLIMITED
         }
-        Cell::PartCarried(_) => false,
+        CellLayout::PartCarried(_) => false,
     }
 }
 
@@ -345,7 +345,7 @@ pub fn turn_modulo(cell: &Cell) -> bool {
 /// (the part is the moving frame: a fixed tool about which the part-carried
 /// robot moves, or coordinated motion with the positioner); `false` when
 /// in the robot base frame.
-pub fn moves_in_part_frame(cell: &Cell, opts: &ProgramOptions) -> bool {
+pub fn moves_in_part_frame(cell: &CellLayout, opts: &ProgramOptions) -> bool {
     struct FixedTool;
     impl ControllerTask for FixedTool {
         type Output = bool;
@@ -354,8 +354,10 @@ pub fn moves_in_part_frame(cell: &Cell, opts: &ProgramOptions) -> bool {
         }
     }
     match cell {
-        Cell::TorchCarried(_) => opts.coordinated,
-        Cell::PartCarried(_) => opts.remote_tcp || with_controller(cell.robot().vendor, FixedTool),
+        CellLayout::TorchCarried(_) => opts.coordinated,
+        CellLayout::PartCarried(_) => {
+            opts.remote_tcp || with_controller(cell.robot().vendor, FixedTool)
+        }
     }
 }
 
@@ -403,13 +405,13 @@ pub fn emit(
 pub fn check_files(
     vendor: Vendor,
     files: &[EmittedFile],
-    cell: &Cell,
+    cell: &CellLayout,
     settings: &ProgramSettings,
     planned: Option<&[Point3]>,
 ) -> Result<ValidationReport, ProgramError> {
     struct Check<'a> {
         files: &'a [EmittedFile],
-        cell: &'a Cell,
+        cell: &'a CellLayout,
         settings: &'a ProgramSettings,
         planned: Option<&'a [Point3]>,
     }

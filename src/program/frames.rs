@@ -17,7 +17,7 @@
 //! frame turned half a turn about its x axis ([`wire_out`]), same origin.
 
 use crate::math::{Isometry3, Point3, Vector3};
-use crate::robot::Cell;
+use crate::robot::CellLayout;
 
 /// Where a program's tool and work frames are (mm).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,7 +52,7 @@ impl ToolFrames {
     /// frame `base_from_user`. In the torch-carried cell the stationary
     /// defaults are the identity.
     pub fn new(
-        cell: &Cell,
+        cell: &CellLayout,
         stationary: bool,
         flange_from_tool: Option<Isometry3>,
         fixed_tool: Option<Isometry3>,
@@ -61,12 +61,12 @@ impl ToolFrames {
         if stationary {
             ToolFrames::Stationary {
                 base_from_tool: fixed_tool.unwrap_or_else(|| match cell {
-                    Cell::PartCarried(c) => fixed_torch_at(&c.deposition_point_mm),
-                    Cell::TorchCarried(_) => Isometry3::identity(),
+                    CellLayout::PartCarried(c) => fixed_torch_at(&c.deposition_point_mm),
+                    CellLayout::TorchCarried(_) => Isometry3::identity(),
                 }),
                 flange_from_work: flange_from_tool.unwrap_or(match cell {
-                    Cell::PartCarried(c) => c.flange_from_part,
-                    Cell::TorchCarried(_) => Isometry3::identity(),
+                    CellLayout::PartCarried(c) => c.flange_from_part,
+                    CellLayout::TorchCarried(_) => Isometry3::identity(),
                 }),
             }
         } else {
@@ -111,11 +111,11 @@ impl ToolFrames {
 /// user's own tool, written as given), else the torch-carried cell's torch
 /// with +Z along the wire out of the torch (`flange_from_tcp ·`
 /// [`wire_out`]) or, in the part-carried cell, the flange itself.
-pub fn held_tool(cell: &Cell, flange_from_tool: Option<Isometry3>) -> Isometry3 {
+pub fn held_tool(cell: &CellLayout, flange_from_tool: Option<Isometry3>) -> Isometry3 {
     match (flange_from_tool, cell) {
         (Some(t), _) => t,
-        (None, Cell::TorchCarried(c)) => c.flange_from_tcp * wire_out(),
-        (None, Cell::PartCarried(_)) => Isometry3::identity(),
+        (None, CellLayout::TorchCarried(c)) => c.flange_from_tcp * wire_out(),
+        (None, CellLayout::PartCarried(_)) => Isometry3::identity(),
     }
 }
 

@@ -1,7 +1,7 @@
 //! **Stage 7 — robot programs.** Takes a planned [`JointTrajectory`] (joints
 //! per path point, rad), the path points it was computed for
 //! ([`PathPointInput`]: layer structure, part-frame positions (mm), tool axes,
-//! `R_Z`), the [`Cell`] and the travel speeds (mm/s), checks that the plan is
+//! `R_Z`), the [`CellLayout`] and the travel speeds (mm/s), checks that the plan is
 //! buildable, and returns a [`Program`]: one bead per layer, every point
 //! carrying its arc flag, with an approach point before and a retract point
 //! after each bead. Emitters turn a [`Program`] into controller files; every
@@ -59,7 +59,7 @@ use crate::math::{Point3, UnitVector3, Vector3};
 use crate::robot::cell::CellPoint;
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::trajectory::{JointTrajectory, PathPointInput};
-use crate::robot::{Cell, Configuration, Joints, Vendor};
+use crate::robot::{CellLayout, Configuration, Joints, Vendor};
 
 /// Errors of the program stage; each names the point, field or file at fault.
 /// `Clone` (an I/O error is shared), so that a plan can keep the program
@@ -309,7 +309,7 @@ pub struct Program {
     /// Program name (controller-safe: letters, digits, `_`, starting with a letter).
     pub name: String,
     /// The cell the program is for.
-    pub cell: Cell,
+    pub cell: CellLayout,
     /// The IK branch of every point.
     pub configuration: Configuration,
     /// The points.
@@ -408,7 +408,7 @@ impl Program {
                 ),
             });
         }
-        let Cell::PartCarried(c) = &self.cell else {
+        let CellLayout::PartCarried(c) = &self.cell else {
             return Ok(());
         };
         if opts.payload_every_layers == 0 {
@@ -496,7 +496,7 @@ pub enum TravelSpeed {
 /// the first.
 pub fn build_program(
     name: &str,
-    cell: &Cell,
+    cell: &CellLayout,
     points: &[PathPointInput],
     trajectory: &JointTrajectory,
     speed: &TravelSpeed,
@@ -717,11 +717,11 @@ impl ProgramOptions {
     }
 
     /// The home position in controller units inside (rad), if any.
-    pub fn home(&self, cell: &Cell) -> Option<HomePosition> {
+    pub fn home(&self, cell: &CellLayout) -> Option<HomePosition> {
         let h = self.home_deg?;
         Some(HomePosition {
             joints: h.map(f64::to_radians),
-            positioner: matches!(cell, Cell::TorchCarried(_)).then(|| {
+            positioner: matches!(cell, CellLayout::TorchCarried(_)).then(|| {
                 self.home_positioner_deg
                     .unwrap_or([0.0; 2])
                     .map(f64::to_radians)
@@ -821,7 +821,7 @@ impl ProgramSettings {
 /// reached, naming the layer.
 pub fn build_program_with(
     name: &str,
-    cell: &Cell,
+    cell: &CellLayout,
     points: &[PathPointInput],
     trajectory: &JointTrajectory,
     speed: &TravelSpeed,
@@ -1040,12 +1040,12 @@ pub fn build_program_with(
 /// [`ProgramError::Infeasible`] naming the layer whose bead turns the
 /// table through more than the stroke holds.
 fn unwind_turns(
-    cell: &Cell,
+    cell: &CellLayout,
     points: &mut [ProgramPoint],
     home: Option<&HomePosition>,
 ) -> Result<(), ProgramError> {
     use std::f64::consts::TAU;
-    let Cell::TorchCarried(c) = cell else {
+    let CellLayout::TorchCarried(c) = cell else {
         return Ok(());
     };
     let stroke = contract::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
@@ -1090,7 +1090,7 @@ fn unwind_turns(
 }
 
 /// Refuses a home position outside the arm's (or positioner's) travel.
-fn check_home(cell: &Cell, h: &HomePosition) -> Result<(), ProgramError> {
+fn check_home(cell: &CellLayout, h: &HomePosition) -> Result<(), ProgramError> {
     let bad = |what: String| ProgramError::InvalidOptions {
         field: "home_deg",
         value: what,
@@ -1099,7 +1099,7 @@ fn check_home(cell: &Cell, h: &HomePosition) -> Result<(), ProgramError> {
     if let Some((j, v)) = cell.robot().limit_violations(&h.joints).next() {
         return Err(bad(format!("J{} = {:.3}°", j + 1, v.to_degrees())));
     }
-    if let (Cell::TorchCarried(c), Some(qp)) = (cell, h.positioner) {
+    if let (CellLayout::TorchCarried(c), Some(qp)) = (cell, h.positioner) {
         let turn = contract::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
         let stroke = [c.positioner.limits[0], turn];
         for (i, (l, v)) in stroke.iter().zip(qp).enumerate() {
@@ -1308,7 +1308,7 @@ fn safe_transits(
 /// fraction of a degree inside its stop), at a half, a quarter or an eighth
 /// of it; refused with the full clearance's reason if none works.
 fn clearance_point_within_travel(
-    cell: &Cell,
+    cell: &CellLayout,
     p: &ProgramPoint,
     input: &PathPointInput,
     flag: ArcFlag,
@@ -1331,7 +1331,7 @@ fn clearance_point_within_travel(
 /// towards `p`'s; refused if a joint leaves its travel or the linear move
 /// between it and `p` outruns a joint at the approach speed.
 fn clearance_point(
-    cell: &Cell,
+    cell: &CellLayout,
     p: &ProgramPoint,
     input: &PathPointInput,
     flag: ArcFlag,
@@ -1528,7 +1528,7 @@ pub fn vendor_name(vendor: Vendor) -> &'static str {
 /// # Errors
 /// [`ProgramError::VendorMismatch`] naming both vendors and the robot.
 pub fn check_vendor(
-    cell: &Cell,
+    cell: &CellLayout,
     vendor: Vendor,
     emitter: &'static str,
 ) -> Result<(), ProgramError> {

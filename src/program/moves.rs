@@ -28,7 +28,7 @@ use crate::program::contract::moves_in_part_frame;
 use crate::program::frames::fixed_torch_at;
 use crate::program::validate::between::{check_between, InterpolatedMove};
 use crate::program::{ArcFlag, Program, ProgramError, ProgramOptions, ProgramPoint};
-use crate::robot::Cell;
+use crate::robot::CellLayout;
 
 /// What thinning did to a program's beads.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
@@ -91,28 +91,28 @@ fn must_keep(bead: &[ProgramPoint]) -> Vec<bool> {
 /// The tool centre point's pose and the positioner joints as the controller
 /// interpolates them for point `p` (module doc): part frame when `in_part`,
 /// else robot base frame.
-fn controller_pose(cell: &Cell, p: &ProgramPoint, in_part: bool) -> ControllerPose {
+fn controller_pose(cell: &CellLayout, p: &ProgramPoint, in_part: bool) -> ControllerPose {
     controller_pose_at(cell, &p.joints, p.positioner, in_part)
 }
 
 /// [`controller_pose`] of the arm at joints `q` (rad) and the positioner
 /// at `qp` (rad).
 pub(crate) fn controller_pose_at(
-    cell: &Cell,
+    cell: &CellLayout,
     q: &crate::robot::Joints,
     qp: Option<[f64; 2]>,
     in_part: bool,
 ) -> ControllerPose {
     let flange = cell.robot().flange_pose(q);
     let (tcp, ext): (Isometry3, Vec<f64>) = match cell {
-        Cell::PartCarried(c) if in_part => {
+        CellLayout::PartCarried(c) if in_part => {
             let base_from_part = flange * c.flange_from_part;
             let torch = fixed_torch_at(&c.deposition_point_mm);
             (base_from_part.inverse() * torch, Vec::new())
         }
         // the held tool (the flange) in the base frame
-        Cell::PartCarried(_) => (flange, Vec::new()),
-        Cell::TorchCarried(c) => {
+        CellLayout::PartCarried(_) => (flange, Vec::new()),
+        CellLayout::TorchCarried(c) => {
             let tcp = flange * c.flange_from_tcp;
             let qp = qp.unwrap_or([0.0; 2]);
             let tcp = if in_part {
@@ -129,17 +129,17 @@ pub(crate) fn controller_pose_at(
 /// The flange pose (robot base frame) that puts the controller's tool at
 /// `pose` ([`controller_pose_at`]'s inverse), with the positioner at
 /// `pose.ext`.
-pub(crate) fn flange_of(cell: &Cell, pose: &ControllerPose, in_part: bool) -> Isometry3 {
+pub(crate) fn flange_of(cell: &CellLayout, pose: &ControllerPose, in_part: bool) -> Isometry3 {
     let controller = Isometry3::from_parts(pose.p.coords.into(), pose.q);
     match cell {
-        Cell::PartCarried(c) if in_part => {
+        CellLayout::PartCarried(c) if in_part => {
             // controller = (flange · F_fp)⁻¹ · torch
             fixed_torch_at(&c.deposition_point_mm)
                 * controller.inverse()
                 * c.flange_from_part.inverse()
         }
-        Cell::PartCarried(_) => controller,
-        Cell::TorchCarried(c) => {
+        CellLayout::PartCarried(_) => controller,
+        CellLayout::TorchCarried(c) => {
             let tcp = if in_part {
                 c.base_from_part(&[pose.ext[0], pose.ext[1]]) * controller
             } else {
@@ -154,7 +154,7 @@ pub(crate) fn flange_of(cell: &Cell, pose: &ControllerPose, in_part: bool) -> Is
 /// checker samples it ([`check_between`]): every joint within its travel,
 /// no jump, no joint above its maximum speed at the planned travel speed.
 fn circle_runs(
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &ProgramOptions,
     a: &ProgramPoint,
     via: &ProgramPoint,
@@ -206,12 +206,12 @@ pub fn thin_beads(
         let controller = Isometry3::from_parts(pose.p.coords.into(), pose.q);
         let frame = match (&cell, in_part) {
             (_, true) => controller,
-            (Cell::TorchCarried(c), false) => {
+            (CellLayout::TorchCarried(c), false) => {
                 let qp = [pose.ext[0], pose.ext[1]];
                 c.base_from_part(&qp).inverse() * controller
             }
             // the fixed torch seen from the part held by the interpolated flange
-            (Cell::PartCarried(c), false) => {
+            (CellLayout::PartCarried(c), false) => {
                 (controller * c.flange_from_part).inverse() * fixed_torch_at(&c.deposition_point_mm)
             }
         };

@@ -11,7 +11,7 @@
 use std::sync::OnceLock;
 
 use crate::math::{Point3, Vector3};
-use crate::robot::{Cell, Joints};
+use crate::robot::{CellLayout, Joints};
 use crate::toolaxis::collision::{Torch, Wall};
 use crate::toolaxis::ToolAxisError;
 
@@ -30,10 +30,14 @@ pub const WALL_POINTS_PER_BEAD: usize = 256;
 /// deposits at (part frame, mm) and its axis from that point towards the
 /// torch (part frame, unit), the [`part_from_torch`](crate::toolaxis::collision::part_from_torch)
 /// inputs. `None` in a torch-carried cell without positioner joints.
-pub fn torch_in_part(cell: &Cell, q: &Joints, qp: Option<[f64; 2]>) -> Option<(Point3, Vector3)> {
+pub fn torch_in_part(
+    cell: &CellLayout,
+    q: &Joints,
+    qp: Option<[f64; 2]>,
+) -> Option<(Point3, Vector3)> {
     let base_from_flange = cell.robot().flange_pose(q);
     match cell {
-        Cell::PartCarried(c) => {
+        CellLayout::PartCarried(c) => {
             // the torch is fixed at D_R, pointing down: its axis towards the
             // torch is the base frame's +Z (eq. 3.8: A·T = +Z)
             let part_from_base = (base_from_flange * c.flange_from_part).inverse();
@@ -42,7 +46,7 @@ pub fn torch_in_part(cell: &Cell, q: &Joints, qp: Option<[f64; 2]>) -> Option<(P
                 part_from_base.rotation * Vector3::z(),
             ))
         }
-        Cell::TorchCarried(c) => {
+        CellLayout::TorchCarried(c) => {
             let base_from_tcp = base_from_flange * c.flange_from_tcp;
             let part_from_base = c.base_from_part(&qp?).inverse();
             // the TCP's z axis points from the deposition point back into
@@ -80,7 +84,7 @@ pub struct TransitClearance {
 /// A message when a sample has no torch pose (torch-carried cell without
 /// positioner joints) or parry cannot answer.
 pub fn joint_move_clearance(
-    cell: &Cell,
+    cell: &CellLayout,
     wall: &(impl TransitWall + ?Sized),
     torch: &Torch,
     (qa, pa): (&Joints, Option<[f64; 2]>),

@@ -56,7 +56,7 @@ impl PyCell {
     /// then have 8 columns.
     #[getter]
     fn has_positioner(&self) -> bool {
-        matches!(self.cell.layout, crate::robot::Cell::TorchCarried(_))
+        matches!(self.cell.layout, crate::robot::CellLayout::TorchCarried(_))
     }
 
     fn __repr__(&self) -> String {

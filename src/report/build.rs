@@ -7,7 +7,7 @@ use super::encode::{f32s, i8s, json_nums, json_str, u32s, unit_i8, JsonObject};
 use super::{PlanView, ReportError, ReportInput};
 use crate::geometry::Substrate;
 use crate::math::{Point3, Vector3};
-use crate::robot::Cell;
+use crate::robot::CellLayout;
 
 /// Indices kept of a run of `n` points with stride `k`: `0, k, 2k, ...` and `n − 1`.
 pub(crate) fn kept(n: usize, k: usize) -> impl Iterator<Item = usize> {
@@ -154,7 +154,7 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
     // the build direction's tilt from the vertical in the world (torch carried)
     let mut tilt = vec![];
     let torch_carried = match input.plan.as_ref().map(|pv| pv.cell) {
-        Some(Cell::TorchCarried(c)) => Some(c),
+        Some(CellLayout::TorchCarried(c)) => Some(c),
         _ => None,
     };
     let robot = input.plan.as_ref().map(|pv| pv.cell.robot());
@@ -542,8 +542,8 @@ fn plan_data(input: &ReportInput, pv: &PlanView) -> (String, Vec<String>) {
                 }
                 let positioner = pp.positioner.or_else(|| match pv.cell {
                     // without a planned positioner pose, turn it as the cell would
-                    Cell::TorchCarried(c) => c.positioner_angles(cp, q8_hint).ok(),
-                    Cell::PartCarried(_) => None,
+                    CellLayout::TorchCarried(c) => c.positioner_angles(cp, q8_hint).ok(),
+                    CellLayout::PartCarried(_) => None,
                 });
                 let s = snapshot(pv.cell, q.as_ref(), positioner.as_ref(), cp, pp.r_z);
                 match s.chain {
@@ -582,13 +582,13 @@ fn plan_data(input: &ReportInput, pv: &PlanView) -> (String, Vec<String>) {
         .iter()
         .map(|l| json_nums(&[l.lower_rad.to_degrees(), l.upper_rad.to_degrees()]))
         .chain(match pv.cell {
-            Cell::TorchCarried(c) => c
+            CellLayout::TorchCarried(c) => c
                 .positioner
                 .limits
                 .iter()
                 .map(|l| json_nums(&[l.lower_rad.to_degrees(), l.upper_rad.to_degrees()]))
                 .collect(),
-            Cell::PartCarried(_) => vec![],
+            CellLayout::PartCarried(_) => vec![],
         })
         .collect();
     let g = &robot.geometry;
@@ -596,8 +596,8 @@ fn plan_data(input: &ReportInput, pv: &PlanView) -> (String, Vec<String>) {
     o.str(
         "cell_kind",
         match pv.cell {
-            Cell::PartCarried(_) => "part carried",
-            Cell::TorchCarried(_) => "torch carried",
+            CellLayout::PartCarried(_) => "part carried",
+            CellLayout::TorchCarried(_) => "torch carried",
         },
     )
     .str("cell", pv.cell.name())
@@ -610,8 +610,8 @@ fn plan_data(input: &ReportInput, pv: &PlanView) -> (String, Vec<String>) {
     .num(
         "max_hose_deg",
         match pv.cell {
-            Cell::TorchCarried(c) => c.max_hose_torsion_rad.to_degrees(),
-            Cell::PartCarried(_) => f64::NAN,
+            CellLayout::TorchCarried(c) => c.max_hose_torsion_rad.to_degrees(),
+            CellLayout::PartCarried(_) => f64::NAN,
         },
     )
     .raw(

@@ -5,7 +5,7 @@
 use crate::math::{Isometry3, Point3, Rotation3, Vector3};
 use crate::robot::model::{Joints, RobotModel};
 use crate::robot::positioner::PositionerJoints;
-use crate::robot::Cell;
+use crate::robot::CellLayout;
 
 /// Points of the arm drawn as solids between consecutive entries.
 pub const CHAIN_POINTS: usize = 8;
@@ -56,7 +56,7 @@ pub fn arm_chain(robot: &RobotModel, q: &Joints) -> [Point3; 7] {
 /// positioner joints `e` (rad), the point `m` and tool axis of the point for
 /// the part-carried pose law, and `r_z` (rad).
 pub fn snapshot(
-    cell: &Cell,
+    cell: &CellLayout,
     q: Option<&Joints>,
     e: Option<&PositionerJoints>,
     point: &crate::robot::CellPoint,
@@ -64,7 +64,7 @@ pub fn snapshot(
 ) -> CellSnapshot {
     let chain7 = q.map(|q| arm_chain(cell.robot(), q));
     match cell {
-        Cell::PartCarried(c) => {
+        CellLayout::PartCarried(c) => {
             let base_from_part = match q {
                 Some(q) => Some(c.robot.flange_pose(q) * c.flange_from_part),
                 None => Some(c.base_from_part(&point.position_mm, &point.tool_axis, r_z)),
@@ -77,7 +77,7 @@ pub fn snapshot(
                 base_from_part,
             }
         }
-        Cell::TorchCarried(c) => {
+        CellLayout::TorchCarried(c) => {
             let positioner = e.map(|e| {
                 let base_from_table =
                     c.base_from_positioner * c.positioner.positioner_from_table(e);

@@ -51,7 +51,7 @@ use crate::geometry::Substrate;
 use crate::optimise::{LayerPoints, Plan};
 use crate::path::{DistanceMap, Path};
 use crate::process::ProcessPlan;
-use crate::robot::Cell;
+use crate::robot::CellLayout;
 use crate::toolaxis::LocalFrame;
 use std::io::Write;
 
@@ -91,7 +91,7 @@ impl Default for ReportOptions {
 #[derive(Debug, Clone, Copy)]
 pub struct PlanView<'a> {
     /// The cell (robot base frame, mm).
-    pub cell: &'a Cell,
+    pub cell: &'a CellLayout,
     /// The layers of the plan, one per path layer, same points (part frame).
     pub layers: &'a [LayerPoints],
     /// The plan made from `layers` in `cell`.

@@ -7,7 +7,7 @@ use crate::math::{Point3, UnitVector3, Vector3};
 use crate::path::{Layer, PathPoint, SliceReport, Strategy};
 use crate::robot::CellPoint;
 
-fn cell(name: &str) -> Cell {
+fn cell(name: &str) -> CellLayout {
     let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("parts/cells")
         .join(name);
@@ -160,7 +160,7 @@ fn the_drawn_cell_puts_the_torch_tip_on_the_path_point() {
             s.torch[0]
         );
         let chain = s.chain.unwrap();
-        if matches!(c, Cell::TorchCarried(_)) {
+        if matches!(c, CellLayout::TorchCarried(_)) {
             assert!((chain[7] - m).norm() < 1e-6, "{name}: TCP on the point");
             // the torch body goes up the tool axis
             let t = base_from_part.rotation * p.tool_axis.into_inner();

@@ -491,41 +491,45 @@ impl TorchCarriedCell {
     }
 }
 
-/// Either cell (closed set).
+/// The physical layout of a cell, either kind (closed set): the robot, the
+/// deposition point or positioner, the torch (robot base frame, mm, rad);
+/// what the optimiser, trajectory and program stages take. The front door's
+/// [`Cell`](crate::Cell) wraps one with the cell file's name, source,
+/// placement bounds and program settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[allow(
     clippy::large_enum_variant,
     reason = "a handful of cells per run, read by reference in the hot loops; boxing would only add an indirection"
 )]
-pub enum Cell {
+pub enum CellLayout {
     /// Fixed torch, the robot holds the part.
     PartCarried(PartCarriedCell),
     /// Part on the positioner, the robot holds the torch.
     TorchCarried(TorchCarriedCell),
 }
 
-impl Cell {
+impl CellLayout {
     /// The arm of the cell.
     pub fn robot(&self) -> &RobotModel {
         match self {
-            Cell::PartCarried(c) => &c.robot,
-            Cell::TorchCarried(c) => &c.robot,
+            CellLayout::PartCarried(c) => &c.robot,
+            CellLayout::TorchCarried(c) => &c.robot,
         }
     }
 
     /// The IK branch of the cell.
     pub fn configuration(&self) -> Configuration {
         match self {
-            Cell::PartCarried(c) => c.configuration,
-            Cell::TorchCarried(c) => c.configuration,
+            CellLayout::PartCarried(c) => c.configuration,
+            CellLayout::TorchCarried(c) => c.configuration,
         }
     }
 
     /// Name of the cell.
     pub fn name(&self) -> &str {
         match self {
-            Cell::PartCarried(c) => &c.name,
-            Cell::TorchCarried(c) => &c.name,
+            CellLayout::PartCarried(c) => &c.name,
+            CellLayout::TorchCarried(c) => &c.name,
         }
     }
 
@@ -535,8 +539,8 @@ impl Cell {
     /// As the cells' `validate`.
     pub fn validate(&self) -> Result<(), RobotError> {
         match self {
-            Cell::PartCarried(c) => c.validate(),
-            Cell::TorchCarried(c) => c.validate(),
+            CellLayout::PartCarried(c) => c.validate(),
+            CellLayout::TorchCarried(c) => c.validate(),
         }
     }
 
@@ -549,8 +553,8 @@ impl Cell {
     /// and the reach.
     pub fn check_reach(&self, part_radius_mm: f64) -> Result<(), RobotError> {
         match self {
-            Cell::PartCarried(c) => c.check_reach(part_radius_mm),
-            Cell::TorchCarried(c) => c.check_reach(part_radius_mm),
+            CellLayout::PartCarried(c) => c.check_reach(part_radius_mm),
+            CellLayout::TorchCarried(c) => c.check_reach(part_radius_mm),
         }
     }
 
@@ -560,8 +564,8 @@ impl Cell {
     /// As the cells' `pose`.
     pub fn pose(&self, p: &CellPoint, r_z: f64, q8_hint: f64) -> Result<CellPose, RobotError> {
         match self {
-            Cell::PartCarried(c) => c.pose(p, r_z),
-            Cell::TorchCarried(c) => c.pose(p, r_z, q8_hint),
+            CellLayout::PartCarried(c) => c.pose(p, r_z),
+            CellLayout::TorchCarried(c) => c.pose(p, r_z, q8_hint),
         }
     }
 
@@ -569,7 +573,7 @@ impl Cell {
     /// towards `near` when given; also returns the cell pose.
     ///
     /// # Errors
-    /// As [`Cell::pose`] and [`RobotModel::inverse`].
+    /// As [`CellLayout::pose`] and [`RobotModel::inverse`].
     pub fn joints(
         &self,
         p: &CellPoint,
@@ -590,18 +594,18 @@ impl Cell {
     /// flange twist of [`CellPose::flange_twist_per_rz`] [SPEC §7].
     ///
     /// # Errors
-    /// [`RobotError::SingularJacobian`] at a singularity; as [`Cell::pose`].
+    /// [`RobotError::SingularJacobian`] at a singularity; as [`CellLayout::pose`].
     pub fn dq_drz(&self, pose: &CellPose, q: &Joints) -> Result<Joints, RobotError> {
         self.dq_drz_from(pose, &self.robot().jacobian(q), None)
     }
 
-    /// [`Cell::dq_drz`] from the robot's Jacobian `j` at the joints
+    /// [`CellLayout::dq_drz`] from the robot's Jacobian `j` at the joints
     /// (already computed by the caller) and, when known, a lower bound of
     /// its dexterity at the length scale `length_scale_mm` (`(bound,
     /// scale)`), which can spare the singularity test's SVD.
     ///
     /// # Errors
-    /// As [`Cell::dq_drz`].
+    /// As [`CellLayout::dq_drz`].
     pub(crate) fn dq_drz_from(
         &self,
         pose: &CellPose,

@@ -45,7 +45,7 @@ pub enum RobotError {
     /// the field (the part-carried deposition point, or the torch-carried
     /// positioner's tilt centre) is too far from (or too near to) the
     /// shoulder for any pose of the arm, whatever the path. See
-    /// [`Cell::check_reach`](crate::robot::Cell::check_reach).
+    /// [`CellLayout::check_reach`](crate::robot::CellLayout::check_reach).
     #[error("{0}")]
     OutOfReach(Box<OutOfReach>),
     /// The wrist centre lies on the J1 axis: J1 is undetermined.

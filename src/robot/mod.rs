@@ -13,7 +13,7 @@
 //! | indices (eq. 1.4–1.8, 4.10–4.12) | [`indices`] | [`indices::dexterity`], [`indices::positioning_uncertainty`] |
 //! | Bryant, FANUC WPR, KUKA ABC, quaternions | [`orientation`] | [`orientation::Bryant`], [`orientation::FanucWpr`] |
 //! | 2-axis positioner | [`positioner`] | [`Positioner::angles_for_vertical`] |
-//! | part-carried / torch-carried cells | [`cell`] | [`Cell`], [`Cell::dq_drz`] |
+//! | part-carried / torch-carried cells | [`cell`] | [`CellLayout`], [`CellLayout::dq_drz`] |
 //! | joint trajectory of a path and its report | [`trajectory`] | [`trajectory::joint_trajectory`] |
 //! | calibration of the lengths (eq. 3.17) | [`calibration`] | [`calibration::calibrate_lengths`] |
 //!
@@ -45,7 +45,7 @@ pub mod orientation;
 pub mod positioner;
 pub mod trajectory;
 
-pub use cell::{Cell, CellPoint, CellPose, PartCarriedCell, TorchCarriedCell};
+pub use cell::{CellLayout, CellPoint, CellPose, PartCarriedCell, TorchCarriedCell};
 pub use error::{OutOfReach, RobotError};
 pub use ik::{ArmSide, Configuration, Elbow, FanucConfig, Wrist};
 pub use jacobian::{Jacobian, Twist};

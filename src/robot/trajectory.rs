@@ -14,7 +14,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 use crate::math::{Point3, UnitVector3};
-use crate::robot::cell::{Cell, CellPoint};
+use crate::robot::cell::{CellLayout, CellPoint};
 use crate::robot::ik::Configuration;
 use crate::robot::indices::{dexterity_warm, SvdWarmStart};
 use crate::robot::model::Joints;
@@ -339,7 +339,7 @@ impl JointTrajectory {
 /// [`RobotError::BadPathPoint`] (non-finite position or `R_Z`). Points without
 /// solution are reported, not errors.
 pub fn joint_trajectory(
-    cell: &Cell,
+    cell: &CellLayout,
     points: &[PathPointInput],
     travel_speed_mm_s: f64,
     opts: &TrajectoryOptions,
@@ -354,7 +354,7 @@ pub fn joint_trajectory(
 /// # Errors
 /// As [`joint_trajectory`].
 pub(crate) fn joint_trajectory_without_measures(
-    cell: &Cell,
+    cell: &CellLayout,
     points: &[PathPointInput],
     travel_speed_mm_s: f64,
     opts: &TrajectoryOptions,
@@ -363,7 +363,7 @@ pub(crate) fn joint_trajectory_without_measures(
 }
 
 fn trajectory(
-    cell: &Cell,
+    cell: &CellLayout,
     points: &[PathPointInput],
     travel_speed_mm_s: f64,
     opts: &TrajectoryOptions,
@@ -395,8 +395,8 @@ fn trajectory(
     }
     let robot = cell.robot();
     let hose_limit = match cell {
-        Cell::TorchCarried(c) => Some(c.max_hose_torsion_rad),
-        Cell::PartCarried(_) => None,
+        CellLayout::TorchCarried(c) => Some(c.max_hose_torsion_rad),
+        CellLayout::PartCarried(_) => None,
     };
     let mut report = TrajectoryReport::default();
     let mut out: Vec<JointPoint> = Vec::with_capacity(points.len());
@@ -478,7 +478,7 @@ fn trajectory(
                                 });
                             }
                         }
-                        if let (Cell::TorchCarried(c), Some(qp), Some(qpp)) =
+                        if let (CellLayout::TorchCarried(c), Some(qp), Some(qpp)) =
                             (cell, pose.positioner, out[idx - 1].positioner)
                         {
                             for k in 0..2 {
@@ -496,7 +496,7 @@ fn trajectory(
                 }
             }
         }
-        if let (Cell::TorchCarried(c), Some(qp)) = (cell, pose.positioner) {
+        if let (CellLayout::TorchCarried(c), Some(qp)) = (cell, pose.positioner) {
             let tilt = c.build_tilt(&cp, &qp);
             // rounding of the chain of rotations: [`BUILD_TILT_ROUNDING_RAD`]
             if tilt > c.max_vertical_error_rad + BUILD_TILT_ROUNDING_RAD {

@@ -11,7 +11,7 @@ use waam_slicer::optimise::{
 };
 use waam_slicer::path::slice;
 use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions, ViolationKind};
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 use waam_slicer::toolaxis::tool_axes;
 
 /// Layer `layer` of `part` (its own settings, `delta_mm` if given) with its
@@ -21,7 +21,7 @@ fn kuka_torch_layer(
     part: &str,
     delta_mm: Option<f64>,
     layer: usize,
-) -> (Vec<LayerPoints>, Cell, OptimiseOptions) {
+) -> (Vec<LayerPoints>, CellLayout, OptimiseOptions) {
     let part = load_part(part);
     let mut so = part.slice_options();
     if let Some(d) = delta_mm {
@@ -63,7 +63,7 @@ fn a_layer_held_on_the_hose_bound_passes_the_trajectory_recheck() {
     let plan = optimise(&cell, &layers, &opts).unwrap();
     let l = &plan.layers[0];
     let max = match &cell {
-        Cell::TorchCarried(c) => c.max_hose_torsion_rad,
+        CellLayout::TorchCarried(c) => c.max_hose_torsion_rad,
         _ => unreachable!(),
     };
     // the bound is active on this layer

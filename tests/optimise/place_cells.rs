@@ -140,9 +140,10 @@ fn a_placed_cell_placed_again_finds_itself() {
     let replaced = place_part(&part, &again, &req).unwrap();
     assert!(replaced.placement.feasible, "{:#}", replaced.summary());
     let (a, b) = match (&placed.cell.layout, &replaced.cell.layout) {
-        (waam_slicer::robot::Cell::PartCarried(a), waam_slicer::robot::Cell::PartCarried(b)) => {
-            (a, b)
-        }
+        (
+            waam_slicer::robot::CellLayout::PartCarried(a),
+            waam_slicer::robot::CellLayout::PartCarried(b),
+        ) => (a, b),
         _ => panic!("part carried"),
     };
     let d = (a.deposition_point_mm - b.deposition_point_mm).norm();

@@ -16,7 +16,7 @@ use waam_slicer::optimise::{
     layer_points, optimise, ConfigurationChoice, LayerPlan, LayerPoints, OptimiseOptions, Plan,
 };
 use waam_slicer::path::Discretisation;
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 use waam_slicer::{slice_part_with, Control, SliceOverrides};
 
 use crate::common::{load_part, part_path, SAMPLE_CELLS, SAMPLE_PARTS};
@@ -65,7 +65,7 @@ struct Compared {
 /// Compares the two plans of `layers` in `cell`.
 fn compare(
     what: &str,
-    cell: &Cell,
+    cell: &CellLayout,
     layers: &[LayerPoints],
     speed: f64,
     samples: usize,
@@ -128,7 +128,7 @@ fn compare(
 
 /// Every point of every feasible layer of `plan` has joints inside the
 /// robot's travel, and the plan's trajectory re-check found nothing there.
-fn check_plan(what: &str, cell: &Cell, plan: &Plan) {
+fn check_plan(what: &str, cell: &CellLayout, plan: &Plan) {
     let robot = cell.robot();
     for l in plan.layers.iter().filter(|l| l.status.is_feasible()) {
         assert!(
@@ -153,7 +153,7 @@ fn check_plan(what: &str, cell: &Cell, plan: &Plan) {
     }
 }
 
-fn cell(name: &str) -> Cell {
+fn cell(name: &str) -> CellLayout {
     read_cell_file(part_path(&format!("cells/{name}")))
         .unwrap_or_else(|e| panic!("{e}"))
         .cell
@@ -165,7 +165,7 @@ fn cell(name: &str) -> Cell {
 /// layers of each part.
 #[test]
 fn subsampled_and_whole_layer_optimisation_agree_on_every_part_and_cell() {
-    let cells: Vec<(&str, Cell)> = SAMPLE_CELLS.iter().map(|c| (*c, cell(c))).collect();
+    let cells: Vec<(&str, CellLayout)> = SAMPLE_CELLS.iter().map(|c| (*c, cell(c))).collect();
     let samples = OptimiseOptions::default().subsample_points;
     let (mut layers_seen, mut certified, mut worst) = (0, 0, 0.0f64);
     for part in SAMPLE_PARTS {
@@ -204,7 +204,7 @@ fn subsampled_and_whole_layer_optimisation_agree_on_every_part_and_cell() {
 #[test]
 #[ignore = "minutes: run in release by hand"]
 fn full_size_subsampled_and_whole_layer_verdicts_agree() {
-    let cells: Vec<(&str, Cell)> = SAMPLE_CELLS.iter().map(|c| (*c, cell(c))).collect();
+    let cells: Vec<(&str, CellLayout)> = SAMPLE_CELLS.iter().map(|c| (*c, cell(c))).collect();
     let samples = OptimiseOptions::default().subsample_points;
     // `SUBSAMPLE_PARTS=quarter-torus.toml,elbow.toml`: those parts only
     let only = std::env::var("SUBSAMPLE_PARTS").ok();

@@ -4,10 +4,10 @@ use crate::common::{load_part, part_path};
 use waam_slicer::io::cell_file::read_cell_file;
 use waam_slicer::optimise::{layer_points, optimise, LayerPoints, OptimiseOptions, Plan};
 use waam_slicer::path::slice;
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 use waam_slicer::toolaxis::local_frames;
 
-pub fn cell(name: &str) -> Cell {
+pub fn cell(name: &str) -> CellLayout {
     read_cell_file(part_path(&format!("cells/{name}")))
         .unwrap_or_else(|e| panic!("{e}"))
         .cell

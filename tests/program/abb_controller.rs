@@ -64,7 +64,7 @@ use waam_slicer::program::{
     build_program, BeadSetup, EmittedFile, HomePosition, Payload, ProcessControl, Program,
     ProgramError, TravelSpeed,
 };
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 
 use crate::fixture::{cell, program, ABB_CELLS};
 use crate::golden::check_golden;
@@ -77,7 +77,7 @@ fn planned(prog: &Program) -> Vec<Point3> {
     prog.planned.clone()
 }
 
-fn check(text: &str, c: &Cell, opts: &AbbOptions, plan: &[Point3]) -> ValidationReport {
+fn check(text: &str, c: &CellLayout, opts: &AbbOptions, plan: &[Point3]) -> ValidationReport {
     let m = parse_mod(text, "HEMI.mod").unwrap_or_else(|e| panic!("{e}\n{text}"));
     validate_abb(&m, c, opts, Some(plan))
 }
@@ -177,7 +177,7 @@ fn abb_setup_golden_reads_back_home_payload_dwell_and_wait() {
     }
     // the payload's centre of gravity is written in the part (object) frame
     // of the robot-held work object: flange_from_part⁻¹ · cog
-    let Cell::PartCarried(pc) = cell(PART) else {
+    let CellLayout::PartCarried(pc) = cell(PART) else {
         unreachable!()
     };
     let want = pc.flange_from_part.inverse() * Point3::new(-41.5, 0.5, 10.25);

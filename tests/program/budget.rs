@@ -31,7 +31,7 @@ use waam_slicer::program::validate::{ProblemKind, ValidationReport};
 use waam_slicer::program::{
     write_files, EmittedFile, HomePosition, Program, ProgramError, ProgramOptions, ProgramSettings,
 };
-use waam_slicer::robot::{Cell, Vendor};
+use waam_slicer::robot::{CellLayout, Vendor};
 
 use crate::fixture::{cell, program, ABB_CELLS, FANUC_CELLS, KUKA_CELLS};
 
@@ -41,7 +41,7 @@ use crate::fixture::{cell, program, ABB_CELLS, FANUC_CELLS, KUKA_CELLS};
 fn build(
     file: &str,
 ) -> (
-    Cell,
+    CellLayout,
     Program,
     Vec<waam_slicer::math::Point3>,
     ProgramSettings,

@@ -43,7 +43,7 @@ fn every_sample_cell_writes_programs_with_home_dwell_transit_and_payload_that_ch
                 "{file}"
             );
         }
-        let part_carried = matches!(cell.layout, waam_slicer::robot::Cell::PartCarried(_));
+        let part_carried = matches!(cell.layout, waam_slicer::robot::CellLayout::PartCarried(_));
         let first = program.bead_setup[0].payload;
         assert_eq!(
             first.is_some(),

@@ -25,7 +25,7 @@ use crate::fixture::{cell, hemisphere, law, trajectory, TS_MM_S};
 /// The hemisphere's `layers` at 240 points a layer in `c`, thinned at the
 /// default tolerances (circular moves on).
 fn thinned_hemisphere(
-    c: &waam_slicer::robot::Cell,
+    c: &waam_slicer::robot::CellLayout,
     layers: std::ops::Range<usize>,
 ) -> waam_slicer::program::Program {
     let path = hemisphere(layers, 240, law(c));

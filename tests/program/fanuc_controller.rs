@@ -66,7 +66,7 @@ use waam_slicer::program::PositionMode;
 use waam_slicer::program::{
     BeadSetup, HomePosition, Payload, Program, ProgramError, ProgramOptions,
 };
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 
 use crate::fixture::{cell, part_carried, program};
 use crate::golden::check_golden;
@@ -80,7 +80,7 @@ fn home_deg(prog: &Program) -> [f64; 6] {
 /// Two layers of 8 points with a home position and a set-up before each
 /// bead: payload before both (2.5 kg at 40 mm, then 2.6 kg at 41.5 mm on
 /// the flange's z), before the second a 30 s dwell and a wait for DI[3].
-fn with_setup(cell: &Cell) -> (Program, Vec<Point3>) {
+fn with_setup(cell: &CellLayout) -> (Program, Vec<Point3>) {
     let (mut prog, path) = program(cell, 0..2, 8);
     let last = *prog.points.last().unwrap();
     prog.home = Some(HomePosition {
@@ -140,7 +140,7 @@ fn read_all(files: &[waam_slicer::program::EmittedFile]) -> Vec<TpProgram> {
         .collect()
 }
 
-fn steps_of(tps: &[TpProgram], cell: &Cell, opts: &FanucOptions) -> Vec<Step> {
+fn steps_of(tps: &[TpProgram], cell: &CellLayout, opts: &FanucOptions) -> Vec<Step> {
     let mut report = ValidationReport::default();
     let steps = fanuc_steps(tps, cell, opts, &mut report);
     assert!(report.is_ok(), "{report}");
@@ -377,7 +377,7 @@ fn edit(text: &str, needle: &str, after: usize, f: impl Fn(&str) -> String) -> (
 
 fn check_text(
     text: &str,
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &FanucOptions,
     planned: &[Point3],
 ) -> ValidationReport {

@@ -7,7 +7,7 @@ use waam_slicer::program::{build_program, Program, TravelSpeed};
 use waam_slicer::robot::trajectory::{
     joint_trajectory, JointTrajectory, PathPointInput, TrajectoryOptions,
 };
-use waam_slicer::robot::{Cell, Vendor};
+use waam_slicer::robot::{CellLayout, Vendor};
 
 /// TS 36 cm/min = 6 mm/s [thesis table 3.1].
 pub const TS_MM_S: f64 = 6.0;
@@ -22,7 +22,7 @@ pub fn hemisphere(
 }
 
 /// A cell from `parts/cells/`.
-pub fn cell(file: &str) -> Cell {
+pub fn cell(file: &str) -> CellLayout {
     let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("parts/cells")
         .join(file);
@@ -32,11 +32,11 @@ pub fn cell(file: &str) -> Cell {
         .expect("a cell")
 }
 
-pub fn part_carried() -> Cell {
+pub fn part_carried() -> CellLayout {
     cell("robowam_part_carried.toml")
 }
 
-pub fn trajectory(cell: &Cell, path: &[PathPointInput]) -> JointTrajectory {
+pub fn trajectory(cell: &CellLayout, path: &[PathPointInput]) -> JointTrajectory {
     joint_trajectory(cell, path, TS_MM_S, &TrajectoryOptions::default()).unwrap()
 }
 
@@ -46,13 +46,13 @@ pub fn trajectory(cell: &Cell, path: &[PathPointInput]) -> JointTrajectory {
 /// robot holds the part (with `−v`, J5 leaves its ±120°/±130° travel half
 /// way round), `R_Z = π` where it carries the torch (with 0 the hose
 /// torsion |J4 + J6| is 180°: their flange axes differ from FANUC's).
-pub fn law(cell: &Cell) -> fn(f64) -> f64 {
+pub fn law(cell: &CellLayout) -> fn(f64) -> f64 {
     let fanuc = cell.robot().vendor == Vendor::Fanuc;
     match (cell, fanuc) {
-        (Cell::PartCarried(_), true) => |v| -v,
-        (Cell::PartCarried(_), false) => |_| 0.0,
-        (Cell::TorchCarried(_), true) => |_| 0.0,
-        (Cell::TorchCarried(_), false) => |_| std::f64::consts::PI,
+        (CellLayout::PartCarried(_), true) => |v| -v,
+        (CellLayout::PartCarried(_), false) => |_| 0.0,
+        (CellLayout::TorchCarried(_), true) => |_| 0.0,
+        (CellLayout::TorchCarried(_), false) => |_| std::f64::consts::PI,
     }
 }
 
@@ -78,7 +78,7 @@ pub const FANUC_CELLS: [&str; 3] = [
 
 /// The program of layers `layers` (`points` per layer) in `cell`.
 pub fn program(
-    cell: &Cell,
+    cell: &CellLayout,
     layers: std::ops::Range<usize>,
     points: usize,
 ) -> (Program, Vec<PathPointInput>) {

@@ -15,19 +15,19 @@ use waam_slicer::program::kuka::{kuka_files, KukaOptions};
 use waam_slicer::program::validate::ValidationReport;
 use waam_slicer::program::PositionMode;
 use waam_slicer::program::{EmittedFile, Program, ProgramError};
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 
 use crate::fixture::{cell, part_carried, program, ABB_CELLS, KUKA_CELLS};
 
-fn kuka_part_carried() -> Cell {
+fn kuka_part_carried() -> CellLayout {
     cell("kuka_kr16_2_part_carried.toml")
 }
 
-fn abb_part_carried() -> Cell {
+fn abb_part_carried() -> CellLayout {
     cell("abb_irb2600_part_carried.toml")
 }
 
-fn hemi(cell: &Cell) -> (Program, Vec<Point3>) {
+fn hemi(cell: &CellLayout) -> (Program, Vec<Point3>) {
     let (prog, _) = program(cell, 0..4, 24);
     let planned = prog.planned.clone();
     (prog, planned)
@@ -55,7 +55,7 @@ fn kuka_check(
     files: &[EmittedFile],
     src: &str,
     dat: &str,
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &KukaOptions,
     planned: &[Point3],
 ) -> ValidationReport {
@@ -63,7 +63,7 @@ fn kuka_check(
     validate_kuka(&p, cell, opts, Some(planned))
 }
 
-fn abb_check(text: &str, cell: &Cell, planned: &[Point3]) -> ValidationReport {
+fn abb_check(text: &str, cell: &CellLayout, planned: &[Point3]) -> ValidationReport {
     let m = parse_mod(text, "HEMI.mod").unwrap_or_else(|e| panic!("{e}"));
     validate_abb(&m, cell, &AbbOptions::default(), Some(planned))
 }

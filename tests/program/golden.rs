@@ -257,12 +257,12 @@ fn abb_golden() {
 /// gives pure ASCII files in every format.
 #[test]
 fn every_emitted_file_is_ascii_whatever_the_cell_name() {
-    use waam_slicer::robot::Cell;
+    use waam_slicer::robot::CellLayout;
     let rename = |file: &str| {
         let mut c = cell(file);
         match &mut c {
-            Cell::PartCarried(p) => p.name = "cell §3.3 · 45° – test".into(),
-            Cell::TorchCarried(t) => t.name = "cell §3.3 · 45° – test".into(),
+            CellLayout::PartCarried(p) => p.name = "cell §3.3 · 45° – test".into(),
+            CellLayout::TorchCarried(t) => t.name = "cell §3.3 · 45° – test".into(),
         }
         program(&c, 0..1, 8).0
     };

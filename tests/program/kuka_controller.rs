@@ -67,7 +67,7 @@ use waam_slicer::program::validate::{ProblemKind, ValidationReport};
 use waam_slicer::program::{
     BeadSetup, EmittedFile, HomePosition, Payload, ProcessControl, Program,
 };
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 
 use crate::fixture::{cell, program};
 use crate::golden::check_golden;
@@ -75,7 +75,7 @@ use crate::golden::check_golden;
 const TORCH: &str = "kuka_kr16_2_torch_carried.toml";
 const PART: &str = "kuka_kr16_2_part_carried.toml";
 
-fn two_layers(file: &str) -> (Program, Cell) {
+fn two_layers(file: &str) -> (Program, CellLayout) {
     let c = cell(file);
     (program(&c, 0..2, 8).0, c)
 }
@@ -84,7 +84,7 @@ fn check(
     files: &[EmittedFile],
     src: &str,
     dat: &str,
-    c: &Cell,
+    c: &CellLayout,
     opts: &KukaOptions,
 ) -> ValidationReport {
     let p = parse_krl(src, &files[0].name, dat, &files[1].name).unwrap_or_else(|e| panic!("{e}"));

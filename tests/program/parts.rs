@@ -19,7 +19,7 @@ use waam_slicer::program::kuka::KukaOptions;
 use waam_slicer::program::PositionMode;
 use waam_slicer::program::{build_program, Program, TravelSpeed};
 use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions};
-use waam_slicer::robot::{Cell, Vendor};
+use waam_slicer::robot::{CellLayout, Vendor};
 use waam_slicer::toolaxis::local_frames;
 
 use crate::fixture::cell;
@@ -40,7 +40,7 @@ fn layers_planned(part: &str, cell: &str) -> usize {
 }
 
 /// The program of `part` in `cell`, or why there is none.
-fn plan_program(part: &str, cell: &Cell, layers_max: usize) -> Result<Program, String> {
+fn plan_program(part: &str, cell: &CellLayout, layers_max: usize) -> Result<Program, String> {
     let p = load_part(part);
     let mut so = p.slice_options();
     so.delta_mm = 5.0;
@@ -69,7 +69,7 @@ fn plan_program(part: &str, cell: &Cell, layers_max: usize) -> Result<Program, S
 /// Emits `prog` with `C`'s emitter, reads it back with `C`'s reader and
 /// validates it against `cell` and the planned points: no problem, every
 /// motion and bead found. The one round trip of every vendor.
-fn round_trip<C: Controller>(what: &str, prog: &Program, cell: &Cell, opts: &C::Options) {
+fn round_trip<C: Controller>(what: &str, prog: &Program, cell: &CellLayout, opts: &C::Options) {
     let planned: Vec<Point3> = prog.planned.clone();
     let files = C::emit(prog, opts).unwrap_or_else(|e| panic!("{what}: {e}"));
     let read = C::read(&files).unwrap_or_else(|e| panic!("{what}: {e}"));
@@ -85,7 +85,7 @@ fn round_trip<C: Controller>(what: &str, prog: &Program, cell: &Cell, opts: &C::
 /// Emits, reads back and validates `prog` in the format of the cell
 /// robot's vendor (FANUC joint and Cartesian, KUKA joint and Cartesian, or
 /// ABB); panics naming the first problem.
-fn check_all_formats(what: &str, prog: &Program, cell: &Cell) {
+fn check_all_formats(what: &str, prog: &Program, cell: &CellLayout) {
     for positions in [PositionMode::Joint, PositionMode::Cartesian] {
         match cell.robot().vendor {
             Vendor::Fanuc => {

@@ -20,7 +20,7 @@ use waam_slicer::program::MoveKind;
 use waam_slicer::program::{
     build_program_with, ArcFlag, ProgramError, ProgramOptions, TravelSpeed,
 };
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 use waam_slicer::toolaxis::collision::Torch;
 
 use crate::fixture::{
@@ -144,7 +144,7 @@ fn a_home_outside_the_travel_is_refused_naming_the_field_and_joint() {
 #[test]
 fn payloads_are_the_substrate_plus_the_beads_before_in_the_flange_frame() {
     let cell = part_carried();
-    let Cell::PartCarried(pc) = &cell else {
+    let CellLayout::PartCarried(pc) = &cell else {
         unreachable!()
     };
     let (mut prog, _) = program(&cell, 0..5, 12);
@@ -287,7 +287,7 @@ fn motion(line: usize, q: [f64; 6], kind: MoveKind) -> Step {
 
 /// The steps of a two-bead program in the part-carried cell as a reader
 /// would decode them, with `before_second` between the beads.
-fn two_beads(home: Option<[f64; 6]>, before_second: Vec<Step>) -> (Vec<Step>, Cell) {
+fn two_beads(home: Option<[f64; 6]>, before_second: Vec<Step>) -> (Vec<Step>, CellLayout) {
     let cell = part_carried();
     let (prog, _) = program(&cell, 0..2, 12);
     let mut steps = Vec::new();

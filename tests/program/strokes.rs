@@ -13,7 +13,7 @@
 use waam_slicer::io::cell_file::parse_cell_file;
 use waam_slicer::program::contract::{emit, Controller, Fanuc};
 use waam_slicer::program::{Program, ProgramSettings};
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 
 use crate::fixture::{cell, program};
 
@@ -35,7 +35,7 @@ fn the_plan_winds_the_turn_and_the_program_unwinds_it_between_beads() {
     ] {
         let c = cell(file);
         let (prog, path) = program(&c, 0..4, 24);
-        let Cell::TorchCarried(tc) = &c else {
+        let CellLayout::TorchCarried(tc) = &c else {
             panic!("{file}: a torch-carried cell")
         };
         let stroke = tc
@@ -110,7 +110,7 @@ fn a_bead_wider_than_the_stroke_is_refused_naming_the_layer() {
     // turning 360 degrees cannot be written (the cell file refuses such a
     // stroke; built here to reach the program stage's own refusal)
     let mut c = cell("robowam_torch_carried.toml");
-    if let Cell::TorchCarried(tc) = &mut c {
+    if let CellLayout::TorchCarried(tc) = &mut c {
         tc.positioner.turn_stroke = Some(waam_slicer::robot::JointLimit {
             lower_rad: (-100.0f64).to_radians(),
             upper_rad: 100.0f64.to_radians(),

@@ -15,7 +15,7 @@ use crate::fixture::{cell, hemisphere, law, trajectory, TS_MM_S};
 /// apart on the 45 mm sphere) in `c`, thinned at the default tolerances,
 /// and the planned path points.
 fn thinned_hemisphere(
-    c: &waam_slicer::robot::Cell,
+    c: &waam_slicer::robot::CellLayout,
     layers: std::ops::Range<usize>,
 ) -> (
     waam_slicer::program::Program,

@@ -19,7 +19,7 @@ use waam_slicer::program::abb::{abb_files, AbbOptions};
 use waam_slicer::program::fanuc::{fanuc_files, FanucOptions};
 use waam_slicer::program::kuka::{kuka_files, KukaOptions};
 use waam_slicer::program::Program;
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 
 use crate::fixture::{cell, program};
 
@@ -55,7 +55,7 @@ fn rz_ry_rx(z_deg: f64, y_deg: f64, x_deg: f64) -> Rotation3<f64> {
 /// Asserts that the tool `(t, r)` (flange frame, mm) puts the wire down into
 /// the part at every bead point of `prog`, with the TCP at the planner's.
 fn wire_points_into_the_part(vendor: &str, prog: &Program, t: Vector3<f64>, r: Rotation3<f64>) {
-    let Cell::TorchCarried(c) = &prog.cell else {
+    let CellLayout::TorchCarried(c) = &prog.cell else {
         panic!("a torch-carried cell")
     };
     // the planner's TCP (z into the torch) and the program's share the origin

@@ -9,7 +9,7 @@ use waam_slicer::program::fanuc::{
 use waam_slicer::program::validate::{ProblemKind, ValidationReport};
 use waam_slicer::program::PositionMode;
 use waam_slicer::program::{build_program, ProgramError, TravelSpeed};
-use waam_slicer::robot::Cell;
+use waam_slicer::robot::CellLayout;
 
 use crate::fixture::{cell, hemisphere, part_carried, program, trajectory, TS_MM_S};
 
@@ -19,7 +19,7 @@ const CELLS: [&str; 3] = [
     "robowam_torch_carried.toml",
 ];
 
-fn emitted(cell: &Cell, opts: &FanucOptions) -> (String, Vec<waam_slicer::math::Point3>) {
+fn emitted(cell: &CellLayout, opts: &FanucOptions) -> (String, Vec<waam_slicer::math::Point3>) {
     let (prog, path) = program(cell, 0..4, 24);
     let files = fanuc_files(&prog, opts).unwrap();
     assert_eq!(files.len(), 1);
@@ -31,7 +31,7 @@ fn emitted(cell: &Cell, opts: &FanucOptions) -> (String, Vec<waam_slicer::math::
 
 fn check(
     text: &str,
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &FanucOptions,
     planned: &[waam_slicer::math::Point3],
 ) -> ValidationReport {

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use waam_slicer::io::cell_file::{parse_cell_file, read_cell_file, CellFileError};
 use waam_slicer::math::Point3;
-use waam_slicer::robot::{Cell, Configuration, RobotModel, Vendor};
+use waam_slicer::robot::{CellLayout, Configuration, RobotModel, Vendor};
 
 fn cells_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("parts/cells")
@@ -28,7 +28,7 @@ fn every_shipped_cell_file_reads_and_validates() {
 #[test]
 fn robowam_part_carried_files_match_the_thesis() {
     let f = read_cell_file(cells_dir().join("robowam_part_carried.toml")).unwrap();
-    let Some(Cell::PartCarried(c)) = f.cell else {
+    let Some(CellLayout::PartCarried(c)) = f.cell else {
         panic!("part-carried cell expected")
     };
     assert_eq!(
@@ -43,7 +43,7 @@ fn robowam_part_carried_files_match_the_thesis() {
         RobotModel::arcmate_120ic_nominal().geometry
     );
     let f = read_cell_file(cells_dir().join("robowam_part_carried_second_position.toml")).unwrap();
-    let Some(Cell::PartCarried(c)) = f.cell else {
+    let Some(CellLayout::PartCarried(c)) = f.cell else {
         panic!()
     };
     assert_eq!(
@@ -55,7 +55,7 @@ fn robowam_part_carried_files_match_the_thesis() {
 #[test]
 fn robowam_torch_carried_file_matches_the_thesis() {
     let f = read_cell_file(cells_dir().join("robowam_torch_carried.toml")).unwrap();
-    let Some(Cell::TorchCarried(c)) = f.cell else {
+    let Some(CellLayout::TorchCarried(c)) = f.cell else {
         panic!("torch-carried cell expected")
     };
     assert_eq!(c.positioner.tilt_to_table_mm, 149.631);

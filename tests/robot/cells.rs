@@ -6,14 +6,14 @@ use waam_slicer::robot::cell::{part_carried_angles, torch_carried_angles};
 use waam_slicer::robot::orientation::FanucPose;
 use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
 use waam_slicer::robot::{
-    Cell, CellPoint, Configuration, Positioner, RobotModel, TorchCarriedCell,
+    CellLayout, CellPoint, Configuration, Positioner, RobotModel, TorchCarriedCell,
 };
 
 use crate::common::{joint_error, Rng};
 use crate::hemisphere::{robowam_part_carried, thesis_configuration};
 
-pub fn robowam_torch_carried() -> Cell {
-    Cell::TorchCarried(TorchCarriedCell {
+pub fn robowam_torch_carried() -> CellLayout {
+    CellLayout::TorchCarried(TorchCarriedCell {
         name: "ROBOWAM torch carried".into(),
         robot: RobotModel::arcmate_120ic_nominal(),
         positioner: Positioner::robowam_identified(),
@@ -62,7 +62,7 @@ fn torch_carried_angles_put_the_torch_z_on_the_tool_axis() {
 
 #[test]
 fn part_carried_pose_puts_m_at_d_r() {
-    let Cell::PartCarried(cell) = robowam_part_carried(thesis_configuration()) else {
+    let CellLayout::PartCarried(cell) = robowam_part_carried(thesis_configuration()) else {
         unreachable!()
     };
     let mut rng = Rng::new(33);
@@ -82,7 +82,7 @@ fn part_carried_pose_puts_m_at_d_r() {
 #[test]
 fn torch_carried_pose_puts_the_torch_on_the_point_with_b_vertical() {
     let cell = robowam_torch_carried();
-    let Cell::TorchCarried(tc) = &cell else {
+    let CellLayout::TorchCarried(tc) = &cell else {
         unreachable!()
     };
     let mut rng = Rng::new(34);
@@ -114,7 +114,7 @@ fn torch_carried_pose_puts_the_torch_on_the_point_with_b_vertical() {
 }
 
 /// dq/dR_Z = J⁻¹ · twist against central differences of the IK.
-fn check_dq_drz(cell: &Cell, points: &[(CellPoint, f64)]) {
+fn check_dq_drz(cell: &CellLayout, points: &[(CellPoint, f64)]) {
     let h = 1e-6;
     let mut checked = 0;
     for (p, r_z) in points {
@@ -193,9 +193,9 @@ fn dq_drz_matches_finite_differences_torch_carried() {
 }
 
 /// The trajectory's `dq/dR_Z` (from its own Jacobian, the singularity test
-/// spared where its dexterity bounds the test's) against [`Cell::dq_drz`]
+/// spared where its dexterity bounds the test's) against [`CellLayout::dq_drz`]
 /// at the same joints and pose, for several dexterity length scales.
-fn check_trajectory_dq_drz(cell: &Cell, points: &[PathPointInput]) {
+fn check_trajectory_dq_drz(cell: &CellLayout, points: &[PathPointInput]) {
     // 1e-9 mm: the bound is too weak, the singularity test runs every time
     for scale in [1.0, 1000.0, 1e5, 1e-9] {
         let opts = TrajectoryOptions {
@@ -338,7 +338,7 @@ fn torch_carried_circle_uncertainty_matches_thesis() {
     use waam_slicer::robot::indices::{positioning_uncertainty, UncertaintyFormula};
     use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
     let cell = robowam_torch_carried();
-    let Cell::TorchCarried(tc) = &cell else {
+    let CellLayout::TorchCarried(tc) = &cell else {
         unreachable!()
     };
     let path: Vec<_> = (0..385)

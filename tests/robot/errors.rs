@@ -2,7 +2,7 @@
 
 use waam_slicer::math::{Point3, UnitVector3, Vector3};
 use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
-use waam_slicer::robot::{Cell, CellPoint, Positioner, RobotError};
+use waam_slicer::robot::{CellLayout, CellPoint, Positioner, RobotError};
 
 use crate::hemisphere::{robowam_part_carried, thesis_configuration};
 
@@ -80,7 +80,7 @@ fn degenerate_tool_axis_is_reported() {
 #[test]
 fn singular_jacobian_is_reported_by_dq_drz() {
     let cell = robowam_part_carried(thesis_configuration());
-    let Cell::PartCarried(pc) = &cell else {
+    let CellLayout::PartCarried(pc) = &cell else {
         unreachable!()
     };
     let q = [0.2, 0.1, -0.3, 0.4, 0.0, 0.5]; // J5 = 0

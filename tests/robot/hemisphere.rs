@@ -7,7 +7,7 @@ use waam_slicer::math::Point3;
 use waam_slicer::robot::trajectory::{
     joint_trajectory, PathPointInput, TrajectoryOptions, ViolationKind,
 };
-use waam_slicer::robot::{Cell, Configuration, PartCarriedCell, RobotModel};
+use waam_slicer::robot::{CellLayout, Configuration, PartCarriedCell, RobotModel};
 
 /// Radius R_s (mm), meridian arc spacing Delta (mm), points per layer.
 pub const R_S: f64 = 45.0;
@@ -23,8 +23,8 @@ pub fn hemisphere(r_z: impl Fn(usize, f64) -> f64) -> Vec<PathPointInput> {
 }
 
 /// ROBOWAM part-carried cell at D_R of §3.3, J5 ±135° (table A.1 note 1).
-pub fn robowam_part_carried(config: Configuration) -> Cell {
-    Cell::PartCarried(PartCarriedCell {
+pub fn robowam_part_carried(config: Configuration) -> CellLayout {
+    CellLayout::PartCarried(PartCarriedCell {
         name: "ROBOWAM part carried".into(),
         robot: RobotModel::arcmate_120ic_nominal().with_j5_travel_deg(135.0),
         deposition_point_mm: Point3::new(1045.747, -630.155, 653.167),

@@ -247,7 +247,7 @@ fn unreachable_cell_names_the_layer_point_and_reach() {
     .unwrap()
     .cell
     .unwrap();
-    if let waam_slicer::robot::Cell::PartCarried(c) = &mut cell {
+    if let waam_slicer::robot::CellLayout::PartCarried(c) = &mut cell {
         c.deposition_point_mm = waam_slicer::math::Point3::new(6000.0, 0.0, 653.167);
     }
     let part = parse_part(

@@ -4,7 +4,7 @@
 //! optimised; every sample cell still reads.
 
 use waam_slicer::io::cell_file::{parse_cell_file, read_cell_file, CellFileError};
-use waam_slicer::robot::{Cell, OutOfReach, RobotError};
+use waam_slicer::robot::{CellLayout, OutOfReach, RobotError};
 
 use crate::common::part_path;
 
@@ -208,7 +208,8 @@ fn huge_mounts_are_refused_naming_the_field() {
 #[test]
 fn reachable_deposition_points_are_never_refused() {
     let text = sample("robowam_part_carried.toml");
-    let Some(Cell::PartCarried(base)) = parse_cell_file(&text, "robowam.toml").unwrap().cell else {
+    let Some(CellLayout::PartCarried(base)) = parse_cell_file(&text, "robowam.toml").unwrap().cell
+    else {
         panic!("not a part-carried cell")
     };
     let mut state = 12345_u64;

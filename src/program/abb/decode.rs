@@ -19,7 +19,7 @@ use crate::program::abb::read::{RapidFrame, RapidModule, ToolArg};
 use crate::program::abb::{AbbOptions, PREDEFINED_ZONES_MM};
 use crate::program::MoveKind;
 use crate::program::ProcessControl;
-use crate::robot::{Cell, Configuration};
+use crate::robot::{CellLayout, Configuration};
 
 use crate::program::validate::ProblemKind;
 use crate::program::validate::{arm_of, wrist_of_j5};
@@ -62,7 +62,11 @@ impl FileFrames {
     /// `tooldata`/`wobjdata` as a [`crate::program::frames::ToolFrames`] at
     /// positioner joints `qp` (`None` when a coordinated work object has
     /// no positioner joints or no positioner).
-    fn at(&self, cell: &Cell, qp: Option<[f64; 2]>) -> Option<crate::program::abb::AbbFrames> {
+    fn at(
+        &self,
+        cell: &CellLayout,
+        qp: Option<[f64; 2]>,
+    ) -> Option<crate::program::abb::AbbFrames> {
         use crate::program::abb::AbbFrames;
         Some(match *self {
             FileFrames::Held {
@@ -76,7 +80,7 @@ impl FileFrames {
                 flange_from_tool,
                 oframe,
             } => {
-                let Cell::TorchCarried(c) = cell else {
+                let CellLayout::TorchCarried(c) = cell else {
                     return None;
                 };
                 AbbFrames::Held {
@@ -119,7 +123,7 @@ impl FileFrames {
 /// a coordination that differs from the options.
 fn file_frames(
     module: &RapidModule,
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &AbbOptions,
     report: &mut ValidationReport,
 ) -> Option<FileFrames> {
@@ -140,7 +144,7 @@ fn file_frames(
             base_from_work: w.pose,
         },
         (true, false, false) => {
-            if !matches!(cell, Cell::TorchCarried(_)) {
+            if !matches!(cell, CellLayout::TorchCarried(_)) {
                 push(
                     report,
                     ProblemKind::Frame,
@@ -494,7 +498,7 @@ fn check_motion_args(
 /// is refused: the report holds that one problem (line 1 of the module).
 pub fn validate_abb(
     module: &RapidModule,
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &AbbOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
@@ -509,7 +513,7 @@ pub fn validate_abb(
 /// `report`). The cell's robot must be an ABB arm.
 pub(crate) fn abb_steps(
     module: &RapidModule,
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &AbbOptions,
     report: &mut ValidationReport,
 ) -> Option<Vec<Step>> {
@@ -543,7 +547,7 @@ pub(crate) fn abb_steps(
     let mut steps = Vec::new();
     let mut conf_l = false;
     let mut prev_positioner: Option<[f64; 2]> = None;
-    let mut unit = UnitState::new(matches!(cell, Cell::TorchCarried(_)));
+    let mut unit = UnitState::new(matches!(cell, CellLayout::TorchCarried(_)));
     for ins in &module.instructions {
         let line = ins.line;
         if matches!(ins.op, RapidOp::MoveAbsJ { .. } | RapidOp::Linear { .. }) {
@@ -729,7 +733,7 @@ pub(crate) fn abb_steps(
                         mm_s: v,
                         flange_from_tcp: *flange_from_tool,
                         extax_fraction: match cell {
-                            Cell::TorchCarried(c) => [0, 1].map(|n| {
+                            CellLayout::TorchCarried(c) => [0, 1].map(|n| {
                                 let max = c.positioner.max_speed_rad_s[n];
                                 if max.is_finite() && max > 0.0 {
                                     (v_reax_deg_s.to_radians() / max).min(1.0)
@@ -737,7 +741,7 @@ pub(crate) fn abb_steps(
                                     1.0
                                 }
                             }),
-                            Cell::PartCarried(_) => [1.0; 2],
+                            CellLayout::PartCarried(_) => [1.0; 2],
                         },
                     },
                     // a stationary tool or a coordinated work object: v_tcp

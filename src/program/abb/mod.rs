@@ -158,7 +158,7 @@ use crate::program::{
     ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::abb_quaternion;
-use crate::robot::{Cell, Joints, RobotModel, Vendor};
+use crate::robot::{CellLayout, Joints, RobotModel, Vendor};
 
 /// The emitter's name in [`ProgramError::VendorMismatch`].
 pub const EMITTER: &str = "ABB RAPID";
@@ -509,7 +509,7 @@ pub fn is_rapid_name(s: &str) -> bool {
 
 impl AbbOptions {
     /// The frames written for `cell`.
-    pub fn frames(&self, cell: &Cell) -> AbbFrames {
+    pub fn frames(&self, cell: &CellLayout) -> AbbFrames {
         ToolFrames::new(
             cell,
             self.stationary(cell),
@@ -519,16 +519,18 @@ impl AbbOptions {
         )
     }
 
-    fn stationary(&self, cell: &Cell) -> bool {
+    fn stationary(&self, cell: &CellLayout) -> bool {
         self.stationary_tool
-            .unwrap_or(matches!(cell, Cell::PartCarried(_)))
+            .unwrap_or(matches!(cell, CellLayout::PartCarried(_)))
     }
 
     /// `true` when the work object is coordinated with the positioner's
     /// mechanical unit: `[program] coordinated`, a torch-carried cell and a
     /// robot-held tool.
-    pub fn coordinated(&self, cell: &Cell) -> bool {
-        self.common.coordinated && matches!(cell, Cell::TorchCarried(_)) && !self.stationary(cell)
+    pub fn coordinated(&self, cell: &CellLayout) -> bool {
+        self.common.coordinated
+            && matches!(cell, CellLayout::TorchCarried(_))
+            && !self.stationary(cell)
     }
 
     /// Checks every field.
@@ -782,7 +784,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     let slots = opts.positioner_slots().map_err(std::io::Error::other)?;
     // the coordinated work object: the part on the positioner's table
     let coordinated = match (&program.cell, opts.coordinated(&program.cell)) {
-        (Cell::TorchCarried(c), true) => Some(c),
+        (CellLayout::TorchCarried(c), true) => Some(c),
         _ => None,
     };
     writeln!(w, "MODULE {}", module_name(&program.name))?;
@@ -958,7 +960,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
     }
     writeln!(w, "  PROC {}()", program.name)?;
     // the positioner's unit moves only while active
-    let unit = matches!(program.cell, Cell::TorchCarried(_)).then_some(opts.ufmec.as_str());
+    let unit = matches!(program.cell, CellLayout::TorchCarried(_)).then_some(opts.ufmec.as_str());
     if let Some(u) = unit {
         writeln!(
             w,
@@ -1309,7 +1311,7 @@ impl Controller for Abb {
 
     fn steps(
         read: &read::RapidModule,
-        cell: &Cell,
+        cell: &CellLayout,
         opts: &AbbOptions,
         report: &mut ValidationReport,
     ) -> Option<Vec<Step>> {

@@ -32,7 +32,7 @@ use crate::program::validate::{
 };
 use crate::program::ProcessControl;
 use crate::robot::orientation::FanucPose;
-use crate::robot::{Cell, Configuration};
+use crate::robot::{CellLayout, Configuration};
 
 /// Largest difference between a stated frame and the options' frame:
 /// position (mm) and rotation (deg); the remarks print 3 decimals.
@@ -45,7 +45,7 @@ pub const FRAME_TOLERANCE: f64 = 0.005;
 /// [`validate_fanuc`]).
 pub fn fanuc_steps(
     programs: &[TpProgram],
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &FanucOptions,
     report: &mut ValidationReport,
 ) -> Vec<Step> {
@@ -71,7 +71,7 @@ type StatedFrame = ([Option<f64>; 6], usize);
 /// What the decoder carries through the calls.
 struct Decoder<'a> {
     programs: &'a [TpProgram],
-    cell: &'a Cell,
+    cell: &'a CellLayout,
     opts: &'a FanucOptions,
     frames: FanucFrames,
     /// Values assigned to each payload schedule so far (kg, cm; with the
@@ -532,7 +532,7 @@ fn xyzwpr(v: &[f64; 6]) -> String {
 /// message, line 1 of the main program).
 pub fn validate_fanuc(
     programs: &[TpProgram],
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &FanucOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {

@@ -134,7 +134,7 @@ use crate::program::{
     segment_length_mm, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::FanucPose;
-use crate::robot::{Cell, Joints, Vendor};
+use crate::robot::{CellLayout, Joints, Vendor};
 
 /// The emitter's name in [`ProgramError::VendorMismatch`].
 pub const EMITTER: &str = "FANUC TP";
@@ -364,9 +364,11 @@ impl FanucOptions {
     /// `cell` (see [`FanucOptions::segment_time_based`] for single
     /// segments): with [`MotionTiming::Auto`], the part-carried cell
     /// without remote TCP.
-    pub fn time_based(&self, cell: &Cell) -> bool {
+    pub fn time_based(&self, cell: &CellLayout) -> bool {
         match self.timing {
-            MotionTiming::Auto => matches!(cell, Cell::PartCarried(_)) && !self.remote_tcp(cell),
+            MotionTiming::Auto => {
+                matches!(cell, CellLayout::PartCarried(_)) && !self.remote_tcp(cell)
+            }
             MotionTiming::TcpSpeed => false,
             MotionTiming::Time => true,
         }
@@ -386,19 +388,19 @@ impl FanucOptions {
 
     /// `true` when linear moves carry the `RTCP` motion option in `cell`:
     /// the part-carried cell with `common.remote_tcp`.
-    pub fn remote_tcp(&self, cell: &Cell) -> bool {
-        matches!(cell, Cell::PartCarried(_)) && self.common.remote_tcp
+    pub fn remote_tcp(&self, cell: &CellLayout) -> bool {
+        matches!(cell, CellLayout::PartCarried(_)) && self.common.remote_tcp
     }
 
     /// `true` when linear moves carry the `COORD` motion option in `cell`:
     /// the torch-carried cell (positioner = group 2, the leader) with
     /// `common.coordinated`.
-    pub fn coordinated(&self, cell: &Cell) -> bool {
-        matches!(cell, Cell::TorchCarried(_)) && self.common.coordinated
+    pub fn coordinated(&self, cell: &CellLayout) -> bool {
+        matches!(cell, CellLayout::TorchCarried(_)) && self.common.coordinated
     }
 
     /// The tool frame used for Cartesian positions in `cell` (mm).
-    pub fn tool_in(&self, cell: &Cell) -> Isometry3 {
+    pub fn tool_in(&self, cell: &CellLayout) -> Isometry3 {
         held_tool(cell, self.flange_from_tool)
     }
 
@@ -406,9 +408,9 @@ impl FanucOptions {
     /// (module doc, "Frames"): with remote TCP the remote TCP frame at the
     /// fixed torch, else `user_frame`/`base_from_user`; the tool
     /// [`FanucOptions::tool_in`].
-    pub fn frames(&self, cell: &Cell) -> FanucFrames {
+    pub fn frames(&self, cell: &CellLayout) -> FanucFrames {
         let (user_frame, base_from_user) = match cell {
-            Cell::PartCarried(c) if self.remote_tcp(cell) => (
+            CellLayout::PartCarried(c) if self.remote_tcp(cell) => (
                 self.remote_tcp_frame,
                 self.base_from_torch
                     .unwrap_or_else(|| fixed_torch_at(&c.deposition_point_mm)),
@@ -1087,7 +1089,7 @@ pub fn joint_speed_ratio(program: &Program, i: usize, v: f64) -> f64 {
     for j in 0..6 {
         ratio = ratio.max((p.joints[j] - prev.joints[j]).abs() / dt / robot.max_speed_rad_s[j]);
     }
-    if let (Cell::TorchCarried(c), Some(a), Some(b)) =
+    if let (CellLayout::TorchCarried(c), Some(a), Some(b)) =
         (&program.cell, p.positioner, prev.positioner)
     {
         for n in 0..2 {
@@ -1110,9 +1112,9 @@ fn frame_header(program: &Program, opts: &FanucOptions, frames: &FanucFrames) ->
         "WORK"
     };
     let what_tool = match &program.cell {
-        Cell::TorchCarried(_) => "TORCH TCP",
-        Cell::PartCarried(_) if is_identity(&frames.flange_from_tool) => "FLANGE",
-        Cell::PartCarried(_) => "PART ON FLANGE",
+        CellLayout::TorchCarried(_) => "TORCH TCP",
+        CellLayout::PartCarried(_) if is_identity(&frames.flange_from_tool) => "FLANGE",
+        CellLayout::PartCarried(_) => "PART ON FLANGE",
     };
     let mut remarks = vec![
         "FRAMES: X,Y,Z MM W,P,R DEG".to_string(),
@@ -1438,7 +1440,7 @@ impl Controller for Fanuc {
 
     fn steps(
         read: &Vec<TpProgram>,
-        cell: &Cell,
+        cell: &CellLayout,
         opts: &FanucOptions,
         report: &mut ValidationReport,
     ) -> Option<Vec<Step>> {

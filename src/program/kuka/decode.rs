@@ -18,7 +18,7 @@ use crate::program::kuka::read::{
 use crate::program::kuka::{ArcLoss, KukaOptions, StatedBase, ARC_LOST_HANDLER};
 use crate::program::kuka::{CIRC_CIRC_TYPE, CIRC_ORI_TYPE};
 use crate::program::MoveKind;
-use crate::robot::{Cell, Configuration, Joints};
+use crate::robot::{CellLayout, Configuration, Joints};
 
 use crate::program::validate::ProblemKind;
 use crate::program::validate::{arm_of, wrist_of_j5};
@@ -35,7 +35,7 @@ use crate::program::validate::{decode_pose, push, Motion, MotionSpeed, Step, Val
 /// arm is refused: the report holds that one problem (line 1 of the `.src`).
 pub fn validate_kuka(
     program: &KrlProgram,
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &KukaOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
@@ -50,7 +50,7 @@ pub fn validate_kuka(
 /// a KUKA arm.
 pub(crate) fn kuka_steps(
     program: &KrlProgram,
-    cell: &Cell,
+    cell: &CellLayout,
     opts: &KukaOptions,
     report_out: &mut ValidationReport,
 ) -> Vec<Step> {
@@ -593,8 +593,8 @@ pub(crate) fn kuka_steps(
                     ),
                 );
             }
-            let mut positioner =
-                matches!(cell, Cell::TorchCarried(_)).then(|| pos.external.map(f64::to_radians));
+            let mut positioner = matches!(cell, CellLayout::TorchCarried(_))
+                .then(|| pos.external.map(f64::to_radians));
             if let (true, Some(qp)) = (modulo, positioner.as_mut()) {
                 if qp[1].abs() > std::f64::consts::PI + 1e-9 {
                     push(
@@ -1353,7 +1353,7 @@ mod tests {
 
     /// Two layers of the hemisphere (R_s 45 mm, Delta 5 mm, 8 points) in
     /// the KUKA part-carried example cell, `R_Z = 0`.
-    fn program() -> (crate::program::Program, Cell) {
+    fn program() -> (crate::program::Program, CellLayout) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("parts/cells/kuka_kr16_2_part_carried.toml");
         let cell = crate::io::cell_file::read_cell_file(&path)

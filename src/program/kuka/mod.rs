@@ -153,7 +153,7 @@ use crate::program::{
     segment_length_mm, ArcFlag, BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::KukaAbc;
-use crate::robot::{ArmSide, Cell, Elbow, Joints, RobotModel, Vendor};
+use crate::robot::{ArmSide, CellLayout, Elbow, Joints, RobotModel, Vendor};
 
 /// The emitter's name in [`ProgramError::VendorMismatch`].
 pub const EMITTER: &str = "KUKA KRL";
@@ -280,15 +280,15 @@ impl Default for KukaOptions {
 
 impl KukaOptions {
     /// `true` when `$IPO_MODE = #TCP` is written for `cell`.
-    pub fn uses_external_tcp(&self, cell: &Cell) -> bool {
+    pub fn uses_external_tcp(&self, cell: &CellLayout) -> bool {
         self.external_tcp
-            .unwrap_or(matches!(cell, Cell::PartCarried(_)))
+            .unwrap_or(matches!(cell, CellLayout::PartCarried(_)))
     }
 
     /// `($BASE, $TOOL)` in `cell` (robot base frame, flange frame; mm): the
     /// frames Cartesian positions are written in, `$BASE · pos = flange ·
     /// $TOOL`.
-    pub fn frames(&self, cell: &Cell) -> (Isometry3, Isometry3) {
+    pub fn frames(&self, cell: &CellLayout) -> (Isometry3, Isometry3) {
         match ToolFrames::new(
             cell,
             self.uses_external_tcp(cell),
@@ -310,16 +310,16 @@ impl KukaOptions {
     /// `true` when the positioner is math-coupled to the base (`$BASE =
     /// EK(...)`): a torch-carried cell outside the fixed-tool mode with
     /// [`crate::program::ProgramOptions::coordinated`] on (module doc).
-    pub fn coordinated(&self, cell: &Cell) -> bool {
+    pub fn coordinated(&self, cell: &CellLayout) -> bool {
         self.common.coordinated
-            && matches!(cell, Cell::TorchCarried(_))
+            && matches!(cell, CellLayout::TorchCarried(_))
             && !self.uses_external_tcp(cell)
     }
 
     /// The `$BASE` a program states for `cell` (module doc, "Frames").
-    pub fn stated_base(&self, cell: &Cell) -> StatedBase {
+    pub fn stated_base(&self, cell: &CellLayout) -> StatedBase {
         match cell {
-            Cell::TorchCarried(c) if self.coordinated(cell) => StatedBase::Coupled {
+            CellLayout::TorchCarried(c) if self.coordinated(cell) => StatedBase::Coupled {
                 machine: self.ek_machine,
                 offset: c.table_from_part,
             },
@@ -331,9 +331,11 @@ impl KukaOptions {
     /// written in at positioner joints `positioner` (rad): with a coupled
     /// base the part frame on the positioner there, else
     /// [`KukaOptions::frames`]' base.
-    pub fn base_at(&self, cell: &Cell, positioner: Option<[f64; 2]>) -> Isometry3 {
+    pub fn base_at(&self, cell: &CellLayout, positioner: Option<[f64; 2]>) -> Isometry3 {
         match (cell, positioner) {
-            (Cell::TorchCarried(c), Some(q)) if self.coordinated(cell) => c.base_from_part(&q),
+            (CellLayout::TorchCarried(c), Some(q)) if self.coordinated(cell) => {
+                c.base_from_part(&q)
+            }
             _ => self.frames(cell).0,
         }
     }
@@ -627,7 +629,7 @@ pub struct TimedSegment {
 /// moves ([`positioner_moves`]); `None` elsewhere (the planned speed is the
 /// TCP's: `$VEL.CP` = the planned speed).
 pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<TimedSegment> {
-    let Cell::TorchCarried(c) = &program.cell else {
+    let CellLayout::TorchCarried(c) = &program.cell else {
         return None;
     };
     if opts.uses_external_tcp(&program.cell)
@@ -718,7 +720,8 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
             w,
             "  ; external TCP: the tool is the part on the flange, the base the fixed torch (z towards the part)"
         )?;
-    } else if matches!(program.cell, Cell::TorchCarried(_)) && opts.flange_from_tool.is_none() {
+    } else if matches!(program.cell, CellLayout::TorchCarried(_)) && opts.flange_from_tool.is_none()
+    {
         writeln!(
             w,
             "  ; the tool is the torch, +Z along the wire out of the torch (set $TOOL_DIRECTION = #Z for tool-frame weaving and jogging)"
@@ -1333,7 +1336,7 @@ impl Controller for Kuka {
 
     fn steps(
         read: &read::KrlProgram,
-        cell: &Cell,
+        cell: &CellLayout,
         opts: &KukaOptions,
         report: &mut ValidationReport,
     ) -> Option<Vec<Step>> {

@@ -20,7 +20,7 @@ use crate::program::compress::interpolate;
 use crate::program::contract::moves_in_part_frame;
 use crate::program::moves::{controller_pose_at, flange_of};
 use crate::program::ProgramOptions;
-use crate::robot::{Cell, Joints};
+use crate::robot::{CellLayout, Joints};
 
 use super::{deposition_point, ProblemKind, NAMES, REACH_TOLERANCE_MM};
 
@@ -49,7 +49,7 @@ pub(crate) struct InterpolatedMove<'a> {
 /// The problems found between the ends of `mv` (module doc), each with its
 /// kind; at most one of each kind.
 pub(crate) fn check_between(
-    cell: &Cell,
+    cell: &CellLayout,
     common: &ProgramOptions,
     mv: &InterpolatedMove<'_>,
 ) -> Vec<(ProblemKind, String)> {

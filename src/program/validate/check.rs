@@ -9,7 +9,7 @@ use crate::program::compress::{arc_length, interpolate, ControllerPose};
 use crate::program::transit::{joint_move_clearance, WallBeads};
 use crate::program::MoveKind;
 use crate::program::ProgramOptions;
-use crate::robot::{Cell, Joints};
+use crate::robot::{CellLayout, Joints};
 use crate::toolaxis::collision::Torch;
 use nalgebra::UnitQuaternion;
 
@@ -24,7 +24,7 @@ use super::{
 /// frame, mm), one per bead motion in execution order.
 pub fn check_steps(
     steps: &[Step],
-    cell: &Cell,
+    cell: &CellLayout,
     planned: Option<&[Point3]>,
     common: &crate::program::ProgramOptions,
     report: &mut ValidationReport,
@@ -168,7 +168,7 @@ pub fn check_steps(
             );
         }
         let qp = m.positioner;
-        if let Cell::TorchCarried(c) = cell {
+        if let CellLayout::TorchCarried(c) = cell {
             match qp {
                 None => push(
                     report,
@@ -291,7 +291,7 @@ pub fn check_steps(
                     let via_tcp = circle_via.as_ref().map(|(qv, _, _)| Point3::from(tcp(qv)));
                     let mut t =
                         path_length(&Point3::from(tcp(pq)), &Point3::from(tcp(&q)), via_tcp) / mm_s;
-                    if let (Cell::TorchCarried(c), Some(a), Some(b)) = (cell, qp, pqp) {
+                    if let (CellLayout::TorchCarried(c), Some(a), Some(b)) = (cell, qp, pqp) {
                         for n in 0..2 {
                             let max = c.positioner.max_speed_rad_s[n] * extax_fraction[n];
                             let turn = (a[n] - b[n]).abs();
@@ -366,7 +366,7 @@ pub fn check_steps(
                         ));
                     }
                 }
-                if let (Cell::TorchCarried(c), Some(a), Some(b)) = (cell, qp, pqp) {
+                if let (CellLayout::TorchCarried(c), Some(a), Some(b)) = (cell, qp, pqp) {
                     for n in 0..2 {
                         let sp = (a[n] - b[n]).abs() / dt;
                         if sp > c.positioner.max_speed_rad_s[n] {
@@ -424,7 +424,7 @@ const HOME_TOLERANCE_RAD: f64 = 0.01 * PI / 180.0;
 /// the files and is not checked). `bead[i]`: step `i` is a bead motion.
 fn check_setup(
     steps: &[Step],
-    cell: &Cell,
+    cell: &CellLayout,
     common: &ProgramOptions,
     bead: &[bool],
     report: &mut ValidationReport,
@@ -432,7 +432,7 @@ fn check_setup(
     check_home_ends(steps, cell, common, [true, true], report);
     // what happens before each bead: from the end of the previous bead (or
     // the program start) to the bead's process-on
-    let part_carried = matches!(cell, Cell::PartCarried(_));
+    let part_carried = matches!(cell, CellLayout::PartCarried(_));
     let mut on = false;
     let mut beads_started = 0usize;
     let mut waited_s = 0.0;
@@ -565,7 +565,7 @@ fn check_setup(
 /// budget (each group starts and ends at home).
 pub(crate) fn check_home_ends(
     steps: &[Step],
-    cell: &Cell,
+    cell: &CellLayout,
     common: &ProgramOptions,
     ends: [bool; 2],
     report: &mut ValidationReport,
@@ -646,7 +646,7 @@ pub(crate) fn check_home_ends(
 /// Every arc-off joint move against the wall of the beads before it.
 fn check_transits(
     steps: &[Step],
-    cell: &Cell,
+    cell: &CellLayout,
     common: &ProgramOptions,
     bead: &[bool],
     report: &mut ValidationReport,

@@ -30,7 +30,7 @@ use std::fmt;
 use crate::math::{Isometry3, Point3};
 use crate::program::MoveKind;
 use crate::robot::ik::wrap_pi;
-use crate::robot::{ArmSide, Cell, Configuration, Elbow, Joints, RobotModel, Vendor, Wrist};
+use crate::robot::{ArmSide, CellLayout, Configuration, Elbow, Joints, RobotModel, Vendor, Wrist};
 
 /// Largest accepted distance between a position and what it should reach (mm).
 pub const REACH_TOLERANCE_MM: f64 = 0.01;
@@ -275,14 +275,14 @@ pub(crate) fn push(
 /// Deposition point in the part frame (mm) at joints `q`, positioner `qp`:
 /// the fixed torch's point seen from the part (part-carried cell), or the
 /// TCP seen from the part on the positioner (torch-carried cell).
-pub fn deposition_point(cell: &Cell, q: &Joints, qp: Option<[f64; 2]>) -> Option<Point3> {
+pub fn deposition_point(cell: &CellLayout, q: &Joints, qp: Option<[f64; 2]>) -> Option<Point3> {
     let flange = cell.robot().flange_pose(q);
     match cell {
-        Cell::PartCarried(c) => {
+        CellLayout::PartCarried(c) => {
             let base_from_part = flange * c.flange_from_part;
             Some(base_from_part.inverse() * c.deposition_point_mm)
         }
-        Cell::TorchCarried(c) => {
+        CellLayout::TorchCarried(c) => {
             let tcp = flange * c.flange_from_tcp;
             let base_from_part = c.base_from_part(&qp?);
             Some(base_from_part.inverse() * Point3::from(tcp.translation.vector))
@@ -358,7 +358,7 @@ pub(crate) fn decode_pose(
 /// is not a `vendor` arm: its joints are in another controller's convention
 /// and nothing else in the file can be checked against it.
 pub(crate) fn vendor_matches(
-    cell: &Cell,
+    cell: &CellLayout,
     vendor: Vendor,
     emitter: &'static str,
     file: &str,
