@@ -1,4 +1,4 @@
-//! Stages 4 and 6 alone, without the optimiser (robot programs,
+//! Stages 5 and 7 alone, without the optimiser (robot programs,
 //! [`waam_slicer::program`]): the first layers of the hemisphere in the
 //! thesis's part-carried cell with the thesis's law `R_Z = −v` (the robot
 //! turns the part under the torch about the tool axis, thesis §4.3), the

@@ -1,4 +1,4 @@
-//! Stage 4 alone (robot kinematics, [`waam_slicer::robot`]): the FANUC
+//! Stage 5 alone (robot kinematics, [`waam_slicer::robot`]): the FANUC
 //! ArcMate 120iC of the thesis's cell, forward kinematics against the
 //! closed-form check values of SPEC §6.1 (FANUC's own joint conventions),
 //! then the inverse kinematics of a flange pose in each of the eight

@@ -79,12 +79,15 @@
 //!   * `examples/stage_slice.rs` — stage 2: the quarter torus sliced normal to
 //!     the guide (60 % distance variation, closed form) and at constant
 //!     distance (below 1e-6);
-//!   * `examples/stage_ik.rs` — stage 4: the ArcMate 120iC's forward kinematics
+//!   * `examples/stage_ik.rs` — stage 5: the ArcMate 120iC's forward kinematics
 //!     against SPEC §6.1's check values, the inverse in all eight
 //!     configurations;
-//!   * `examples/stage_emit.rs` — stages 4 and 6 without the optimiser: the
+//!   * `examples/stage_emit.rs` — stages 5 and 7 without the optimiser: the
 //!     hemisphere's first layers with the thesis's law `R_Z = −v`, a FANUC
-//!     program emitted, read back and checked.
+//!     program emitted, read back and checked;
+//!   * `examples/stage_place.rs` — stage 8: the hemisphere refused in the KUKA
+//!     part-carried cell as it stands, placed, and the placed cell file read
+//!     back, planned again and its program checked.
 #![warn(missing_docs, missing_debug_implementations)]
 #![forbid(unsafe_code)]
 // `!(x > 0.0)` is how we reject NaN together with the bad range; keep it readable.
