@@ -236,7 +236,7 @@ pub struct PlanArgs {
 /// Arguments of `check`.
 #[derive(Debug, clap::Args)]
 pub struct CheckArgs {
-    /// The program: FANUC main .ls (sub-programs it calls are read from the same folder), KUKA .src (its .dat beside it) or ABB .mod.
+    /// The program: FANUC .ls, KUKA .src (its .dat beside it) or ABB .mod; a build cut into groups is read whole from any of them; or the folder `plan` wrote, holding one program.
     pub program: PathBuf,
     /// The cell file (TOML, parts/cells/).
     #[arg(long)]

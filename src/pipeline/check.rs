@@ -20,7 +20,8 @@ use crate::Error;
 /// `.dat` (its pair beside it) or an ABB `.mod` (with the part modules a
 /// main module loads); for a build cut to the controller's memory budget,
 /// any of its groups `NAME_P01`, `NAME_P02`, … (or `NAME` itself) brings
-/// all of them, checked as one build — and validates it against
+/// all of them, checked as one build; a folder holding one program (as
+/// `plan` writes it) stands for that program — and validates it against
 /// `cell`, with the emitter options and set-up (home, dwell, interpass
 /// wait, payload, transit) of the cell file's `[program]` table. Problems
 /// found are data: the report lists each with its `file:line`.
@@ -31,7 +32,13 @@ use crate::Error;
 /// [`ProgramError::VendorMismatch`] is reported as a problem by the
 /// validators, not as an error.
 pub fn check_program(path: impl AsRef<FsPath>, cell: &Cell) -> Result<ValidationReport, Error> {
-    let (vendor, files) = files_on_disk(path.as_ref())?;
+    let path = path.as_ref();
+    let path = if path.is_dir() {
+        program_in_folder(path)?
+    } else {
+        path.to_path_buf()
+    };
+    let (vendor, files) = files_on_disk(&path)?;
     Ok(check_files(
         vendor,
         &files,
@@ -50,4 +57,57 @@ pub fn read_fanuc_with_calls(main: &FsPath) -> Result<Vec<TpProgram>, ProgramErr
     use crate::program::contract::Controller;
     use crate::program::fanuc::Fanuc;
     Fanuc::read(&Fanuc::files_on_disk(main)?)
+}
+
+/// The one program in folder `dir`: its `.ls`, `.src` or `.mod` files,
+/// their group suffix `_Pnn` set aside, must name one program; its main file
+/// (`NAME`, else its first group).
+///
+/// # Errors
+/// [`ProgramError::Read`] naming the folder when it holds no program or
+/// several.
+fn program_in_folder(dir: &FsPath) -> Result<std::path::PathBuf, ProgramError> {
+    let read_error = |reason: String| ProgramError::Read {
+        file: dir.display().to_string(),
+        line: 0,
+        reason,
+    };
+    let entries = std::fs::read_dir(dir).map_err(|e| read_error(format!("cannot list: {e}")))?;
+    let mut files: Vec<(String, std::path::PathBuf)> = Vec::new();
+    for entry in entries.flatten() {
+        let path = entry.path();
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if !matches!(ext, "ls" | "src" | "mod") {
+            continue;
+        }
+        let Some(stem) = path.file_stem().and_then(|s| s.to_str()) else {
+            continue;
+        };
+        files.push((stem.to_string(), path));
+    }
+    files.sort();
+    let base = |stem: &str| -> String {
+        match stem.rsplit_once("_P") {
+            Some((b, n)) if n.len() == 2 && n.bytes().all(|c| c.is_ascii_digit()) => b.to_string(),
+            _ => stem.to_string(),
+        }
+    };
+    let mut names: Vec<String> = files.iter().map(|(s, _)| base(s)).collect();
+    names.dedup();
+    match names.as_slice() {
+        [] => Err(read_error(
+            "no program file (.ls, .src or .mod) in this folder".into(),
+        )),
+        [name] => Ok(files
+            .iter()
+            .find(|(s, _)| s == name)
+            .unwrap_or(&files[0])
+            .1
+            .clone()),
+        several => Err(read_error(format!(
+            "{} programs in this folder ({}): name the one to check",
+            several.len(),
+            several.join(", ")
+        ))),
+    }
 }

@@ -44,6 +44,15 @@ fn one_call_plan_writes_a_program_that_reads_back_clean() {
     assert!(report.problems.is_empty(), "{:?}", report.problems);
     // Every planned point is in the program: the validator saw every bead.
     assert_eq!(report.beads, planned.plan.layers.len());
+    // The folder plan wrote stands for its one program.
+    let by_folder = check_program(dir.path(), &cell).unwrap();
+    assert_eq!(
+        (by_folder.motions, by_folder.beads),
+        (report.motions, report.beads)
+    );
+    let empty = tempfile::tempdir().unwrap();
+    let m = check_program(empty.path(), &cell).unwrap_err().to_string();
+    assert!(m.contains("no program file"), "{m}");
 
     // Serialisable: summary plus one entry per point.
     let v = serde_json::to_value(&planned).unwrap();
