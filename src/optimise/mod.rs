@@ -81,9 +81,9 @@
 //! ```
 //! use waam_slicer::math::{Point3, UnitVector3, Vector3};
 //! use waam_slicer::optimise::{optimise, LayerPoints, OptimiseOptions};
-//! use waam_slicer::robot::{Cell, CellPoint, Configuration, PartCarriedCell, RobotModel};
+//! use waam_slicer::robot::{CellLayout, CellPoint, Configuration, PartCarriedCell, RobotModel};
 //!
-//! let cell = Cell::PartCarried(PartCarriedCell {
+//! let cell = CellLayout::PartCarried(PartCarriedCell {
 //!     name: "ROBOWAM".into(),
 //!     robot: RobotModel::arcmate_120ic_nominal().with_j5_travel_deg(135.0),
 //!     deposition_point_mm: Point3::new(1045.747, -630.155, 653.167),
