@@ -11,6 +11,7 @@ use std::path::Path as FsPath;
 use super::Cell;
 use crate::program::contract::{check_files, files_on_disk};
 use crate::program::fanuc::TpProgram;
+use crate::program::split::parse_group_name;
 use crate::program::validate::ValidationReport;
 use crate::program::ProgramError;
 use crate::Error;
@@ -60,7 +61,7 @@ pub fn read_fanuc_with_calls(main: &FsPath) -> Result<Vec<TpProgram>, ProgramErr
 }
 
 /// The one program in folder `dir`: its `.ls`, `.src` or `.mod` files,
-/// their group suffix `_Pnn` set aside, must name one program; its main file
+/// their group suffix set aside ([`parse_group_name`]), must name one program; its main file
 /// (`NAME`, else its first group).
 ///
 /// # Errors
@@ -86,13 +87,14 @@ fn program_in_folder(dir: &FsPath) -> Result<std::path::PathBuf, ProgramError> {
         files.push((stem.to_string(), path));
     }
     files.sort();
+    // a build's groups NAME_P01, NAME_P02, … are one program
     let base = |stem: &str| -> String {
-        match stem.rsplit_once("_P") {
-            Some((b, n)) if n.len() == 2 && n.bytes().all(|c| c.is_ascii_digit()) => b.to_string(),
-            _ => stem.to_string(),
-        }
+        parse_group_name(stem)
+            .map_or(stem, |(name, _)| name)
+            .to_string()
     };
     let mut names: Vec<String> = files.iter().map(|(s, _)| base(s)).collect();
+    names.sort();
     names.dedup();
     match names.as_slice() {
         [] => Err(read_error(
