@@ -115,7 +115,7 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     };
     let t_programs = t.elapsed().as_secs_f64();
     // Last, with every writer's time.
-    let mut summary = planned.summary();
+    let mut summary = serde_json::to_value(planned.summary()).map_err(|e| input(e.to_string()))?;
     let times = &mut summary["run_time_s"];
     times["read"] = t_read.into();
     times["joints_csv"] = t_csv.into();

@@ -118,7 +118,7 @@ pub fn run(args: &SliceArgs, quiet: bool) -> Result<(), String> {
             .map_err(|e| format!("{}: {e}", dir.join(name).display()))?;
     }
     let t_plots = t4.elapsed().as_secs_f64();
-    let mut summary = sliced.summary();
+    let mut summary = serde_json::to_value(sliced.summary()).map_err(|e| e.to_string())?;
     summary["run_time_s"]["read"] = t_read.into();
     summary["run_time_s"]["path_csv"] = t_csv.into();
     summary["run_time_s"]["wall_stl"] = t_wall.into();

@@ -217,8 +217,9 @@ pub struct Layer {
     pub closed: bool,
 }
 
-/// Why the generation stopped.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Why the generation stopped (`summary.json`: its snake_case name).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum StopReason {
     /// The next layer would pass `t_max` (whole layers only).
     ReachedEnd,

@@ -28,6 +28,7 @@ mod options;
 mod place;
 mod planned;
 mod sliced;
+pub mod summary;
 
 use std::path::Path as FsPath;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -7,8 +7,10 @@
 
 use std::f64::consts::PI;
 
-use serde_json::{json, Value};
-
+use super::summary::{
+    BindingSummary, InfeasibleLayerSummary, KeepOutSummary, PlacementSummary,
+    PlacementVariableSummary,
+};
 use super::{slice_part_with, Cell, Part, SliceOverrides};
 use crate::io::cell_file::placed_cell_file;
 use crate::optimise::{layer_points, ConfigurationChoice, OptimiseError, OptimiseOptions};
@@ -169,38 +171,57 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
 impl PlacedCell {
     /// The content of `placement.json`: the bounds, the values found, the
     /// margins before and after, candidates, feasible fraction, binding
-    /// constraint and time (s).
-    pub fn summary(&self) -> Value {
+    /// constraint and time (s); `serde_json::to_value` gives the JSON.
+    pub fn summary(&self) -> PlacementSummary {
         let p = &self.placement;
-        json!({
-            "feasible": p.feasible,
-            "variables": self.bounds.variables.iter().zip(p.values.in_table_order(&p.cell)).map(|(v, x)| {
-                let deg = v.angle;
-                let k = if deg { 180.0 / PI } else { 1.0 };
-                json!({
-                    "name": v.name,
-                    "unit": if deg { "deg" } else { "mm" },
-                    "lower": v.lower * k,
-                    "upper": v.upper * k,
-                    "given": v.current * k,
-                    "found": x * k,
+        let variables = self
+            .bounds
+            .variables
+            .iter()
+            .zip(p.values.in_table_order(&p.cell))
+            .map(|(v, x)| {
+                let k = if v.angle { 180.0 / PI } else { 1.0 };
+                PlacementVariableSummary {
+                    name: v.name,
+                    unit: if v.angle { "deg" } else { "mm" },
+                    lower: v.lower * k,
+                    upper: v.upper * k,
+                    given: v.current * k,
+                    found: x * k,
+                }
+            })
+            .collect();
+        PlacementSummary {
+            feasible: p.feasible,
+            variables,
+            keep_out: self
+                .bounds
+                .keep_out
+                .map(|(min_mm, max_mm)| KeepOutSummary { min_mm, max_mm }),
+            margins: p.margins,
+            margins_before: p.margins_before,
+            candidates: p.candidates,
+            certified: p.certified,
+            rounds: p.rounds,
+            stopped_on: p.stopped_on.as_ref().map(ToString::to_string),
+            subsample_layers: p.subsample_layers.0,
+            subsample_layers_full: p.subsample_layers.1,
+            times: p.times,
+            feasible_fraction: p.feasible_fraction,
+            binding: p.binding.as_ref().map(|b| BindingSummary {
+                constraint: b.to_string(),
+                share: b.share(),
+            }),
+            infeasible_layers: p
+                .plan
+                .infeasible_layers()
+                .map(|l| InfeasibleLayerSummary {
+                    layer: l.layer,
+                    status: l.status.to_string(),
                 })
-            }).collect::<Vec<_>>(),
-            "keep_out": self.bounds.keep_out.map(|(a, b)| json!({"min_mm": a, "max_mm": b})),
-            "margins": p.margins,
-            "margins_before": p.margins_before,
-            "candidates": p.candidates,
-            "certified": p.certified,
-            "rounds": p.rounds,
-            "stopped_on": p.stopped_on.as_ref().map(ToString::to_string),
-            "subsample_layers": p.subsample_layers.0,
-            "subsample_layers_full": p.subsample_layers.1,
-            "times": p.times,
-            "feasible_fraction": p.feasible_fraction,
-            "binding": p.binding.as_ref().map(|b| json!({"constraint": b.to_string(), "share": b.share()})),
-            "infeasible_layers": p.plan.infeasible_layers().map(|l| json!({"layer": l.layer, "status": l.status.to_string()})).collect::<Vec<_>>(),
-            "time_s": p.time_s,
-        })
+                .collect(),
+            time_s: p.time_s,
+        }
     }
 }
 

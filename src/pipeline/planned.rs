@@ -7,12 +7,14 @@ use std::time::Instant;
 
 use serde::ser::SerializeMap;
 use serde::Serialize;
-use serde_json::{json, Value};
 
-use super::sliced::merge;
+use super::summary::{
+    deg6, finite, LawSummary, LayerSummary, ObjectiveSummary, PlanSummary, PositionerSummary,
+    QualitySummary, SolverSummary, TransitionSummary, UnbuildableLayer, UnbuildableProof,
+};
 use super::{slice_part_with, Cell, Control, Part, PlanOptions, ProgramFormat, RzLaw, SlicedPart};
 use crate::optimise::{
-    layer_points, optimise_with, trajectory_inputs, ConfigurationChoice, LayerPoints,
+    layer_points, optimise_with, trajectory_inputs, ConfigurationChoice, LayerPlan, LayerPoints,
     OptimiseOptions, Plan,
 };
 use crate::program::{
@@ -271,10 +273,6 @@ fn check_every_layer(layers: &[LayerPoints], plan: &Plan) -> Result<(), ProgramE
     Ok(())
 }
 
-fn deg6(q: &[f64; 6]) -> Vec<f64> {
-    q.iter().map(|v| v.to_degrees()).collect()
-}
-
 impl PlannedPart {
     /// `true` when every layer is feasible and the program model was built:
     /// [`PlannedPart::write_programs`] will write it.
@@ -378,97 +376,93 @@ impl PlannedPart {
     /// `R_Z` law, travel speed, feasibility, every violation, per layer the
     /// status, IK branch, law, objective, quality figures and solver counts,
     /// the layer transitions, run times (s) and the path summary
-    /// ([`SlicedPart::path_summary`]).
-    pub fn summary(&self) -> Value {
+    /// ([`SlicedPart::path_summary`]); `serde_json::to_value` gives the JSON.
+    pub fn summary(&self) -> PlanSummary {
         let plan = &self.plan;
-        let layers: Vec<_> = plan
-            .layers
-            .iter()
-            .map(|l| {
-                let q = &l.quality;
-                json!({
-                    "layer": l.layer,
-                    "status": l.status.to_string(),
-                    "feasible": l.status.is_feasible(),
-                    "configuration": l.configuration.chosen.to_string(),
-                    "configuration_reason": l.configuration.reason,
-                    "law": format!("{:?}", l.law),
-                    "points": l.points.len(),
-                    "objective": {
-                        "joint_displacement": l.objective.joint_displacement,
-                        "uncertainty_sum_sq_mm2": l.objective.uncertainty_sum_sq_mm2,
-                        "mean_uncertainty_mm": l.objective.mean_uncertainty_mm,
-                        "centring": l.objective.centring,
-                    },
-                    "quality": {
-                        "joint_travel_deg": deg6(&q.joint_travel_rad),
-                        "peak_speed_deg_s": deg6(&q.peak_speed_rad_s),
-                        "peak_acceleration_deg_s2": deg6(&q.peak_acceleration_rad_s2),
-                        "summed_acceleration_j1_j5_deg_s": q.summed_acceleration_rad_s.to_degrees(),
-                        "direction_reversals": q.direction_reversals,
-                        "min_dexterity": q.min_dexterity,
-                        "min_limit_distance_deg": q.min_limit_distance_rad.to_degrees(),
-                        "min_limit_distance_joint": q.min_limit_distance_joint,
-                        "max_hose_torsion_deg": q.max_hose_torsion_rad.to_degrees(),
-                    },
-                    "positioner": l.positioner.as_ref().map(positioner_summary),
-                    "solver": {
-                        "iterations": l.solver.iterations,
-                        "qp_solves": l.solver.qp_solves,
-                        "qp_failures": l.solver.qp_failures,
-                        "branches_tried": l.solver.branches_tried,
-                        // points the law was optimised on (null: every
-                        // point); it is certified on every point either way
-                        "samples": l.solver.samples,
-                        "time_s": l.solver.time_s,
-                    },
+        PlanSummary {
+            part: self.sliced.part_name.clone(),
+            part_file: self.sliced.part_file.clone(),
+            cell_file: self.cell.file.clone(),
+            rz: self.rz.to_string(),
+            travel_speed_mm_s: self.optimise.travel_speed_mm_s,
+            feasible: plan.is_feasible(),
+            infeasible_layers: plan.infeasible_layers().map(|l| l.layer).collect(),
+            unbuildable_layers: plan.layers.iter().filter_map(unbuildable).collect(),
+            violations: plan.violations().map(|v| v.to_string()).collect(),
+            layer_plans: plan.layers.iter().map(layer_summary).collect(),
+            transitions: plan
+                .transitions
+                .iter()
+                .map(|t| TransitionSummary {
+                    from_layer: t.from_layer,
+                    to_layer: t.to_layer,
+                    joint_change_deg: deg6(&t.joint_change_rad),
+                    branch_change: t.branch_change,
+                    start_limit_distance_deg: t.start_limit_distance_rad.to_degrees(),
                 })
-            })
-            .collect();
-        let violations: Vec<String> = plan.violations().map(|v| v.to_string()).collect();
-        let mut s = json!({
-            "part": self.sliced.part_name,
-            "part_file": self.sliced.part_file,
-            "cell_file": self.cell.file,
-            "rz": self.rz.to_string(),
-            "travel_speed_mm_s": self.optimise.travel_speed_mm_s,
-            "feasible": plan.is_feasible(),
-            "infeasible_layers": plan.infeasible_layers().map(|l| l.layer).collect::<Vec<_>>(),
-            // layers that no motion of arm and positioner within the cone
-            // can build, by a bound from the geometry alone
-            "unbuildable_layers": plan.layers.iter().filter_map(|l| {
-                let law = l.positioner.as_ref()?;
-                law.proven_infeasible.then(|| json!({
-                    "layer": l.layer,
-                    // "rate": the positioner cannot turn the part fast
-                    // enough between the two points; "reachability": no
-                    // positioner path reaches the point within the cone
-                    "proof": if law.required_rate_rad_s > law.available_rate_rad_s { "rate" } else { "reachability" },
-                    "required_rate_deg_s": finite_or_null(law.required_rate_rad_s.to_degrees()),
-                    "available_rate_deg_s": finite_or_null(law.available_rate_rad_s.to_degrees()),
-                    "between_points": [law.required_between.0, law.required_between.1],
-                    "unreachable_point": law.unreachable_point,
-                }))
-            }).collect::<Vec<_>>(),
-            "violations": violations,
-            "layer_plans": layers,
-            "transitions": plan.transitions.iter().map(|t| json!({
-                "from_layer": t.from_layer,
-                "to_layer": t.to_layer,
-                "joint_change_deg": deg6(&t.joint_change_rad),
-                "branch_change": t.branch_change,
-                "start_limit_distance_deg": t.start_limit_distance_rad.to_degrees(),
-            })).collect::<Vec<_>>(),
-            "program": Value::Null,
-            "run_time_s": {
-                "slice": self.times.slice,
-                "tool_axes": self.times.tool_axes,
-                "optimise": self.times.optimise,
-                "program": self.times.program,
-            },
-        });
-        merge(&mut s, self.sliced.path_summary());
-        s
+                .collect(),
+            program: None,
+            run_time_s: self.times,
+            path: self.sliced.path_summary(),
+        }
+    }
+}
+
+/// A layer's entry under `unbuildable_layers`, when its positioner laws
+/// prove it unbuildable from the geometry.
+fn unbuildable(l: &LayerPlan) -> Option<UnbuildableLayer> {
+    let law = l.positioner.as_ref()?;
+    law.proven_infeasible.then(|| UnbuildableLayer {
+        layer: l.layer,
+        proof: if law.required_rate_rad_s > law.available_rate_rad_s {
+            UnbuildableProof::Rate
+        } else {
+            UnbuildableProof::Reachability
+        },
+        required_rate_deg_s: finite(law.required_rate_rad_s.to_degrees()),
+        available_rate_deg_s: finite(law.available_rate_rad_s.to_degrees()),
+        between_points: [law.required_between.0, law.required_between.1],
+        unreachable_point: law.unreachable_point,
+    })
+}
+
+/// A layer's entry under `layer_plans`.
+fn layer_summary(l: &LayerPlan) -> LayerSummary {
+    let q = &l.quality;
+    LayerSummary {
+        layer: l.layer,
+        status: l.status.to_string(),
+        feasible: l.status.is_feasible(),
+        configuration: l.configuration.chosen.to_string(),
+        configuration_reason: l.configuration.reason.clone(),
+        law: LawSummary::from(&l.law),
+        points: l.points.len(),
+        objective: ObjectiveSummary {
+            joint_displacement: l.objective.joint_displacement,
+            uncertainty_sum_sq_mm2: l.objective.uncertainty_sum_sq_mm2,
+            mean_uncertainty_mm: l.objective.mean_uncertainty_mm,
+            centring: l.objective.centring,
+        },
+        quality: QualitySummary {
+            joint_travel_deg: deg6(&q.joint_travel_rad),
+            peak_speed_deg_s: deg6(&q.peak_speed_rad_s),
+            peak_acceleration_deg_s2: deg6(&q.peak_acceleration_rad_s2),
+            summed_acceleration_j1_j5_deg_s: q.summed_acceleration_rad_s.to_degrees(),
+            direction_reversals: q.direction_reversals,
+            min_dexterity: q.min_dexterity,
+            min_limit_distance_deg: q.min_limit_distance_rad.to_degrees(),
+            min_limit_distance_joint: q.min_limit_distance_joint,
+            max_hose_torsion_deg: q.max_hose_torsion_rad.to_degrees(),
+        },
+        positioner: l.positioner.as_ref().map(PositionerSummary::from),
+        solver: SolverSummary {
+            iterations: l.solver.iterations,
+            qp_solves: l.solver.qp_solves,
+            qp_failures: l.solver.qp_failures,
+            branches_tried: l.solver.branches_tried,
+            samples: l.solver.samples,
+            time_s: l.solver.time_s,
+        },
     }
 }
 
@@ -509,32 +503,4 @@ impl Serialize for PlannedPart {
         m.serialize_entry("points", &points)?;
         m.end()
     }
-}
-
-/// A number for JSON, `null` when not finite (an unbounded rate).
-fn finite_or_null(v: f64) -> Value {
-    if v.is_finite() {
-        json!(v)
-    } else {
-        Value::Null
-    }
-}
-
-/// One layer's positioner laws in `summary.json` (angles in degrees, rates
-/// in deg/s; `null` for an unbounded rate).
-fn positioner_summary(law: &crate::optimise::positioner::PositionerLaw) -> Value {
-    json!({
-        "seed": law.seed,
-        "feasible": law.feasible,
-        "binding": law.binding.map(|b| b.to_string()),
-        "max_tilt_deg": law.max_tilt_rad.to_degrees(),
-        "max_tilt_point": law.max_tilt_point,
-        "required_rate_deg_s": finite_or_null(law.required_rate_rad_s.to_degrees()),
-        "available_rate_deg_s": finite_or_null(law.available_rate_rad_s.to_degrees()),
-        "required_between_points": [law.required_between.0, law.required_between.1],
-        "proven_infeasible": law.proven_infeasible,
-        "unreachable_point": law.unreachable_point,
-        "iterations": law.iterations,
-        "samples": law.samples,
-    })
 }

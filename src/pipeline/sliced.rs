@@ -6,8 +6,10 @@ use std::time::Instant;
 
 use serde::ser::{SerializeMap, SerializeStruct};
 use serde::Serialize;
-use serde_json::{json, Value};
 
+use super::summary::{
+    DistanceSummary, PathSummary, ProcessSummary, SliceSummary, SlicerSummary, ToolAxesSummary,
+};
 use super::{Control, Part, SliceOverrides};
 use crate::path::{distance_map, DistanceMap, Path, SliceOptions};
 use crate::process::{plan_process, ProcessParameters, ProcessPlan};
@@ -141,66 +143,62 @@ impl SlicedPart {
     /// `summary.json`): strategy, Delta, layers, slices, points, arc starts,
     /// bead length (mm), process estimates, tool-axis report and the local
     /// interlayer distances overall and per layer.
-    pub fn path_summary(&self) -> Value {
+    pub fn path_summary(&self) -> PathSummary {
         let (path, map, params, axes) = (&self.path, &self.map, &self.process, &self.axes);
         let est = self.process_plan.estimates;
-        json!({
-            "strategy": path.strategy.name(),
-            "delta_mm": path.delta_mm,
-            "layers": path.layers.len(),
-            "slices": path.num_slices(),
-            "points": path.num_points(),
-            "arc_starts": est.arc_starts,
-            "length_mm": path.length_mm(),
-            "process": {
-                "material": params.material,
-                "travel_speed_mm_s": params.travel_speed_mm_s,
-                "wire_feed_speed_mm_s": params.wire_feed_speed_mm_s,
-                "deposition_time_s": est.deposition_time_s,
-                "wire_length_mm": est.wire_length_mm,
-                "deposited_mass_g": est.deposited_mass_g,
-                "speed_window_violations": self.process_plan.violation_count,
+        PathSummary {
+            strategy: path.strategy.name(),
+            delta_mm: path.delta_mm,
+            layers: path.layers.len(),
+            slices: path.num_slices(),
+            points: path.num_points(),
+            arc_starts: est.arc_starts,
+            length_mm: path.length_mm(),
+            process: ProcessSummary {
+                material: params.material.clone(),
+                travel_speed_mm_s: params.travel_speed_mm_s,
+                wire_feed_speed_mm_s: params.wire_feed_speed_mm_s,
+                deposition_time_s: est.deposition_time_s,
+                wire_length_mm: est.wire_length_mm,
+                deposited_mass_g: est.deposited_mass_g,
+                speed_window_violations: self.process_plan.violation_count,
             },
-            "tool_axes": {
-                "normals": format!("{:?}", axes.report.normals),
-                "max_angle_from_z_deg": axes.report.max_angle_from_z_rad.to_degrees(),
-                "max_rate_deg_per_mm": axes.report.max_rate_rad_per_mm.to_degrees(),
-                "rule_active_points": axes.report.rule_active_points,
-                "rule_unreachable_points": axes.report.rule_unreachable_count,
-                "smoothed_points": axes.report.smoothed_points,
+            tool_axes: ToolAxesSummary {
+                normals: axes.report.normals,
+                max_angle_from_z_deg: axes.report.max_angle_from_z_rad.to_degrees(),
+                max_rate_deg_per_mm: axes.report.max_rate_rad_per_mm.to_degrees(),
+                rule_active_points: axes.report.rule_active_points,
+                rule_unreachable_points: axes.report.rule_unreachable_count,
+                smoothed_points: axes.report.smoothed_points,
             },
-            "distance": {
-                "overall": map.overall,
-                "per_layer": map.per_layer,
+            distance: DistanceSummary {
+                overall: map.overall,
+                per_layer: map.per_layer.clone(),
             },
-        })
+        }
     }
 
     /// The content of `slice`'s `summary.json`: the part, what the slicer
-    /// did, the run times (s) and [`SlicedPart::path_summary`].
-    pub fn summary(&self) -> Value {
+    /// did, the run times (s) and [`SlicedPart::path_summary`]
+    /// (`serde_json::to_value` gives the JSON).
+    pub fn summary(&self) -> SliceSummary {
         let r = &self.path.report;
-        let mut s = json!({
-            "part": self.part_name,
-            "part_file": self.part_file,
-            "slicer": {
-                "grid_points": r.grid_points,
-                "root_finds": r.root_finds,
-                "evaluations": r.evaluations,
-                "max_residual_mm": r.max_residual_mm,
-                "truncated_points": r.truncated_points,
-                "stop": format!("{:?}", r.stop),
-                "max_turn_before_deg": r.max_turn_before_rad.to_degrees(),
-                "max_turn_after_deg": r.max_turn_after_rad.to_degrees(),
+        SliceSummary {
+            part: self.part_name.clone(),
+            part_file: self.part_file.clone(),
+            slicer: SlicerSummary {
+                grid_points: r.grid_points,
+                root_finds: r.root_finds,
+                evaluations: r.evaluations,
+                max_residual_mm: r.max_residual_mm,
+                truncated_points: r.truncated_points,
+                stop: r.stop,
+                max_turn_before_deg: r.max_turn_before_rad.to_degrees(),
+                max_turn_after_deg: r.max_turn_after_rad.to_degrees(),
             },
-            "run_time_s": {
-                "slice": self.times.slice,
-                "distance_map": self.times.distance_map,
-                "tool_axes": self.times.tool_axes,
-            },
-        });
-        merge(&mut s, self.path_summary());
-        s
+            run_time_s: self.times,
+            path: self.path_summary(),
+        }
     }
 
     /// Writes `path.csv` (one row per point, see [`crate::io::path_csv`]).
@@ -273,13 +271,6 @@ impl SlicedPart {
         );
         crate::report::write_report(dest, &self.report_input(&title, substrate, width_mm))?;
         Ok(())
-    }
-}
-
-/// Adds the keys of `extra` (an object) to `into` (an object).
-pub(crate) fn merge(into: &mut Value, extra: Value) {
-    if let (Some(into), Value::Object(extra)) = (into.as_object_mut(), extra) {
-        into.extend(extra);
     }
 }
 

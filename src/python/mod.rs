@@ -117,12 +117,14 @@ pub(crate) fn stage_error(e: impl Into<crate::Error>) -> PyErr {
     raise(e.kind(), e.to_string())
 }
 
-/// A `serde_json` value (a summary) as Python objects, through `json.loads`.
+/// A summary (any serialisable value) as Python objects, through its JSON
+/// (keys sorted, as the CLI writes it) and `json.loads`.
 pub(crate) fn json_to_py<'py>(
     py: Python<'py>,
-    value: &serde_json::Value,
+    value: &impl serde::Serialize,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let text = serde_json::to_string(value).map_err(waam_error)?;
+    let value = serde_json::to_value(value).map_err(waam_error)?;
+    let text = serde_json::to_string(&value).map_err(waam_error)?;
     py.import("json")?.call_method1("loads", (text,))
 }
 

@@ -3,7 +3,9 @@
 //! one JSON object whose arrays are base64 typed arrays.
 
 use super::cell_view::{snapshot, CHAIN_POINTS};
-use super::encode::{f32s, i8s, json_nums, json_str, u32s, unit_i8, JsonObject};
+use serde::Serialize;
+
+use super::encode::{f32s, i8s, u32s, unit_i8};
 use super::{PlanView, ReportError, ReportInput};
 use crate::geometry::Substrate;
 use crate::math::{Point3, Vector3};
@@ -309,98 +311,164 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
         ));
     }
 
-    let mut o = JsonObject::new();
-    o.num("version", 1.0)
-        .str("title", input.title)
-        .str("strategy", path.strategy.name())
-        .num("delta_mm", delta)
-        .num("bead_width_mm", input.bead_width_mm)
-        .num("points_total", total as f64)
-        .num("points_shown", shown as f64)
-        .num("stride", k as f64)
-        .num("length_mm", path.length_mm());
-    o.raw(
-        "layer_slice",
-        json_nums(
-            &path
-                .layers
-                .iter()
-                .map(|l| l.slice as f64)
-                .collect::<Vec<_>>(),
-        ),
-    );
-    o.raw(
-        "layer_closed",
-        json_nums(
-            &path
-                .layers
-                .iter()
-                .map(|l| f64::from(u8::from(l.closed)))
-                .collect::<Vec<_>>(),
-        ),
-    );
-    o.raw(
-        "layer_points",
-        json_nums(
-            &path
-                .layers
-                .iter()
-                .map(|l| l.points.len() as f64)
-                .collect::<Vec<_>>(),
-        ),
-    );
-    o.str("layer_start", &u32s(&layer_start));
-    o.str("pos", &f32s(&pos));
-    o.str("tool", &i8s(&tool));
-    o.str("normal", &i8s(&normal));
-    o.str("build", &i8s(&build));
-    let fields_json: Vec<String> = fields
-        .iter()
-        .map(|f| {
-            let mut j = JsonObject::new();
-            j.str("key", f.key)
-                .str("name", f.name)
-                .str("unit", f.unit)
-                .raw("diverging", if f.diverging { "true" } else { "false" })
-                .num("min_half_range", f.min_half_range)
-                .str("data", &f32s(&f.values));
-            j.finish()
-        })
-        .collect();
-    o.raw("fields", format!("[{}]", fields_json.join(",")));
     let (substrate, substrate_note) = substrate_triangles(input.substrate, &pos);
-    match substrate {
-        Some(t) => o.str("substrate", &f32s(&t)),
-        None => o.raw("substrate", "null"),
-    };
     if let Some(n) = substrate_note {
         notes.push(n.into());
     }
-    let marks_json: Vec<String> = marks
-        .iter()
-        .map(|m| {
-            let p = path.layers[m.layer].points[m.point].position;
-            let mut j = JsonObject::new();
-            j.num("layer", m.layer as f64)
-                .num("point", m.point as f64)
-                .str("text", &m.text)
-                .raw("at", json_nums(&[p.x, p.y, p.z]));
-            j.finish()
-        })
-        .collect();
-    o.raw("marks", format!("[{}]", marks_json.join(",")));
-    o.num("marks_total", marks_total as f64);
-    match &input.plan {
-        Some(pv) => {
-            let (plan_json, plan_notes) = plan_data(input, pv);
-            notes.extend(plan_notes);
-            o.raw("plan", plan_json)
-        }
-        None => o.raw("plan", "null"),
+    let plan = input.plan.as_ref().map(|pv| {
+        let (plan, plan_notes) = plan_data(input, pv);
+        notes.extend(plan_notes);
+        plan
+    });
+    let data = PageData {
+        version: 1,
+        title: input.title,
+        strategy: path.strategy.name(),
+        delta_mm: delta,
+        bead_width_mm: input.bead_width_mm,
+        points_total: total,
+        points_shown: shown,
+        stride: k,
+        length_mm: path.length_mm(),
+        layer_slice: path.layers.iter().map(|l| l.slice).collect(),
+        layer_closed: path.layers.iter().map(|l| u8::from(l.closed)).collect(),
+        layer_points: path.layers.iter().map(|l| l.points.len()).collect(),
+        layer_start: u32s(&layer_start),
+        pos: f32s(&pos),
+        tool: i8s(&tool),
+        normal: i8s(&normal),
+        build: i8s(&build),
+        fields: fields
+            .iter()
+            .map(|f| FieldData {
+                key: f.key,
+                name: f.name,
+                unit: f.unit,
+                diverging: f.diverging,
+                min_half_range: f.min_half_range,
+                data: f32s(&f.values),
+            })
+            .collect(),
+        substrate: substrate.map(|t| f32s(&t)),
+        marks: marks
+            .iter()
+            .map(|m| {
+                let p = path.layers[m.layer].points[m.point].position;
+                MarkData {
+                    layer: m.layer,
+                    point: m.point,
+                    text: &m.text,
+                    at: [p.x, p.y, p.z],
+                }
+            })
+            .collect(),
+        marks_total,
+        plan,
+        notes,
     };
-    let notes: Vec<String> = notes.iter().map(|n| json_str(n)).collect();
-    o.raw("notes", format!("[{}]", notes.join(",")));
-    Ok(o.finish())
+    script_safe_json(&data)
+}
+
+/// The page's data object (`report.html`'s embedded JSON): the path drawn
+/// (part frame, mm; base64 typed arrays), its colour fields, marks, notes
+/// and the plan's animation data.
+#[derive(Serialize)]
+struct PageData<'a> {
+    version: u32,
+    title: &'a str,
+    strategy: &'static str,
+    delta_mm: f64,
+    bead_width_mm: f64,
+    points_total: usize,
+    points_shown: usize,
+    stride: usize,
+    length_mm: f64,
+    layer_slice: Vec<usize>,
+    layer_closed: Vec<u8>,
+    layer_points: Vec<usize>,
+    /// Base64 `Uint32Array`: each layer's first drawn point, then the total.
+    layer_start: String,
+    /// Base64 `Float32Array`: drawn points, xyz (mm).
+    pos: String,
+    /// Base64 `Int8Array`s: unit vectors × 127.
+    tool: String,
+    normal: String,
+    build: String,
+    fields: Vec<FieldData>,
+    /// Base64 `Float32Array` of the substrate's triangles, `null` if none.
+    substrate: Option<String>,
+    marks: Vec<MarkData<'a>>,
+    marks_total: usize,
+    plan: Option<PlanData<'a>>,
+    notes: Vec<String>,
+}
+
+/// A colour field: one value per drawn point (base64 `Float32Array`).
+#[derive(Serialize)]
+struct FieldData {
+    key: &'static str,
+    name: &'static str,
+    unit: &'static str,
+    diverging: bool,
+    min_half_range: f64,
+    data: String,
+}
+
+/// A marked point (a violation).
+#[derive(Serialize)]
+struct MarkData<'a> {
+    layer: usize,
+    point: usize,
+    text: &'a str,
+    /// Part frame (mm).
+    at: [f64; 3],
+}
+
+/// The plan's part of the page data: the cell, limits (deg) and the cell at
+/// every animation frame (base64 typed arrays).
+#[derive(Serialize)]
+struct PlanData<'a> {
+    cell_kind: &'static str,
+    cell: &'a str,
+    robot: &'a str,
+    reach_mm: f64,
+    /// `[lower, upper]` per axis (J1–J6, then J7–J8 with a positioner), deg.
+    limits_deg: Vec<[f64; 2]>,
+    /// `null` in a part-carried cell.
+    max_hose_deg: Option<f64>,
+    feasible: bool,
+    infeasible_layers: Vec<usize>,
+    frames: usize,
+    points_total: usize,
+    frame_stride: usize,
+    duration_s: f64,
+    f_layer: String,
+    f_point: String,
+    f_time: String,
+    f_rz: String,
+    f_joints: String,
+    f_chain: String,
+    f_torch: String,
+    f_table: String,
+    f_part: String,
+}
+
+/// `value` as JSON text that can sit inside a `<script>` element: `<`, `>`,
+/// `&` and the line separators U+2028/U+2029 (only ever inside strings) are
+/// written as `\u00XX` escapes. Non-finite numbers are `null`.
+pub(crate) fn script_safe_json(value: &impl Serialize) -> Result<String, ReportError> {
+    let text =
+        serde_json::to_string(value).map_err(|e| ReportError::Encode(std::sync::Arc::new(e)))?;
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '<' | '>' | '&' | '\u{2028}' | '\u{2029}' => {
+                out.push_str(&format!("\\u{:04x}", c as u32));
+            }
+            c => out.push(c),
+        }
+    }
+    Ok(out)
 }
 
 /// Smallest distance of `q` to its joint limits (rad; negative outside),
@@ -497,8 +565,7 @@ fn substrate_triangles(
 }
 
 /// The plan part of the data: cell, limits and the cell at every frame.
-fn plan_data(input: &ReportInput, pv: &PlanView) -> (String, Vec<String>) {
-    let path = input.path;
+fn plan_data<'a>(input: &ReportInput<'a>, pv: &PlanView<'a>) -> (PlanData<'a>, Vec<String>) {
     let total: usize = pv.layers.iter().map(|l| l.points.len()).sum();
     let k = stride(total, input.options.max_frames);
     let robot = pv.cell.robot();
@@ -577,79 +644,47 @@ fn plan_data(input: &ReportInput, pv: &PlanView) -> (String, Vec<String>) {
         }
     }
     let frames = f_layer.len();
-    let limits: Vec<String> = robot
-        .limits
-        .iter()
-        .map(|l| json_nums(&[l.lower_rad.to_degrees(), l.upper_rad.to_degrees()]))
-        .chain(match pv.cell {
-            CellLayout::TorchCarried(c) => c
-                .positioner
-                .limits
-                .iter()
-                .map(|l| json_nums(&[l.lower_rad.to_degrees(), l.upper_rad.to_degrees()]))
-                .collect(),
-            CellLayout::PartCarried(_) => vec![],
-        })
-        .collect();
+    let span =
+        |l: &crate::robot::model::JointLimit| [l.lower_rad.to_degrees(), l.upper_rad.to_degrees()];
+    let mut limits_deg: Vec<[f64; 2]> = robot.limits.iter().map(span).collect();
+    if let CellLayout::TorchCarried(c) = pv.cell {
+        limits_deg.extend(c.positioner.limits.iter().map(span));
+    }
     let g = &robot.geometry;
-    let mut o = JsonObject::new();
-    o.str(
-        "cell_kind",
-        match pv.cell {
+    let data = PlanData {
+        cell_kind: match pv.cell {
             CellLayout::PartCarried(_) => "part carried",
             CellLayout::TorchCarried(_) => "torch carried",
         },
-    )
-    .str("cell", pv.cell.name())
-    .str("robot", &robot.name)
-    .num(
-        "reach_mm",
-        g.upper_arm_mm + g.forearm_mm + g.wrist_to_flange_mm,
-    )
-    .raw("limits_deg", format!("[{}]", limits.join(",")))
-    .num(
-        "max_hose_deg",
-        match pv.cell {
-            CellLayout::TorchCarried(c) => c.max_hose_torsion_rad.to_degrees(),
-            CellLayout::PartCarried(_) => f64::NAN,
+        cell: pv.cell.name(),
+        robot: &robot.name,
+        reach_mm: g.upper_arm_mm + g.forearm_mm + g.wrist_to_flange_mm,
+        limits_deg,
+        max_hose_deg: match pv.cell {
+            CellLayout::TorchCarried(c) => Some(c.max_hose_torsion_rad.to_degrees()),
+            CellLayout::PartCarried(_) => None,
         },
-    )
-    .raw(
-        "feasible",
-        if pv.plan.is_feasible() {
-            "true"
-        } else {
-            "false"
-        },
-    )
-    .raw(
-        "infeasible_layers",
-        json_nums(
-            &pv.plan
-                .infeasible_layers()
-                .map(|l| l.layer as f64)
-                .collect::<Vec<_>>(),
-        ),
-    )
-    .num("frames", frames as f64)
-    .num("points_total", total as f64)
-    .num("frame_stride", k as f64)
-    .num("duration_s", f_time.last().map_or(0.0, |t| f64::from(*t)))
-    .str("f_layer", &u32s(&f_layer))
-    .str("f_point", &u32s(&f_point))
-    .str("f_time", &f32s(&f_time))
-    .str("f_rz", &f32s(&f_rz))
-    .str("f_joints", &f32s(&f_joints))
-    .str("f_chain", &f32s(&f_chain))
-    .str("f_torch", &f32s(&f_torch))
-    .str("f_table", &f32s(&f_table))
-    .str("f_part", &f32s(&f_part));
+        feasible: pv.plan.is_feasible(),
+        infeasible_layers: pv.plan.infeasible_layers().map(|l| l.layer).collect(),
+        frames,
+        points_total: total,
+        frame_stride: k,
+        duration_s: f_time.last().map_or(0.0, |t| f64::from(*t)),
+        f_layer: u32s(&f_layer),
+        f_point: u32s(&f_point),
+        f_time: f32s(&f_time),
+        f_rz: f32s(&f_rz),
+        f_joints: f32s(&f_joints),
+        f_chain: f32s(&f_chain),
+        f_torch: f32s(&f_torch),
+        f_table: f32s(&f_table),
+        f_part: f32s(&f_part),
+    };
     let mut notes = vec![];
     if k > 1 {
         notes.push(format!(
             "{total} planned points: the animation shows {frames} of them (every {k}th and the last)."
         ));
     }
-    let _ = path;
-    (o.finish(), notes)
+    (data, notes)
 }

@@ -192,6 +192,9 @@ pub enum ReportError {
     /// The path has no point.
     #[error("report: the path has no point")]
     EmptyPath,
+    /// The page data could not be encoded as JSON.
+    #[error("report: encoding the page data: {0}")]
+    Encode(#[source] std::sync::Arc<serde_json::Error>),
     /// Writing the page failed.
     #[error("report: writing {file}: {source}")]
     Io {

@@ -1,6 +1,7 @@
+use super::build::script_safe_json;
 use super::build::{kept, stride};
 use super::cell_view::{arm_chain, snapshot};
-use super::encode::{base64, json_str};
+use super::encode::base64;
 use super::*;
 use crate::io::cell_file::read_cell_file;
 use crate::math::{Point3, UnitVector3, Vector3};
@@ -90,7 +91,7 @@ fn base64_matches_rfc_4648_vectors() {
 
 #[test]
 fn strings_cannot_close_the_data_script() {
-    let s = json_str("a</script><!-- \"q\" \\ \n");
+    let s = script_safe_json(&"a</script><!-- \"q\" \\ \n").unwrap();
     assert!(!s.contains('<') && !s.contains('>'));
     assert_eq!(s, r#""a\u003c/script\u003e\u003c!-- \"q\" \\ \n""#);
 }

@@ -190,7 +190,7 @@ fn the_s_bent_tube_refused_in_the_robowam_part_carried_cell_plans_after_placemen
         ..PlaceRequest::default()
     };
     let placed = place_part(&part, &cell, &req).unwrap();
-    assert!(placed.placement.feasible, "{:#}", placed.summary());
+    assert!(placed.placement.feasible, "{:#?}", placed.summary());
     let again = Cell::from_toml_str(&placed.toml, "placed.toml").unwrap();
     let planned = plan_part(&part, &again, &opts).unwrap();
     assert!(planned.is_feasible(), "{:?}", planned.refusal());
@@ -265,7 +265,7 @@ fn the_s_bent_tube_at_its_own_grid_plans_after_placement() {
     let before = plan_part(&part, &cell, &opts).unwrap();
     assert!(!before.is_feasible(), "the cell as given must refuse it");
     let placed = place_part(&part, &cell, &PlaceRequest::default()).unwrap();
-    assert!(placed.placement.feasible, "{:#}", placed.summary());
+    assert!(placed.placement.feasible, "{:#?}", placed.summary());
     let again = Cell::from_toml_str(&placed.toml, "placed.toml").unwrap();
     let planned = plan_part(&part, &again, &opts).unwrap();
     assert!(planned.is_feasible(), "{:?}", planned.refusal());
@@ -325,7 +325,7 @@ fn a_refused_placement_names_the_joint_limit_as_a_typed_binding() {
     };
     let placed = waam_slicer::place_part(&part, &cell, &req).unwrap();
     let p = &placed.placement;
-    assert!(!p.feasible, "{:#}", placed.summary());
+    assert!(!p.feasible, "{:#?}", placed.summary());
     let binding = p.binding.as_ref().expect("a refused placement names why");
     assert_eq!(binding.limit(), Some(&Limit::Layer(j5)), "{binding:?}");
     assert!(
@@ -337,7 +337,7 @@ fn a_refused_placement_names_the_joint_limit_as_a_typed_binding() {
     );
     assert!(binding.share() > 0.0 && binding.share() <= 1.0);
     assert_eq!(
-        placed.summary()["binding"]["constraint"],
+        serde_json::to_value(placed.summary()).unwrap()["binding"]["constraint"],
         binding.to_string().as_str()
     );
     assert!(binding.to_string().starts_with("J5 travel"), "{binding}");

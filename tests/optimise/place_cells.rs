@@ -135,10 +135,10 @@ fn a_placed_cell_placed_again_finds_itself() {
     let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
     let req = small_search();
     let placed = place_part(&part, &cell, &req).unwrap();
-    assert!(placed.placement.feasible, "{:#}", placed.summary());
+    assert!(placed.placement.feasible, "{:#?}", placed.summary());
     let again = Cell::from_toml_str(&placed.toml, "placed.toml").unwrap();
     let replaced = place_part(&part, &again, &req).unwrap();
-    assert!(replaced.placement.feasible, "{:#}", replaced.summary());
+    assert!(replaced.placement.feasible, "{:#?}", replaced.summary());
     let (a, b) = match (&placed.cell.layout, &replaced.cell.layout) {
         (
             waam_slicer::robot::CellLayout::PartCarried(a),

@@ -1,0 +1,467 @@
+//! The typed content of `summary.json` (`slice`, `plan`) and
+//! `placement.json` (`place`): plain `#[derive(Serialize)]` structs built from
+//! a sliced, planned or placed part, so that a host reads the figures as
+//! fields and the JSON follows from the types. Angles in degrees, lengths in
+//! mm, rates in deg/s, times in s, unless a field's name says otherwise.
+
+use serde::Serialize;
+
+use crate::optimise::positioner::{PositionerLaw, PositionerSeed};
+use crate::optimise::RzLaw;
+use crate::path::distance_map::DistanceStats;
+use crate::toolaxis::NormalMethod;
+
+/// What `slice` and `plan` report of the path (the shared part of
+/// `summary.json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PathSummary {
+    /// The slicing strategy's name.
+    pub strategy: &'static str,
+    /// Delta, the target interlayer distance (mm).
+    pub delta_mm: f64,
+    /// Number of layers.
+    pub layers: usize,
+    /// Number of slices (layers at the same height of a branching path share one).
+    pub slices: usize,
+    /// Number of path points.
+    pub points: usize,
+    /// Arc starts (one per layer, or one for a spiral).
+    pub arc_starts: usize,
+    /// Bead length over the whole path (mm).
+    pub length_mm: f64,
+    /// The process parameters and estimates.
+    pub process: ProcessSummary,
+    /// What the tool-axis stage did.
+    pub tool_axes: ToolAxesSummary,
+    /// The local interlayer distance, overall and per layer (mm; `null` on
+    /// the first slice).
+    pub distance: DistanceSummary,
+}
+
+/// Process parameters and the build's estimates.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProcessSummary {
+    /// The material's name.
+    pub material: String,
+    /// Travel speed of the torch over the part (mm/s).
+    pub travel_speed_mm_s: f64,
+    /// Wire feed speed (mm/s).
+    pub wire_feed_speed_mm_s: f64,
+    /// Arc-on time (s).
+    pub deposition_time_s: f64,
+    /// Wire used (mm).
+    pub wire_length_mm: f64,
+    /// Deposited mass (g).
+    pub deposited_mass_g: f64,
+    /// Points whose travel speed leaves the process window.
+    pub speed_window_violations: usize,
+}
+
+/// The tool-axis stage's report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ToolAxesSummary {
+    /// How the wall normals were obtained.
+    pub normals: NormalMethod,
+    /// Largest angle of a tool axis from the part's Z (deg).
+    pub max_angle_from_z_deg: f64,
+    /// Largest turning rate of the tool axis along the path (deg/mm).
+    pub max_rate_deg_per_mm: f64,
+    /// Points where the lead/tilt rule was active.
+    pub rule_active_points: usize,
+    /// Points where the rule could not be met.
+    pub rule_unreachable_points: usize,
+    /// Points whose axis was smoothed.
+    pub smoothed_points: usize,
+}
+
+/// The local interlayer distances (mm).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DistanceSummary {
+    /// Over the whole path (`null` with a single slice).
+    pub overall: Option<DistanceStats>,
+    /// Per layer, in path order (`null` on the first slice).
+    pub per_layer: Vec<Option<DistanceStats>>,
+}
+
+/// What the slicer did.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SlicerSummary {
+    /// Grid points the layers were sought on.
+    pub grid_points: usize,
+    /// Root findings run.
+    pub root_finds: usize,
+    /// Distance evaluations.
+    pub evaluations: usize,
+    /// Largest residual of a root found (mm).
+    pub max_residual_mm: f64,
+    /// Points dropped at the part's ends.
+    pub truncated_points: usize,
+    /// Why the generation stopped.
+    pub stop: crate::path::StopReason,
+    /// Largest turning angle between consecutive segments before smoothing (deg).
+    pub max_turn_before_deg: f64,
+    /// The same after smoothing (deg).
+    pub max_turn_after_deg: f64,
+}
+
+/// `slice`'s `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SliceSummary {
+    /// The part's name.
+    pub part: String,
+    /// The part file, as given.
+    pub part_file: String,
+    /// What the slicer did.
+    pub slicer: SlicerSummary,
+    /// Run time of each stage (s).
+    pub run_time_s: super::SliceTimes,
+    /// The path, process, tool axes and distances.
+    #[serde(flatten)]
+    pub path: PathSummary,
+}
+
+/// `plan`'s `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlanSummary {
+    /// The part's name.
+    pub part: String,
+    /// The part file, as given.
+    pub part_file: String,
+    /// The cell file, as given.
+    pub cell_file: String,
+    /// The `R_Z` law asked for (its command-line form).
+    pub rz: String,
+    /// Programmed travel speed (mm/s).
+    pub travel_speed_mm_s: f64,
+    /// Every layer feasible.
+    pub feasible: bool,
+    /// The infeasible layers' numbers.
+    pub infeasible_layers: Vec<usize>,
+    /// Layers that no motion of arm and positioner within the cone can
+    /// build, by a bound from the geometry alone (torch-carried cells).
+    pub unbuildable_layers: Vec<UnbuildableLayer>,
+    /// Every violation, as a sentence naming layer, point and joint.
+    pub violations: Vec<String>,
+    /// Per layer.
+    pub layer_plans: Vec<LayerSummary>,
+    /// Between consecutive layers.
+    pub transitions: Vec<TransitionSummary>,
+    /// Filled by the writer of the program files (`null` here).
+    pub program: Option<()>,
+    /// Run time of each stage (s).
+    pub run_time_s: super::PlanTimes,
+    /// The path, process, tool axes and distances.
+    #[serde(flatten)]
+    pub path: PathSummary,
+}
+
+/// A layer proven unbuildable from the geometry.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UnbuildableLayer {
+    /// The layer.
+    pub layer: usize,
+    /// The proof.
+    pub proof: UnbuildableProof,
+    /// The positioner rotation rate the layer needs (deg/s; `null`: unbounded).
+    pub required_rate_deg_s: Option<f64>,
+    /// The rate the positioner can give, `v7 + v8` (deg/s; `null`: unlimited).
+    pub available_rate_deg_s: Option<f64>,
+    /// The two points the required rate is measured between.
+    pub between_points: [usize; 2],
+    /// The first point no positioner path reaches within the cone.
+    pub unreachable_point: Option<usize>,
+}
+
+/// How a layer was proven unbuildable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum UnbuildableProof {
+    /// The positioner cannot turn the part fast enough between two points.
+    Rate,
+    /// No positioner path reaches a point within the cone.
+    Reachability,
+}
+
+/// One layer's plan.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LayerSummary {
+    /// The layer.
+    pub layer: usize,
+    /// Its status (`feasible`, or the binding constraint).
+    pub status: String,
+    /// Feasible.
+    pub feasible: bool,
+    /// The IK branch kept.
+    pub configuration: String,
+    /// Why that branch.
+    pub configuration_reason: String,
+    /// The `R_Z` law found.
+    pub law: LawSummary,
+    /// Points in the layer.
+    pub points: usize,
+    /// The objective's terms.
+    pub objective: ObjectiveSummary,
+    /// Quality figures of the joint trajectory.
+    pub quality: QualitySummary,
+    /// The positioner's laws (torch-carried cell).
+    pub positioner: Option<PositionerSummary>,
+    /// The solver's counts.
+    pub solver: SolverSummary,
+}
+
+/// The `R_Z` law found for a layer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "family", rename_all = "snake_case")]
+pub enum LawSummary {
+    /// Constant.
+    Fixed {
+        /// `R_Z` (deg).
+        rz_deg: f64,
+    },
+    /// Polynomial [eq. 4.1–4.2].
+    Polynomial {
+        /// Degree kept.
+        degree: usize,
+        /// Abscissa: cylindrical angle (rad) when `true`, else the 1-based point index.
+        cylindrical: bool,
+        /// Coefficients (deg per abscissa power), highest power first.
+        coefficients_deg: Vec<f64>,
+        /// `[degree, objective]` for each degree tried.
+        objective_per_degree: Vec<(usize, f64)>,
+    },
+    /// One value per point with a smoothness penalty.
+    SmoothingSpline,
+    /// Point by point.
+    PointByPoint,
+}
+
+impl From<&RzLaw> for LawSummary {
+    fn from(law: &RzLaw) -> Self {
+        match law {
+            RzLaw::Fixed(rz) => Self::Fixed {
+                rz_deg: rz.to_degrees(),
+            },
+            RzLaw::Polynomial {
+                degree,
+                cylindrical,
+                coefficients_deg,
+                objective_per_degree,
+            } => Self::Polynomial {
+                degree: *degree,
+                cylindrical: *cylindrical,
+                coefficients_deg: coefficients_deg.clone(),
+                objective_per_degree: objective_per_degree.clone(),
+            },
+            RzLaw::SmoothingSpline => Self::SmoothingSpline,
+            RzLaw::PointByPoint => Self::PointByPoint,
+        }
+    }
+}
+
+/// The objective's terms for a layer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ObjectiveSummary {
+    /// Weighted joint displacement [eq. 4.3] (rad², weighted).
+    pub joint_displacement: f64,
+    /// Sum of the squared positioning uncertainties (mm²).
+    pub uncertainty_sum_sq_mm2: f64,
+    /// Mean positioning uncertainty (mm).
+    pub mean_uncertainty_mm: f64,
+    /// Centring term (unitless).
+    pub centring: f64,
+}
+
+/// Quality figures of a layer's joint trajectory (J1–J6).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct QualitySummary {
+    /// Travel of each joint (deg).
+    pub joint_travel_deg: Vec<f64>,
+    /// Peak speed of each joint at the travel speed (deg/s).
+    pub peak_speed_deg_s: Vec<f64>,
+    /// Peak acceleration of each joint (deg/s²).
+    pub peak_acceleration_deg_s2: Vec<f64>,
+    /// Summed acceleration of J1–J5 (deg/s).
+    pub summed_acceleration_j1_j5_deg_s: f64,
+    /// Direction reversals of each joint.
+    pub direction_reversals: [usize; 6],
+    /// Smallest dexterity (unitless).
+    pub min_dexterity: f64,
+    /// Smallest distance to a joint stop (deg).
+    pub min_limit_distance_deg: f64,
+    /// The joint (1-based) at that distance.
+    pub min_limit_distance_joint: usize,
+    /// Largest hose torsion (deg).
+    pub max_hose_torsion_deg: f64,
+}
+
+/// One layer's positioner laws (torch-carried cell).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PositionerSummary {
+    /// The start the kept law came from.
+    pub seed: PositionerSeed,
+    /// The law keeps every constraint.
+    pub feasible: bool,
+    /// Its binding constraint, if any.
+    pub binding: Option<String>,
+    /// Largest tilt of `b` from the vertical (deg).
+    pub max_tilt_deg: f64,
+    /// The point of that tilt.
+    pub max_tilt_point: usize,
+    /// The rotation rate the layer needs (deg/s; `null`: unbounded).
+    pub required_rate_deg_s: Option<f64>,
+    /// The rate the positioner gives (deg/s; `null`: unlimited).
+    pub available_rate_deg_s: Option<f64>,
+    /// The points the required rate is measured between.
+    pub required_between_points: [usize; 2],
+    /// Proven unbuildable from the geometry.
+    pub proven_infeasible: bool,
+    /// The first point no positioner path reaches within the cone.
+    pub unreachable_point: Option<usize>,
+    /// SQP iterations.
+    pub iterations: usize,
+    /// Points the law was solved on.
+    pub samples: usize,
+}
+
+impl From<&PositionerLaw> for PositionerSummary {
+    fn from(law: &PositionerLaw) -> Self {
+        Self {
+            seed: law.seed,
+            feasible: law.feasible,
+            binding: law.binding.map(|b| b.to_string()),
+            max_tilt_deg: law.max_tilt_rad.to_degrees(),
+            max_tilt_point: law.max_tilt_point,
+            required_rate_deg_s: finite(law.required_rate_rad_s.to_degrees()),
+            available_rate_deg_s: finite(law.available_rate_rad_s.to_degrees()),
+            required_between_points: [law.required_between.0, law.required_between.1],
+            proven_infeasible: law.proven_infeasible,
+            unreachable_point: law.unreachable_point,
+            iterations: law.iterations,
+            samples: law.samples,
+        }
+    }
+}
+
+/// The solver's counts for a layer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SolverSummary {
+    /// SQP iterations.
+    pub iterations: usize,
+    /// QPs solved.
+    pub qp_solves: usize,
+    /// QPs that failed.
+    pub qp_failures: usize,
+    /// IK branches tried.
+    pub branches_tried: usize,
+    /// Points the law was optimised on (`null`: every point); it is
+    /// certified on every point either way.
+    pub samples: Option<usize>,
+    /// Time (s).
+    pub time_s: f64,
+}
+
+/// Between two consecutive layers.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TransitionSummary {
+    /// From this layer.
+    pub from_layer: usize,
+    /// To this one.
+    pub to_layer: usize,
+    /// Joint change J1–J6 (deg).
+    pub joint_change_deg: Vec<f64>,
+    /// The IK branch changes.
+    pub branch_change: bool,
+    /// Distance to a joint stop at the next layer's start (deg).
+    pub start_limit_distance_deg: f64,
+}
+
+/// A number, `None` (JSON `null`) when not finite (an unbounded rate).
+pub(crate) fn finite(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
+/// Joint angles (rad) in degrees.
+pub(crate) fn deg6(q: &[f64; 6]) -> Vec<f64> {
+    q.iter().map(|v| v.to_degrees()).collect()
+}
+
+/// `place`'s `placement.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlacementSummary {
+    /// A placement was found.
+    pub feasible: bool,
+    /// Each placement variable: its bounds, the value given and the one found.
+    pub variables: Vec<PlacementVariableSummary>,
+    /// The keep-out box, robot base frame (mm).
+    pub keep_out: Option<KeepOutSummary>,
+    /// Worst-layer margins at the placement found.
+    pub margins: crate::place::Margins,
+    /// The same at the cell file's own placement.
+    pub margins_before: crate::place::Margins,
+    /// Candidates screened.
+    pub candidates: usize,
+    /// Candidates certified on the full path.
+    pub certified: usize,
+    /// Feedback rounds.
+    pub rounds: usize,
+    /// The constraint the search stopped on.
+    pub stopped_on: Option<String>,
+    /// Layers of the last subsample.
+    pub subsample_layers: usize,
+    /// Layers of the full path.
+    pub subsample_layers_full: usize,
+    /// Time of each phase (s).
+    pub times: crate::place::PlaceTimes,
+    /// Fraction of the screened candidates feasible on the subsample.
+    pub feasible_fraction: f64,
+    /// The binding constraint and the share of candidates it bound.
+    pub binding: Option<BindingSummary>,
+    /// The infeasible layers of the best plan and their status.
+    pub infeasible_layers: Vec<InfeasibleLayerSummary>,
+    /// The search's time (s).
+    pub time_s: f64,
+}
+
+/// A placement variable in `placement.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlacementVariableSummary {
+    /// Its cell-file name.
+    pub name: &'static str,
+    /// `deg` or `mm`.
+    pub unit: &'static str,
+    /// Lower bound (unit).
+    pub lower: f64,
+    /// Upper bound (unit).
+    pub upper: f64,
+    /// The cell file's value (unit).
+    pub given: f64,
+    /// The value found (unit).
+    pub found: f64,
+}
+
+/// An axis-aligned keep-out box, robot base frame (mm).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct KeepOutSummary {
+    /// Lower corner (mm).
+    pub min_mm: [f64; 3],
+    /// Upper corner (mm).
+    pub max_mm: [f64; 3],
+}
+
+/// Placement's binding constraint.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BindingSummary {
+    /// The constraint, as a sentence.
+    pub constraint: String,
+    /// Share of the candidates it bound (0–1).
+    pub share: f64,
+}
+
+/// An infeasible layer and its status.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct InfeasibleLayerSummary {
+    /// The layer.
+    pub layer: usize,
+    /// Its binding constraint.
+    pub status: String,
+}
