@@ -37,17 +37,17 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
         None => None,
     };
     let mut opts = PlanOptions {
-        rz: a.rz.parse().map_err(|e| input(format!("--rz {e}")))?,
         format,
         ..PlanOptions::default()
-    };
+    }
+    .with_rz(a.rz.parse().map_err(|e| input(format!("--rz {e}")))?);
     opts.slice.max_layers = a.max_layers;
     opts.slice.smoothing = a.smooth.map(|deg| waam_slicer::path::smooth::Smoothing {
         max_turn_rad: deg.to_radians(),
         tolerance: a.smooth_tol,
     });
     if a.positioner == "vertical" {
-        opts.positioner.mode = waam_slicer::optimise::positioner::PositionerMode::Vertical;
+        opts.optimise.positioner.mode = waam_slicer::optimise::positioner::PositionerMode::Vertical;
     }
     a.grid.apply(&mut opts.slice);
     a.axes.apply(&mut opts.slice);

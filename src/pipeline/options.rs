@@ -5,7 +5,9 @@
 use std::fmt;
 use std::str::FromStr;
 
-use crate::optimise::{Abscissa, Parameterisation, DEFAULT_STOP_RELATIVE_GAIN};
+use crate::optimise::{
+    Abscissa, ConfigurationChoice, OptimiseOptions, Parameterisation, DEFAULT_STOP_RELATIVE_GAIN,
+};
 use crate::path::smooth::Smoothing;
 use crate::path::{Discretisation, SliceOptions, Strategy};
 use crate::process::ProcessParameters;
@@ -285,24 +287,55 @@ impl fmt::Display for RzLaw {
 }
 
 /// Options of [`plan_part`](crate::plan_part): the slicing overrides, the
-/// `R_Z` law, the positioner's mode and the program format. Plain data (a
-/// host's progress callback and cancel flag go to
-/// [`plan_part_with`](crate::plan_part_with) as a [`Control`](super::Control));
-/// `Default` plans with the part file's settings, `poly:4` and the cell
+/// program format and the optimiser's options (the `R_Z` law and the
+/// positioner's mode among them). Plain data (a host's progress callback
+/// and cancel flag go to [`plan_part_with`](crate::plan_part_with) as a
+/// [`Control`](super::Control)); `Default` plans with the part file's
+/// settings, `poly:4`, the cell's IK branch on every layer and the cell
 /// robot's vendor's format.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PlanOptions {
     /// Overrides of the part file's slicing, tool-axis and process settings
     /// (the travel speed among them, given once).
     pub slice: SliceOverrides,
-    /// How `R_Z` varies along a layer.
-    pub rz: RzLaw,
     /// Program format; `None`: the cell robot's vendor's. The one place a
     /// format is asked: checked against the cell's robot before any work
     /// (another vendor's is refused), kept as [`PlannedPart::format`](crate::PlannedPart::format)
     /// and written by [`PlannedPart::write_programs`](crate::PlannedPart::write_programs).
     pub format: Option<ProgramFormat>,
-    /// The torch-carried cell's positioner: optimised laws within the cell's
-    /// cone of the vertical (default) or the thesis's exact vertical.
-    pub positioner: crate::optimise::positioner::PositionerOptions,
+    /// The optimiser's options, used as given (the `R_Z` law in
+    /// `parameterisation`, see [`PlanOptions::with_rz`]; the torch-carried
+    /// cell's positioner in `positioner`) but for `travel_speed_mm_s`, which
+    /// is the process's: the part file's or [`SliceOverrides`]'s, the one
+    /// place the travel speed is given.
+    pub optimise: OptimiseOptions,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        Self {
+            slice: SliceOverrides::default(),
+            format: None,
+            optimise: OptimiseOptions {
+                parameterisation: RzLaw::default().0,
+                configuration: ConfigurationChoice::Cell,
+                ..OptimiseOptions::default()
+            },
+        }
+    }
+}
+
+impl PlanOptions {
+    /// These options with the `R_Z` law `law` (its command-line form parses
+    /// into an [`RzLaw`]: `"poly:4"`, `"fixed:90"`, ...).
+    #[must_use]
+    pub fn with_rz(mut self, law: RzLaw) -> Self {
+        self.optimise.parameterisation = law.0;
+        self
+    }
+
+    /// The `R_Z` law of these options.
+    pub fn rz(&self) -> RzLaw {
+        RzLaw(self.optimise.parameterisation)
+    }
 }

@@ -14,8 +14,7 @@ use super::summary::{
 };
 use super::{slice_part_with, Cell, Control, Part, PlanOptions, ProgramFormat, RzLaw, SlicedPart};
 use crate::optimise::{
-    layer_points, optimise_with, trajectory_inputs, ConfigurationChoice, LayerPlan, LayerPoints,
-    OptimiseOptions, Plan,
+    layer_points, optimise_with, trajectory_inputs, LayerPlan, LayerPoints, OptimiseOptions, Plan,
 };
 use crate::program::{
     build_program_with, check_vendor, write_files, LayerRefusal, Program, ProgramError, TravelSpeed,
@@ -143,11 +142,8 @@ pub fn plan_part_with(
     let layers = layer_points(&sliced.path, &sliced.axes.frames);
     let t_axes = sliced.times.tool_axes + t.elapsed().as_secs_f64();
     let optimise_opts = OptimiseOptions {
-        parameterisation: opts.rz.0,
         travel_speed_mm_s: sliced.process.travel_speed_mm_s,
-        configuration: ConfigurationChoice::Cell,
-        positioner: opts.positioner,
-        ..OptimiseOptions::default()
+        ..opts.optimise
     };
     optimise_opts.validate()?;
     control.check("optimising")?;
@@ -180,7 +176,7 @@ pub fn plan_part_with(
         cell: cell.clone(),
         layers,
         optimise: optimise_opts,
-        rz: opts.rz,
+        rz: opts.rz(),
         format,
         plan,
         program,

@@ -145,14 +145,15 @@ impl PyPart {
             ),
         };
         let host = HostControl::new(progress);
-        let opts = PlanOptions {
+        let mut opts = PlanOptions {
             slice,
-            rz,
             format,
-            positioner: PositionerOptions {
-                mode,
-                ..PositionerOptions::default()
-            },
+            ..PlanOptions::default()
+        }
+        .with_rz(rz);
+        opts.optimise.positioner = PositionerOptions {
+            mode,
+            ..PositionerOptions::default()
         };
         let result = py.detach(|| {
             crate::pipeline::plan_part_with(&self.part, &cell.cell, &opts, &host.control)

@@ -68,10 +68,7 @@ fn one_call_plan_writes_a_program_that_reads_back_clean() {
 fn an_infeasible_plan_cannot_write_a_program_and_names_its_layer() {
     let part = Part::read(part_path("hemisphere.toml")).unwrap();
     let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
-    let opts = PlanOptions {
-        rz: "fixed:0".parse().unwrap(),
-        ..small(60)
-    };
+    let opts = small(60).with_rz("fixed:0".parse().unwrap());
     let planned = plan_part(&part, &cell, &opts).unwrap();
     assert!(!planned.is_feasible());
     let first = planned.plan.infeasible_layers().next().unwrap().layer;
@@ -251,10 +248,7 @@ fn a_plans_progress_rises_from_0_to_1() {
     let s2 = seen.clone();
     let control = Control::default()
         .with_progress(move |stage, f| s2.lock().unwrap().push((stage.to_string(), f)));
-    let opts = PlanOptions {
-        rz: "fixed:90".parse().unwrap(),
-        ..small(40)
-    };
+    let opts = small(40).with_rz("fixed:90".parse().unwrap());
     plan_part_with(&part, &cell, &opts, &control).unwrap();
     let seen = seen.lock().unwrap();
     let fractions: Vec<f64> = seen.iter().map(|s| s.1).collect();
