@@ -1187,16 +1187,19 @@ where
         let poses = self.poses;
         let (cl, ct) = &self.controller_cum;
         let (len, turn) = (cl[j] - cl[i], ct[j] - ct[i]);
-        ((i + 1)..j).all(|k| {
-            let s = if len > f64::EPSILON {
-                (cl[k] - cl[i]) / len
-            } else if turn > 0.0 {
-                (ct[k] - ct[i]) / turn
-            } else {
-                0.0
-            };
+        // The controller moves position and orientation on one time
+        // fraction; a planned pose is reached at the fraction its position
+        // gives, or (where the tool centre barely moves, e.g. the flange of
+        // a part turned about J6 under a fixed torch, whose path length is
+        // rounding noise) the fraction its turning gives: either will do.
+        let follows = |k: usize, s: f64| {
             let expected = poses[i].q.slerp(&poses[j].q, s);
             expected.angle_to(&poses[k].q).to_degrees() <= tol
+        };
+        ((i + 1)..j).all(|k| {
+            let by_length = len > f64::EPSILON && follows(k, (cl[k] - cl[i]) / len);
+            let by_turn = turn > 0.0 && follows(k, (ct[k] - ct[i]) / turn);
+            by_length || by_turn || (len <= f64::EPSILON && turn <= 0.0 && follows(k, 0.0))
         })
     }
 
@@ -1951,6 +1954,47 @@ mod tests {
             c.moves.len()
         );
         assert_turntable_moves(&spiral, &c);
+    }
+
+    /// The part held on the flange and turned about the flange axis (J6)
+    /// under a fixed torch: the flange's position is constant but for
+    /// rounding noise (1e-13 mm, as forward kinematics gives it) while its
+    /// orientation turns. The full-rotation check must take each planned
+    /// pose's fraction from the turning, not from the noise: one move for
+    /// 100° of turn (the torch point on a circle of radius 45 mm).
+    #[test]
+    fn a_turn_in_place_is_one_move_despite_position_noise() {
+        let n = 140;
+        let step = 100f64.to_radians() / (n - 1) as f64;
+        let poses: Vec<_> = (0..n)
+            .map(|k| {
+                let noise = if k % 3 == 0 { 1e-13 } else { -2e-13 };
+                ControllerPose::new(
+                    Point3::new(noise, -noise, 0.5 * noise),
+                    UnitQuaternion::from_axis_angle(&Vector3::z_axis(), step * k as f64),
+                    vec![],
+                )
+            })
+            .collect();
+        // the fixed torch at (45, 0, 0) seen from the turned part
+        let map = |pose: &ControllerPose| {
+            let inv = pose.q.inverse();
+            (inv * Point3::new(45.0, 0.0, 0.0), inv * -Vector3::z())
+        };
+        let opts = CompressOptions {
+            rotation_tolerance_deg: Some(DEFAULT_ORIENTATION_TOLERANCE_DEG),
+            ..defaults()
+        };
+        let c = compress(&poses, &[], &map, &opts).expect("valid");
+        assert_eq!(c.moves, vec![Move::Linear { to: n - 1 }]);
+        // the move sweeps the radius-45 circle the planned points lie on: the
+        // error left is the planned polyline's sagitta, 45 (1 - cos(step/2))
+        let sagitta = 45.0 * (1.0 - (0.5 * step).cos());
+        assert!(
+            (c.max_path_error_mm - sagitta).abs() < 1e-6,
+            "{} against {sagitta}",
+            c.max_path_error_mm
+        );
     }
 
     #[test]
