@@ -255,7 +255,7 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
     };
     match opts.parameterisation {
         Parameterisation::Fixed { r_z_rad } => {
-            outcome.law = RzLaw::Fixed(r_z_rad);
+            outcome.law = RzLaw::Fixed { r_z_rad };
             outcome.eval = problem.evaluate(&vec![r_z_rad; p]);
         }
         Parameterisation::PointByPoint => {

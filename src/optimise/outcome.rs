@@ -188,11 +188,17 @@ pub struct ConfigurationChoiceReport {
     pub reason: String,
 }
 
-/// The `R_Z` law of a layer.
-#[derive(Debug, Clone, PartialEq)]
+/// The `R_Z` law of a layer. Serialises (`summary.json`) as an object
+/// tagged by `family` (`fixed`, `polynomial`, `smoothing_spline`,
+/// `point_by_point`) with the variant's fields.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(tag = "family", rename_all = "snake_case")]
 pub enum RzLaw {
-    /// Constant (rad).
-    Fixed(f64),
+    /// Constant.
+    Fixed {
+        /// `R_Z` (rad).
+        r_z_rad: f64,
+    },
     /// Polynomial of `degree` [eq. 4.1–4.2]: coefficients of the thesis's
     /// form (highest power first, degrees, abscissa the 1-based point index
     /// or the cylindrical angle in rad).

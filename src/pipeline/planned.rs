@@ -9,8 +9,8 @@ use serde::ser::SerializeMap;
 use serde::Serialize;
 
 use super::summary::{
-    deg6, finite, LawSummary, LayerSummary, ObjectiveSummary, PlanSummary, PositionerSummary,
-    QualitySummary, SolverSummary, TransitionSummary, UnbuildableLayer, UnbuildableProof,
+    deg6, finite, LayerSummary, ObjectiveSummary, PlanSummary, PositionerSummary, QualitySummary,
+    SolverSummary, TransitionSummary, UnbuildableLayer, UnbuildableProof,
 };
 use super::{slice_part_with, Cell, Control, Part, PlanOptions, ProgramFormat, RzLaw, SlicedPart};
 use crate::optimise::{
@@ -431,7 +431,7 @@ fn layer_summary(l: &LayerPlan) -> LayerSummary {
         feasible: l.status.is_feasible(),
         configuration: l.configuration.chosen.to_string(),
         configuration_reason: l.configuration.reason.clone(),
-        law: LawSummary::from(&l.law),
+        law: l.law.clone(),
         points: l.points.len(),
         objective: ObjectiveSummary {
             joint_displacement: l.objective.joint_displacement,

@@ -196,7 +196,7 @@ pub struct LayerSummary {
     /// Why that branch.
     pub configuration_reason: String,
     /// The `R_Z` law found.
-    pub law: LawSummary,
+    pub law: RzLaw,
     /// Points in the layer.
     pub points: usize,
     /// The objective's terms.
@@ -207,55 +207,6 @@ pub struct LayerSummary {
     pub positioner: Option<PositionerSummary>,
     /// The solver's counts.
     pub solver: SolverSummary,
-}
-
-/// The `R_Z` law found for a layer.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-#[serde(tag = "family", rename_all = "snake_case")]
-pub enum LawSummary {
-    /// Constant.
-    Fixed {
-        /// `R_Z` (deg).
-        rz_deg: f64,
-    },
-    /// Polynomial [eq. 4.1–4.2].
-    Polynomial {
-        /// Degree kept.
-        degree: usize,
-        /// Abscissa: cylindrical angle (rad) when `true`, else the 1-based point index.
-        cylindrical: bool,
-        /// Coefficients (deg per abscissa power), highest power first.
-        coefficients_deg: Vec<f64>,
-        /// `[degree, objective]` for each degree tried.
-        objective_per_degree: Vec<(usize, f64)>,
-    },
-    /// One value per point with a smoothness penalty.
-    SmoothingSpline,
-    /// Point by point.
-    PointByPoint,
-}
-
-impl From<&RzLaw> for LawSummary {
-    fn from(law: &RzLaw) -> Self {
-        match law {
-            RzLaw::Fixed(rz) => Self::Fixed {
-                rz_deg: rz.to_degrees(),
-            },
-            RzLaw::Polynomial {
-                degree,
-                cylindrical,
-                coefficients_deg,
-                objective_per_degree,
-            } => Self::Polynomial {
-                degree: *degree,
-                cylindrical: *cylindrical,
-                coefficients_deg: coefficients_deg.clone(),
-                objective_per_degree: objective_per_degree.clone(),
-            },
-            RzLaw::SmoothingSpline => Self::SmoothingSpline,
-            RzLaw::PointByPoint => Self::PointByPoint,
-        }
-    }
 }
 
 /// The objective's terms for a layer.
