@@ -26,11 +26,17 @@ pub struct TubeFit {
     pub guide_points: Vec<Point3>,
     /// Guide parameter of each point: cumulative chord length (mm).
     pub knots: Vec<f64>,
+    /// Guide parameter of the start end (mm): the first and last guide
+    /// points lie one knot interval past the ends, so that the spline's
+    /// natural end condition (no curvature) falls outside the tube.
+    pub t_min: f64,
+    /// Guide parameter of the other end (mm).
+    pub t_max: f64,
     /// Radius of the (mid-surface) profile at each knot (mm).
     pub radius_mm: Vec<f64>,
     /// Wall thickness at each knot (mm), when two skins were given.
     pub thickness_mm: Option<Vec<f64>>,
-    /// A point of the substrate plane: the guide's start (mm).
+    /// A point of the substrate plane: the guide's point at `t_min` (mm).
     pub substrate_point: Point3,
     /// The substrate's normal, toward the part: the start end's plane.
     pub substrate_normal: UnitVector3,
@@ -42,9 +48,9 @@ pub struct TubeFit {
 }
 
 impl TubeFit {
-    /// Length of the guide's parameter range (mm).
+    /// Length of the tube's parameter range `t_max - t_min` (mm).
     pub fn length(&self) -> f64 {
-        *self.knots.last().expect("at least 3 knots")
+        self.t_max - self.t_min
     }
 
     /// The guide curve.
@@ -115,11 +121,12 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
     while iterations < opts.max_iterations {
         iterations += 1;
         let spline = spline_of(mesh, &guide)?;
-        let len = chord_knots(&guide)[guide.len() - 1];
-        let t = project_all(&spline, len, &samples, hints.as_deref(), 2.0 * r0);
-        let stations = sections(&spline, len, spacing, &samples, &t);
-        let knots = smooth::graded_knots(len, knot_h, spacing);
-        let next = refit_guide(mesh, &stations, &knots)?;
+        let range = tube_range(&guide);
+        let t = project_all(&spline, range, &samples, hints.as_deref(), 2.0 * r0);
+        let stations = sections(&spline, range, spacing, &samples, &t);
+        let knots = fit_knots(range, knot_h, spacing);
+        let mut next = refit_guide(mesh, &stations, &knots)?;
+        anchor_ends(&mut next, &start, &finish);
         last_move = knots
             .iter()
             .zip(&next)
@@ -134,9 +141,9 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
     }
     let spline = spline_of(mesh, &guide)?;
     let knots = chord_knots(&guide);
-    let len = knots[knots.len() - 1];
-    let t = project_all(&spline, len, &samples, hints.as_deref(), 2.0 * r0);
-    let stations = sections(&spline, len, spacing, &samples, &t);
+    let range = tube_range(&guide);
+    let t = project_all(&spline, range, &samples, hints.as_deref(), 2.0 * r0);
+    let stations = sections(&spline, range, spacing, &samples, &t);
     check_sections(mesh, &stations, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick);
     let mut radius_mm = law(&|s| s.radius)?;
@@ -151,14 +158,16 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
     };
     let outer = outer_skin(&stations);
     let mut normal = start.normal;
-    if normal.dot(&spline.d1(0.0)) < 0.0 {
+    if normal.dot(&spline.d1(range.0)) < 0.0 {
         normal = -normal;
     }
-    let tilt = normal.angle(&spline.d1(0.0));
+    let tilt = normal.angle(&spline.d1(range.0));
     let extend_before_mm = start.radius * tilt.tan().min(10.0) + 1.0;
     let mut fit = TubeFit {
         file: mesh.file.clone(),
-        substrate_point: guide[0],
+        substrate_point: guide[1],
+        t_min: range.0,
+        t_max: range.1,
         guide_points: guide,
         knots,
         radius_mm,
@@ -208,6 +217,24 @@ fn spline_of(mesh: &TubeMesh, points: &[Point3]) -> Result<CubicSpline, FitError
         station: 0,
         reason: format!("the guide's spline: {e}"),
     })
+}
+
+/// The tube's parameter range: from the second guide point to the one
+/// before last (the outer points lie past the ends).
+fn tube_range(points: &[Point3]) -> (f64, f64) {
+    let k = chord_knots(points);
+    (k[1], k[k.len() - 2])
+}
+
+/// Knots of the refit: graded over the tube's range, plus one knot past
+/// each end (as far as the first interval is long).
+fn fit_knots(range: (f64, f64), knot_h: f64, spacing: f64) -> Vec<f64> {
+    let inner = smooth::graded_knots(range.1 - range.0, knot_h, spacing);
+    let (first, last) = (inner[1] - inner[0], inner[inner.len() - 1] - inner[inner.len() - 2]);
+    let mut k = vec![range.0 - first];
+    k.extend(inner.iter().map(|x| x + range.0));
+    k.push(range.1 + last);
+    k
 }
 
 /// Cumulative chord lengths of `points` (mm): the spline guide's `t`.
@@ -393,15 +420,28 @@ fn initial_guide(
             found: "the two open ends have the same centre".into(),
         });
     }
+    // One point past each end, along the end chord.
+    let n = pts.len();
+    let before = pts[0] + (pts[0] - pts[1]).normalize() * (0.25 * knot_h);
+    let after = pts[n - 1] + (pts[n - 1] - pts[n - 2]).normalize() * (0.25 * knot_h);
+    pts.insert(0, before);
+    pts.push(after);
     Ok(pts)
 }
 
 /// Guide parameter of the nearest guide point of every sample: Newton from
 /// the hint, or from the nearest point of a polyline of the guide (parry3d
 /// BVH query) when there is no hint or Newton does not settle.
-fn project_all(spline: &CubicSpline, len: f64, s: &Samples, hints: Option<&[f64]>, ext: f64) -> Vec<f64> {
-    let n = ((len + 2.0 * ext) / 0.5).ceil().clamp(16.0, 20_000.0) as usize;
-    let ts: Vec<f64> = (0..=n).map(|i| -ext + (len + 2.0 * ext) * i as f64 / n as f64).collect();
+fn project_all(
+    spline: &CubicSpline,
+    range: (f64, f64),
+    s: &Samples,
+    hints: Option<&[f64]>,
+    ext: f64,
+) -> Vec<f64> {
+    let (lo, hi) = (range.0 - ext, range.1 + ext);
+    let n = ((hi - lo) / 0.5).ceil().clamp(16.0, 20_000.0) as usize;
+    let ts: Vec<f64> = (0..=n).map(|i| lo + (hi - lo) * i as f64 / n as f64).collect();
     let line = Polyline::new(ts.iter().map(|&t| spline.point(t)).collect(), None);
     let global = |p: &Point3| {
         let (_, (seg, loc)) = line.project_local_point_and_get_location(p, false);
@@ -413,11 +453,11 @@ fn project_all(spline: &CubicSpline, len: f64, s: &Samples, hints: Option<&[f64]
         .enumerate()
         .map(|(i, p)| {
             let hint = hints.and_then(|h| h.get(i).copied());
-            match hint.and_then(|t0| newton(spline, p, t0, -ext, len + ext)) {
+            match hint.and_then(|t0| newton(spline, p, t0, lo, hi)) {
                 Some(t) => t,
                 None => {
                     let t0 = global(p);
-                    newton(spline, p, t0, -ext, len + ext).unwrap_or(t0)
+                    newton(spline, p, t0, lo, hi).unwrap_or(t0)
                 }
             }
         })
@@ -451,24 +491,25 @@ fn rotate(a: &Vector3, b: &Vector3, x: &Vector3) -> Vector3 {
     x * c + v.cross(x) + v * (v.dot(x) / (1.0 + c))
 }
 
-/// Stations every `spacing` mm over `[0, len]`; each takes the samples
+/// Stations every `spacing` mm over the tube's range; each takes the samples
 /// whose nearest guide parameter is nearest to it, carried into its normal
 /// plane by the minimal rotation of their own normal plane, and fits one
 /// circle per skin.
-fn sections(spline: &CubicSpline, len: f64, spacing: f64, s: &Samples, t: &[f64]) -> Vec<Station> {
+fn sections(spline: &CubicSpline, range: (f64, f64), spacing: f64, s: &Samples, t: &[f64]) -> Vec<Station> {
+    let len = range.1 - range.0;
     let n = ((len / spacing).ceil() as usize).max(2);
     let step = len / n as f64;
     let mut bins: Vec<Vec<SectionPoint>> = vec![Vec::new(); (n + 1) * s.skins];
     let frames: Vec<(f64, Point3, Vector3, Vector3, Vector3)> = (0..=n)
         .map(|i| {
-            let ti = i as f64 * step;
+            let ti = range.0 + i as f64 * step;
             let tan = UnitVector3::new_normalize(spline.d1(ti));
             let (e1, e2) = plane_basis(&tan);
             (ti, spline.point(ti), tan.into_inner(), e1, e2)
         })
         .collect();
     for (k, (p, &tv)) in s.pos.iter().zip(t).enumerate() {
-        let i = ((tv / step).round().max(0.0) as usize).min(n);
+        let i = (((tv - range.0) / step).round().max(0.0) as usize).min(n);
         let (ti, _, tan_i, e1, e2) = &frames[i];
         let o = p - spline.point(tv);
         let o = rotate(&spline.d1(tv).normalize(), tan_i, &o);
@@ -536,6 +577,24 @@ fn refit_guide(mesh: &TubeMesh, stations: &[Station], knots: &[f64]) -> Result<V
         });
     }
     Ok(pts)
+}
+
+/// Slides each end point of the guide along its end chord onto its open
+/// end's plane: the guide runs from end to end (a least-squares refit alone
+/// lets the ends creep along the tangent).
+fn anchor_ends(points: &mut [Point3], start: &EndRing, finish: &EndRing) {
+    let n = points.len();
+    for (i, j, ring) in [(1, 2, start), (n - 2, n - 3, finish)] {
+        let d = points[j] - points[i];
+        let along = d.dot(&ring.normal);
+        if along.abs() > 0.2 * d.norm() {
+            let s = (ring.centre - points[i]).dot(&ring.normal) / along;
+            // Never past the neighbouring point.
+            if s < 0.9 {
+                points[i] += d * s;
+            }
+        }
+    }
 }
 
 /// A law over `knots` fitted to the stations' values.

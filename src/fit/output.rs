@@ -115,8 +115,8 @@ impl TubeFit {
             frame: FrameSpec::default(),
             profile: self.profile_spec(),
             range: RangeSpec {
-                t_min: Scalar::Number(0.0),
-                t_max: Scalar::Number(self.length()),
+                t_min: Scalar::Number(self.t_min),
+                t_max: Scalar::Number(self.t_max),
                 extend_before: Some(Scalar::Number(self.extend_before_mm)),
                 extend_after: None,
             },

@@ -144,42 +144,31 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> FitReport {
     let guide = fit.guide();
     let len = fit.length();
     let m_r = smooth::natural_second_derivatives(&fit.knots, &fit.radius_mm);
-    let radius = |t: f64| smooth::eval(&fit.knots, &fit.radius_mm, &m_r, t.clamp(0.0, len));
+    let radius = |t: f64| smooth::eval(&fit.knots, &fit.radius_mm, &m_r, t);
     let thick = fit.thickness_mm.as_ref().map(|e| {
         let m = smooth::natural_second_derivatives(&fit.knots, e);
-        move |t: f64| smooth::eval(&fit.knots, e, &m, t.clamp(0.0, len))
+        move |t: f64| smooth::eval(&fit.knots, e, &m, t)
     });
     let skin_radius = |skin: u8, t: f64| match &thick {
         Some(e) if skin as usize == cx.outer => radius(t) + 0.5 * e(t),
         Some(e) => radius(t) - 0.5 * e(t),
         None => radius(t),
     };
-    // Distance of each vertex to the fitted surface (a finite tube: beyond an
-    // end, the distance to that end's circle).
+    // Distance of each vertex to the fitted surface: past an end, to the
+    // surface as the part extends it (the substrate, not the end's normal
+    // plane, cuts the built tube).
     let dist: Vec<f64> = cx
         .samples_pos
         .par_iter()
         .zip(cx.t.par_iter())
         .zip(cx.samples_skin.par_iter())
-        .map(|((p, &t), &skin)| {
-            let tc = t.clamp(0.0, len);
-            let o = p - guide.point(tc);
-            let a = skin_radius(skin, tc);
-            if tc == t {
-                (o.norm() - a).abs()
-            } else {
-                let tan = guide.d1(tc).normalize();
-                let axial = o.dot(&tan);
-                let radial = (o - tan * axial).norm();
-                (axial * axial + (radial - a).powi(2)).sqrt()
-            }
-        })
+        .map(|((p, &t), &skin)| ((p - guide.point(t)).norm() - skin_radius(skin, t)).abs())
         .collect();
     let n = cx.stations.len();
     let step = len / (n - 1).max(1) as f64;
     let mut sums = vec![(0.0, 0usize); n];
     for (&t, &d) in cx.t.iter().zip(&dist) {
-        let i = ((t / step).round().max(0.0) as usize).min(n - 1);
+        let i = (((t - fit.t_min) / step).round().max(0.0) as usize).min(n - 1);
         sums[i].0 += d * d;
         sums[i].1 += 1;
     }

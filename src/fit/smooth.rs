@@ -108,6 +108,28 @@ pub fn fit(
             }
         }
     }
+    // Third differences over the first and last four knots, weighted as one
+    // average station: past the data, the curve goes on with the curvature
+    // it has at its ends (a circle's third derivative is small; a natural
+    // end's zero curvature is not imposed).
+    if nk >= 4 {
+        let station = weights.iter().sum::<f64>() / weights.len().max(1) as f64;
+        for first in [0, nk - 4] {
+            let x = &knots[first..first + 4];
+            let h = (x[3] - x[0]) / 3.0;
+            let row: Vec<f64> = (0..4)
+                .map(|i| {
+                    let den: f64 = (0..4).filter(|&j| j != i).map(|j| x[i] - x[j]).product();
+                    6.0 * h * h * h / den
+                })
+                .collect();
+            for (a, ra) in row.iter().enumerate() {
+                for (b, rb) in row.iter().enumerate() {
+                    normal[(first + a, first + b)] += station * ra * rb;
+                }
+            }
+        }
+    }
     let sol = normal.cholesky()?.solve(&rhs);
     sol.iter().all(|x| x.is_finite()).then_some(sol)
 }

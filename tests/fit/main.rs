@@ -335,3 +335,20 @@ fn binary_and_ascii_stl_files_give_the_same_fit() {
     assert!(json["stations"].as_array().unwrap().len() > 10);
     Part::read(&files[0]).unwrap();
 }
+
+#[test]
+#[ignore]
+fn scratch_debug() {
+    let truth = gen::torus();
+    let (v, f) = gen::mesh(&truth, 0.5, 0.0, 0.0, 1);
+    let fitted = fit_mesh(v, f, "t.stl", &FitOptions::default()).unwrap();
+    let r = fitted.report();
+    eprintln!("max at {:?} start {:?} end {:?} len {} knots {:?}", r.max_at_mm, r.start, r.end, r.length_mm, &fitted.fit.knots);
+    for s in r.stations.iter().take(5).chain(r.stations.iter().rev().take(5)) {
+        eprintln!("{:?}", s);
+    }
+    for p in fitted.fit.guide_points.iter().take(4).chain(fitted.fit.guide_points.iter().rev().take(4)) {
+        eprintln!("{p:?}");
+    }
+    eprintln!("truth end {:?}", (truth.centre)(truth.length));
+}
