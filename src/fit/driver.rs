@@ -117,16 +117,39 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
         .max(1.5 * spacing);
     let mut guide = initial_guide(mesh, &surf, &start, &finish, edge, knot_h)?;
     let mut hints: Option<Vec<f64>> = None;
+    // The radius law's slope from the previous pass (none at first).
+    let mut slope: Option<(Vec<f64>, Vec<f64>)> = None;
     let (mut iterations, mut converged, mut last_move) = (0, false, f64::INFINITY);
+    let first_length = {
+        let r = tube_range(&guide);
+        r.1 - r.0
+    };
     while iterations < opts.max_iterations {
         iterations += 1;
         let spline = spline_of(mesh, &guide)?;
         let range = tube_range(&guide);
         let t = project_all(&spline, range, &samples, hints.as_deref(), 2.0 * r0);
-        let stations = sections(&spline, range, spacing, &samples, &t);
+        if range.1 - range.0 > 3.0 * first_length {
+            return Err(FitError::Degenerate {
+                file: mesh.file.clone(),
+                station: 0,
+                reason: format!(
+                    "the guide diverged ({:.1} mm long, from {first_length:.1} mm)",
+                    range.1 - range.0
+                ),
+            });
+        }
+        let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref());
+        if iterations > 1 {
+            check_sections(mesh, &stations, opts)?;
+        }
         let knots = fit_knots(range, knot_h, spacing);
+        slope = fit_law(mesh, &stations, &knots, &|s| s.radius)
+            .ok()
+            .map(|v| (knots.clone(), v));
         let mut next = refit_guide(mesh, &stations, &knots)?;
         anchor_ends(&mut next, &start, &finish);
+        let previous = last_move;
         last_move = knots
             .iter()
             .zip(&next)
@@ -134,7 +157,9 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
             .fold(0.0, f64::max);
         hints = Some(t);
         guide = next;
-        if last_move < opts.tolerance_mm {
+        // Converged, or stalled at the level of the mesh's noise.
+        let stalled = last_move < 10.0 * opts.tolerance_mm && last_move > 0.8 * previous;
+        if last_move < opts.tolerance_mm || stalled {
             converged = true;
             break;
         }
@@ -143,7 +168,7 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
     let knots = chord_knots(&guide);
     let range = tube_range(&guide);
     let t = project_all(&spline, range, &samples, hints.as_deref(), 2.0 * r0);
-    let stations = sections(&spline, range, spacing, &samples, &t);
+    let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref());
     check_sections(mesh, &stations, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick);
     let mut radius_mm = law(&|s| s.radius)?;
@@ -264,7 +289,7 @@ fn ring(mesh: &TubeMesh, vertices: &[u32]) -> Option<(Point3, UnitVector3, f64)>
             dt: 0.0,
         })
         .collect();
-    let f = fit_circle(&sp)?;
+    let f = fit_circle(&sp, 0.0)?;
     Some((c + e1 * f.centre[0] + e2 * f.centre[1], n, f.radius))
 }
 
@@ -495,7 +520,21 @@ fn rotate(a: &Vector3, b: &Vector3, x: &Vector3) -> Vector3 {
 /// whose nearest guide parameter is nearest to it, carried into its normal
 /// plane by the minimal rotation of their own normal plane, and fits one
 /// circle per skin.
-fn sections(spline: &CubicSpline, range: (f64, f64), spacing: f64, s: &Samples, t: &[f64]) -> Vec<Station> {
+fn sections(
+    spline: &CubicSpline,
+    range: (f64, f64),
+    spacing: f64,
+    s: &Samples,
+    t: &[f64],
+    law: Option<&(Vec<f64>, Vec<f64>)>,
+) -> Vec<Station> {
+    let law = law.map(|(k, v)| (k, v, smooth::natural_second_derivatives(k, v)));
+    let slope_at = |t: f64| {
+        law.as_ref().map_or(0.0, |(k, v, m)| {
+            let h = 0.5 * spacing;
+            (smooth::eval(k, v, m, t + h) - smooth::eval(k, v, m, t - h)) / (2.0 * h)
+        })
+    };
     let len = range.1 - range.0;
     let n = ((len / spacing).ceil() as usize).max(2);
     let step = len / n as f64;
@@ -519,14 +558,26 @@ fn sections(spline: &CubicSpline, range: (f64, f64), spacing: f64, s: &Samples, 
             dt: tv - ti,
         });
     }
+    // A station with under half the usual points is a partial ring (past an
+    // end cut obliquely): left out.
+    let mut counts: Vec<usize> = (0..=n)
+        .map(|i| (0..s.skins).map(|k| bins[i * s.skins + k].len()).sum())
+        .collect();
+    let median = *counts.select_nth_unstable(n / 2).1;
     frames
         .par_iter()
         .enumerate()
         .map(|(i, (ti, c, _, e1, e2))| {
-            let fits: Vec<Option<CircleFit>> =
-                (0..s.skins).map(|k| fit_circle(&bins[i * s.skins + k])).collect();
+            let slope = slope_at(*ti);
+            let fits: Vec<Option<CircleFit>> = (0..s.skins)
+                .map(|k| fit_circle(&bins[i * s.skins + k], slope))
+                .collect();
             let points = (0..s.skins).map(|k| bins[i * s.skins + k].len()).sum();
-            let all: Option<Vec<CircleFit>> = fits.iter().copied().collect();
+            let all: Option<Vec<CircleFit>> = if 2 * points >= median {
+                fits.iter().copied().collect()
+            } else {
+                None
+            };
             let (centre, radius, thickness) = match all {
                 Some(f) => {
                     let m = f.len() as f64;
@@ -639,10 +690,13 @@ fn outer_skin(stations: &[Station]) -> usize {
     usize::from(stations.first().is_some_and(|s| s.fits.len() == 2) && mean(1) > mean(0))
 }
 
-/// Refuses a section far from a circle or not closed.
+/// Refuses a section far from a circle, or a run of three sections that are
+/// not closed rings (one alone is a ring split between two stations).
 fn check_sections(mesh: &TubeMesh, stations: &[Station], opts: &FitOptions) -> Result<(), FitError> {
     let gap_max = opts.max_section_gap_deg.to_radians();
+    let mut run = 0;
     for (i, s) in stations.iter().enumerate() {
+        let mut open = None;
         for (k, f) in s.fits.iter().enumerate() {
             let Some(f) = f else { continue };
             let skin = if s.fits.len() == 2 { format!("skin {k}: ") } else { String::new() };
@@ -659,17 +713,21 @@ fn check_sections(mesh: &TubeMesh, stations: &[Station], opts: &FitOptions) -> R
                 });
             }
             if f.max_gap_rad > gap_max {
-                return Err(FitError::SectionNotCircle {
-                    file: mesh.file.clone(),
-                    station: i,
-                    t_mm: s.t,
-                    found: format!(
-                        "{skin}the points leave a gap of {:.0} degrees around the circle (allowed {:.0})",
-                        f.max_gap_rad.to_degrees(),
-                        opts.max_section_gap_deg
-                    ),
-                });
+                open = Some((skin, f.max_gap_rad));
             }
+        }
+        run = if open.is_some() { run + 1 } else { 0 };
+        if let (Some((skin, gap)), 3) = (open, run) {
+            return Err(FitError::SectionNotCircle {
+                file: mesh.file.clone(),
+                station: i - 2,
+                t_mm: stations[i - 2].t,
+                found: format!(
+                    "{skin}not a closed ring: the points of this station and the next two leave a gap of up to {:.0} degrees around the circle (allowed {:.0})",
+                    gap.to_degrees(),
+                    opts.max_section_gap_deg
+                ),
+            });
         }
     }
     Ok(())

@@ -65,7 +65,8 @@ pub struct FitOptions {
     /// above it the section is refused as not near a circle.
     pub max_section_rms_ratio: f64,
     /// Largest angular gap (degrees) between a section's points around its
-    /// circle; above it the section is refused as not a closed ring.
+    /// circle; three stations in a row above it are refused as not a closed
+    /// ring.
     pub max_section_gap_deg: f64,
     /// Spacing (mm) of the stations along the guide where a circle is fitted;
     /// `None`: twice the median edge length, within `[0.5, radius / 4]`.
@@ -74,7 +75,9 @@ pub struct FitOptions {
     /// the tube; quarter and half of it next to each end. `None`: half the
     /// radius at the start, within `[4, 12]`.
     pub knot_spacing_mm: Option<f64>,
-    /// The iteration stops once no guide point moves more than this (mm).
+    /// The iteration stops once no guide point moves more than this (mm),
+    /// or once the moves, under ten times this, stop shrinking (the level of
+    /// the mesh's noise).
     pub tolerance_mm: f64,
     /// Most refits of the guide.
     pub max_iterations: usize,

@@ -1,5 +1,5 @@
-//! **The problem of one section**: a least-squares circle whose radius may
-//! vary linearly along the guide, fitted to points carried into the plane
+//! **The problem of one section**: a least-squares circle whose radius
+//! varies along the guide at a given rate, fitted to points carried into the plane
 //! normal to the guide at a station (station-plane coordinates, mm), and the
 //! least-squares plane of a point set (for the open ends and flat faces).
 //!
@@ -8,7 +8,7 @@
 //! equations with nalgebra's Cholesky factorisation.
 
 use crate::math::{Point3, UnitVector3, Vector3};
-use nalgebra::{Matrix3, Matrix4, SymmetricEigen, Vector4};
+use nalgebra::{Matrix3, SymmetricEigen};
 
 /// One point of a section: `x`, `y` in the station plane (mm, any
 /// orthonormal basis normal to the guide) and `dt`, its guide parameter
@@ -23,14 +23,15 @@ pub struct SectionPoint {
     pub dt: f64,
 }
 
-/// A fitted circle: `|p - centre| = radius + slope * dt` (station plane, mm).
+/// A fitted circle: `|p - centre| = radius + slope * dt` (station plane, mm),
+/// `slope` given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CircleFit {
     /// Centre in the station plane (mm).
     pub centre: [f64; 2],
     /// Radius at the station (mm).
     pub radius: f64,
-    /// Change of the radius along the guide (mm per mm).
+    /// Change of the radius along the guide (mm per mm), as given.
     pub slope: f64,
     /// RMS of the points' distances to the circle (mm).
     pub rms: f64,
@@ -45,17 +46,21 @@ pub struct CircleFit {
 /// Fewest points a section needs.
 pub const MIN_SECTION_POINTS: usize = 6;
 
-/// Fits a circle to `points`. `None` with fewer than [`MIN_SECTION_POINTS`]
-/// points, collinear points, or a non-finite result.
-pub fn fit_circle(points: &[SectionPoint]) -> Option<CircleFit> {
+/// Fits a circle to `points`, whose radius changes by `slope` (mm per mm)
+/// with their `dt`. The slope is given, not fitted: in a section cut
+/// obliquely, `dt` varies with the angle around the circle and a fitted
+/// slope would trade itself for a shift of the centre.
+/// `None` with fewer than [`MIN_SECTION_POINTS`] points, collinear points,
+/// or a non-finite result.
+pub fn fit_circle(points: &[SectionPoint], slope: f64) -> Option<CircleFit> {
     if points.len() < MIN_SECTION_POINTS {
         return None;
     }
     let n = points.len() as f64;
     // Work about the mean for conditioning.
-    let (mx, my, mt) = points.iter().fold((0.0, 0.0, 0.0), |a, p| {
-        (a.0 + p.x / n, a.1 + p.y / n, a.2 + p.dt / n)
-    });
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |a, p| (a.0 + p.x / n, a.1 + p.y / n));
     // Kåsa: x² + y² + D x + E y + F = 0 in least squares.
     let mut a = Matrix3::zeros();
     let mut b = Vector3::zeros();
@@ -71,33 +76,30 @@ pub fn fit_circle(points: &[SectionPoint]) -> Option<CircleFit> {
     if !(r2 > 0.0) {
         return None;
     }
-    let mut p4 = Vector4::new(cx, cy, r2.sqrt(), 0.0);
-    // Gauss–Newton on (cx, cy, r0, r1): residual |p - c| - r0 - r1 dt.
+    let mut p3 = Vector3::new(cx, cy, r2.sqrt());
+    // Gauss–Newton on (cx, cy, r0): residual |p - c| - r0 - slope dt.
     for _ in 0..20 {
-        let mut jtj = Matrix4::zeros();
-        let mut jtr = Vector4::zeros();
+        let mut jtj = Matrix3::zeros();
+        let mut jtr = Vector3::zeros();
         for p in points {
-            let (dx, dy) = (p.x - mx - p4[0], p.y - my - p4[1]);
+            let (dx, dy) = (p.x - mx - p3[0], p.y - my - p3[1]);
             let d = (dx * dx + dy * dy).sqrt().max(1e-12);
-            let dt = p.dt - mt;
-            let res = d - p4[2] - p4[3] * dt;
-            let j = Vector4::new(-dx / d, -dy / d, -1.0, -dt);
+            let res = d - p3[2] - slope * p.dt;
+            let j = Vector3::new(-dx / d, -dy / d, -1.0);
             jtj += j * j.transpose();
             jtr += j * res;
         }
-        // A tiny ridge on the slope: a section of one ring cannot see it.
-        jtj[(3, 3)] += 1e-9 * n;
         let step = jtj.cholesky()?.solve(&jtr);
-        p4 -= step;
-        if !p4.iter().all(|x| x.is_finite()) {
+        p3 -= step;
+        if !p3.iter().all(|x| x.is_finite()) {
             return None;
         }
-        if step.norm() < 1e-12 * (1.0 + p4[2].abs()) {
+        if step.norm() < 1e-12 * (1.0 + p3[2].abs()) {
             break;
         }
     }
-    (cx, cy) = (p4[0], p4[1]);
-    let (r0, r1) = (p4[2], p4[3]);
+    (cx, cy) = (p3[0], p3[1]);
+    let r0 = p3[2];
     if !(r0 > 0.0) {
         return None;
     }
@@ -105,7 +107,7 @@ pub fn fit_circle(points: &[SectionPoint]) -> Option<CircleFit> {
     let mut angles = Vec::with_capacity(points.len());
     for p in points {
         let (dx, dy) = (p.x - mx - cx, p.y - my - cy);
-        let res = (dx * dx + dy * dy).sqrt() - r0 - r1 * (p.dt - mt);
+        let res = (dx * dx + dy * dy).sqrt() - r0 - slope * p.dt;
         ss += res * res;
         max_dev = max_dev.max(res.abs());
         angles.push(dy.atan2(dx));
@@ -115,11 +117,10 @@ pub fn fit_circle(points: &[SectionPoint]) -> Option<CircleFit> {
     for w in angles.windows(2) {
         gap = gap.max(w[1] - w[0]);
     }
-    // Back to the station: the radius at dt = 0.
     let fit = CircleFit {
         centre: [cx + mx, cy + my],
-        radius: r0 - r1 * mt,
-        slope: r1,
+        radius: r0,
+        slope,
         rms: (ss / n).sqrt(),
         max_dev,
         max_gap_rad: gap,
@@ -182,9 +183,9 @@ mod tests {
                 }
             })
             .collect();
-        let f = fit_circle(&pts).unwrap();
+        let f = fit_circle(&pts, 0.1).unwrap();
         assert!((f.centre[0] - 3.0).abs() < 1e-9 && (f.centre[1] + 2.0).abs() < 1e-9);
-        assert!((f.radius - 10.0).abs() < 1e-9 && (f.slope - 0.1).abs() < 1e-9);
+        assert!((f.radius - 10.0).abs() < 1e-9);
         assert!(f.rms < 1e-9);
     }
 
@@ -200,7 +201,7 @@ mod tests {
                 }
             })
             .collect();
-        let f = fit_circle(&pts).unwrap();
+        let f = fit_circle(&pts, 0.0).unwrap();
         assert!((f.max_gap_rad - std::f64::consts::PI).abs() < 1e-6);
     }
 }

@@ -170,9 +170,21 @@ pub fn frames(t: &Truth, rings: usize) -> Vec<(f64, Point3, Vector3, Vector3)> {
 /// A mesh of the tube's surface with edges about `h` mm, `noise_mm` of
 /// Gaussian noise on each coordinate; `offset` is added to the radius (a skin).
 pub fn mesh(t: &Truth, h: f64, noise_mm: f64, offset: f64, seed: u64) -> (Vec<Point3>, Vec<[u32; 3]>) {
-    let rings = (t.length / h).ceil() as usize;
     let rmax = (0..=100).map(|i| (t.radius)(t.length * i as f64 / 100.0)).fold(0.0, f64::max) + offset;
     let around = ((TAU * rmax / h).ceil() as usize).max(8);
+    mesh_around(t, h, around, noise_mm, offset, seed)
+}
+
+/// As [`mesh`] with `around` points on each ring.
+pub fn mesh_around(
+    t: &Truth,
+    h: f64,
+    around: usize,
+    noise_mm: f64,
+    offset: f64,
+    seed: u64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let rings = (t.length / h).ceil() as usize;
     let mut rng = Rng::new(seed);
     let mut v = Vec::new();
     for (i, (s, x, ti, n)) in frames(t, rings).into_iter().enumerate() {

@@ -178,9 +178,10 @@ fn two_skins_give_the_mid_surface_and_the_wall_thickness() {
 fn a_watertight_wall_is_split_into_its_skins() {
     // Outer and inner skins joined by flat annular end faces.
     let truth = gen::straight();
-    let (mut v, mut f) = gen::mesh(&truth, 1.0, 0.0, 1.0, 0);
-    let (vi, fi) = gen::mesh(&truth, 1.0, 0.0, -1.0, 0);
-    let around = (std::f64::consts::TAU * 16.0 / 1.0).ceil() as u32;
+    let around = 100;
+    let (mut v, mut f) = gen::mesh_around(&truth, 1.0, around, 0.0, 1.0, 0);
+    let (vi, fi) = gen::mesh_around(&truth, 1.0, around, 0.0, -1.0, 0);
+    let around = around as u32;
     let rings = (v.len() as u32) / around;
     let base = v.len() as u32;
     v.extend(vi);
@@ -215,7 +216,7 @@ fn the_start_end_is_the_lowest_or_the_capped_one() {
         f.push([last + j, last + (j + 1) % around, centre]);
     }
     let low = fit_mesh(v.clone(), f.clone(), "cup.stl", &FitOptions::default()).unwrap();
-    let p0 = low.fit.guide_points[0];
+    let p0 = low.fit.substrate_point;
     assert!(p0.z.abs() < 0.05, "{p0}");
     assert!(!low.report().start.capped && low.report().end.capped);
     let opts = FitOptions {
@@ -223,7 +224,7 @@ fn the_start_end_is_the_lowest_or_the_capped_one() {
         ..FitOptions::default()
     };
     let capped = fit_mesh(v, f, "cup.stl", &opts).unwrap();
-    let p0 = capped.fit.guide_points[0];
+    let p0 = capped.fit.substrate_point;
     assert!((p0.z - truth.length).abs() < 0.05, "{p0}");
     assert!(capped.fit.substrate_normal.z < -0.999, "the substrate faces the part");
 }
@@ -274,7 +275,7 @@ fn a_branch_is_refused_naming_the_station() {
         panic!("{msg}")
     };
     assert!(msg.starts_with("y.stl: not one tube: a branch at station"), "{msg}");
-    assert!(station > 0 && (z - 30.0).abs() < 6.0, "{msg}");
+    assert!(station > 0 && z > 30.0 && z < 50.0, "{msg}");
 }
 
 #[test]
@@ -339,8 +340,12 @@ fn binary_and_ascii_stl_files_give_the_same_fit() {
 #[test]
 #[ignore]
 fn scratch_debug() {
-    let truth = gen::torus();
-    let (v, f) = gen::mesh(&truth, 0.5, 0.0, 0.0, 1);
+    let truth = gen::straight();
+    let (v, f) = gen::mesh(&truth, 0.5, 0.1, 0.0, 1);
+    for it in [2, 3, 4, 5, 6, 8, 10, 15] {
+        let fitted = fit_mesh(v.clone(), f.clone(), "t.stl", &FitOptions { max_iterations: it, ..FitOptions::default() }).unwrap();
+        eprintln!("{it}: last move {}", fitted.report().last_move_mm);
+    }
     let fitted = fit_mesh(v, f, "t.stl", &FitOptions::default()).unwrap();
     let r = fitted.report();
     eprintln!("max at {:?} start {:?} end {:?} len {} knots {:?}", r.max_at_mm, r.start, r.end, r.length_mm, &fitted.fit.knots);
