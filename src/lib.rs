@@ -123,11 +123,11 @@ pub use error::{Error, ErrorKind};
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
+pub use fit::{FitOptions, FitReport, StartEnd};
+pub use pipeline::FittedPart;
 pub use pipeline::{
     check_program, place_part, plan_part, plan_part_with, slice_part, slice_part_with, Cell,
     Control, Part, PlaceRequest, PlacedCell, PlanOptions, PlannedPart, ProgramFormat, RzLaw,
     SliceOverrides, SlicedPart,
 };
-pub use fit::{FitOptions, FitReport, StartEnd};
-pub use pipeline::FittedPart;
 pub use place::PlaceOptions;

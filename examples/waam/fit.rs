@@ -32,7 +32,10 @@ pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
             r.radius_max_mm,
             r.wall
                 .as_ref()
-                .map(|w| format!("; wall {:.3} mm ({:.3} to {:.3})", w.mean_mm, w.min_mm, w.max_mm))
+                .map(|w| format!(
+                    "; wall {:.3} mm ({:.3} to {:.3})",
+                    w.mean_mm, w.min_mm, w.max_mm
+                ))
                 .unwrap_or_default()
         );
         println!(

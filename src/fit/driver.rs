@@ -143,7 +143,7 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
         if iterations > 1 {
             check_sections(mesh, &stations, opts)?;
         }
-        let knots = fit_knots(range, knot_h, spacing);
+        let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
         slope = fit_law(mesh, &stations, &knots, &|s| s.radius)
             .ok()
             .map(|v| (knots.clone(), v));
@@ -172,7 +172,9 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
     check_sections(mesh, &stations, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick);
     let mut radius_mm = law(&|s| s.radius)?;
-    let spread = radius_mm.iter().fold((f64::MAX, f64::MIN), |a, &r| (a.0.min(r), a.1.max(r)));
+    let spread = radius_mm
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, &r| (a.0.min(r), a.1.max(r)));
     if spread.1 - spread.0 < 2.0 * opts.constant_radius_tol_mm {
         let mean = radius_mm.iter().sum::<f64>() / radius_mm.len() as f64;
         radius_mm.iter_mut().for_each(|r| *r = mean);
@@ -255,11 +257,33 @@ fn tube_range(points: &[Point3]) -> (f64, f64) {
 /// each end (as far as the first interval is long).
 fn fit_knots(range: (f64, f64), knot_h: f64, spacing: f64) -> Vec<f64> {
     let inner = smooth::graded_knots(range.1 - range.0, knot_h, spacing);
-    let (first, last) = (inner[1] - inner[0], inner[inner.len() - 1] - inner[inner.len() - 2]);
+    let (first, last) = (
+        inner[1] - inner[0],
+        inner[inner.len() - 1] - inner[inner.len() - 2],
+    );
     let mut k = vec![range.0 - first];
     k.extend(inner.iter().map(|x| x + range.0));
     k.push(range.1 + last);
     k
+}
+
+/// Shortest knot interval (mm) that keeps the refit stable on a tube whose
+/// radius changes: a guide tilted by `alpha` moves a section's centre by
+/// about `A' A alpha` (the points of one side come from a wider part), so a
+/// wiggle of wavelength `2 h` grows unless `h > pi |A'| A`; 20 % margin.
+fn coupling_gap(law: Option<&(Vec<f64>, Vec<f64>)>) -> f64 {
+    let Some((k, v)) = law else { return 0.0 };
+    let m = smooth::natural_second_derivatives(k, v);
+    let mut worst = 0.0_f64;
+    for w in k.windows(2) {
+        for f in [0.0, 0.5, 1.0] {
+            let t = w[0] + f * (w[1] - w[0]);
+            let h = 1e-3 * (w[1] - w[0]);
+            let d = (smooth::eval(k, v, &m, t + h) - smooth::eval(k, v, &m, t - h)) / (2.0 * h);
+            worst = worst.max(d.abs() * smooth::eval(k, v, &m, t));
+        }
+    }
+    1.2 * std::f64::consts::PI * worst
 }
 
 /// Cumulative chord lengths of `points` (mm): the spline guide's `t`.
@@ -272,13 +296,18 @@ pub(super) fn chord_knots(points: &[Point3]) -> Vec<f64> {
 }
 
 fn centroid(points: impl Iterator<Item = Point3>) -> Point3 {
-    let (s, n) = points.fold((Vector3::zeros(), 0usize), |(s, n), p| (s + p.coords, n + 1));
+    let (s, n) = points.fold((Vector3::zeros(), 0usize), |(s, n), p| {
+        (s + p.coords, n + 1)
+    });
     Point3::from(s / n.max(1) as f64)
 }
 
 /// Plane and circle of one open end.
 fn ring(mesh: &TubeMesh, vertices: &[u32]) -> Option<(Point3, UnitVector3, f64)> {
-    let pts: Vec<Point3> = vertices.iter().map(|&v| mesh.vertices[v as usize]).collect();
+    let pts: Vec<Point3> = vertices
+        .iter()
+        .map(|&v| mesh.vertices[v as usize])
+        .collect();
     let (c, n, _) = fit_plane(&pts)?;
     let (e1, e2) = plane_basis(&n);
     let sp: Vec<SectionPoint> = pts
@@ -326,7 +355,11 @@ fn end_rings(mesh: &TubeMesh, surf: &Surfaces) -> Result<[EndRing; 2], FitError>
             loops: vec![l0],
         };
         if let Some(other) = fitted.get(1) {
-            let l1 = if (other[0].0 - c0).norm() <= (other[1].0 - c0).norm() { 0 } else { 1 };
+            let l1 = if (other[0].0 - c0).norm() <= (other[1].0 - c0).norm() {
+                0
+            } else {
+                1
+            };
             let (c1, _, r1) = other[l1];
             if (c1 - c0).norm() > 0.5 * r0.max(r1) {
                 return Err(FitError::NotATube {
@@ -347,7 +380,11 @@ fn end_rings(mesh: &TubeMesh, surf: &Surfaces) -> Result<[EndRing; 2], FitError>
     Ok([make(0)?, make(1)?])
 }
 
-fn choose_start(mesh: &TubeMesh, ends: [EndRing; 2], opts: &FitOptions) -> Result<[EndRing; 2], FitError> {
+fn choose_start(
+    mesh: &TubeMesh,
+    ends: [EndRing; 2],
+    opts: &FitOptions,
+) -> Result<[EndRing; 2], FitError> {
     let [a, b] = ends;
     let swap = match opts.start {
         StartEnd::Lowest => b.centre.z < a.centre.z,
@@ -431,7 +468,9 @@ fn initial_guide(
     }
     let mut pts = vec![start.centre];
     for p in raw.into_iter().skip(1) {
-        if (p - pts[pts.len() - 1]).norm() >= 0.5 * knot_h && (finish.centre - p).norm() >= 0.5 * knot_h {
+        if (p - pts[pts.len() - 1]).norm() >= 0.5 * knot_h
+            && (finish.centre - p).norm() >= 0.5 * knot_h
+        {
             pts.push(p);
         }
     }
@@ -466,7 +505,9 @@ fn project_all(
 ) -> Vec<f64> {
     let (lo, hi) = (range.0 - ext, range.1 + ext);
     let n = ((hi - lo) / 0.5).ceil().clamp(16.0, 20_000.0) as usize;
-    let ts: Vec<f64> = (0..=n).map(|i| lo + (hi - lo) * i as f64 / n as f64).collect();
+    let ts: Vec<f64> = (0..=n)
+        .map(|i| lo + (hi - lo) * i as f64 / n as f64)
+        .collect();
     let line = Polyline::new(ts.iter().map(|&t| spline.point(t)).collect(), None);
     let global = |p: &Point3| {
         let (_, (seg, loc)) = line.project_local_point_and_get_location(p, false);
@@ -496,7 +537,11 @@ fn newton(spline: &CubicSpline, p: &Point3, mut t: f64, lo: f64, hi: f64) -> Opt
         let d1 = spline.d1(t);
         let f = d.dot(&d1);
         let fp = d1.norm_squared() + d.dot(&spline.d2(t));
-        let step = if fp > 0.1 * d1.norm_squared() { f / fp } else { f / d1.norm_squared() };
+        let step = if fp > 0.1 * d1.norm_squared() {
+            f / fp
+        } else {
+            f / d1.norm_squared()
+        };
         let next = (t - step).clamp(lo, hi);
         if (next - t).abs() < 1e-10 {
             return Some(next);
@@ -589,16 +634,30 @@ fn sections(
                 }
                 None => (None, None, None),
             };
-            Station { t: *ti, fits, centre, radius, thickness, points }
+            Station {
+                t: *ti,
+                fits,
+                centre,
+                radius,
+                thickness,
+                points,
+            }
         })
         .collect()
 }
 
 /// The guide's new points at `knots`: the smoothing fit of the section centres.
-fn refit_guide(mesh: &TubeMesh, stations: &[Station], knots: &[f64]) -> Result<Vec<Point3>, FitError> {
+fn refit_guide(
+    mesh: &TubeMesh,
+    stations: &[Station],
+    knots: &[f64],
+) -> Result<Vec<Point3>, FitError> {
     let ok: Vec<&Station> = stations.iter().filter(|s| s.centre.is_some()).collect();
     if ok.len() < 3 || ok.len() * 2 < stations.len() {
-        let first_bad = stations.iter().position(|s| s.centre.is_none()).unwrap_or(0);
+        let first_bad = stations
+            .iter()
+            .position(|s| s.centre.is_none())
+            .unwrap_or(0);
         return Err(FitError::Degenerate {
             file: mesh.file.clone(),
             station: first_bad,
@@ -692,14 +751,22 @@ fn outer_skin(stations: &[Station]) -> usize {
 
 /// Refuses a section far from a circle, or a run of three sections that are
 /// not closed rings (one alone is a ring split between two stations).
-fn check_sections(mesh: &TubeMesh, stations: &[Station], opts: &FitOptions) -> Result<(), FitError> {
+fn check_sections(
+    mesh: &TubeMesh,
+    stations: &[Station],
+    opts: &FitOptions,
+) -> Result<(), FitError> {
     let gap_max = opts.max_section_gap_deg.to_radians();
     let mut run = 0;
     for (i, s) in stations.iter().enumerate() {
         let mut open = None;
         for (k, f) in s.fits.iter().enumerate() {
             let Some(f) = f else { continue };
-            let skin = if s.fits.len() == 2 { format!("skin {k}: ") } else { String::new() };
+            let skin = if s.fits.len() == 2 {
+                format!("skin {k}: ")
+            } else {
+                String::new()
+            };
             let allowed = (opts.max_section_rms_ratio * f.radius).max(opts.max_rms_mm);
             if f.rms > allowed {
                 return Err(FitError::SectionNotCircle {

@@ -77,7 +77,11 @@ impl TubeMesh {
         let mut triangles = Vec::with_capacity(mesh.faces.len());
         for f in &mesh.faces {
             let [a, b, c] = f.vertices;
-            let ok = |i: usize| u32::try_from(i).ok().filter(|&i| (i as usize) < vertices.len());
+            let ok = |i: usize| {
+                u32::try_from(i)
+                    .ok()
+                    .filter(|&i| (i as usize) < vertices.len())
+            };
             match (ok(a), ok(b), ok(c)) {
                 (Some(a), Some(b), Some(c)) => triangles.push([a, b, c]),
                 _ => return Err(bad("a triangle refers to a missing vertex".into())),

@@ -96,7 +96,9 @@ pub enum FitError {
         found: String,
     },
     /// A section normal to the fitted guide is not near a circle.
-    #[error("{file}: station {station} (t = {t_mm:.2} mm): the section is not near a circle: {found}")]
+    #[error(
+        "{file}: station {station} (t = {t_mm:.2} mm): the section is not near a circle: {found}"
+    )]
     SectionNotCircle {
         /// The mesh file.
         file: String,

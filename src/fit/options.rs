@@ -153,7 +153,10 @@ impl FitOptions {
             ("crease_angle_deg", self.crease_angle_deg),
         ] {
             if !(x > 0.0 && x < 180.0) {
-                return Err(bad(field, format!("must be within (0, 180) degrees, got {x}")));
+                return Err(bad(
+                    field,
+                    format!("must be within (0, 180) degrees, got {x}"),
+                ));
             }
         }
         if self.max_iterations == 0 {

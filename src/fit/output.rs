@@ -54,10 +54,7 @@ impl TubeFit {
         let pieces = (0..n)
             .map(|i| ProfilePieceSpec {
                 until: (i + 1 < n).then(|| Scalar::Number(self.knots[i + 1])),
-                radius: cubic_text(
-                    smooth::interval_cubic(&self.knots, r, &m, i),
-                    self.knots[i],
-                ),
+                radius: cubic_text(smooth::interval_cubic(&self.knots, r, &m, i), self.knots[i]),
             })
             .collect();
         ProfileSpec::Piecewise { pieces }

@@ -184,9 +184,12 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> FitReport {
         .enumerate()
         .map(|(i, s)| {
             let law = radius(s.t);
-            let worst = s.fits.iter().flatten().map(|f| f.rms).fold(None, |a: Option<f64>, r| {
-                Some(a.map_or(r, |a| a.max(r)))
-            });
+            let worst = s
+                .fits
+                .iter()
+                .flatten()
+                .map(|f| f.rms)
+                .fold(None, |a: Option<f64>, r| Some(a.map_or(r, |a| a.max(r))));
             StationReport {
                 index: i,
                 t_mm: s.t,
@@ -210,7 +213,10 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> FitReport {
             max_mm: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         }
     });
-    let surface = cx.check_surface.then(|| surface_to_mesh(cx, &guide, &stations, &skin_radius)).flatten();
+    let surface = cx
+        .check_surface
+        .then(|| surface_to_mesh(cx, &guide, &stations, &skin_radius))
+        .flatten();
     FitReport {
         file: cx.mesh.file.clone(),
         triangles: cx.mesh.triangles.len(),
@@ -222,14 +228,25 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> FitReport {
         end: end(cx.finish),
         iterations: cx.iterations,
         converged: cx.converged,
-        last_move_mm: if cx.last_move_mm.is_finite() { cx.last_move_mm } else { 0.0 },
+        last_move_mm: if cx.last_move_mm.is_finite() {
+            cx.last_move_mm
+        } else {
+            0.0
+        },
         length_mm: len,
         guide_points: fit.guide_points.len(),
         radius_min_mm: fit.radius_mm.iter().copied().fold(f64::INFINITY, f64::min),
-        radius_max_mm: fit.radius_mm.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        radius_max_mm: fit
+            .radius_mm
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max),
         rms_mm: rms,
         max_mm: max,
-        max_at_mm: cx.samples_pos.get(imax).map_or([0.0; 3], |p| p.coords.into()),
+        max_at_mm: cx
+            .samples_pos
+            .get(imax)
+            .map_or([0.0; 3], |p| p.coords.into()),
         surface_to_mesh_max_mm: surface,
         wall,
         stations,

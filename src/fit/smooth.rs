@@ -21,7 +21,8 @@ pub fn natural_second_derivatives(knots: &[f64], values: &[f64]) -> Vec<f64> {
     let mut c = vec![0.0; n];
     let mut d = vec![0.0; n];
     for i in 1..n - 1 {
-        let rhs = 6.0 * ((values[i + 1] - values[i]) / h[i] - (values[i] - values[i - 1]) / h[i - 1]);
+        let rhs =
+            6.0 * ((values[i + 1] - values[i]) / h[i] - (values[i] - values[i - 1]) / h[i - 1]);
         let a = if i == 1 { 0.0 } else { h[i - 1] };
         let diag = 2.0 * (h[i - 1] + h[i]) - a * c[i - 1];
         c[i] = if i + 1 < n - 1 { h[i] / diag } else { 0.0 };
@@ -36,7 +37,10 @@ pub fn natural_second_derivatives(knots: &[f64], values: &[f64]) -> Vec<f64> {
 /// Index of the knot interval holding `t` (clamped to the end intervals).
 pub fn interval(knots: &[f64], t: f64) -> usize {
     let n = knots.len();
-    knots.partition_point(|&k| k <= t).saturating_sub(1).min(n - 2)
+    knots
+        .partition_point(|&k| k <= t)
+        .saturating_sub(1)
+        .min(n - 2)
 }
 
 /// Value at `t` of the natural spline with knot values `values` and second
@@ -47,7 +51,9 @@ pub fn eval(knots: &[f64], values: &[f64], m: &[f64], t: f64) -> f64 {
     let h = knots[i + 1] - knots[i];
     let a = (knots[i + 1] - t) / h;
     let b = (t - knots[i]) / h;
-    values[i] * a + values[i + 1] * b + (m[i] * (a * a * a - a) + m[i + 1] * (b * b * b - b)) * (h * h / 6.0)
+    values[i] * a
+        + values[i + 1] * b
+        + (m[i] * (a * a * a - a) + m[i + 1] * (b * b * b - b)) * (h * h / 6.0)
 }
 
 /// The cubic of knot interval `i` as coefficients of `(t - knots[i])^k`,
@@ -101,7 +107,11 @@ pub fn fit(
     for j in 1..nk.saturating_sub(1) {
         let (h0, h1) = (knots[j] - knots[j - 1], knots[j + 1] - knots[j]);
         let hm = 0.5 * (h0 + h1);
-        let row = [1.0 / (h0 * hm), -(1.0 / h0 + 1.0 / h1) / hm, 1.0 / (h1 * hm)];
+        let row = [
+            1.0 / (h0 * hm),
+            -(1.0 / h0 + 1.0 / h1) / hm,
+            1.0 / (h1 * hm),
+        ];
         for (a, ra) in row.iter().enumerate() {
             for (b, rb) in row.iter().enumerate() {
                 normal[(j - 1 + a, j - 1 + b)] += scale * ra * rb * hm.powi(4);

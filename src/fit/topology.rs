@@ -199,7 +199,10 @@ pub fn surfaces(mesh: &TubeMesh, opts: &FitOptions) -> Result<Surfaces, FitError
         let small_face = (comp.len() / 200).max(1);
         for face in faces {
             let vertices = vertices_of(mesh, &face);
-            let pts: Vec<Point3> = vertices.iter().map(|&v| mesh.vertices[v as usize]).collect();
+            let pts: Vec<Point3> = vertices
+                .iter()
+                .map(|&v| mesh.vertices[v as usize])
+                .collect();
             if let Some((centroid, normal, dev)) = fit_plane(&pts) {
                 let extent = pts
                     .iter()
@@ -285,14 +288,20 @@ fn branch_error(mesh: &TubeMesh, tris: &[u32], loops: &[Vec<u32>]) -> FitError {
                 x: c.x,
                 y: c.y,
                 z: c.z,
-                found: format!("{found}; the level set there falls apart in {} rings", sets.bands[k].pieces),
+                found: format!(
+                    "{found}; the level set there falls apart in {} rings",
+                    sets.bands[k].pieces
+                ),
             }
         }
         None => {
             let c = Point3::from(
-                loops[0].iter().fold(crate::math::Vector3::zeros(), |a, &v| {
-                    a + mesh.vertices[v as usize].coords
-                }) / loops[0].len() as f64,
+                loops[0]
+                    .iter()
+                    .fold(crate::math::Vector3::zeros(), |a, &v| {
+                        a + mesh.vertices[v as usize].coords
+                    })
+                    / loops[0].len() as f64,
             );
             FitError::Branch {
                 file: mesh.file.clone(),

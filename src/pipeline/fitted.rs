@@ -40,7 +40,8 @@ impl FittedPart {
         let part = dir.join("part.toml");
         write_atomic(&part, |w| w.write_all(self.toml.as_bytes())).map_err(|e| io(&part, e))?;
         let json = dir.join("fit.json");
-        let text = serde_json::to_string_pretty(&self.fit.report).map_err(|e| io(&json, e.into()))?;
+        let text =
+            serde_json::to_string_pretty(&self.fit.report).map_err(|e| io(&json, e.into()))?;
         write_atomic(&json, |w| w.write_all(text.as_bytes())).map_err(|e| io(&json, e))?;
         Ok(vec![part, json])
     }

@@ -19,12 +19,19 @@ fn fit_writes_a_part_that_slices() {
         .args(["--start", "lowest"])
         .output()
         .unwrap();
-    assert!(done.status.success(), "{}", String::from_utf8_lossy(&done.stderr));
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
     assert!(report["rms_mm"].as_f64().unwrap() < 0.1, "{report}");
     let text = std::fs::read_to_string(out.join("part.toml")).unwrap();
-    assert!(text.contains("kind = \"spline\"") && text.contains("name = \"s-bend\""), "{text}");
+    assert!(
+        text.contains("kind = \"spline\"") && text.contains("name = \"s-bend\""),
+        "{text}"
+    );
     let sliced = dir.path().join("sliced");
     let done = waam()
         .args(["--quiet", "slice"])
@@ -33,7 +40,11 @@ fn fit_writes_a_part_that_slices() {
         .arg(&sliced)
         .output()
         .unwrap();
-    assert!(done.status.success(), "{}", String::from_utf8_lossy(&done.stderr));
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
     assert!(sliced.join("path.csv").exists());
 }
 
@@ -43,9 +54,18 @@ fn fit_refuses_a_blob_naming_the_file() {
     let (v, f) = gen::sphere(15.0, 16);
     let stl = dir.path().join("blob.stl");
     std::fs::write(&stl, gen::binary_stl(&v, &f)).unwrap();
-    let done = waam().arg("fit").arg(&stl).arg("--out").arg(dir.path().join("o")).output().unwrap();
+    let done = waam()
+        .arg("fit")
+        .arg(&stl)
+        .arg("--out")
+        .arg(dir.path().join("o"))
+        .output()
+        .unwrap();
     assert_eq!(done.status.code(), Some(1));
     let err = String::from_utf8_lossy(&done.stderr);
-    assert!(err.contains("blob.stl") && err.contains("not a tube"), "{err}");
+    assert!(
+        err.contains("blob.stl") && err.contains("not a tube"),
+        "{err}"
+    );
     assert!(!dir.path().join("o").join("part.toml").exists());
 }

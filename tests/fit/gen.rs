@@ -48,7 +48,13 @@ pub fn elbow_centre(leg: f64, r: f64) -> impl Fn(f64) -> Point3 + Sync {
         if s <= leg {
             Point3::new(0.0, 0.0, s)
         } else if s <= leg + bend {
-            arc(Point3::new(0.0, 0.0, leg), Vector3::z(), Vector3::x(), r, s - leg)
+            arc(
+                Point3::new(0.0, 0.0, leg),
+                Vector3::z(),
+                Vector3::x(),
+                r,
+                s - leg,
+            )
         } else {
             Point3::new(r + (s - leg - bend), 0.0, leg + r)
         }
@@ -144,7 +150,11 @@ pub fn frames(t: &Truth, rings: usize) -> Vec<(f64, Point3, Vector3, Vector3)> {
     };
     let mut out = Vec::with_capacity(rings + 1);
     let t0 = tangent(0.0);
-    let pick = if t0.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let pick = if t0.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
     let mut r = (pick - t0 * pick.dot(&t0)).normalize();
     let mut prev = ((t.centre)(0.0), t0);
     for i in 0..=rings {
@@ -158,7 +168,11 @@ pub fn frames(t: &Truth, rings: usize) -> Vec<(f64, Point3, Vector3, Vector3)> {
             let tl = prev.1 - v1 * (2.0 / c1 * v1.dot(&prev.1));
             let v2 = ti - tl;
             let c2 = v2.dot(&v2);
-            r = if c2 > 0.0 { rl - v2 * (2.0 / c2 * v2.dot(&rl)) } else { rl };
+            r = if c2 > 0.0 {
+                rl - v2 * (2.0 / c2 * v2.dot(&rl))
+            } else {
+                rl
+            };
             r = (r - ti * r.dot(&ti)).normalize();
         }
         out.push((s, x, ti, r));
@@ -169,8 +183,17 @@ pub fn frames(t: &Truth, rings: usize) -> Vec<(f64, Point3, Vector3, Vector3)> {
 
 /// A mesh of the tube's surface with edges about `h` mm, `noise_mm` of
 /// Gaussian noise on each coordinate; `offset` is added to the radius (a skin).
-pub fn mesh(t: &Truth, h: f64, noise_mm: f64, offset: f64, seed: u64) -> (Vec<Point3>, Vec<[u32; 3]>) {
-    let rmax = (0..=100).map(|i| (t.radius)(t.length * i as f64 / 100.0)).fold(0.0, f64::max) + offset;
+pub fn mesh(
+    t: &Truth,
+    h: f64,
+    noise_mm: f64,
+    offset: f64,
+    seed: u64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let rmax = (0..=100)
+        .map(|i| (t.radius)(t.length * i as f64 / 100.0))
+        .fold(0.0, f64::max)
+        + offset;
     let around = ((TAU * rmax / h).ceil() as usize).max(8);
     mesh_around(t, h, around, noise_mm, offset, seed)
 }
@@ -254,7 +277,11 @@ pub fn sphere(r: f64, n: usize) -> (Vec<Point3>, Vec<[u32; 3]>) {
         let phi = -FRAC_PI_2 + PI * i as f64 / n as f64;
         for j in 0..2 * n {
             let th = PI * j as f64 / n as f64;
-            v.push(Point3::new(r * phi.cos() * th.cos(), r * phi.cos() * th.sin(), r * phi.sin()));
+            v.push(Point3::new(
+                r * phi.cos() * th.cos(),
+                r * phi.cos() * th.sin(),
+                r * phi.sin(),
+            ));
         }
     }
     v.push(Point3::new(0.0, 0.0, r));

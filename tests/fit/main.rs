@@ -3,9 +3,9 @@
 //! generator's closed-form truth, the goals of issue 28, the refusals, the
 //! written part sliced like the true part.
 
+mod cli;
 #[path = "../common/mod.rs"]
 mod common;
-mod cli;
 mod gen;
 
 use gen::Truth;
@@ -24,7 +24,12 @@ struct Errors {
     vertex_max: f64,
 }
 
-fn fit_mesh(v: Vec<Point3>, f: Vec<[u32; 3]>, name: &str, opts: &FitOptions) -> Result<FittedPart, Error> {
+fn fit_mesh(
+    v: Vec<Point3>,
+    f: Vec<[u32; 3]>,
+    name: &str,
+    opts: &FitOptions,
+) -> Result<FittedPart, Error> {
     let mesh = TubeMesh::new(v, f, name).unwrap();
     Part::from_tube_mesh(&mesh, opts)
 }
@@ -123,7 +128,11 @@ fn half_millimetre_meshes_with_noise_meet_the_goals() {
         assert!(e.guide_rms < 0.05, "{}: {e:?}", truth.name);
         assert!(e.radius_rms < 0.05, "{}: {e:?}", truth.name);
         // The vertices carry the noise: about its 3-D size normal to the surface.
-        assert!(e.vertex_rms < 0.13 && e.vertex_rms > 0.07, "{}: {e:?}", truth.name);
+        assert!(
+            e.vertex_rms < 0.13 && e.vertex_rms > 0.07,
+            "{}: {e:?}",
+            truth.name
+        );
     }
 }
 
@@ -168,7 +177,10 @@ fn two_skins_give_the_mid_surface_and_the_wall_thickness() {
     assert_eq!(rep.skins, 2);
     let wall = rep.wall.as_ref().unwrap();
     assert!((wall.mean_mm - 3.0).abs() < 0.02, "{wall:?}");
-    assert!((wall.min_mm - 3.0).abs() < 0.05 && (wall.max_mm - 3.0).abs() < 0.05, "{wall:?}");
+    assert!(
+        (wall.min_mm - 3.0).abs() < 0.05 && (wall.max_mm - 3.0).abs() < 0.05,
+        "{wall:?}"
+    );
     let e = errors(&truth, &fitted);
     assert!(e.guide_rms < 0.05 && e.radius_rms < 0.05, "{e:?}");
     assert!(rep.max_mm < 0.1, "{}", rep.max_mm);
@@ -226,7 +238,10 @@ fn the_start_end_is_the_lowest_or_the_capped_one() {
     let capped = fit_mesh(v, f, "cup.stl", &opts).unwrap();
     let p0 = capped.fit.substrate_point;
     assert!((p0.z - truth.length).abs() < 0.05, "{p0}");
-    assert!(capped.fit.substrate_normal.z < -0.999, "the substrate faces the part");
+    assert!(
+        capped.fit.substrate_normal.z < -0.999,
+        "the substrate faces the part"
+    );
 }
 
 #[test]
@@ -261,9 +276,15 @@ fn a_bent_tube_slices_like_the_true_part() {
 fn a_closed_blob_is_refused() {
     let (v, f) = gen::sphere(20.0, 24);
     let e = fit_mesh(v, f, "blob.stl", &FitOptions::default()).unwrap_err();
-    assert!(matches!(e, Error::Fit(FitError::ClosedSurface { .. })), "{e}");
+    assert!(
+        matches!(e, Error::Fit(FitError::ClosedSurface { .. })),
+        "{e}"
+    );
     let msg = e.to_string();
-    assert!(msg.starts_with("blob.stl: not a tube") && msg.contains("blob"), "{msg}");
+    assert!(
+        msg.starts_with("blob.stl: not a tube") && msg.contains("blob"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -274,7 +295,10 @@ fn a_branch_is_refused_naming_the_station() {
     let Error::Fit(FitError::Branch { station, z, .. }) = e else {
         panic!("{msg}")
     };
-    assert!(msg.starts_with("y.stl: not one tube: a branch at station"), "{msg}");
+    assert!(
+        msg.starts_with("y.stl: not one tube: a branch at station"),
+        "{msg}"
+    );
     assert!(station > 0 && z > 30.0 && z < 50.0, "{msg}");
 }
 
@@ -286,8 +310,14 @@ fn an_oval_section_is_refused_naming_the_station() {
     }
     let e = fit_mesh(v, f, "oval.stl", &FitOptions::default()).unwrap_err();
     let msg = e.to_string();
-    assert!(matches!(e, Error::Fit(FitError::SectionNotCircle { .. })), "{msg}");
-    assert!(msg.starts_with("oval.stl: station ") && msg.contains("not near a circle"), "{msg}");
+    assert!(
+        matches!(e, Error::Fit(FitError::SectionNotCircle { .. })),
+        "{msg}"
+    );
+    assert!(
+        msg.starts_with("oval.stl: station ") && msg.contains("not near a circle"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -301,7 +331,10 @@ fn a_residual_over_the_bound_is_refused() {
     let e = fit_mesh(v, f, "noisy.stl", &opts).unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, Error::Fit(FitError::Residual { .. })), "{msg}");
-    assert!(msg.contains("noisy.stl") && msg.contains("worst at station"), "{msg}");
+    assert!(
+        msg.contains("noisy.stl") && msg.contains("worst at station"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -312,7 +345,10 @@ fn a_bad_option_names_its_field() {
         ..FitOptions::default()
     };
     let msg = fit_mesh(v, f, "pipe.stl", &opts).unwrap_err().to_string();
-    assert!(msg.contains("pipe.stl") && msg.contains("max_rms_mm"), "{msg}");
+    assert!(
+        msg.contains("pipe.stl") && msg.contains("max_rms_mm"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -331,29 +367,9 @@ fn binary_and_ascii_stl_files_give_the_same_fit() {
     assert!(missing.to_string().contains("none.stl"), "{missing}");
     assert_eq!(missing.kind(), waam_slicer::ErrorKind::Io);
     let files = a.write(dir.path().join("out")).unwrap();
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&files[1]).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&files[1]).unwrap()).unwrap();
     assert!(json["rms_mm"].as_f64().unwrap() < 0.01);
     assert!(json["stations"].as_array().unwrap().len() > 10);
     Part::read(&files[0]).unwrap();
-}
-
-#[test]
-#[ignore]
-fn scratch_debug() {
-    let truth = gen::straight();
-    let (v, f) = gen::mesh(&truth, 0.5, 0.1, 0.0, 1);
-    for it in [2, 3, 4, 5, 6, 8, 10, 15] {
-        let fitted = fit_mesh(v.clone(), f.clone(), "t.stl", &FitOptions { max_iterations: it, ..FitOptions::default() }).unwrap();
-        eprintln!("{it}: last move {}", fitted.report().last_move_mm);
-    }
-    let fitted = fit_mesh(v, f, "t.stl", &FitOptions::default()).unwrap();
-    let r = fitted.report();
-    eprintln!("max at {:?} start {:?} end {:?} len {} knots {:?}", r.max_at_mm, r.start, r.end, r.length_mm, &fitted.fit.knots);
-    for s in r.stations.iter().take(5).chain(r.stations.iter().rev().take(5)) {
-        eprintln!("{:?}", s);
-    }
-    for p in fitted.fit.guide_points.iter().take(4).chain(fitted.fit.guide_points.iter().rev().take(4)) {
-        eprintln!("{p:?}");
-    }
-    eprintln!("truth end {:?}", (truth.centre)(truth.length));
 }
