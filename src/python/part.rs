@@ -67,7 +67,9 @@ impl PyPart {
         let mut opts = crate::FitOptions::default();
         if let Some(s) = start {
             opts.start = match s.extract::<String>() {
-                Ok(text) => text.parse().map_err(waam_error)?,
+                Ok(text) => text
+                    .parse()
+                    .map_err(|e: String| waam_error(format!("start: {e}")))?,
                 Err(_) => {
                     let p: (f64, f64, f64) = s.extract().map_err(|_| {
                         waam_error("start: expected \"lowest\", \"highest\", \"capped\" or a point (x, y, z)")
