@@ -136,12 +136,4 @@ pub enum FitError {
         /// What failed.
         reason: String,
     },
-    /// The fitted tube is not a valid tube (it folds: `A κ >= 1`).
-    #[error("{file}: the fitted tube is invalid: {reason}")]
-    InvalidTube {
-        /// The mesh file.
-        file: String,
-        /// The geometry stage's message.
-        reason: String,
-    },
 }
