@@ -7,8 +7,8 @@
 //! `cargo bench --bench fit`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use std::hint::black_box;
 use std::f64::consts::{FRAC_PI_2, TAU};
+use std::hint::black_box;
 use waam_slicer::fit::{fit_tube, TubeMesh};
 use waam_slicer::math::{Point3, Vector3};
 use waam_slicer::FitOptions;
