@@ -46,6 +46,24 @@ fn fit_writes_a_part_that_slices() {
         String::from_utf8_lossy(&done.stderr)
     );
     assert!(sliced.join("path.csv").exists());
+    // plan takes it as it is: planned (exit 0) or refused by the cell (exit
+    // 2), never bad input (exit 1).
+    let planned = dir.path().join("planned");
+    let done = waam()
+        .args(["--quiet", "plan"])
+        .arg(out.join("part.toml"))
+        .arg("--cell")
+        .arg(crate::common::part_path("cells/robowam_part_carried.toml"))
+        .args(["--points", "40", "--delta", "6", "--out"])
+        .arg(&planned)
+        .output()
+        .unwrap();
+    assert!(
+        matches!(done.status.code(), Some(0 | 2)),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(planned.join("summary.json").exists());
 }
 
 #[test]
