@@ -150,15 +150,31 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
         let mut next = refit_guide(mesh, &stations, &knots)?;
         anchor_ends(&mut next, &start, &finish);
         let previous = last_move;
+        // The points past the ends are left out: the data barely hold them.
         last_move = knots
             .iter()
             .zip(&next)
+            .skip(1)
+            .take(knots.len() - 2)
             .map(|(&k, p)| (spline.point(k) - p).norm())
             .fold(0.0, f64::max);
         hints = Some(t);
         guide = next;
-        // Converged, or stalled at the level of the mesh's noise.
-        let stalled = last_move < 10.0 * opts.tolerance_mm && last_move > 0.8 * previous;
+        // Converged, or stalled at the level of the mesh's noise (a quarter
+        // of the sections' typical scatter: vertices changing station make
+        // the last moves go back and forth).
+        let mut scatter: Vec<f64> = stations
+            .iter()
+            .flat_map(|s| s.fits.iter().flatten().map(|f| f.rms))
+            .collect();
+        let noise = if scatter.is_empty() {
+            0.0
+        } else {
+            let k = scatter.len() / 2;
+            *scatter.select_nth_unstable_by(k, f64::total_cmp).1
+        };
+        let stall_level = (10.0 * opts.tolerance_mm).max(0.25 * noise);
+        let stalled = last_move < stall_level && last_move > 0.8 * previous;
         if last_move < opts.tolerance_mm || stalled {
             converged = true;
             break;

@@ -76,7 +76,8 @@ pub struct FitOptions {
     /// radius at the start, within `[4, 12]`.
     pub knot_spacing_mm: Option<f64>,
     /// The iteration stops once no guide point moves more than this (mm),
-    /// or once the moves, under ten times this, stop shrinking (the level of
+    /// or once the moves stop shrinking below ten times this or a quarter of
+    /// the sections' median RMS scatter, whichever is larger (the level of
     /// the mesh's noise).
     pub tolerance_mm: f64,
     /// Most refits of the guide.
