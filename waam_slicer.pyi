@@ -9,7 +9,7 @@ Slicing, planning, writing and checking release the GIL.
 
 import os
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -48,6 +48,31 @@ class Part:
         """Parses part-file text; `name` stands for the file in messages and
         relative paths in the text (an STL substrate) are resolved from its
         folder."""
+    @staticmethod
+    def from_mesh(
+        path: _PathLike,
+        *,
+        start: Union[str, Tuple[float, float, float], None] = None,
+        max_rms_mm: Optional[float] = None,
+        template: Optional[_PathLike] = None,
+        name: Optional[str] = None,
+        station_spacing_mm: Optional[float] = None,
+        knot_spacing_mm: Optional[float] = None,
+        check_surface: Optional[bool] = None,
+    ) -> "Part":
+        """Fits a part to a tubular mesh (binary or ASCII STL, mm): a spline
+        guide and a radius law from end to end (and the wall thickness when
+        the mesh holds both skins), a flat substrate at the start end
+        ("lowest", "highest", "capped" or nearest a point). Raises
+        InputError naming the file and station for a mesh that is not one
+        tube (a branch, a closed blob, a section far from a circle, a residual
+        over max_rms_mm)."""
+    @property
+    def fit_report(self) -> Optional[Dict[str, Any]]:
+        """The fit report (fit.json of `waam fit`: rms_mm, max_mm, stations,
+        wall), or None for a part read from a file."""
+    def write_fit(self, out: _PathLike) -> List[Path]:
+        """Writes part.toml and fit.json of a fitted part into `out`."""
     @property
     def name(self) -> str:
         """The part's name (the file's `name`)."""

@@ -1,6 +1,7 @@
 //! The crate-level error: one variant per stage, each wrapping that stage's own
 //! error enum (which names the file, field, layer or point at fault).
 
+use crate::fit::FitError;
 use crate::geometry::GeometryError;
 use crate::io::cell_file::CellFileError;
 use crate::io::joints_csv::JointsCsvError;
@@ -23,6 +24,9 @@ pub enum Error {
     /// A part file could not be read.
     #[error(transparent)]
     PartFile(#[from] PartFileError),
+    /// A mesh could not be fitted as a tube (unreadable, not a tube).
+    #[error(transparent)]
+    Fit(#[from] FitError),
     /// The robot stage failed (invalid model or cell, unreachable or singular pose).
     #[error(transparent)]
     Robot(#[from] RobotError),
@@ -78,6 +82,15 @@ pub enum Error {
         /// The budget (points).
         budget: u64,
     },
+    /// A file could not be written.
+    #[error("{path}: cannot write: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The system's error.
+        #[source]
+        source: std::sync::Arc<std::io::Error>,
+    },
     /// The host program asked to stop (see [`Control`](crate::pipeline::Control)).
     #[error("cancelled during {stage}")]
     Cancelled {
@@ -118,8 +131,12 @@ impl Error {
             ) => ErrorKind::Infeasible,
             Error::Program(ProgramError::Io { .. })
             | Error::PartFile(PartFileError::Io { .. })
+            | Error::Io { .. }
             | Error::CellFile(CellFileError::Io { .. })
             | Error::Report(crate::report::ReportError::Io { .. }) => ErrorKind::Io,
+            Error::Fit(FitError::Stl { reason, .. }) if reason.starts_with("cannot") => {
+                ErrorKind::Io
+            }
             _ => ErrorKind::Input,
         }
     }

@@ -31,6 +31,7 @@
 //! | 7. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
 //! | 8. placement of the part in the cell: an outer search over 6 and 7 (the optimiser as its oracle, the program stage's checks in certification) | [`place`] | — |
 //! | files at the edges: part and cell files read into the stages' types, CSV and STL written | [`io`] | §2, §6 |
+//! | 0a. a tube from a mesh: guide spline and radius law fitted to a tubular STL, written as a part | [`fit`] | §2 |
 //! | the interactive 3-D report | [`report`] | |
 //! | the front door: one call per job | [`pipeline`] | |
 //!
@@ -56,7 +57,7 @@
 //! [`Cell::read`], [`slice_part`], [`plan_part`] →
 //! [`PlannedPart::write_programs`], [`check_program`], and [`place_part`]
 //! ([`PlaceRequest`] → [`PlacedCell`]) when a cell refuses a part where it
-//! stands.
+//! stands; [`Part::from_mesh`] fits a part to a tubular STL.
 //!
 //! ```no_run
 //! use waam_slicer::{Cell, Part, PlanOptions};
@@ -96,6 +97,7 @@
 pub use nalgebra;
 
 pub mod error;
+pub mod fit;
 pub mod geometry;
 pub mod io;
 pub mod math;
@@ -121,6 +123,8 @@ pub use error::{Error, ErrorKind};
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
+pub use fit::{FitOptions, FitReport, StartEnd};
+pub use pipeline::FittedPart;
 pub use pipeline::{
     check_program, place_part, plan_part, plan_part_with, slice_part, slice_part_with, Cell,
     Control, Part, PlaceRequest, PlacedCell, PlanOptions, PlannedPart, ProgramFormat, RzLaw,

@@ -49,6 +49,11 @@ pub enum Command {
     /// so that every layer is feasible with the widest margin; writes cell.toml and placement.json
     /// in --out (exit 0 found, 2 none found, 1 bad input).
     Place(PlaceArgs),
+    /// Fit a part to a tubular mesh (binary or ASCII STL: the mid-surface, or the inner and outer
+    /// skins of the wall): a spline guide and a radius law from end to end; writes part.toml
+    /// (which slice, plan and place take) and fit.json (the residuals) in --out.
+    /// Exit 0 fitted, 1 bad input or not a tube.
+    Fit(FitArgs),
     /// List the sample parts (and cells) with one line each.
     Parts {
         /// Folder holding the part files.
@@ -266,4 +271,30 @@ pub struct PlaceArgs {
     /// Output folder (default out/<part name>-placed).
     #[arg(long)]
     pub out: Option<PathBuf>,
+}
+
+/// Arguments of `waam fit`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct FitArgs {
+    /// The mesh (STL, binary or ASCII; mm).
+    pub mesh: PathBuf,
+    /// Output folder.
+    #[arg(long, default_value = "out/fit")]
+    pub out: PathBuf,
+    /// A part file whose [slicing], [tool_axis] and [process] tables the written part takes.
+    #[arg(long, value_name = "PART.toml")]
+    pub template: Option<PathBuf>,
+    /// The start end (on the substrate): lowest, highest, capped, or a point X,Y,Z (mm) it is nearest.
+    #[arg(long, default_value = "lowest", value_parser = parse_start)]
+    pub start: waam_slicer::StartEnd,
+    /// Refuse the mesh if its vertices are further than this from the fitted tube (RMS, mm).
+    #[arg(long, value_name = "MM", default_value_t = 0.5)]
+    pub max_rms: f64,
+    /// Name of the written part (default: the mesh file's stem).
+    #[arg(long)]
+    pub name: Option<String>,
+}
+
+fn parse_start(s: &str) -> Result<waam_slicer::StartEnd, String> {
+    s.parse()
 }

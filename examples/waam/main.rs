@@ -4,10 +4,12 @@
 //! cargo run --release --example waam -- parts
 //! cargo run --release --example waam -- geometry parts/quarter-torus.toml
 //! cargo run --release --example waam -- slice parts/quarter-torus.toml
+//! cargo run --release --example waam -- fit scan.stl --out out/scan
 //! ```
 //! Exit codes: 0 done, 1 bad input (the message names the file and field).
 
 mod args;
+mod fit;
 mod place;
 mod plan;
 mod plots;
@@ -36,6 +38,7 @@ fn main() -> ExitCode {
         Command::Parts { dir } => list_parts(dir),
         Command::Geometry { part, points } => geometry(part, *points, args.quiet),
         Command::Slice(cmd) => slice::run(cmd, args.quiet),
+        Command::Fit(a) => fit::run(a, args.quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -24,6 +24,7 @@
 //! ```
 
 mod check;
+mod fitted;
 mod options;
 mod place;
 mod planned;
@@ -35,6 +36,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 pub use check::{check_program, read_fanuc_with_calls};
+pub use fitted::FittedPart;
 pub use options::DEFAULT_MAX_POINTS;
 pub use options::{
     AxisOverrides, ParseOptionError, PlanOptions, ProgramFormat, RzLaw, SliceOverrides,

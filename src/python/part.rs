@@ -10,7 +10,7 @@ use super::control::{HostControl, SliceKeywords};
 use super::placed::PyPlacedCell;
 use super::planned::PyPlannedPart;
 use super::sliced::PySlicedPart;
-use super::{stage_error, waam_error};
+use super::{json_to_py, stage_error, waam_error};
 use crate::pipeline::{Part, PlaceRequest, PlanOptions, RzLaw};
 
 /// A tube to build: geometry, substrate and the part file's slicing,
@@ -18,6 +18,8 @@ use crate::pipeline::{Part, PlaceRequest, PlanOptions, RzLaw};
 #[pyclass(frozen, name = "Part", module = "waam_slicer")]
 pub(crate) struct PyPart {
     pub part: Part,
+    /// The fit, when the part was fitted to a mesh (`Part.from_mesh`).
+    pub fitted: Option<crate::FittedPart>,
 }
 
 #[pymethods]
@@ -27,6 +29,7 @@ impl PyPart {
     fn read(path: PathBuf) -> PyResult<Self> {
         Ok(Self {
             part: Part::read(&path).map_err(stage_error)?,
+            fitted: None,
         })
     }
 
@@ -37,7 +40,84 @@ impl PyPart {
     fn from_toml(text: &str, name: &str) -> PyResult<Self> {
         Ok(Self {
             part: Part::from_toml_str(text, name).map_err(stage_error)?,
+            fitted: None,
         })
+    }
+
+    /// Fits a part to a tubular mesh (binary or ASCII STL, mm): a spline
+    /// guide and a radius law from end to end (and the wall thickness when
+    /// the mesh holds both skins), a flat substrate at the start end
+    /// (`start`: `"lowest"`, `"highest"`, `"capped"` or a point `(x, y, z)`);
+    /// the other keywords are `FitOptions`' fields. Releases the GIL.
+    #[staticmethod]
+    #[pyo3(signature = (path, *, start = None, max_rms_mm = None, template = None, name = None,
+        station_spacing_mm = None, knot_spacing_mm = None, check_surface = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn from_mesh(
+        py: Python<'_>,
+        path: PathBuf,
+        start: Option<Bound<'_, PyAny>>,
+        max_rms_mm: Option<f64>,
+        template: Option<PathBuf>,
+        name: Option<String>,
+        station_spacing_mm: Option<f64>,
+        knot_spacing_mm: Option<f64>,
+        check_surface: Option<bool>,
+    ) -> PyResult<Self> {
+        let mut opts = crate::FitOptions::default();
+        if let Some(s) = start {
+            opts.start = match s.extract::<String>() {
+                Ok(text) => text
+                    .parse()
+                    .map_err(|e: String| waam_error(format!("start: {e}")))?,
+                Err(_) => {
+                    let p: (f64, f64, f64) = s.extract().map_err(|_| {
+                        waam_error("start: expected \"lowest\", \"highest\", \"capped\" or a point (x, y, z)")
+                    })?;
+                    crate::StartEnd::Near([p.0, p.1, p.2])
+                }
+            };
+        }
+        if let Some(x) = max_rms_mm {
+            opts.max_rms_mm = x;
+        }
+        opts.template = template;
+        opts.name = name;
+        opts.station_spacing_mm = station_spacing_mm;
+        opts.knot_spacing_mm = knot_spacing_mm;
+        if let Some(c) = check_surface {
+            opts.check_surface = c;
+        }
+        let fitted = py
+            .detach(|| Part::from_mesh(&path, &opts))
+            .map_err(stage_error)?;
+        Ok(Self {
+            part: fitted.part.clone(),
+            fitted: Some(fitted),
+        })
+    }
+
+    /// The fit report as a dict (the `fit.json` of `waam fit`), or `None`
+    /// for a part read from a file.
+    #[getter]
+    fn fit_report<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        match &self.fitted {
+            Some(f) => {
+                let v = serde_json::to_value(f.report()).map_err(waam_error)?;
+                Ok(Some(json_to_py(py, &v)?))
+            }
+            None => Ok(None),
+        }
+    }
+
+    /// Writes `part.toml` and `fit.json` of a fitted part into `out`
+    /// (created if missing); returns their paths. Raises `InputError` for a
+    /// part that was not fitted.
+    fn write_fit(&self, out: PathBuf) -> PyResult<Vec<PathBuf>> {
+        let f = self.fitted.as_ref().ok_or_else(|| {
+            waam_error("write_fit: this part was not fitted to a mesh (Part.from_mesh)")
+        })?;
+        f.write(&out).map_err(stage_error)
     }
 
     /// The part's name (the file's `name`).

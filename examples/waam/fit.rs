@@ -1,0 +1,50 @@
+//! `waam fit`: a part fitted to a tubular mesh.
+
+use crate::args::FitArgs;
+use waam_slicer::{FitOptions, Part};
+
+pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
+    let opts = FitOptions {
+        start: a.start,
+        max_rms_mm: a.max_rms,
+        template: a.template.clone(),
+        name: a.name.clone(),
+        ..FitOptions::default()
+    };
+    let fitted = Part::from_mesh(&a.mesh, &opts).map_err(|e| e.to_string())?;
+    let files = fitted.write(&a.out).map_err(|e| e.to_string())?;
+    if !quiet {
+        let r = fitted.report();
+        println!(
+            "fitted      {} ({} triangles, {} skin{}): guide {:.2} mm through {} points, {} iterations{}",
+            r.file,
+            r.triangles,
+            r.skins,
+            if r.skins == 1 { "" } else { "s" },
+            r.length_mm,
+            r.guide_points,
+            r.iterations,
+            if r.converged { "" } else { " (not converged)" }
+        );
+        println!(
+            "radius      {:.3} to {:.3} mm{}",
+            r.radius_min_mm,
+            r.radius_max_mm,
+            r.wall
+                .as_ref()
+                .map(|w| format!(
+                    "; wall {:.3} mm ({:.3} to {:.3})",
+                    w.mean_mm, w.min_mm, w.max_mm
+                ))
+                .unwrap_or_default()
+        );
+        println!(
+            "residual    {:.4} mm RMS, {:.4} mm at most (vertices to the fitted surface)",
+            r.rms_mm, r.max_mm
+        );
+        for f in files {
+            println!("wrote       {}", f.display());
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,817 @@
+//! **The driver**: open ends and start end, a first guide from the level
+//! sets, then sections normal to the current guide, a circle per section and
+//! a smooth refit of the guide, until the guide stops moving; a final pass
+//! fits the radius law (and wall thickness) and measures the residuals.
+
+use super::report::{self, FitReport};
+use super::section::{fit_circle, fit_plane, plane_basis, CircleFit, SectionPoint};
+use super::topology::{self, median_edge, Surfaces};
+use super::{smooth, FitError, FitOptions, StartEnd, TubeMesh};
+use crate::geometry::guide::{CubicSpline, GuideCurve};
+use crate::math::{Point3, UnitVector3, Vector3};
+use nalgebra::DMatrix;
+use parry3d_f64::query::PointQueryWithLocation;
+use parry3d_f64::shape::Polyline;
+use rayon::prelude::*;
+
+/// A fitted tube (part frame = mesh frame, mm): the guide as the points of a
+/// natural cubic spline (`t` = chord length from the start end, mm), the
+/// radius law and the wall thickness as natural cubic splines over the same
+/// knots, the substrate plane at the start end, and the fit report.
+#[derive(Debug, Clone)]
+pub struct TubeFit {
+    /// The mesh file.
+    pub file: String,
+    /// Points of the spline guide, from the start end (mm).
+    pub guide_points: Vec<Point3>,
+    /// Guide parameter of each point: cumulative chord length (mm).
+    pub knots: Vec<f64>,
+    /// Guide parameter of the start end (mm): the first and last guide
+    /// points lie one knot interval past the ends, so that the spline's
+    /// natural end condition (no curvature) falls outside the tube.
+    pub t_min: f64,
+    /// Guide parameter of the other end (mm).
+    pub t_max: f64,
+    /// Radius of the (mid-surface) profile at each knot (mm).
+    pub radius_mm: Vec<f64>,
+    /// Wall thickness at each knot (mm), when two skins were given.
+    pub thickness_mm: Option<Vec<f64>>,
+    /// A point of the substrate plane: the guide's point at `t_min` (mm).
+    pub substrate_point: Point3,
+    /// The substrate's normal, toward the part: the start end's plane.
+    pub substrate_normal: UnitVector3,
+    /// Parameter range needed below `t = 0` for the substrate to cut the
+    /// tube when the start end is not normal to the guide (mm).
+    pub extend_before_mm: f64,
+    /// What the fit found and how well it fits.
+    pub report: FitReport,
+}
+
+impl TubeFit {
+    /// Length of the tube's parameter range `t_max - t_min` (mm).
+    pub fn length(&self) -> f64 {
+        self.t_max - self.t_min
+    }
+
+    /// The guide curve.
+    pub fn guide(&self) -> CubicSpline {
+        CubicSpline::new(&self.guide_points).expect("validated when fitted")
+    }
+
+    /// The radius law `A(t)` (mm).
+    pub fn radius(&self, t: f64) -> f64 {
+        let m = smooth::natural_second_derivatives(&self.knots, &self.radius_mm);
+        smooth::eval(&self.knots, &self.radius_mm, &m, t)
+    }
+}
+
+/// An open end of the tube (mesh frame, mm).
+#[derive(Debug, Clone)]
+pub(super) struct EndRing {
+    pub centre: Point3,
+    pub normal: UnitVector3,
+    pub radius: f64,
+    pub capped: bool,
+    /// The loop index of this end in each skin.
+    pub loops: Vec<usize>,
+}
+
+/// The points the fit uses: every skin vertex, with its skin.
+struct Samples {
+    pos: Vec<Point3>,
+    skin: Vec<u8>,
+    skins: usize,
+}
+
+/// One station's sections (one per skin) and the combined centre and radius.
+#[derive(Debug, Clone)]
+pub(super) struct Station {
+    pub t: f64,
+    pub fits: Vec<Option<CircleFit>>,
+    pub centre: Option<Point3>,
+    pub radius: Option<f64>,
+    pub thickness: Option<f64>,
+    pub points: usize,
+}
+
+/// Fits a tube to `mesh`.
+///
+/// # Errors
+/// [`FitError`] naming the file and, where there is one, the station: a
+/// bad option, a branch, a closed blob, a section not near a circle, a
+/// residual over [`FitOptions::max_rms_mm`], a degenerate fit.
+pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
+    opts.validate(&mesh.file)?;
+    let surf = topology::surfaces(mesh, opts)?;
+    let ends = end_rings(mesh, &surf)?;
+    let [start, finish] = choose_start(mesh, ends, opts)?;
+    let samples = samples(mesh, &surf);
+    let edge = median_edge(mesh, &surf.skins[0].triangles);
+    let r0 = start.radius.min(finish.radius);
+    let spacing = opts
+        .station_spacing_mm
+        .unwrap_or_else(|| (2.0 * edge).clamp(0.5, (0.25 * r0).max(0.5)));
+    let knot_h = opts
+        .knot_spacing_mm
+        .unwrap_or_else(|| (0.5 * r0).clamp(4.0, 12.0))
+        .max(1.5 * spacing);
+    let mut guide = initial_guide(mesh, &surf, &start, &finish, edge, knot_h)?;
+    let mut hints: Option<Vec<f64>> = None;
+    // The radius law's slope from the previous pass (none at first).
+    let mut slope: Option<(Vec<f64>, Vec<f64>)> = None;
+    let (mut iterations, mut converged, mut last_move) = (0, false, f64::INFINITY);
+    let first_length = {
+        let r = tube_range(&guide);
+        r.1 - r.0
+    };
+    while iterations < opts.max_iterations {
+        iterations += 1;
+        let spline = spline_of(mesh, &guide)?;
+        let range = tube_range(&guide);
+        let t = project_all(&spline, range, &samples, hints.as_deref(), 2.0 * r0);
+        if range.1 - range.0 > 3.0 * first_length {
+            return Err(FitError::Degenerate {
+                file: mesh.file.clone(),
+                station: 0,
+                reason: format!(
+                    "the guide diverged ({:.1} mm long, from {first_length:.1} mm)",
+                    range.1 - range.0
+                ),
+            });
+        }
+        let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref());
+        if iterations > 1 {
+            check_sections(mesh, &stations, opts)?;
+        }
+        let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
+        slope = fit_law(mesh, &stations, &knots, &|s| s.radius)
+            .ok()
+            .map(|v| (knots.clone(), v));
+        let mut next = refit_guide(mesh, &stations, &knots)?;
+        anchor_ends(&mut next, &start, &finish);
+        let previous = last_move;
+        // The points past the ends are left out: the data barely hold them.
+        last_move = knots
+            .iter()
+            .zip(&next)
+            .skip(1)
+            .take(knots.len() - 2)
+            .map(|(&k, p)| (spline.point(k) - p).norm())
+            .fold(0.0, f64::max);
+        hints = Some(t);
+        guide = next;
+        // Converged, or stalled at the level of the mesh's noise (a quarter
+        // of the sections' typical scatter: vertices changing station make
+        // the last moves go back and forth).
+        let mut scatter: Vec<f64> = stations
+            .iter()
+            .flat_map(|s| s.fits.iter().flatten().map(|f| f.rms))
+            .collect();
+        let noise = if scatter.is_empty() {
+            0.0
+        } else {
+            let k = scatter.len() / 2;
+            *scatter.select_nth_unstable_by(k, f64::total_cmp).1
+        };
+        let stall_level = (10.0 * opts.tolerance_mm).max(0.25 * noise);
+        let stalled = last_move < stall_level && last_move > 0.8 * previous;
+        if last_move < opts.tolerance_mm || stalled {
+            converged = true;
+            break;
+        }
+    }
+    let spline = spline_of(mesh, &guide)?;
+    let knots = chord_knots(&guide);
+    let range = tube_range(&guide);
+    let t = project_all(&spline, range, &samples, hints.as_deref(), 2.0 * r0);
+    let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref());
+    check_sections(mesh, &stations, opts)?;
+    let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick);
+    let mut radius_mm = law(&|s| s.radius)?;
+    let spread = radius_mm
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, &r| (a.0.min(r), a.1.max(r)));
+    if spread.1 - spread.0 < 2.0 * opts.constant_radius_tol_mm {
+        let mean = radius_mm.iter().sum::<f64>() / radius_mm.len() as f64;
+        radius_mm.iter_mut().for_each(|r| *r = mean);
+    }
+    let thickness_mm = match samples.skins {
+        2 => Some(law(&|s| s.thickness)?),
+        _ => None,
+    };
+    let outer = outer_skin(&stations);
+    let mut normal = start.normal;
+    if normal.dot(&spline.d1(range.0)) < 0.0 {
+        normal = -normal;
+    }
+    let tilt = normal.angle(&spline.d1(range.0));
+    let extend_before_mm = start.radius * tilt.tan().min(10.0) + 1.0;
+    let mut fit = TubeFit {
+        file: mesh.file.clone(),
+        substrate_point: guide[1],
+        t_min: range.0,
+        t_max: range.1,
+        guide_points: guide,
+        knots,
+        radius_mm,
+        thickness_mm,
+        substrate_normal: normal,
+        extend_before_mm,
+        report: FitReport::default(),
+    };
+    let ctx = report::Context {
+        mesh,
+        surfaces: &surf,
+        samples_pos: &samples.pos,
+        samples_skin: &samples.skin,
+        outer,
+        t: &t,
+        stations: &stations,
+        start: &start,
+        finish: &finish,
+        iterations,
+        converged,
+        last_move_mm: last_move,
+        check_surface: opts.check_surface,
+    };
+    fit.report = report::build(&ctx, &fit);
+    if fit.report.rms_mm > opts.max_rms_mm {
+        let worst = fit
+            .report
+            .stations
+            .iter()
+            .max_by(|a, b| a.vertex_rms_mm.total_cmp(&b.vertex_rms_mm))
+            .expect("stations");
+        return Err(FitError::Residual {
+            file: mesh.file.clone(),
+            rms_mm: fit.report.rms_mm,
+            max_rms_mm: opts.max_rms_mm,
+            station: worst.index,
+            t_mm: worst.t_mm,
+            station_rms_mm: worst.vertex_rms_mm,
+        });
+    }
+    Ok(fit)
+}
+
+fn spline_of(mesh: &TubeMesh, points: &[Point3]) -> Result<CubicSpline, FitError> {
+    CubicSpline::new(points).map_err(|e| FitError::Degenerate {
+        file: mesh.file.clone(),
+        station: 0,
+        reason: format!("the guide's spline: {e}"),
+    })
+}
+
+/// The tube's parameter range: from the second guide point to the one
+/// before last (the outer points lie past the ends).
+fn tube_range(points: &[Point3]) -> (f64, f64) {
+    let k = chord_knots(points);
+    (k[1], k[k.len() - 2])
+}
+
+/// Knots of the refit: graded over the tube's range, plus one knot past
+/// each end (as far as the first interval is long).
+fn fit_knots(range: (f64, f64), knot_h: f64, spacing: f64) -> Vec<f64> {
+    let inner = smooth::graded_knots(range.1 - range.0, knot_h, spacing);
+    let (first, last) = (
+        inner[1] - inner[0],
+        inner[inner.len() - 1] - inner[inner.len() - 2],
+    );
+    let mut k = vec![range.0 - first];
+    k.extend(inner.iter().map(|x| x + range.0));
+    k.push(range.1 + last);
+    k
+}
+
+/// Shortest knot interval (mm) that keeps the refit stable on a tube whose
+/// radius changes: a guide tilted by `alpha` moves a section's centre by
+/// about `A' A alpha` (the points of one side come from a wider part), so a
+/// wiggle of wavelength `2 h` grows unless `h > pi |A'| A`; 20 % margin.
+fn coupling_gap(law: Option<&(Vec<f64>, Vec<f64>)>) -> f64 {
+    let Some((k, v)) = law else { return 0.0 };
+    let m = smooth::natural_second_derivatives(k, v);
+    let mut worst = 0.0_f64;
+    for w in k.windows(2) {
+        for f in [0.0, 0.5, 1.0] {
+            let t = w[0] + f * (w[1] - w[0]);
+            let h = 1e-3 * (w[1] - w[0]);
+            let d = (smooth::eval(k, v, &m, t + h) - smooth::eval(k, v, &m, t - h)) / (2.0 * h);
+            worst = worst.max(d.abs() * smooth::eval(k, v, &m, t));
+        }
+    }
+    1.2 * std::f64::consts::PI * worst
+}
+
+/// Cumulative chord lengths of `points` (mm): the spline guide's `t`.
+pub(super) fn chord_knots(points: &[Point3]) -> Vec<f64> {
+    let mut k = vec![0.0];
+    for w in points.windows(2) {
+        k.push(k[k.len() - 1] + (w[1] - w[0]).norm());
+    }
+    k
+}
+
+fn centroid(points: impl Iterator<Item = Point3>) -> Point3 {
+    let (s, n) = points.fold((Vector3::zeros(), 0usize), |(s, n), p| {
+        (s + p.coords, n + 1)
+    });
+    Point3::from(s / n.max(1) as f64)
+}
+
+/// Plane and circle of one open end.
+fn ring(mesh: &TubeMesh, vertices: &[u32]) -> Option<(Point3, UnitVector3, f64)> {
+    let pts: Vec<Point3> = vertices
+        .iter()
+        .map(|&v| mesh.vertices[v as usize])
+        .collect();
+    let (c, n, _) = fit_plane(&pts)?;
+    let (e1, e2) = plane_basis(&n);
+    let sp: Vec<SectionPoint> = pts
+        .iter()
+        .map(|p| SectionPoint {
+            x: (p - c).dot(&e1),
+            y: (p - c).dot(&e2),
+            dt: 0.0,
+        })
+        .collect();
+    let f = fit_circle(&sp, 0.0)?;
+    Some((c + e1 * f.centre[0] + e2 * f.centre[1], n, f.radius))
+}
+
+/// The two open ends, each averaged over the skins (loops paired by nearest centre).
+fn end_rings(mesh: &TubeMesh, surf: &Surfaces) -> Result<[EndRing; 2], FitError> {
+    let fitted: Vec<[(Point3, UnitVector3, f64); 2]> = surf
+        .skins
+        .iter()
+        .map(|s| {
+            let f = |l: &Vec<u32>| {
+                ring(mesh, l).ok_or_else(|| FitError::Degenerate {
+                    file: mesh.file.clone(),
+                    station: 0,
+                    reason: format!("the open end of {} vertices is not a ring", l.len()),
+                })
+            };
+            Ok([f(&s.loops[0])?, f(&s.loops[1])?])
+        })
+        .collect::<Result<_, FitError>>()?;
+    let capped = |skin: usize, l: usize| {
+        surf.caps.iter().any(|c| {
+            surf.skins[skin].loops[l]
+                .iter()
+                .any(|v| c.vertices.binary_search(v).is_ok())
+        })
+    };
+    let make = |l0: usize| -> Result<EndRing, FitError> {
+        let (c0, n0, r0) = fitted[0][l0];
+        let mut end = EndRing {
+            centre: c0,
+            normal: n0,
+            radius: r0,
+            capped: capped(0, l0),
+            loops: vec![l0],
+        };
+        if let Some(other) = fitted.get(1) {
+            let l1 = if (other[0].0 - c0).norm() <= (other[1].0 - c0).norm() {
+                0
+            } else {
+                1
+            };
+            let (c1, _, r1) = other[l1];
+            if (c1 - c0).norm() > 0.5 * r0.max(r1) {
+                return Err(FitError::NotATube {
+                    file: mesh.file.clone(),
+                    found: format!(
+                        "two surfaces whose ends are {:.2} mm apart (radii {r0:.2} and {r1:.2} mm): not the two skins of one wall",
+                        (c1 - c0).norm()
+                    ),
+                });
+            }
+            end.centre = Point3::from(0.5 * (c0.coords + c1.coords));
+            end.radius = 0.5 * (r0 + r1);
+            end.capped |= capped(1, l1);
+            end.loops.push(l1);
+        }
+        Ok(end)
+    };
+    Ok([make(0)?, make(1)?])
+}
+
+fn choose_start(
+    mesh: &TubeMesh,
+    ends: [EndRing; 2],
+    opts: &FitOptions,
+) -> Result<[EndRing; 2], FitError> {
+    let [a, b] = ends;
+    let swap = match opts.start {
+        StartEnd::Lowest => b.centre.z < a.centre.z,
+        StartEnd::Highest => b.centre.z > a.centre.z,
+        StartEnd::Near(p) => {
+            let p = Point3::new(p[0], p[1], p[2]);
+            (b.centre - p).norm() < (a.centre - p).norm()
+        }
+        StartEnd::Capped => match (a.capped, b.capped) {
+            (true, false) => false,
+            (false, true) => true,
+            (x, _) => {
+                return Err(FitError::NotATube {
+                    file: mesh.file.clone(),
+                    found: format!(
+                        "start = capped, but {} ends are closed by a flat cap (need exactly one)",
+                        if x { "both" } else { "no" }
+                    ),
+                })
+            }
+        },
+    };
+    Ok(if swap { [b, a] } else { [a, b] })
+}
+
+fn samples(mesh: &TubeMesh, surf: &Surfaces) -> Samples {
+    let mut pos = Vec::new();
+    let mut skin = Vec::new();
+    for (k, s) in surf.skins.iter().enumerate() {
+        pos.extend(s.vertices.iter().map(|&v| mesh.vertices[v as usize]));
+        skin.extend(std::iter::repeat_n(k as u8, s.vertices.len()));
+    }
+    Samples {
+        pos,
+        skin,
+        skins: surf.skins.len(),
+    }
+}
+
+/// First guide: the start end's centre, the centroids of the level sets of
+/// the geodesic distance from the start end (those before the far end), the
+/// far end's centre; thinned to points `knot_h / 2` apart.
+fn initial_guide(
+    mesh: &TubeMesh,
+    surf: &Surfaces,
+    start: &EndRing,
+    finish: &EndRing,
+    edge: f64,
+    knot_h: f64,
+) -> Result<Vec<Point3>, FitError> {
+    let skin = &surf.skins[0];
+    let width = (3.0 * edge).max(start.radius / 3.0);
+    let sets = topology::level_sets(mesh, &skin.triangles, &skin.loops[start.loops[0]], width);
+    let far = skin.loops[finish.loops[0]]
+        .iter()
+        .map(|&v| sets.distance[v as usize])
+        .fold(f64::INFINITY, f64::min);
+    if !far.is_finite() {
+        return Err(FitError::NotATube {
+            file: mesh.file.clone(),
+            found: "the two open ends are not connected by the surface".into(),
+        });
+    }
+    let complete = ((far / width).floor() as usize).saturating_sub(1);
+    let mut raw = vec![start.centre];
+    for (k, band) in sets.bands.iter().take(complete).enumerate() {
+        if band.pieces >= 2 {
+            return Err(FitError::Branch {
+                file: mesh.file.clone(),
+                station: k,
+                t_mm: (k as f64 + 0.5) * width,
+                x: band.centroid.x,
+                y: band.centroid.y,
+                z: band.centroid.z,
+                found: format!("the level set falls apart in {} rings", band.pieces),
+            });
+        }
+        if band.vertices > 0 {
+            raw.push(band.centroid);
+        }
+    }
+    let mut pts = vec![start.centre];
+    for p in raw.into_iter().skip(1) {
+        if (p - pts[pts.len() - 1]).norm() >= 0.5 * knot_h
+            && (finish.centre - p).norm() >= 0.5 * knot_h
+        {
+            pts.push(p);
+        }
+    }
+    pts.push(finish.centre);
+    if pts.len() == 2 {
+        pts.insert(1, centroid(pts.iter().copied()));
+    }
+    if (pts[pts.len() - 1] - pts[0]).norm() < 1e-3 {
+        return Err(FitError::NotATube {
+            file: mesh.file.clone(),
+            found: "the two open ends have the same centre".into(),
+        });
+    }
+    // One point past each end, along the end chord.
+    let n = pts.len();
+    let before = pts[0] + (pts[0] - pts[1]).normalize() * (0.25 * knot_h);
+    let after = pts[n - 1] + (pts[n - 1] - pts[n - 2]).normalize() * (0.25 * knot_h);
+    pts.insert(0, before);
+    pts.push(after);
+    Ok(pts)
+}
+
+/// Guide parameter of the nearest guide point of every sample: Newton from
+/// the hint, or from the nearest point of a polyline of the guide (parry3d
+/// BVH query) when there is no hint or Newton does not settle.
+fn project_all(
+    spline: &CubicSpline,
+    range: (f64, f64),
+    s: &Samples,
+    hints: Option<&[f64]>,
+    ext: f64,
+) -> Vec<f64> {
+    let (lo, hi) = (range.0 - ext, range.1 + ext);
+    let n = ((hi - lo) / 0.5).ceil().clamp(16.0, 20_000.0) as usize;
+    let ts: Vec<f64> = (0..=n)
+        .map(|i| lo + (hi - lo) * i as f64 / n as f64)
+        .collect();
+    let line = Polyline::new(ts.iter().map(|&t| spline.point(t)).collect(), None);
+    let global = |p: &Point3| {
+        let (_, (seg, loc)) = line.project_local_point_and_get_location(p, false);
+        let [u, v] = loc.barycentric_coordinates();
+        ts[seg as usize] * u + ts[seg as usize + 1] * v
+    };
+    s.pos
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let hint = hints.and_then(|h| h.get(i).copied());
+            match hint.and_then(|t0| newton(spline, p, t0, lo, hi)) {
+                Some(t) => t,
+                None => {
+                    let t0 = global(p);
+                    newton(spline, p, t0, lo, hi).unwrap_or(t0)
+                }
+            }
+        })
+        .collect()
+}
+
+/// Nearest-point parameter by Newton on `(C(t) - p) · C'(t) = 0` in `[lo, hi]`.
+fn newton(spline: &CubicSpline, p: &Point3, mut t: f64, lo: f64, hi: f64) -> Option<f64> {
+    for _ in 0..12 {
+        let d = spline.point(t) - p;
+        let d1 = spline.d1(t);
+        let f = d.dot(&d1);
+        let fp = d1.norm_squared() + d.dot(&spline.d2(t));
+        let step = if fp > 0.1 * d1.norm_squared() {
+            f / fp
+        } else {
+            f / d1.norm_squared()
+        };
+        let next = (t - step).clamp(lo, hi);
+        if (next - t).abs() < 1e-10 {
+            return Some(next);
+        }
+        t = next;
+    }
+    None
+}
+
+/// Minimal rotation taking unit `a` to unit `b`, applied to `x`.
+fn rotate(a: &Vector3, b: &Vector3, x: &Vector3) -> Vector3 {
+    let v = a.cross(b);
+    let c = a.dot(b);
+    if c < -0.999 {
+        return *x;
+    }
+    x * c + v.cross(x) + v * (v.dot(x) / (1.0 + c))
+}
+
+/// Stations every `spacing` mm over the tube's range; each takes the samples
+/// whose nearest guide parameter is nearest to it, carried into its normal
+/// plane by the minimal rotation of their own normal plane, and fits one
+/// circle per skin.
+fn sections(
+    spline: &CubicSpline,
+    range: (f64, f64),
+    spacing: f64,
+    s: &Samples,
+    t: &[f64],
+    law: Option<&(Vec<f64>, Vec<f64>)>,
+) -> Vec<Station> {
+    let law = law.map(|(k, v)| (k, v, smooth::natural_second_derivatives(k, v)));
+    let slope_at = |t: f64| {
+        law.as_ref().map_or(0.0, |(k, v, m)| {
+            let h = 0.5 * spacing;
+            (smooth::eval(k, v, m, t + h) - smooth::eval(k, v, m, t - h)) / (2.0 * h)
+        })
+    };
+    let len = range.1 - range.0;
+    let n = ((len / spacing).ceil() as usize).max(2);
+    let step = len / n as f64;
+    let mut bins: Vec<Vec<SectionPoint>> = vec![Vec::new(); (n + 1) * s.skins];
+    let frames: Vec<(f64, Point3, Vector3, Vector3, Vector3)> = (0..=n)
+        .map(|i| {
+            let ti = range.0 + i as f64 * step;
+            let tan = UnitVector3::new_normalize(spline.d1(ti));
+            let (e1, e2) = plane_basis(&tan);
+            (ti, spline.point(ti), tan.into_inner(), e1, e2)
+        })
+        .collect();
+    for (k, (p, &tv)) in s.pos.iter().zip(t).enumerate() {
+        let i = (((tv - range.0) / step).round().max(0.0) as usize).min(n);
+        let (ti, _, tan_i, e1, e2) = &frames[i];
+        let o = p - spline.point(tv);
+        let o = rotate(&spline.d1(tv).normalize(), tan_i, &o);
+        bins[i * s.skins + s.skin[k] as usize].push(SectionPoint {
+            x: o.dot(e1),
+            y: o.dot(e2),
+            dt: tv - ti,
+        });
+    }
+    // A station with under half the usual points is a partial ring (past an
+    // end cut obliquely): left out.
+    let mut counts: Vec<usize> = (0..=n)
+        .map(|i| (0..s.skins).map(|k| bins[i * s.skins + k].len()).sum())
+        .collect();
+    let median = *counts.select_nth_unstable(n / 2).1;
+    frames
+        .par_iter()
+        .enumerate()
+        .map(|(i, (ti, c, _, e1, e2))| {
+            let slope = slope_at(*ti);
+            let fits: Vec<Option<CircleFit>> = (0..s.skins)
+                .map(|k| fit_circle(&bins[i * s.skins + k], slope))
+                .collect();
+            let points = (0..s.skins).map(|k| bins[i * s.skins + k].len()).sum();
+            let all: Option<Vec<CircleFit>> = if 2 * points >= median {
+                fits.iter().copied().collect()
+            } else {
+                None
+            };
+            let (centre, radius, thickness) = match all {
+                Some(f) => {
+                    let m = f.len() as f64;
+                    let cx = f.iter().map(|f| f.centre[0]).sum::<f64>() / m;
+                    let cy = f.iter().map(|f| f.centre[1]).sum::<f64>() / m;
+                    let r = f.iter().map(|f| f.radius).sum::<f64>() / m;
+                    let e = (f.len() == 2).then(|| (f[0].radius - f[1].radius).abs());
+                    (Some(c + e1 * cx + e2 * cy), Some(r), e)
+                }
+                None => (None, None, None),
+            };
+            Station {
+                t: *ti,
+                fits,
+                centre,
+                radius,
+                thickness,
+                points,
+            }
+        })
+        .collect()
+}
+
+/// The guide's new points at `knots`: the smoothing fit of the section centres.
+fn refit_guide(
+    mesh: &TubeMesh,
+    stations: &[Station],
+    knots: &[f64],
+) -> Result<Vec<Point3>, FitError> {
+    let ok: Vec<&Station> = stations.iter().filter(|s| s.centre.is_some()).collect();
+    if ok.len() < 3 || ok.len() * 2 < stations.len() {
+        let first_bad = stations
+            .iter()
+            .position(|s| s.centre.is_none())
+            .unwrap_or(0);
+        return Err(FitError::Degenerate {
+            file: mesh.file.clone(),
+            station: first_bad,
+            reason: format!(
+                "only {} of {} stations have enough points for a circle (need half of them)",
+                ok.len(),
+                stations.len()
+            ),
+        });
+    }
+    let ts: Vec<f64> = ok.iter().map(|s| s.t).collect();
+    let w: Vec<f64> = ok.iter().map(|s| s.points as f64).collect();
+    let ys = DMatrix::from_fn(ok.len(), 3, |i, k| ok[i].centre.expect("filtered")[k]);
+    let sol = smooth::fit(knots, &ts, &ys, &w, 1e-6).ok_or_else(|| FitError::Degenerate {
+        file: mesh.file.clone(),
+        station: 0,
+        reason: "the guide's least-squares system is singular".into(),
+    })?;
+    let pts: Vec<Point3> = (0..knots.len())
+        .map(|j| Point3::new(sol[(j, 0)], sol[(j, 1)], sol[(j, 2)]))
+        .collect();
+    if pts.windows(2).any(|w| (w[1] - w[0]).norm() < 1e-6) {
+        return Err(FitError::Degenerate {
+            file: mesh.file.clone(),
+            station: 0,
+            reason: "two points of the fitted guide coincide".into(),
+        });
+    }
+    Ok(pts)
+}
+
+/// Slides each end point of the guide along its end chord onto its open
+/// end's plane: the guide runs from end to end (a least-squares refit alone
+/// lets the ends creep along the tangent).
+fn anchor_ends(points: &mut [Point3], start: &EndRing, finish: &EndRing) {
+    let n = points.len();
+    for (i, j, ring) in [(1, 2, start), (n - 2, n - 3, finish)] {
+        let d = points[j] - points[i];
+        let along = d.dot(&ring.normal);
+        if along.abs() > 0.2 * d.norm() {
+            let s = (ring.centre - points[i]).dot(&ring.normal) / along;
+            // Never past the neighbouring point.
+            if s < 0.9 {
+                points[i] += d * s;
+            }
+        }
+    }
+}
+
+/// A law over `knots` fitted to the stations' values.
+fn fit_law(
+    mesh: &TubeMesh,
+    stations: &[Station],
+    knots: &[f64],
+    pick: &dyn Fn(&Station) -> Option<f64>,
+) -> Result<Vec<f64>, FitError> {
+    let ok: Vec<(f64, f64, f64)> = stations
+        .iter()
+        .filter_map(|s| pick(s).map(|v| (s.t, v, s.points as f64)))
+        .collect();
+    let ts: Vec<f64> = ok.iter().map(|x| x.0).collect();
+    let w: Vec<f64> = ok.iter().map(|x| x.2).collect();
+    let ys = DMatrix::from_fn(ok.len(), 1, |i, _| ok[i].1);
+    let sol = smooth::fit(knots, &ts, &ys, &w, 1e-6).ok_or_else(|| FitError::Degenerate {
+        file: mesh.file.clone(),
+        station: 0,
+        reason: "the radius law's least-squares system is singular".into(),
+    })?;
+    let v: Vec<f64> = sol.column(0).iter().copied().collect();
+    if let Some(j) = v.iter().position(|&r| !(r > 0.0)) {
+        return Err(FitError::Degenerate {
+            file: mesh.file.clone(),
+            station: j,
+            reason: format!("the fitted law is not positive at t = {:.2} mm", knots[j]),
+        });
+    }
+    Ok(v)
+}
+
+/// Index of the outer skin (larger mean radius), when two.
+fn outer_skin(stations: &[Station]) -> usize {
+    let mean = |k: usize| {
+        let v: Vec<f64> = stations
+            .iter()
+            .filter_map(|s| s.fits.get(k).copied().flatten().map(|f| f.radius))
+            .collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    usize::from(stations.first().is_some_and(|s| s.fits.len() == 2) && mean(1) > mean(0))
+}
+
+/// Refuses a section far from a circle, or a run of three sections that are
+/// not closed rings (one alone is a ring split between two stations).
+fn check_sections(
+    mesh: &TubeMesh,
+    stations: &[Station],
+    opts: &FitOptions,
+) -> Result<(), FitError> {
+    let gap_max = opts.max_section_gap_deg.to_radians();
+    let mut run = 0;
+    for (i, s) in stations.iter().enumerate() {
+        let mut open = None;
+        for (k, f) in s.fits.iter().enumerate() {
+            let Some(f) = f else { continue };
+            let skin = if s.fits.len() == 2 {
+                format!("skin {k}: ")
+            } else {
+                String::new()
+            };
+            let allowed = (opts.max_section_rms_ratio * f.radius).max(opts.max_rms_mm);
+            if f.rms > allowed {
+                return Err(FitError::SectionNotCircle {
+                    file: mesh.file.clone(),
+                    station: i,
+                    t_mm: s.t,
+                    found: format!(
+                        "{skin}{} points {:.3} mm RMS (largest {:.3} mm) from their best circle of radius {:.3} mm; allowed {allowed:.3} mm",
+                        f.points, f.rms, f.max_dev, f.radius
+                    ),
+                });
+            }
+            if f.max_gap_rad > gap_max {
+                open = Some((skin, f.max_gap_rad));
+            }
+        }
+        run = if open.is_some() { run + 1 } else { 0 };
+        if let (Some((skin, gap)), 3) = (open, run) {
+            return Err(FitError::SectionNotCircle {
+                file: mesh.file.clone(),
+                station: i - 2,
+                t_mm: stations[i - 2].t,
+                found: format!(
+                    "{skin}not a closed ring: the points of this station and the next two leave a gap of up to {:.0} degrees around the circle (allowed {:.0})",
+                    gap.to_degrees(),
+                    opts.max_section_gap_deg
+                ),
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,178 @@
+//! Options of the mesh fit: plain data with defaults, checked by
+//! [`FitOptions::validate`] (which names the field).
+
+use super::FitError;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// Which end of the tube is its start: the end built first, standing on the
+/// substrate.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StartEnd {
+    /// The end whose centre is lowest (smallest Z of the mesh frame).
+    #[default]
+    Lowest,
+    /// The end whose centre is highest.
+    Highest,
+    /// The end closed by a flat cap (a plate or bottom in the mesh); refused
+    /// unless exactly one end is capped.
+    Capped,
+    /// The end whose centre is nearest this point (mesh frame, mm).
+    Near([f64; 3]),
+}
+
+impl std::str::FromStr for StartEnd {
+    type Err = String;
+
+    /// `lowest`, `highest`, `capped`, or a point `x,y,z` (mm).
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            "lowest" => Ok(Self::Lowest),
+            "highest" => Ok(Self::Highest),
+            "capped" => Ok(Self::Capped),
+            other => {
+                let parts: Vec<&str> = other.split(',').collect();
+                let xyz: Vec<f64> = parts
+                    .iter()
+                    .filter_map(|p| p.trim().parse::<f64>().ok())
+                    .filter(|x| x.is_finite())
+                    .collect();
+                if parts.len() == 3 && xyz.len() == 3 {
+                    Ok(Self::Near([xyz[0], xyz[1], xyz[2]]))
+                } else {
+                    Err(format!(
+                        "`{s}`: expected `lowest`, `highest`, `capped` or a point `x,y,z` (mm)"
+                    ))
+                }
+            }
+        }
+    }
+}
+
+/// How a tubular mesh is fitted ([`fit_tube`](super::fit_tube)). Lengths in
+/// mm, angles in degrees (as typed by a user; converted inside).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FitOptions {
+    /// Which end stands on the substrate (default: the lowest).
+    pub start: StartEnd,
+    /// Largest RMS distance (mm) of the mesh's vertices to the fitted tube
+    /// surface; above it the mesh is refused as not a tube.
+    pub max_rms_mm: f64,
+    /// Largest RMS distance of a section's points to their least-squares
+    /// circle, as a fraction of its radius (or `max_rms_mm` when larger);
+    /// above it the section is refused as not near a circle.
+    pub max_section_rms_ratio: f64,
+    /// Largest angular gap (degrees) between a section's points around its
+    /// circle; three stations in a row above it are refused as not a closed
+    /// ring.
+    pub max_section_gap_deg: f64,
+    /// Spacing (mm) of the stations along the guide where a circle is fitted;
+    /// `None`: twice the median edge length, within `[0.5, radius / 4]`.
+    pub station_spacing_mm: Option<f64>,
+    /// Spacing (mm) of the spline's points (guide and radius law) inside
+    /// the tube; quarter and half of it next to each end. `None`: half the
+    /// radius at the start, within `[4, 12]`.
+    pub knot_spacing_mm: Option<f64>,
+    /// The iteration stops once no guide point moves more than this (mm),
+    /// or once the moves stop shrinking below ten times this or a quarter of
+    /// the sections' median RMS scatter, whichever is larger (the level of
+    /// the mesh's noise).
+    pub tolerance_mm: f64,
+    /// Most refits of the guide.
+    pub max_iterations: usize,
+    /// Two triangles meeting at more than this angle (degrees) are on
+    /// different faces: splits a closed wall into skins and flat end faces,
+    /// and finds a flat cap. Used only on a surface that is not an open tube.
+    pub crease_angle_deg: f64,
+    /// A radius law whose values all lie within this (mm) of their mean is
+    /// written as a constant radius.
+    pub constant_radius_tol_mm: f64,
+    /// Measure the distance of the fitted surface to the mesh as well (a
+    /// parry3d BVH query per sample of the fitted tube): finds a fitted tube
+    /// running past the mesh.
+    pub check_surface: bool,
+    /// A part file whose `[slicing]`, `[tool_axis]` and `[process]` tables
+    /// the written part takes; `None`: constant-distance slicing with
+    /// `Delta` = 2 mm, 400 points, the axis rate bounded to 10°/mm, CMT steel.
+    pub template: Option<PathBuf>,
+    /// The written part's name; `None`: the mesh file's stem.
+    pub name: Option<String>,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            start: StartEnd::Lowest,
+            max_rms_mm: 0.5,
+            max_section_rms_ratio: 0.03,
+            max_section_gap_deg: 90.0,
+            station_spacing_mm: None,
+            knot_spacing_mm: None,
+            tolerance_mm: 1e-3,
+            max_iterations: 30,
+            crease_angle_deg: 45.0,
+            constant_radius_tol_mm: 0.01,
+            check_surface: true,
+            template: None,
+            name: None,
+        }
+    }
+}
+
+impl FitOptions {
+    /// Checks every field; `file` names the mesh in the error.
+    ///
+    /// # Errors
+    /// [`FitError::InvalidOption`] naming the field.
+    pub fn validate(&self, file: &str) -> Result<(), FitError> {
+        let bad = |field: &str, reason: String| FitError::InvalidOption {
+            file: file.to_string(),
+            field: field.to_string(),
+            reason,
+        };
+        let positive = |field: &str, x: f64| {
+            if x.is_finite() && x > 0.0 {
+                Ok(())
+            } else {
+                Err(bad(field, format!("must be positive and finite, got {x}")))
+            }
+        };
+        positive("max_rms_mm", self.max_rms_mm)?;
+        positive("max_section_rms_ratio", self.max_section_rms_ratio)?;
+        positive("tolerance_mm", self.tolerance_mm)?;
+        positive("constant_radius_tol_mm", self.constant_radius_tol_mm)?;
+        if let Some(s) = self.station_spacing_mm {
+            positive("station_spacing_mm", s)?;
+        }
+        if let Some(s) = self.knot_spacing_mm {
+            positive("knot_spacing_mm", s)?;
+        }
+        for (field, x) in [
+            ("max_section_gap_deg", self.max_section_gap_deg),
+            ("crease_angle_deg", self.crease_angle_deg),
+        ] {
+            if !(x > 0.0 && x < 180.0) {
+                return Err(bad(
+                    field,
+                    format!("must be within (0, 180) degrees, got {x}"),
+                ));
+            }
+        }
+        if self.max_iterations == 0 {
+            return Err(bad("max_iterations", "must be at least 1".into()));
+        }
+        if let StartEnd::Near(p) = self.start {
+            if !p.iter().all(|x| x.is_finite()) {
+                return Err(bad("start", format!("point {p:?} is not finite")));
+            }
+        }
+        if let Some(name) = &self.name {
+            if name.trim().is_empty() {
+                return Err(bad("name", "must not be empty".into()));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,438 @@
+//! The mesh's surfaces: connected pieces, their open ends (boundary loops),
+//! faces split at creases, flat end faces (caps), and the level sets of the
+//! geodesic distance from an open end (a first guide, and where a tube
+//! branches). Mesh frame, mm.
+
+use super::section::fit_plane;
+use super::{FitError, FitOptions, TubeMesh};
+use crate::math::{Point3, UnitVector3};
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap};
+
+/// One skin of the tube wall (or its mid-surface): an open surface with two
+/// open ends.
+#[derive(Debug, Clone)]
+pub struct Skin {
+    /// Its triangles (indices into the mesh's triangles).
+    pub triangles: Vec<u32>,
+    /// Its vertices (indices into the mesh's vertices, sorted).
+    pub vertices: Vec<u32>,
+    /// Its two open ends, as vertex sets.
+    pub loops: [Vec<u32>; 2],
+}
+
+/// A flat face closing an end (mesh frame, mm).
+#[derive(Debug, Clone)]
+pub struct Cap {
+    /// Its vertices (sorted).
+    pub vertices: Vec<u32>,
+    /// Centroid of its vertices (mm).
+    pub centroid: Point3,
+    /// Its plane's normal (either sense).
+    pub normal: UnitVector3,
+}
+
+/// The mesh seen as a tube: one skin (mid-surface) or two (wall), and flat caps.
+#[derive(Debug, Clone)]
+pub struct Surfaces {
+    /// The skins, largest first.
+    pub skins: Vec<Skin>,
+    /// Flat end faces.
+    pub caps: Vec<Cap>,
+    /// Triangles of small stray pieces left out of the fit.
+    pub ignored_triangles: usize,
+}
+
+struct UnionFind(Vec<u32>);
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        Self((0..n as u32).collect())
+    }
+    fn find(&mut self, mut i: u32) -> u32 {
+        while self.0[i as usize] != i {
+            let p = self.0[self.0[i as usize] as usize];
+            self.0[i as usize] = p;
+            i = p;
+        }
+        i
+    }
+    fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            let (lo, hi) = (ra.min(rb), ra.max(rb));
+            self.0[hi as usize] = lo;
+        }
+    }
+}
+
+/// Edges `(lo, hi, triangle)` of the given triangles, sorted.
+fn edges(mesh: &TubeMesh, tris: &[u32]) -> Vec<(u32, u32, u32)> {
+    let mut e = Vec::with_capacity(3 * tris.len());
+    for &t in tris {
+        let v = mesh.triangles[t as usize];
+        for k in 0..3 {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            e.push((a.min(b), a.max(b), t));
+        }
+    }
+    e.sort_unstable();
+    e
+}
+
+/// Groups of `tris` joined across edges that `joins(t1, t2)` accepts.
+fn pieces(mesh: &TubeMesh, tris: &[u32], joins: impl Fn(u32, u32) -> bool) -> Vec<Vec<u32>> {
+    let index: HashMap<u32, u32> = tris
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| (t, i as u32))
+        .collect();
+    let mut uf = UnionFind::new(tris.len());
+    let e = edges(mesh, tris);
+    for group in e.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)) {
+        for w in group.windows(2) {
+            if joins(w[0].2, w[1].2) {
+                uf.union(index[&w[0].2], index[&w[1].2]);
+            }
+        }
+    }
+    let mut by_root: HashMap<u32, Vec<u32>> = HashMap::new();
+    for (i, &t) in tris.iter().enumerate() {
+        by_root.entry(uf.find(i as u32)).or_default().push(t);
+    }
+    let mut out: Vec<Vec<u32>> = by_root.into_values().collect();
+    out.sort_by_key(|p| (Reverse(p.len()), p[0]));
+    out
+}
+
+/// The open ends of a set of triangles: loops of the edges used by one of
+/// them only, as vertex sets (sorted, loops ordered by their first vertex).
+pub fn boundary_loops(mesh: &TubeMesh, tris: &[u32]) -> Vec<Vec<u32>> {
+    let e = edges(mesh, tris);
+    let boundary: Vec<(u32, u32)> = e
+        .chunk_by(|a, b| (a.0, a.1) == (b.0, b.1))
+        .filter(|g| g.len() == 1)
+        .map(|g| (g[0].0, g[0].1))
+        .collect();
+    let mut local: HashMap<u32, u32> = HashMap::new();
+    for &(a, b) in &boundary {
+        for v in [a, b] {
+            let n = local.len() as u32;
+            local.entry(v).or_insert(n);
+        }
+    }
+    let mut uf = UnionFind::new(local.len());
+    for &(a, b) in &boundary {
+        uf.union(local[&a], local[&b]);
+    }
+    let mut by_root: HashMap<u32, Vec<u32>> = HashMap::new();
+    for (&v, &i) in &local {
+        by_root.entry(uf.find(i)).or_default().push(v);
+    }
+    let mut loops: Vec<Vec<u32>> = by_root
+        .into_values()
+        .map(|mut l| {
+            l.sort_unstable();
+            l
+        })
+        .collect();
+    loops.sort_by_key(|l| l[0]);
+    loops
+}
+
+fn vertices_of(mesh: &TubeMesh, tris: &[u32]) -> Vec<u32> {
+    let mut v: Vec<u32> = tris
+        .iter()
+        .flat_map(|&t| mesh.triangles[t as usize])
+        .collect();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+fn unit_normal(mesh: &TubeMesh, t: u32) -> crate::math::Vector3 {
+    let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.vertices[i as usize]);
+    (b - a).cross(&(c - a)).normalize()
+}
+
+/// Finds the skins and caps of `mesh`.
+///
+/// A connected piece with two open ends is a skin as it is; any other piece
+/// is split at creases ([`FitOptions::crease_angle_deg`]) into faces: flat
+/// faces are caps, faces with two open ends skins.
+///
+/// # Errors
+/// [`FitError::ClosedSurface`] for a closed face without flat faces,
+/// [`FitError::Branch`] for a face with three open ends or more,
+/// [`FitError::NotATube`] for one open end or a count of skins other than 1 or 2.
+pub fn surfaces(mesh: &TubeMesh, opts: &FitOptions) -> Result<Surfaces, FitError> {
+    let all: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
+    let components = pieces(mesh, &all, |_, _| true);
+    let small = (mesh.triangles.len() / 100).max(1);
+    let cos_crease = opts.crease_angle_deg.to_radians().cos();
+    let normals: Vec<_> = all.iter().map(|&t| unit_normal(mesh, t)).collect();
+    let mut out = Surfaces {
+        skins: Vec::new(),
+        caps: Vec::new(),
+        ignored_triangles: 0,
+    };
+    for comp in components {
+        if comp.len() < small {
+            out.ignored_triangles += comp.len();
+            continue;
+        }
+        let loops = boundary_loops(mesh, &comp);
+        if loops.len() >= 3 {
+            return Err(branch_error(mesh, &comp, &loops));
+        }
+        if let Ok(pair) = <[Vec<u32>; 2]>::try_from(loops) {
+            out.skins.push(Skin {
+                vertices: vertices_of(mesh, &comp),
+                triangles: comp,
+                loops: pair,
+            });
+            continue;
+        }
+        let faces = pieces(mesh, &comp, |a, b| {
+            normals[a as usize].dot(&normals[b as usize]).abs() >= cos_crease
+        });
+        let small_face = (comp.len() / 200).max(1);
+        for face in faces {
+            let vertices = vertices_of(mesh, &face);
+            let pts: Vec<Point3> = vertices
+                .iter()
+                .map(|&v| mesh.vertices[v as usize])
+                .collect();
+            if let Some((centroid, normal, dev)) = fit_plane(&pts) {
+                let extent = pts
+                    .iter()
+                    .map(|p| (p - centroid).norm())
+                    .fold(0.0, f64::max);
+                if dev <= 1e-4 * extent + 1e-3 {
+                    out.caps.push(Cap {
+                        vertices,
+                        centroid,
+                        normal,
+                    });
+                    continue;
+                }
+            }
+            if face.len() < small_face {
+                out.ignored_triangles += face.len();
+                continue;
+            }
+            let loops = boundary_loops(mesh, &face);
+            match loops.len() {
+                0 => {
+                    return Err(FitError::ClosedSurface {
+                        file: mesh.file.clone(),
+                        found: format!(
+                            "a closed surface ({} vertices, {} triangles) with no open end and no flat end face: a blob",
+                            vertices.len(),
+                            face.len()
+                        ),
+                    })
+                }
+                1 => {
+                    return Err(FitError::NotATube {
+                        file: mesh.file.clone(),
+                        found: format!(
+                            "a surface of {} triangles with one open end only: the other end is closed without a flat cap",
+                            face.len()
+                        ),
+                    })
+                }
+                2 => {
+                    let pair = <[Vec<u32>; 2]>::try_from(loops).expect("two loops");
+                    out.skins.push(Skin {
+                        triangles: face,
+                        vertices,
+                        loops: pair,
+                    });
+                }
+                _ => return Err(branch_error(mesh, &face, &loops)),
+            }
+        }
+    }
+    out.skins.sort_by_key(|s| Reverse(s.triangles.len()));
+    if out.skins.is_empty() || out.skins.len() > 2 {
+        return Err(FitError::NotATube {
+            file: mesh.file.clone(),
+            found: format!(
+                "{} tube surfaces with two open ends (need 1: the mid-surface, or 2: the skins of a wall); {} flat faces",
+                out.skins.len(),
+                out.caps.len()
+            ),
+        });
+    }
+    Ok(out)
+}
+
+/// The branch error of a piece with three open ends or more: names the first
+/// level set (from the lowest end) that falls apart.
+fn branch_error(mesh: &TubeMesh, tris: &[u32], loops: &[Vec<u32>]) -> FitError {
+    let lowest = loops
+        .iter()
+        .min_by(|a, b| mean_z(mesh, a).total_cmp(&mean_z(mesh, b)))
+        .expect("loops");
+    let width = 3.0 * median_edge(mesh, tris);
+    let sets = level_sets(mesh, tris, lowest, width);
+    let found = format!("{} open ends: a branched tube", loops.len());
+    match sets.bands.iter().position(|b| b.pieces >= 2) {
+        Some(k) => {
+            let c = sets.bands[k].centroid;
+            FitError::Branch {
+                file: mesh.file.clone(),
+                station: k,
+                t_mm: (k as f64 + 0.5) * width,
+                x: c.x,
+                y: c.y,
+                z: c.z,
+                found: format!(
+                    "{found}; the level set there falls apart in {} rings",
+                    sets.bands[k].pieces
+                ),
+            }
+        }
+        None => {
+            let c = Point3::from(
+                loops[0]
+                    .iter()
+                    .fold(crate::math::Vector3::zeros(), |a, &v| {
+                        a + mesh.vertices[v as usize].coords
+                    })
+                    / loops[0].len() as f64,
+            );
+            FitError::Branch {
+                file: mesh.file.clone(),
+                station: 0,
+                t_mm: 0.0,
+                x: c.x,
+                y: c.y,
+                z: c.z,
+                found,
+            }
+        }
+    }
+}
+
+fn mean_z(mesh: &TubeMesh, vs: &[u32]) -> f64 {
+    vs.iter().map(|&v| mesh.vertices[v as usize].z).sum::<f64>() / vs.len().max(1) as f64
+}
+
+/// Median edge length of the triangles (mm).
+pub fn median_edge(mesh: &TubeMesh, tris: &[u32]) -> f64 {
+    let mut l: Vec<f64> = tris
+        .iter()
+        .step_by((tris.len() / 20_000).max(1))
+        .flat_map(|&t| {
+            let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.vertices[i as usize]);
+            [(b - a).norm(), (c - b).norm(), (a - c).norm()]
+        })
+        .collect();
+    if l.is_empty() {
+        return 0.0;
+    }
+    let k = l.len() / 2;
+    *l.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
+/// One band of the geodesic distance from the start end.
+#[derive(Debug, Clone, Copy)]
+pub struct Band {
+    /// Centroid of its vertices (mm).
+    pub centroid: Point3,
+    /// Its vertices.
+    pub vertices: usize,
+    /// Its connected rings holding at least a tenth of its vertices.
+    pub pieces: usize,
+}
+
+/// Level sets of the geodesic (edge-path) distance from a set of vertices.
+#[derive(Debug, Clone)]
+pub struct LevelSets {
+    /// Distance of each mesh vertex (mm; infinite off the surface).
+    pub distance: Vec<f64>,
+    /// Bands `[k w, (k + 1) w)`, `w` the width.
+    pub bands: Vec<Band>,
+}
+
+/// Dijkstra over the edges of `tris` from `sources`, then bands of `width` mm.
+pub fn level_sets(mesh: &TubeMesh, tris: &[u32], sources: &[u32], width: f64) -> LevelSets {
+    let n = mesh.vertices.len();
+    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for &t in tris {
+        let v = mesh.triangles[t as usize];
+        for k in 0..3 {
+            adj[v[k] as usize].push(v[(k + 1) % 3]);
+            adj[v[(k + 1) % 3] as usize].push(v[k]);
+        }
+    }
+    let mut dist = vec![f64::INFINITY; n];
+    let mut heap = BinaryHeap::new();
+    for &s in sources {
+        dist[s as usize] = 0.0;
+        heap.push(Reverse((0u64, s)));
+    }
+    while let Some(Reverse((bits, v))) = heap.pop() {
+        let d = f64::from_bits(bits);
+        if d > dist[v as usize] {
+            continue;
+        }
+        for &w in &adj[v as usize] {
+            let nd = d + (mesh.vertices[w as usize] - mesh.vertices[v as usize]).norm();
+            if nd < dist[w as usize] {
+                dist[w as usize] = nd;
+                // Non-negative f64 bits order as the values.
+                heap.push(Reverse((nd.to_bits(), w)));
+            }
+        }
+    }
+    let width = width.max(1e-6);
+    let band_of = |d: f64| (d.is_finite()).then(|| (d / width) as usize);
+    let count = dist
+        .iter()
+        .filter_map(|&d| band_of(d))
+        .max()
+        .map_or(0, |k| k + 1);
+    let mut sum = vec![crate::math::Vector3::zeros(); count];
+    let mut num = vec![0usize; count];
+    for (v, &d) in dist.iter().enumerate() {
+        if let Some(k) = band_of(d) {
+            sum[k] += mesh.vertices[v].coords;
+            num[k] += 1;
+        }
+    }
+    let mut uf = UnionFind::new(n);
+    for (v, list) in adj.iter().enumerate() {
+        for &w in list {
+            if band_of(dist[v]).is_some() && band_of(dist[v]) == band_of(dist[w as usize]) {
+                uf.union(v as u32, w);
+            }
+        }
+    }
+    let mut sizes: HashMap<u32, usize> = HashMap::new();
+    for (v, &d) in dist.iter().enumerate() {
+        if band_of(d).is_some() {
+            *sizes.entry(uf.find(v as u32)).or_default() += 1;
+        }
+    }
+    let mut pieces = vec![0usize; count];
+    for (&root, &size) in &sizes {
+        let k = band_of(dist[root as usize]).expect("on the surface");
+        if size * 10 >= num[k] && size >= 3 {
+            pieces[k] += 1;
+        }
+    }
+    let bands = (0..count)
+        .map(|k| Band {
+            centroid: Point3::from(sum[k] / num[k].max(1) as f64),
+            vertices: num[k],
+            pieces: pieces[k],
+        })
+        .collect();
+    LevelSets {
+        distance: dist,
+        bands,
+    }
+}

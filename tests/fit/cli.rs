@@ -1,0 +1,89 @@
+//! `waam fit`: writes part.toml and fit.json that `waam slice` takes; refuses
+//! a blob with exit 1, naming the file.
+
+use crate::common::waam;
+use crate::gen;
+
+#[test]
+fn fit_writes_a_part_that_slices() {
+    let dir = tempfile::tempdir().unwrap();
+    let (v, f) = gen::mesh(&gen::s_bend(), 1.5, 0.05, 0.0, 2);
+    let stl = dir.path().join("s-bend.stl");
+    std::fs::write(&stl, gen::binary_stl(&v, &f)).unwrap();
+    let out = dir.path().join("fit");
+    let done = waam()
+        .args(["--quiet", "fit"])
+        .arg(&stl)
+        .arg("--out")
+        .arg(&out)
+        .args(["--start", "lowest"])
+        .output()
+        .unwrap();
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
+    assert!(report["rms_mm"].as_f64().unwrap() < 0.1, "{report}");
+    let text = std::fs::read_to_string(out.join("part.toml")).unwrap();
+    assert!(
+        text.contains("kind = \"spline\"") && text.contains("name = \"s-bend\""),
+        "{text}"
+    );
+    let sliced = dir.path().join("sliced");
+    let done = waam()
+        .args(["--quiet", "slice"])
+        .arg(out.join("part.toml"))
+        .args(["--points", "60", "--no-wall", "--out"])
+        .arg(&sliced)
+        .output()
+        .unwrap();
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(sliced.join("path.csv").exists());
+    // plan takes it as it is: planned (exit 0) or refused by the cell (exit
+    // 2), never bad input (exit 1).
+    let planned = dir.path().join("planned");
+    let done = waam()
+        .args(["--quiet", "plan"])
+        .arg(out.join("part.toml"))
+        .arg("--cell")
+        .arg(crate::common::part_path("cells/robowam_part_carried.toml"))
+        .args(["--points", "40", "--delta", "6", "--out"])
+        .arg(&planned)
+        .output()
+        .unwrap();
+    assert!(
+        matches!(done.status.code(), Some(0 | 2)),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(planned.join("summary.json").exists());
+}
+
+#[test]
+fn fit_refuses_a_blob_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (v, f) = gen::sphere(15.0, 16);
+    let stl = dir.path().join("blob.stl");
+    std::fs::write(&stl, gen::binary_stl(&v, &f)).unwrap();
+    let done = waam()
+        .arg("fit")
+        .arg(&stl)
+        .arg("--out")
+        .arg(dir.path().join("o"))
+        .output()
+        .unwrap();
+    assert_eq!(done.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&done.stderr);
+    assert!(
+        err.contains("blob.stl") && err.contains("not a tube"),
+        "{err}"
+    );
+    assert!(!dir.path().join("o").join("part.toml").exists());
+}

@@ -1,0 +1,376 @@
+//! An independent tube-mesh generator for the fit tests: closed-form
+//! centre lines parameterised by arc length, a rotation-minimising frame by
+//! double reflection (Wang et al. 2008) on the sampled centre line, circles of
+//! the given radius in the normal planes, quads split in two triangles; a
+//! seeded Gaussian noise (xorshift64* + Box–Muller); binary and ASCII STL
+//! written by hand. Nothing here uses the library's tube code.
+
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use waam_slicer::math::{Point3, Vector3};
+
+/// A truth tube: centre line `c(s)` (s = arc length, mm) and radius `rho(s)`.
+pub struct Truth {
+    pub name: &'static str,
+    pub length: f64,
+    pub centre: Box<dyn Fn(f64) -> Point3 + Sync>,
+    pub radius: Box<dyn Fn(f64) -> f64 + Sync>,
+}
+
+/// Arc of radius `r` turning from direction `d0` toward `toward` (unit, ⟂ d0).
+fn arc(p0: Point3, d0: Vector3, toward: Vector3, r: f64, s: f64) -> Point3 {
+    let a = s / r;
+    p0 + d0 * (r * a.sin()) + toward * (r * (1.0 - a.cos()))
+}
+
+pub fn straight() -> Truth {
+    Truth {
+        name: "straight pipe",
+        length: 80.0,
+        centre: Box::new(|s| Point3::new(5.0, -3.0, s)),
+        radius: Box::new(|_| 15.0),
+    }
+}
+
+pub fn torus() -> Truth {
+    let r = 50.0;
+    Truth {
+        name: "torus section",
+        length: r * FRAC_PI_2,
+        centre: Box::new(move |s| arc(Point3::origin(), Vector3::z(), Vector3::x(), r, s)),
+        radius: Box::new(|_| 12.0),
+    }
+}
+
+/// Straight `leg`, a 90° bend of radius `r` toward +x, straight `leg` along +x.
+pub fn elbow_centre(leg: f64, r: f64) -> impl Fn(f64) -> Point3 + Sync {
+    move |s| {
+        let bend = r * FRAC_PI_2;
+        if s <= leg {
+            Point3::new(0.0, 0.0, s)
+        } else if s <= leg + bend {
+            arc(
+                Point3::new(0.0, 0.0, leg),
+                Vector3::z(),
+                Vector3::x(),
+                r,
+                s - leg,
+            )
+        } else {
+            Point3::new(r + (s - leg - bend), 0.0, leg + r)
+        }
+    }
+}
+
+pub fn elbow() -> Truth {
+    let (leg, r) = (20.0, 40.0);
+    Truth {
+        name: "elbow",
+        length: 2.0 * leg + r * FRAC_PI_2,
+        centre: Box::new(elbow_centre(leg, r)),
+        radius: Box::new(|_| 12.0),
+    }
+}
+
+pub fn s_bend() -> Truth {
+    let (leg, r) = (15.0, 45.0);
+    let bend = r * FRAC_PI_2;
+    Truth {
+        name: "S-bend",
+        length: 2.0 * leg + 2.0 * bend,
+        centre: Box::new(move |s| {
+            let p1 = Point3::new(0.0, 0.0, leg);
+            let p2 = Point3::new(r, 0.0, leg + r);
+            if s <= leg {
+                Point3::new(0.0, 0.0, s)
+            } else if s <= leg + bend {
+                arc(p1, Vector3::z(), Vector3::x(), r, s - leg)
+            } else if s <= leg + 2.0 * bend {
+                arc(p2, Vector3::x(), Vector3::z(), r, s - leg - bend)
+            } else {
+                Point3::new(2.0 * r, 0.0, leg + 2.0 * r + (s - leg - 2.0 * bend))
+            }
+        }),
+        radius: Box::new(|_| 10.0),
+    }
+}
+
+pub fn helix() -> Truth {
+    let (a, b) = (40.0, 60.0 / TAU); // 60 mm rise per turn
+    let k = (a * a + b * b).sqrt();
+    Truth {
+        name: "helix",
+        length: 0.75 * TAU * k,
+        centre: Box::new(move |s| {
+            let th = s / k;
+            Point3::new(a * th.cos(), a * th.sin(), b * th)
+        }),
+        radius: Box::new(|_| 8.0),
+    }
+}
+
+pub fn swelling() -> Truth {
+    let len = 90.0;
+    Truth {
+        name: "swelling radius",
+        length: len,
+        centre: Box::new(|s| Point3::new(0.0, 0.0, s)),
+        radius: Box::new(move |s| 12.0 + 3.0 * (PI * s / len).sin() - 1.5 * (TAU * s / len).sin()),
+    }
+}
+
+pub fn all() -> Vec<Truth> {
+    vec![straight(), torus(), elbow(), s_bend(), helix(), swelling()]
+}
+
+/// Seeded Gaussian noise: xorshift64* and Box–Muller.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Self(seed.max(1))
+    }
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let x = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D);
+        ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+    pub fn gauss(&mut self) -> f64 {
+        let (u, v) = (self.uniform(), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (TAU * v).cos()
+    }
+}
+
+/// Rings along the centre line: positions, tangents and RMF normals.
+pub fn frames(t: &Truth, rings: usize) -> Vec<(f64, Point3, Vector3, Vector3)> {
+    let tangent = |s: f64| {
+        let h = 1e-5;
+        ((t.centre)(s + h) - (t.centre)(s - h)).normalize()
+    };
+    let mut out = Vec::with_capacity(rings + 1);
+    let t0 = tangent(0.0);
+    let pick = if t0.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let mut r = (pick - t0 * pick.dot(&t0)).normalize();
+    let mut prev = ((t.centre)(0.0), t0);
+    for i in 0..=rings {
+        let s = t.length * i as f64 / rings as f64;
+        let (x, ti) = ((t.centre)(s), tangent(s));
+        if i > 0 {
+            // Double reflection.
+            let v1 = x - prev.0;
+            let c1 = v1.dot(&v1);
+            let rl = r - v1 * (2.0 / c1 * v1.dot(&r));
+            let tl = prev.1 - v1 * (2.0 / c1 * v1.dot(&prev.1));
+            let v2 = ti - tl;
+            let c2 = v2.dot(&v2);
+            r = if c2 > 0.0 {
+                rl - v2 * (2.0 / c2 * v2.dot(&rl))
+            } else {
+                rl
+            };
+            r = (r - ti * r.dot(&ti)).normalize();
+        }
+        out.push((s, x, ti, r));
+        prev = (x, ti);
+    }
+    out
+}
+
+/// A mesh of the tube's surface with edges about `h` mm, `noise_mm` of
+/// Gaussian noise on each coordinate; `offset` is added to the radius (a skin).
+pub fn mesh(
+    t: &Truth,
+    h: f64,
+    noise_mm: f64,
+    offset: f64,
+    seed: u64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let rmax = (0..=100)
+        .map(|i| (t.radius)(t.length * i as f64 / 100.0))
+        .fold(0.0, f64::max)
+        + offset;
+    let around = ((TAU * rmax / h).ceil() as usize).max(8);
+    mesh_around(t, h, around, noise_mm, offset, seed)
+}
+
+/// As [`mesh`] with `around` points on each ring.
+pub fn mesh_around(
+    t: &Truth,
+    h: f64,
+    around: usize,
+    noise_mm: f64,
+    offset: f64,
+    seed: u64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let rings = (t.length / h).ceil() as usize;
+    let mut rng = Rng::new(seed);
+    let mut v = Vec::new();
+    for (i, (s, x, ti, n)) in frames(t, rings).into_iter().enumerate() {
+        let b = ti.cross(&n);
+        let rho = (t.radius)(s) + offset;
+        // Stagger every other ring by half a step: well-shaped triangles.
+        let shift = if i % 2 == 1 { 0.5 } else { 0.0 };
+        for j in 0..around {
+            let a = TAU * (j as f64 + shift) / around as f64;
+            let mut p = x + (n * a.cos() + b * a.sin()) * rho;
+            if noise_mm > 0.0 {
+                p += Vector3::new(rng.gauss(), rng.gauss(), rng.gauss()) * noise_mm;
+            }
+            v.push(p);
+        }
+    }
+    let id = |i: usize, j: usize| (i * around + j % around) as u32;
+    let mut f = Vec::new();
+    for i in 0..rings {
+        for j in 0..around {
+            f.push([id(i, j), id(i, j + 1), id(i + 1, j)]);
+            f.push([id(i, j + 1), id(i + 1, j + 1), id(i + 1, j)]);
+        }
+    }
+    (v, f)
+}
+
+/// Binary STL bytes (f32), written by hand.
+pub fn binary_stl(v: &[Point3], f: &[[u32; 3]]) -> Vec<u8> {
+    let mut out = vec![0u8; 80];
+    out.extend((f.len() as u32).to_le_bytes());
+    for tri in f {
+        let p = tri.map(|i| v[i as usize]);
+        let n = (p[1] - p[0]).cross(&(p[2] - p[0])).normalize();
+        for x in [n.x, n.y, n.z] {
+            out.extend((x as f32).to_le_bytes());
+        }
+        for q in p {
+            for x in [q.x, q.y, q.z] {
+                out.extend((x as f32).to_le_bytes());
+            }
+        }
+        out.extend([0u8, 0u8]);
+    }
+    out
+}
+
+/// ASCII STL text, written by hand.
+pub fn ascii_stl(v: &[Point3], f: &[[u32; 3]]) -> String {
+    let mut s = String::from("solid tube\n");
+    for tri in f {
+        let p = tri.map(|i| v[i as usize]);
+        let n = (p[1] - p[0]).cross(&(p[2] - p[0])).normalize();
+        s += &format!("facet normal {} {} {}\n outer loop\n", n.x, n.y, n.z);
+        for q in p {
+            s += &format!("  vertex {} {} {}\n", q.x, q.y, q.z);
+        }
+        s += " endloop\nendfacet\n";
+    }
+    s + "endsolid tube\n"
+}
+
+/// A UV sphere of radius `r` (closed blob).
+pub fn sphere(r: f64, n: usize) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let mut v = vec![Point3::new(0.0, 0.0, -r)];
+    for i in 1..n {
+        let phi = -FRAC_PI_2 + PI * i as f64 / n as f64;
+        for j in 0..2 * n {
+            let th = PI * j as f64 / n as f64;
+            v.push(Point3::new(
+                r * phi.cos() * th.cos(),
+                r * phi.cos() * th.sin(),
+                r * phi.sin(),
+            ));
+        }
+    }
+    v.push(Point3::new(0.0, 0.0, r));
+    let m = 2 * n;
+    let ring = |i: usize, j: usize| (1 + (i - 1) * m + j % m) as u32;
+    let top = (v.len() - 1) as u32;
+    let mut f = Vec::new();
+    for j in 0..m {
+        f.push([0, ring(1, j + 1), ring(1, j)]);
+        f.push([top, ring(n - 1, j), ring(n - 1, j + 1)]);
+    }
+    for i in 1..n - 1 {
+        for j in 0..m {
+            f.push([ring(i, j), ring(i, j + 1), ring(i + 1, j)]);
+            f.push([ring(i, j + 1), ring(i + 1, j + 1), ring(i + 1, j)]);
+        }
+    }
+    (v, f)
+}
+
+/// A Y (pair of pants): a trunk of radius `r` up to z = `h`, whose top ring
+/// splits into two D-shaped halves (sharing the diameter along y) that
+/// morph into two branches of radius `r / 2` centred at x = ±`r`, rising
+/// `h` more. One manifold surface with three open ends.
+pub fn y_branch(r: f64, h: f64, n: usize) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    // Ring of 4n points: the trunk's circle, angle from +y through -x (left
+    // half: 0..=2n) and back through +x (right half: 2n..4n).
+    let m = 4 * n;
+    let layers = 20;
+    let mut v = Vec::new();
+    let mut f = Vec::new();
+    let circle = |k: usize| {
+        let a = FRAC_PI_2 + TAU * k as f64 / m as f64;
+        (r * a.cos(), r * a.sin())
+    };
+    for i in 0..=layers {
+        let z = h * i as f64 / layers as f64;
+        for k in 0..m {
+            let (x, y) = circle(k);
+            v.push(Point3::new(x, y, z));
+        }
+    }
+    let trunk = |i: usize, k: usize| (i * m + k % m) as u32;
+    for i in 0..layers {
+        for k in 0..m {
+            f.push([trunk(i, k), trunk(i, k + 1), trunk(i + 1, k)]);
+            f.push([trunk(i, k + 1), trunk(i + 1, k + 1), trunk(i + 1, k)]);
+        }
+    }
+    // The septum: points on the diameter x = 0 from y = -r to y = r
+    // (excluding the ends, which are trunk points k = 0 and k = 2n).
+    let septum: Vec<u32> = (1..2 * n)
+        .map(|j| {
+            let y = -r + 2.0 * r * j as f64 / (2 * n) as f64;
+            v.push(Point3::new(0.0, y, h));
+            (v.len() - 1) as u32
+        })
+        .collect();
+    for side in [-1.0_f64, 1.0] {
+        // Base D ring of 4n points: half circle then the septum back.
+        let mut base: Vec<u32> = Vec::new();
+        if side < 0.0 {
+            base.extend((0..=2 * n).map(|k| trunk(layers, k)));
+            base.extend(septum.iter().copied()); // from y = -r up to +r
+        } else {
+            base.extend((2 * n..=4 * n).map(|k| trunk(layers, k)));
+            base.extend(septum.iter().rev().copied());
+        }
+        let base_pts: Vec<Point3> = base.iter().map(|&i| v[i as usize]).collect();
+        let mut prev = base.clone();
+        let steps = 20;
+        for i in 1..=steps {
+            let s = i as f64 / steps as f64;
+            let mut ring = Vec::new();
+            for (k, p) in base_pts.iter().enumerate() {
+                let a = TAU * k as f64 / m as f64 + if side < 0.0 { FRAC_PI_2 } else { -FRAC_PI_2 };
+                let target = Point3::new(side * r + 0.5 * r * a.cos(), 0.5 * r * a.sin(), 2.0 * h);
+                let q = p.coords * (1.0 - s) + target.coords * s;
+                v.push(Point3::new(q.x, q.y, h + (2.0 * h - h) * s));
+                ring.push((v.len() - 1) as u32);
+            }
+            for k in 0..m {
+                let (a, b) = (prev[k], prev[(k + 1) % m]);
+                let (c, d) = (ring[k], ring[(k + 1) % m]);
+                f.push([a, b, c]);
+                f.push([b, d, c]);
+            }
+            prev = ring;
+        }
+    }
+    (v, f)
+}
