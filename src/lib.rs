@@ -111,6 +111,8 @@ pub mod util;
 
 // Stage 8, after the stages it searches over (see the table above).
 pub mod place;
+// Stage 9, a client of the front door.
+pub mod replan;
 
 #[cfg(feature = "python")]
 mod python;
@@ -127,3 +129,4 @@ pub use pipeline::{
     SliceOverrides, SlicedPart,
 };
 pub use place::PlaceOptions;
+pub use replan::{replan_part, replan_part_with, replan_planned, Measured, ReplannedPart};
