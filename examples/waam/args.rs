@@ -298,6 +298,9 @@ pub struct ReplanArgs {
     /// R_Z law: fixed:DEG, poly:N (max degree), spline, point.
     #[arg(long, default_value = "poly:4")]
     pub rz: String,
+    /// Plan the first N layers only (as the build was planned).
+    #[arg(long, value_name = "N")]
+    pub max_layers: Option<usize>,
     /// Scan rows farther than MM from layer K's planned top are outliers
     /// (default max(3 Delta, 3 mm)).
     #[arg(long, value_name = "MM")]

@@ -6,7 +6,6 @@
 //! gave it away), 2 plan infeasible (summary written, no program).
 
 use crate::args::ReplanArgs;
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -43,6 +42,7 @@ fn replan(a: &ReplanArgs, quiet: bool) -> Result<bool, (u8, String)> {
         ..PlanOptions::default()
     };
     a.grid.apply(&mut opts.slice);
+    opts.slice.max_layers = a.max_layers;
     let ropts = ReplanOptions {
         outlier_distance_mm: a.outlier_distance,
         ..ReplanOptions::default()

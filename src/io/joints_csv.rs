@@ -201,13 +201,11 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
             .iter()
             .copied(),
         )
-        .chain(
-            if with_process {
-                PROCESS_COLUMNS.split(',').collect::<Vec<_>>()
-            } else {
-                Vec::new()
-            },
-        )
+        .chain(if with_process {
+            PROCESS_COLUMNS.split(',').collect::<Vec<_>>()
+        } else {
+            Vec::new()
+        })
         .collect();
     let process_at = 15 + if positioner { 2 } else { 0 };
     let mut rows = Vec::new();

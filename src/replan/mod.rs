@@ -68,8 +68,10 @@ pub struct ReplanOptions {
     /// A scan row farther than this from layer `K`'s planned top is an
     /// outlier: named in the summary, not used (mm). `None`: `max(3 Delta, 3 mm)`.
     pub outlier_distance_mm: Option<f64>,
-    /// Half-width of the window along the layer over which scan points are
-    /// averaged into a point's error (mm; 0: each point's own neighbours).
+    /// Half-width of the window along the layer over which the scan is
+    /// fitted (a weighted local line) into a point's error (mm; 0: each
+    /// point's own neighbours). A wider window averages more noise away but
+    /// blurs an error that changes over a few mm.
     pub smoothing_mm: f64,
     /// A scan whose median height error is more than this fraction of
     /// `Delta` is refused as a scan of another layer (relative).
@@ -90,7 +92,7 @@ impl Default for ReplanOptions {
     fn default() -> Self {
         Self {
             outlier_distance_mm: None,
-            smoothing_mm: 2.0,
+            smoothing_mm: 0.5,
             max_median_error_rel: 0.5,
             max_wall_offset_mm: None,
             min_inlier_fraction: 0.5,
@@ -131,7 +133,10 @@ impl ReplanOptions {
             );
         }
         for (field, v) in [
-            ("min_inlier_fraction (must be in [0, 1])", self.min_inlier_fraction),
+            (
+                "min_inlier_fraction (must be in [0, 1])",
+                self.min_inlier_fraction,
+            ),
             ("min_coverage (must be in [0, 1])", self.min_coverage),
         ] {
             if !(0.0..=1.0).contains(&v) {
@@ -684,7 +689,10 @@ fn replan_core(
                         layer: l,
                         corrected: false,
                         speed_mm_s: vec![v_nom; pts.len()],
-                        height_mm: pts.iter().map(|p| p.delta.unwrap_or(path.delta_mm)).collect(),
+                        height_mm: pts
+                            .iter()
+                            .map(|p| p.delta.unwrap_or(path.delta_mm))
+                            .collect(),
                         clamped: vec![false; pts.len()],
                         error_before_mm: before,
                         error_after_mm: vec![0.0; pts.len()],
@@ -757,13 +765,8 @@ fn replan_core(
         travel_speed_mm_s: fastest,
         ..optimise.clone()
     };
-    let mut plan_layers = optimise_with(
-        &cell.layout,
-        &remaining[..r_count],
-        &corrected_opts,
-        &never,
-    )?
-    .layers;
+    let mut plan_layers =
+        optimise_with(&cell.layout, &remaining[..r_count], &corrected_opts, &never)?.layers;
     let rest = &remaining[r_count..];
     let reused: Option<Vec<_>> = nominal.and_then(|(layers, plan)| {
         rest.iter()

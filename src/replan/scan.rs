@@ -254,7 +254,11 @@ pub(super) fn estimate(
                 distances.push(dist);
                 match sample {
                     Some(smp) => {
-                        let k = if smp.column + 1 < n { smp.column + 1 } else { 0 };
+                        let k = if smp.column + 1 < n {
+                            smp.column + 1
+                        } else {
+                            0
+                        };
                         sum[smp.column] += (1.0 - smp.s) * smp.error;
                         weight[smp.column] += 1.0 - smp.s;
                         sum[k] += smp.s * smp.error;
@@ -372,9 +376,14 @@ pub(super) fn estimate(
     } else {
         0
     };
+    // A weighted local line through the points' means (by index along the
+    // layer): unbiased on a ramp of the error, where a plain mean is not.
+    let mean: Vec<Option<f64>> = (0..n)
+        .map(|j| (weight[j] > 0.0).then(|| sum[j] / weight[j]))
+        .collect();
     let mut value: Vec<Option<f64>> = (0..n)
         .map(|i| {
-            let (mut s, mut wt) = (0.0, 0.0);
+            let (mut s0, mut s1, mut s2, mut t0, mut t1) = (0.0, 0.0, 0.0, 0.0, 0.0);
             for k in -(w as isize)..=(w as isize) {
                 let j = i as isize + k;
                 let j = if layer.closed {
@@ -384,10 +393,25 @@ pub(super) fn estimate(
                 } else {
                     j as usize
                 };
-                s += sum[j];
-                wt += weight[j];
+                let Some(y) = mean[j] else { continue };
+                let (wt, x) = (weight[j], k as f64);
+                s0 += wt;
+                s1 += wt * x;
+                s2 += wt * x * x;
+                t0 += wt * y;
+                t1 += wt * x * y;
             }
-            (wt > 0.0).then(|| s / wt)
+            if !(s0 > 0.0) {
+                return None;
+            }
+            let det = s0 * s2 - s1 * s1;
+            let line = (s2 * t0 - s1 * t1) / det;
+            // one column of data (or a degenerate spread): its mean
+            Some(if det > 1e-9 * s0 * s0 && line.is_finite() {
+                line
+            } else {
+                t0 / s0
+            })
         })
         .collect();
     fill_gaps(&mut value, layer.closed);
@@ -503,13 +527,17 @@ mod tests {
                 dh_mm: 0.25
             }])
         );
-        let e = Measured::from_csv_str("a,b\n", "s.csv").unwrap_err().to_string();
+        let e = Measured::from_csv_str("a,b\n", "s.csv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("s.csv") && e.contains("line 1"), "{e}");
         let e = Measured::from_csv_str("x,y,z\n1,2,nan\n", "s.csv")
             .unwrap_err()
             .to_string();
         assert!(e.contains("line 2") && e.contains("`z`"), "{e}");
-        let e = Measured::from_csv_str("x,y,z\n", "s.csv").unwrap_err().to_string();
+        let e = Measured::from_csv_str("x,y,z\n", "s.csv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("no rows"), "{e}");
     }
 
@@ -520,7 +548,10 @@ mod tests {
         let v: Vec<f64> = v.into_iter().map(Option::unwrap).collect();
         assert_eq!(v[2], 2.0);
         // 3 -> 1 over indices 3, 4, 5, 0, 1
-        assert!((v[4] - 2.5).abs() < 1e-12 && (v[0] - 1.5).abs() < 1e-12, "{v:?}");
+        assert!(
+            (v[4] - 2.5).abs() < 1e-12 && (v[0] - 1.5).abs() < 1e-12,
+            "{v:?}"
+        );
         assert_eq!(median(&mut [3.0, 1.0, 2.0, 10.0]), 2.5);
     }
 }
