@@ -607,7 +607,7 @@ pub fn replan_planned(
         &planned.cell,
         planned.sliced.clone(),
         Some((&planned.layers, &planned.plan)),
-        planned.optimise.clone(),
+        planned.optimise,
         planned.rz,
         planned.format,
         measured,
@@ -763,7 +763,7 @@ fn replan_core(
     let never = |_: usize, _: usize| true;
     let corrected_opts = OptimiseOptions {
         travel_speed_mm_s: fastest,
-        ..optimise.clone()
+        ..optimise
     };
     let mut plan_layers =
         optimise_with(&cell.layout, &remaining[..r_count], &corrected_opts, &never)?.layers;
