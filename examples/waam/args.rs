@@ -52,7 +52,7 @@ pub enum Command {
     /// Replan the layers after a measured layer K: reads the scan of layer K's top (points x,y,z or
     /// height errors layer,point,dh_mm), corrects the next layers' travel speeds (and, where the
     /// process window cannot absorb the error, their geometry), optimises them in the cell and writes
-    /// joints.csv, summary.json and the program that resumes the build (exit 0 done, 2 infeasible,
+    /// joints.csv, summary.json, report.html and the program that resumes the build (exit 0 done, 2 infeasible,
     /// 1 bad input or a refused scan).
     Replan(ReplanArgs),
     /// List the sample parts (and cells) with one line each.

@@ -1,7 +1,8 @@
 //! `waam replan`: part file + cell file + the scan of layer K → the
 //! library's `replan_part` (speed correction, then geometry, optimisation of
 //! the remaining layers, the program that resumes the build); writes
-//! `joints.csv`, `summary.json` and, if feasible, the program. Exit codes: 0
+//! `joints.csv`, `summary.json`, `report.html` (layer K as measured, the
+//! replanned layers) and, if feasible, the program. Exit codes: 0
 //! done, 1 bad input or a refused scan (the message names the distance that
 //! gave it away), 2 plan infeasible (summary written, no program).
 
@@ -65,6 +66,11 @@ fn replan(a: &ReplanArgs, quiet: bool) -> Result<bool, (u8, String)> {
         .map_err(|e| input(format!("{}: {e}", csv.display())))?;
     let t_csv = t.elapsed().as_secs_f64();
     let t = Instant::now();
+    replanned
+        .write_report(&dir.join("report.html"), Some(&part.substrate))
+        .map_err(|e| input(e.to_string()))?;
+    let t_report = t.elapsed().as_secs_f64();
+    let t = Instant::now();
     let mut written: Vec<serde_json::Value> = Vec::new();
     let feasible = if replanned.planned.plan.is_feasible() {
         match replanned.write_programs(&dir) {
@@ -92,6 +98,7 @@ fn replan(a: &ReplanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     let times = &mut summary["run_time_s"];
     times["read"] = t_read.into();
     times["joints_csv"] = t_csv.into();
+    times["report_html"] = t_report.into();
     times["program_files"] = t_programs.into();
     summary["program_files"] = written.into();
     let sj = dir.join("summary.json");

@@ -412,6 +412,72 @@ impl ReplannedPart {
         self.planned.write_programs(dir)
     }
 
+    /// Writes the 3-D report (`report.html`, see [`crate::report`])
+    /// atomically to `dest`: layer `K` as measured (each point moved by its
+    /// error along `b`; the distance colour, distance − Delta, is then its
+    /// height error in mm) and the remaining layers as replanned, coloured
+    /// by their corrected travel speeds (mm/s) or bead heights. The path
+    /// only: the robot is not animated (the plan's layers start at `K+1`).
+    ///
+    /// # Errors
+    /// [`Error::Report`] naming the input or the file.
+    pub fn write_report(
+        &self,
+        dest: &FsPath,
+        substrate: Option<&crate::geometry::Substrate>,
+    ) -> Result<(), Error> {
+        let full = &self.planned.sliced;
+        let k = self.after_layer;
+        let delta = full.path.delta_mm;
+        let mut measured = full.path.layers[k].clone();
+        for ((p, f), e) in measured
+            .points
+            .iter_mut()
+            .zip(&full.axes.frames[k])
+            .zip(&self.scan.error_mm)
+        {
+            p.position += f.build * *e;
+            p.delta = Some(delta + e);
+        }
+        let mut layers = vec![measured];
+        layers.extend(full.path.layers[k + 1..].iter().cloned());
+        let path = crate::path::Path {
+            strategy: full.path.strategy,
+            delta_mm: delta,
+            layers,
+            report: Default::default(),
+            spiral: None,
+        };
+        let points: Vec<Vec<Option<(f64, bool)>>> = path
+            .layers
+            .iter()
+            .map(|l| {
+                l.points
+                    .iter()
+                    .map(|p| p.delta.map(|d| (d, false)))
+                    .collect()
+            })
+            .collect();
+        let map = crate::path::DistanceMap {
+            per_layer: full.map.per_layer[k..].to_vec(),
+            overall: full.map.overall,
+            points,
+        };
+        let frames = full.axes.frames[k..].to_vec();
+        let mut process = full.process_plan.clone();
+        process.points = process.points[k..].to_vec();
+        let title = format!(
+            "{}: layers {}.. replanned from the scan of layer {k} (drawn as measured)",
+            full.part_name,
+            k + 1
+        );
+        let mut input = crate::report::ReportInput::new(&title, &path, &frames, &map, delta);
+        input.substrate = substrate;
+        input.process = Some(&process);
+        crate::report::write_report(dest, &input)?;
+        Ok(())
+    }
+
     /// The content of `replan`'s `summary.json`: the plan's summary
     /// ([`PlannedPart::summary`], of the remaining layers) with a `replan`
     /// object: the scan (rows used, outliers named with their row, position

@@ -75,6 +75,8 @@ fn replan_writes_the_remaining_layers_and_refuses_a_scan_of_another_layer() {
     assert_eq!(summary["replan"]["scan"]["outliers"], STRAYS);
     assert!(layers[0]["error_before"]["max_mm"].as_f64().unwrap() > 0.7);
     assert!(out.join("ELBOW_FROM_11.ls").exists());
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("replanned from the scan of layer 10"));
 
     // the scan of layer 11 given as layer 10's
     let wrong = dir.path().join("wrong.csv");
