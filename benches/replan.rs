@@ -24,6 +24,7 @@ fn parts_dir() -> PathBuf {
 
 /// The scan of layer `k`: every point and three between it and the next,
 /// five offsets across the wall, the field along `b`, noise, 20 % dropped.
+#[allow(clippy::needless_range_loop)] // point i and its successor side by side
 fn scan(part: &Part, opts: &PlanOptions, k: usize) -> Vec<Point3> {
     let sliced = slice_part_with(part, &opts.slice, &Control::default()).unwrap();
     let layer = &sliced.path.layers[k];
