@@ -150,11 +150,29 @@ pub(super) fn measured_t(
         .collect()
 }
 
-/// Signed distance (mm) from the nominal point to the predicted one along
-/// the column: + where the predicted top is further along the tube (high).
-fn signed_error(tube: &Tube, v: f64, t: f64, t_nom: f64) -> f64 {
-    let d = (tube.point(t, v) - tube.point(t_nom, v)).norm();
-    if t >= t_nom {
+/// Signed local distance (mm) from the predicted point `M(t, v)` to the
+/// nominal layer (`nominal`, its polyline): + where the predicted top is
+/// further along the tube (high). The local distance, as the slicer
+/// measures a layer's height, not the distance along the column (which is
+/// longer where the column leans from the build direction, on a bend).
+fn signed_error(
+    tube: &Tube,
+    nominal: &SegmentIndex,
+    hint: SegmentId,
+    v: f64,
+    t: f64,
+    t_nom: f64,
+) -> f64 {
+    if t == t_nom {
+        return 0.0;
+    }
+    let d = nominal
+        .nearest_hinted(&tube.point(t, v), Some(hint))
+        .map_or_else(
+            || (tube.point(t, v) - tube.point(t_nom, v)).norm(),
+            |n| n.distance,
+        );
+    if t > t_nom {
         d
     } else {
         -d
@@ -221,6 +239,11 @@ pub(super) fn rebuild(
             })
             .collect();
         let solved: Vec<(f64, f64, bool)> = solved.into_iter().collect::<Result<_, _>>()?;
+        // the nominal layer in column order, to measure the error after
+        let nominal = SegmentIndex::new(vec![(
+            (0..n).map(|c| tube.point(t_nom[c], vs[c])).collect(),
+            true,
+        )]);
         // back to the layer's own point order
         let mut rl = RebuiltLayer {
             layer: offset,
@@ -238,8 +261,12 @@ pub(super) fn rebuild(
             rl.height_mm.push(h);
             rl.speed_mm_s.push(window.speed_for(h));
             rl.clamped.push(clamped);
+            let hint = SegmentId {
+                polyline: 0,
+                segment: c,
+            };
             rl.error_after_mm
-                .push(signed_error(tube, vs[c], t, t_nom[c]));
+                .push(signed_error(tube, &nominal, hint, vs[c], t, t_nom[c]));
         }
         let rejoined = rl.clamped.iter().all(|c| !c);
         out.push(rl);
