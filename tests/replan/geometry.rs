@@ -10,16 +10,16 @@ use crate::common::part_path;
 use crate::support::*;
 use waam_slicer::{replan_part, Cell, Measured};
 
-/// Replans after K with `field`, checks every rebuilt layer's heights
+/// Replans after `k` with `field`, checks every rebuilt layer's heights
 /// against the window, and returns the layer where the nominal is rejoined.
-fn replan_and_check(field: Field, layers: usize) -> usize {
+fn replan_and_check(field: Field, layers: usize, k: usize) -> usize {
     let part = part("elbow.toml");
     let cell_file = part_path("cells/robowam_part_carried.toml");
     let cell = Cell::read(&cell_file).unwrap();
     let opts = elbow_opts(96, layers);
     let sliced = nominal(&part, &opts);
-    let (scan, truth) = synthetic_scan(&sliced, K, &field, 3);
-    let r = replan_part(&part, &cell, &Measured::Points(scan), K, &opts).unwrap();
+    let (scan, truth) = synthetic_scan(&sliced, k, &field, 3);
+    let r = replan_part(&part, &cell, &Measured::Points(scan), k, &opts).unwrap();
     let delta = sliced.path.delta_mm;
     let p = &sliced.process;
     let v_nom = p.travel_speed_mm_s;
@@ -27,8 +27,8 @@ fn replan_and_check(field: Field, layers: usize) -> usize {
         law_height(p.travel_speed_max_mm_s, v_nom, delta),
         law_height(p.travel_speed_min_mm_s, v_nom, delta),
     );
-    let lk = &sliced.path.layers[K];
-    let frames = &sliced.axes.frames[K];
+    let lk = &sliced.path.layers[k];
+    let frames = &sliced.axes.frames[k];
     let mut below: Vec<_> = (0..lk.points.len())
         .map(|i| lk.points[i].position + frames[i].build * truth[i])
         .collect();
@@ -36,7 +36,7 @@ fn replan_and_check(field: Field, layers: usize) -> usize {
     let path = &r.planned.sliced.path;
     let mut clamped_layers = 0;
     for c in r.corrections.iter().take_while(|c| c.layer <= rejoined) {
-        let tol = if c.layer == K + 1 { 0.08 } else { 1e-6 };
+        let tol = if c.layer == k + 1 { 0.08 } else { 1e-6 };
         for pt in &path.layers[c.layer].points {
             let h = distance_to_closed(&pt.position, &below);
             assert!(
@@ -50,7 +50,7 @@ fn replan_and_check(field: Field, layers: usize) -> usize {
         }
         let mut next = vec![below[0]; below.len()];
         for pt in &path.layers[c.layer].points {
-            next[column(&sliced, K, pt.v)] = pt.position;
+            next[column(&sliced, k, pt.v)] = pt.position;
         }
         below = next;
     }
@@ -79,8 +79,23 @@ fn a_wall_2_mm_low_is_rebuilt_within_the_window_and_rejoins_within_three_layers(
             low: 0.0,
         },
         16,
+        K,
     );
     assert!(rejoined <= K + 3, "rejoined at layer {rejoined}");
+}
+
+#[test]
+fn in_the_bend_a_wall_2_mm_low_is_rebuilt_within_the_window_and_rejoins_within_three_layers() {
+    // layer 25 lies in the elbow's bend: columns lean from the build direction
+    let rejoined = replan_and_check(
+        Field {
+            high: -2.0,
+            low: 0.0,
+        },
+        30,
+        25,
+    );
+    assert!(rejoined <= 25 + 3, "rejoined at layer {rejoined}");
 }
 
 #[test]
@@ -104,6 +119,7 @@ fn a_wall_2_mm_high_is_rebuilt_within_the_window_and_rejoins_when_the_window_has
             low: 0.0,
         },
         K + bound + 3,
+        K,
     );
     assert!(
         rejoined <= K + bound + 1,
