@@ -56,7 +56,8 @@
 //! [`Cell::read`], [`slice_part`], [`plan_part`] →
 //! [`PlannedPart::write_programs`], [`check_program`], and [`place_part`]
 //! ([`PlaceRequest`] → [`PlacedCell`]) when a cell refuses a part where it
-//! stands.
+//! stands; [`replan_part`] (or [`replan_planned`]) with a [`Measured`] layer
+//! → [`ReplannedPart`] closes the loop during a build.
 //!
 //! ```no_run
 //! use waam_slicer::{Cell, Part, PlanOptions};
