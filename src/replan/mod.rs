@@ -380,6 +380,10 @@ pub struct ReplannedPart {
     /// The first layer that lands on its nominal layer at every point
     /// (`None`: none of the remaining layers does).
     pub rejoined_at: Option<usize>,
+    /// The first nominal layer dropped because the rebuilt layers reach the
+    /// part's end before it (a wall still too high near the top); `None`:
+    /// every layer is kept.
+    pub dropped_from: Option<usize>,
     /// The payload in effect when the resumed program starts (kg, and its
     /// centre of gravity in the flange frame, mm): the substrate and the
     /// layers `0..=K`. `None` in a torch-carried cell or without payload updates.
@@ -542,6 +546,7 @@ impl ReplannedPart {
             "speed_window_mm_s": self.speed_window_mm_s,
             "height_window_mm": self.height_window_mm,
             "rejoined_at_layer": self.rejoined_at,
+            "layers_dropped_from": self.dropped_from,
             "corrected_layers": self.corrections.iter().filter(|c| c.corrected).count(),
             "resume_payload": self.resume_payload.map(|(m, c)| json!({
                 "mass_kg": m,
@@ -730,13 +735,25 @@ fn replan_core(
         speed_max_mm_s: process.travel_speed_max_mm_s,
     };
     let t_meas = rebuild::measured_t(&part.tube, path, frames, k, &scan.error_mm);
-    let rebuilt = rebuild::rebuild(&part.tube, path, k, &cols, &t_meas, &window)?;
+    let (rebuilt, ended_at) = rebuild::rebuild(&part.tube, path, k, &cols, &t_meas, &window)?;
+    if ended_at == Some(k + 1) {
+        return Err(ReplanError::NoRoot {
+            layer: k + 1,
+            point: 0,
+            height_mm: window.height_min_mm(),
+            reason: "the measured wall is already at the part's end: nothing remains to lay",
+        }
+        .into());
+    }
+    // a wall still too high near the top: the layers from `ended_at` on no
+    // longer fit below the part's end and are dropped
+    let end = ended_at.unwrap_or(nlayers);
     let rejoined_at = rebuilt
         .last()
         .filter(|l| l.clamped.iter().all(|c| !c))
         .map(|l| l.layer);
     // Per remaining layer: before / after errors, speeds, heights.
-    let corrections: Vec<LayerCorrection> = (k + 1..nlayers)
+    let corrections: Vec<LayerCorrection> = (k + 1..end)
         .map(|l| {
             let before: Vec<f64> = cols[l - k].iter().map(|&c| scan.error_mm[c]).collect();
             match rebuilt.iter().find(|r| r.layer == l) {
@@ -769,6 +786,7 @@ fn replan_core(
         .collect();
     // The new path: the corrected layers' points, their heights as deltas.
     let mut new_path = path.clone();
+    new_path.layers.truncate(end);
     for r in &rebuilt {
         for (m, p) in new_path.layers[r.layer].points.iter_mut().enumerate() {
             p.t = r.t[m];
@@ -791,6 +809,7 @@ fn replan_core(
         source: Box::new(e.into()),
     })?;
     let mut process_plan = sliced.process_plan.clone();
+    process_plan.points.truncate(end);
     for r in &rebuilt {
         process_plan.points[r.layer] = r
             .speed_mm_s
@@ -913,6 +932,7 @@ fn replan_core(
         speed_window_mm_s: [window.speed_min_mm_s, window.speed_max_mm_s],
         height_window_mm: [window.height_min_mm(), window.height_max_mm()],
         rejoined_at,
+        dropped_from: ended_at,
         resume_payload,
         times,
     })

@@ -181,7 +181,10 @@ fn signed_error(
 
 /// The layers after `k` rebuilt from the measured top (`t_measured` per
 /// column of layer `k`) until one lands on its nominal layer at every
-/// point (that one included). `cols` from [`columns`].
+/// point (that one included), and the first layer that no longer fits
+/// below the part's end (`t_max`), if the rebuild stopped there (a wall
+/// still too high near the top: the part is finished one or more layers
+/// early). `cols` from [`columns`].
 pub(super) fn rebuild(
     tube: &Tube,
     path: &Path,
@@ -189,7 +192,7 @@ pub(super) fn rebuild(
     cols: &[Vec<usize>],
     t_measured: &[f64],
     window: &Window,
-) -> Result<Vec<RebuiltLayer>, ReplanError> {
+) -> Result<(Vec<RebuiltLayer>, Option<usize>), ReplanError> {
     let n = t_measured.len();
     let vs: Vec<f64> = path.layers[k].points.iter().map(|p| p.v).collect();
     let t_hi = tube.range().t_max;
@@ -205,7 +208,7 @@ pub(super) fn rebuild(
         }
         let below: Vec<Point3> = (0..n).map(|c| tube.point(t_below[c], vs[c])).collect();
         let index = SegmentIndex::new(vec![(below, true)]);
-        let solved: Vec<Result<(f64, f64, bool), ReplanError>> = (0..n)
+        let solved: Vec<Result<Option<(f64, f64, bool)>, ReplanError>> = (0..n)
             .into_par_iter()
             .map(|c| {
                 let hint = SegmentId {
@@ -217,7 +220,7 @@ pub(super) fn rebuild(
                         .nearest_hinted(&tube.point(t_nom[c], vs[c]), Some(hint))
                         .map_or(f64::INFINITY, |near| near.distance);
                     if (h_lo..=h_hi).contains(&d) {
-                        return Ok((t_nom[c], d, false));
+                        return Ok(Some((t_nom[c], d, false)));
                     }
                     d.clamp(h_lo, h_hi)
                 } else {
@@ -232,13 +235,17 @@ pub(super) fn rebuild(
                 match constant_distance::next_t(
                     tube, &index, hint, vs[c], t_below[c], target, t_hi, None,
                 ) {
-                    Ok(Step::Point { t, .. }) => Ok((t, target, true)),
-                    Ok(_) => Err(fail("the column passes the end of the part")),
+                    Ok(Step::Point { t, .. }) => Ok(Some((t, target, true))),
+                    // the column passes the end of the part
+                    Ok(_) => Ok(None),
                     Err(_) => Err(fail("root find failed")),
                 }
             })
             .collect();
-        let solved: Vec<(f64, f64, bool)> = solved.into_iter().collect::<Result<_, _>>()?;
+        let solved: Vec<Option<(f64, f64, bool)>> = solved.into_iter().collect::<Result<_, _>>()?;
+        let Some(solved) = solved.into_iter().collect::<Option<Vec<_>>>() else {
+            return Ok((out, Some(offset)));
+        };
         // the nominal layer in column order, to measure the error after
         let nominal = SegmentIndex::new(vec![(
             (0..n).map(|c| tube.point(t_nom[c], vs[c])).collect(),
@@ -277,5 +284,5 @@ pub(super) fn rebuild(
             t_below[c] = s.0;
         }
     }
-    Ok(out)
+    Ok((out, None))
 }

@@ -127,3 +127,36 @@ fn a_wall_2_mm_high_is_rebuilt_within_the_window_and_rejoins_when_the_window_has
         K + bound + 1
     );
 }
+
+#[test]
+fn a_wall_still_too_high_at_the_top_drops_the_layers_that_no_longer_fit() {
+    let part = part("elbow.toml");
+    let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
+    let opts = crate::support::elbow_opts(96, 200);
+    let sliced = nominal(&part, &opts);
+    let last = sliced.path.layers.len() - 1;
+    let k = last - 2;
+    let field = Field {
+        high: 2.0,
+        low: 0.0,
+    };
+    let (scan, _) = synthetic_scan(&sliced, k, &field, 9);
+    let r = replan_part(&part, &cell, &Measured::Points(scan), k, &opts).unwrap();
+    // the high quarter is still 1.65 mm high after layer k + 1: layer k + 2
+    // would pass the part's end there (less than Delta of tube above it)
+    assert_eq!(r.dropped_from, Some(k + 2), "{:?}", r.rejoined_at);
+    assert_eq!(r.corrections.len(), 1);
+    assert_eq!(r.planned.sliced.path.layers.len(), k + 2);
+    assert!(r.is_feasible(), "{:?}", r.planned.refusal());
+    let beads: Vec<usize> = r
+        .planned
+        .program
+        .as_ref()
+        .unwrap()
+        .bead_setup
+        .iter()
+        .map(|b| b.layer)
+        .collect();
+    assert_eq!(beads, vec![k + 1]);
+    assert_eq!(r.summary()["replan"]["layers_dropped_from"], k + 2);
+}
