@@ -67,6 +67,10 @@ pub(super) struct RebuiltLayer {
     pub error_after_mm: Vec<f64>,
 }
 
+/// One rebuilt point: its guide parameter, its bead height (mm) and
+/// whether the height was clamped to the window.
+type Solved = (f64, f64, bool);
+
 /// For every layer from `k` on, the column (point index of layer `k`) of
 /// each of its points, matched by profile angle `v`.
 pub(super) fn columns(path: &Path, k: usize) -> Result<Vec<Vec<usize>>, ReplanError> {
@@ -208,7 +212,7 @@ pub(super) fn rebuild(
         }
         let below: Vec<Point3> = (0..n).map(|c| tube.point(t_below[c], vs[c])).collect();
         let index = SegmentIndex::new(vec![(below, true)]);
-        let solved: Vec<Result<Option<(f64, f64, bool)>, ReplanError>> = (0..n)
+        let solved: Vec<Result<Option<Solved>, ReplanError>> = (0..n)
             .into_par_iter()
             .map(|c| {
                 let hint = SegmentId {
