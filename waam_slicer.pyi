@@ -101,6 +101,25 @@ class Part:
         progress: called with the fraction of the run done (0..1); an
             exception it raises stops the run and is re-raised.
         """
+    def replan(
+        self,
+        cell: "Cell",
+        measured: Union[_PathLike, npt.ArrayLike],
+        *,
+        after_layer: int,
+        delta_mm: Optional[float] = None,
+        points: Optional[int] = None,
+        chord_mm: Optional[float] = None,
+        rz: Optional[str] = None,
+        max_layers: Optional[int] = None,
+    ) -> "PlannedPart":
+        """Replans the layers after `after_layer` from the measured top of that
+        layer (a scan CSV `x,y,z` / `layer,point,dh_mm`, or an (N, 3) array of
+        points, part frame, mm): corrected travel speeds, geometry where the
+        speed window cannot absorb the error, joints optimised in `cell`.
+        Returns the plan of the remaining layers; `summary()["replan"]` has the
+        outliers and per layer the predicted error before and after. A scan of
+        another layer or part raises InputError naming the distance."""
     def plan(
         self,
         cell: "Cell",

@@ -57,6 +57,9 @@ pub enum Error {
     /// A joints CSV could not be read.
     #[error(transparent)]
     JointsCsv(#[from] JointsCsvError),
+    /// The closed loop refused a scan or cannot replan the path.
+    #[error(transparent)]
+    Replan(#[from] crate::replan::ReplanError),
     /// A stage failed on a part read from a file: the file, then the stage's
     /// error (which names the field, layer or point).
     #[error("{file}: {source}")]

@@ -57,7 +57,9 @@
 //! [`Cell::read`], [`slice_part`], [`plan_part`] →
 //! [`PlannedPart::write_programs`], [`check_program`], and [`place_part`]
 //! ([`PlaceRequest`] → [`PlacedCell`]) when a cell refuses a part where it
-//! stands; [`Part::from_mesh`] fits a part to a tubular STL.
+//! stands; [`Part::from_mesh`] fits a part to a tubular STL; [`replan_part`]
+//! (or [`replan_planned`]) with a [`Measured`] layer → [`ReplannedPart`]
+//! closes the loop during a build.
 //!
 //! ```no_run
 //! use waam_slicer::{Cell, Part, PlanOptions};
@@ -113,6 +115,8 @@ pub mod util;
 
 // Stage 8, after the stages it searches over (see the table above).
 pub mod place;
+// Stage 9, a client of the front door.
+pub mod replan;
 
 #[cfg(feature = "python")]
 mod python;
@@ -131,3 +135,4 @@ pub use pipeline::{
     SliceOverrides, SlicedPart,
 };
 pub use place::PlaceOptions;
+pub use replan::{replan_part, replan_part_with, replan_planned, Measured, ReplannedPart};

@@ -54,6 +54,12 @@ pub enum Command {
     /// (which slice, plan and place take) and fit.json (the residuals) in --out.
     /// Exit 0 fitted, 1 bad input or not a tube.
     Fit(FitArgs),
+    /// Replan the layers after a measured layer K: reads the scan of layer K's top (points x,y,z or
+    /// height errors layer,point,dh_mm), corrects the next layers' travel speeds (and, where the
+    /// process window cannot absorb the error, their geometry), optimises them in the cell and writes
+    /// joints.csv, summary.json, report.html and the program that resumes the build (exit 0 done, 2 infeasible,
+    /// 1 bad input or a refused scan).
+    Replan(ReplanArgs),
     /// List the sample parts (and cells) with one line each.
     Parts {
         /// Folder holding the part files.
@@ -297,4 +303,40 @@ pub struct FitArgs {
 
 fn parse_start(s: &str) -> Result<waam_slicer::StartEnd, String> {
     s.parse()
+}
+
+/// Arguments of `replan`.
+#[derive(Debug, clap::Args)]
+pub struct ReplanArgs {
+    /// The part file (TOML).
+    pub part: PathBuf,
+    /// The cell file (TOML, parts/cells/).
+    #[arg(long)]
+    pub cell: PathBuf,
+    /// The measured layer: a CSV of points `x,y,z` of its deposited top
+    /// (part frame, mm) or of height errors `layer,point,dh_mm`.
+    #[arg(long)]
+    pub measured: PathBuf,
+    /// The layer the scan measured (K): layers K+1.. are replanned.
+    #[arg(long, value_name = "K")]
+    pub after_layer: usize,
+    /// Delta and the discretisation of each layer (as the build was planned).
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// Robot program format; default: the cell robot's vendor.
+    #[arg(long, value_parser = ["fanuc", "kuka", "abb"])]
+    pub format: Option<String>,
+    /// R_Z law: fixed:DEG, poly:N (max degree), spline, point.
+    #[arg(long, default_value = "poly:4")]
+    pub rz: String,
+    /// Plan the first N layers only (as the build was planned).
+    #[arg(long, value_name = "N")]
+    pub max_layers: Option<usize>,
+    /// Scan rows farther than MM from layer K's planned top are outliers
+    /// (default max(3 Delta, 3 mm)).
+    #[arg(long, value_name = "MM")]
+    pub outlier_distance: Option<f64>,
+    /// Output folder (default out/<part name>-replan-K).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }

@@ -14,6 +14,7 @@ mod place;
 mod plan;
 mod plots;
 mod progress;
+mod replan;
 mod slice;
 
 use args::{Args, Command};
@@ -35,6 +36,7 @@ fn main() -> ExitCode {
         Command::Plan(a) => return plan::run(a, args.quiet),
         Command::Check(a) => return plan::check(a, args.quiet),
         Command::Place(a) => return place::run(a, args.quiet),
+        Command::Replan(a) => return replan::run(a, args.quiet),
         Command::Parts { dir } => list_parts(dir),
         Command::Geometry { part, points } => geometry(part, *points, args.quiet),
         Command::Slice(cmd) => slice::run(cmd, args.quiet),

@@ -1,9 +1,14 @@
 //! `joints.csv`: one row per planned point, header
 //! `layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6` (+ `e1,e2` with a
-//! positioner). Position (mm) and tool axis in the part frame, `R_Z` and
-//! joints in degrees, joints in the robot's controller convention (FANUC
-//! J2/J3 for FANUC arms); a point without a joint solution has empty joint
-//! cells. Also reads such a file back.
+//! positioner) `,travel_speed_mm_s,bead_height_mm`. Position (mm) and tool
+//! axis in the part frame, `R_Z` and joints in degrees, joints in the
+//! robot's controller convention (FANUC J2/J3 for FANUC arms); a point
+//! without a joint solution has empty joint cells. The last two columns are
+//! the travel speed the program runs on the way to the point (mm/s) and the
+//! bead height the plan asks for there (mm: the point's local distance to
+//! the layer below, `Delta` on the first layer); every plan writes them, a
+//! replanned one ([`crate::replan`]) with its corrected values. Also reads
+//! such a file back (files without the last two columns too).
 
 use std::io::Write;
 
@@ -13,7 +18,12 @@ use crate::util::decimal::{push_fixed, push_u64};
 /// The header line without the positioner columns.
 pub const HEADER: &str = "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6";
 
-/// Writes `plan`'s points (made from `layers`); `positioner` adds `e1,e2`.
+/// The process columns, last on every line (after `e1,e2` when present).
+pub const PROCESS_COLUMNS: &str = "travel_speed_mm_s,bead_height_mm";
+
+/// Writes `plan`'s points (made from `layers`); `positioner` adds `e1,e2`;
+/// `process[i][m]` is `[travel speed (mm/s), bead height (mm)]` of point `m`
+/// of `layers[i]` (a missing entry writes empty cells).
 /// Numbers with 6 decimals by the fixed-point formatter of
 /// [`decimal`](crate::util::decimal) (within half a unit of the last digit of
 /// the standard formatting), one row at a time into a reused buffer.
@@ -25,11 +35,13 @@ pub fn write_joints_csv(
     layers: &[LayerPoints],
     plan: &Plan,
     positioner: bool,
+    process: &[Vec<[f64; 2]>],
 ) -> std::io::Result<()> {
     write!(w, "{HEADER}")?;
-    writeln!(w, "{}", if positioner { ",e1,e2" } else { "" })?;
+    write!(w, "{}", if positioner { ",e1,e2" } else { "" })?;
+    writeln!(w, ",{PROCESS_COLUMNS}")?;
     let mut row: Vec<u8> = Vec::with_capacity(256);
-    for (lp, l) in layers.iter().zip(&plan.layers) {
+    for (i, (lp, l)) in layers.iter().zip(&plan.layers).enumerate() {
         for (m, (cp, pp)) in lp.points.iter().zip(&l.points).enumerate() {
             row.clear();
             let p = cp.position_mm;
@@ -48,6 +60,7 @@ pub fn write_joints_csv(
                     } else {
                         None
                     },
+                    process: process.get(i).and_then(|l| l.get(m)).copied(),
                 },
             );
             w.write_all(&row)?;
@@ -66,6 +79,8 @@ struct Row {
     joints_rad: Option<[f64; 6]>,
     /// `None`: no positioner columns; `Some(None)`: empty ones.
     positioner_rad: Option<Option<[f64; 2]>>,
+    /// Travel speed (mm/s) and bead height (mm); `None`: empty cells.
+    process: Option<[f64; 2]>,
 }
 
 /// Appends `r` as a line of `joints.csv` (degrees, 6 decimals).
@@ -98,6 +113,15 @@ fn push_row(out: &mut Vec<u8>, r: &Row) {
         Some(None) => out.extend_from_slice(b",,"),
         None => {}
     }
+    match r.process {
+        Some(v) if v.iter().all(|x| x.is_finite()) => {
+            for x in v {
+                out.push(b',');
+                push_fixed(out, x, 6);
+            }
+        }
+        _ => out.extend_from_slice(b",,"),
+    }
     out.push(b'\n');
 }
 
@@ -118,6 +142,11 @@ pub struct JointsRow {
     pub joints_deg: Option<[f64; 6]>,
     /// Positioner joints `e1, e2` (deg); `None` without positioner or solution.
     pub positioner_deg: Option<[f64; 2]>,
+    /// Travel speed on the way to the point (mm/s); `None` when the cell is
+    /// empty or the file has no process columns.
+    pub travel_speed_mm_s: Option<f64>,
+    /// Bead height asked for at the point (mm); `None` as above.
+    pub bead_height_mm: Option<f64>,
 }
 
 /// Error reading `joints.csv`, naming the file, line and column.
@@ -144,13 +173,20 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
         reason,
     };
     let mut lines = text.lines().enumerate();
-    let positioner = match lines.next() {
-        Some((_, h)) if h == HEADER => false,
-        Some((_, h)) if h.strip_suffix(",e1,e2") == Some(HEADER) => true,
+    let (header, with_process) = match lines.next() {
+        Some((_, h)) => match h.strip_suffix(&format!(",{PROCESS_COLUMNS}")) {
+            Some(rest) => (rest, true),
+            None => (h, false),
+        },
+        None => ("", false),
+    };
+    let positioner = match header {
+        h if h == HEADER => false,
+        h if h.strip_suffix(",e1,e2") == Some(HEADER) => true,
         _ => {
             return Err(err(
                 1,
-                format!("expected the header `{HEADER}` (with `,e1,e2` for a positioner)"),
+                format!("expected the header `{HEADER}` (with `,e1,e2` for a positioner), then `,{PROCESS_COLUMNS}`"),
             ))
         }
     };
@@ -165,7 +201,13 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
             .iter()
             .copied(),
         )
+        .chain(if with_process {
+            PROCESS_COLUMNS.split(',').collect::<Vec<_>>()
+        } else {
+            Vec::new()
+        })
         .collect();
+    let process_at = 15 + if positioner { 2 } else { 0 };
     let mut rows = Vec::new();
     for (i, line) in lines {
         let n = i + 1;
@@ -230,6 +272,12 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
             rz_deg: need(8)?,
             joints_deg,
             positioner_deg,
+            travel_speed_mm_s: if with_process { num(process_at)? } else { None },
+            bead_height_mm: if with_process {
+                num(process_at + 1)?
+            } else {
+                None
+            },
         });
     }
     Ok(rows)
@@ -260,6 +308,10 @@ mod tests {
             Some(None) => s += ",,",
             None => {}
         }
+        match r.process {
+            Some(v) => v.iter().for_each(|x| s += &format!(",{x:.6}")),
+            None => s += ",,",
+        }
         s
     }
 
@@ -286,6 +338,7 @@ mod tests {
                     1 => Some(None),
                     _ => Some(Some([next(3.2), next(6.4)])),
                 },
+                process: (i % 5 != 2).then(|| [next(20.0).abs(), next(3.0).abs()]),
             };
             let mut ours = Vec::new();
             push_row(&mut ours, &r);
@@ -328,6 +381,7 @@ mod tests {
                 rz_rad: -std::f64::consts::FRAC_PI_2,
                 joints_rad: None,
                 positioner_rad: Some(None),
+                process: None,
             },
             Row {
                 layer: 2,
@@ -337,15 +391,16 @@ mod tests {
                 rz_rad: 0.25,
                 joints_rad: Some([0.1, -0.2, 0.3, -0.4, 0.5, -3.0]),
                 positioner_rad: Some(Some([-0.5, 1.5])),
+                process: Some([8.5, 1.75]),
             },
         ];
-        let mut text = format!("{HEADER},e1,e2\n").into_bytes();
+        let mut text = format!("{HEADER},e1,e2,{PROCESS_COLUMNS}\n").into_bytes();
         for r in &rows {
             push_row(&mut text, r);
         }
         let text = String::from_utf8(text).unwrap();
         assert!(
-            text.contains("\n2,7,1045.747000,-630.155000,0.500000,0.000000,0.000000,1.000000,-90.000000,,,,,,,,\n"),
+            text.contains("\n2,7,1045.747000,-630.155000,0.500000,0.000000,0.000000,1.000000,-90.000000,,,,,,,,,,\n"),
             "{text}"
         );
         let back = read_joints_csv(&text, "joints.csv").unwrap();
@@ -354,6 +409,20 @@ mod tests {
         assert_eq!(back[0].positioner_deg, None);
         let j = back[1].joints_deg.unwrap();
         assert!((j[5] + 3f64.to_degrees()).abs() < 1e-6, "{j:?}");
+        assert!((back[1].positioner_deg.unwrap()[1] - 1.5f64.to_degrees()).abs() < 1e-6);
+        assert_eq!(back[0].travel_speed_mm_s, None);
+        assert_eq!(back[1].travel_speed_mm_s, Some(8.5));
+        assert_eq!(back[1].bead_height_mm, Some(1.75));
+        // a file written before the process columns still reads
+        let old: String = text
+            .lines()
+            .map(|l| {
+                let cells: Vec<&str> = l.split(',').collect();
+                cells[..cells.len() - 2].join(",") + "\n"
+            })
+            .collect();
+        let back = read_joints_csv(&old, "joints.csv").unwrap();
+        assert_eq!(back[1].bead_height_mm, None);
         assert!((back[1].positioner_deg.unwrap()[1] - 1.5f64.to_degrees()).abs() < 1e-6);
     }
 }

@@ -318,6 +318,14 @@ pub struct ProcessSpec {
     pub travel_speed_min_mm_s: Option<Scalar>,
     /// Fastest admissible travel speed (mm/s).
     pub travel_speed_max_mm_s: Option<Scalar>,
+    /// Exponent `a` of the bead height law `ln h = a ln v + b` (h in mm, v
+    /// in mm/s; default −0.5), used by the closed loop (`waam replan`).
+    #[serde(default)]
+    pub bead_height_law_a: Option<Scalar>,
+    /// Intercept `b` of that law (`ln mm`); default: the nominal travel
+    /// speed lays a bead of `Delta`.
+    #[serde(default)]
+    pub bead_height_law_b: Option<Scalar>,
 }
 
 /// A part file as written (before validation).
@@ -935,6 +943,12 @@ impl Ctx<'_> {
             if let Some(v) = value {
                 *slot = self.positive(&format!("process.{name}"), v)?;
             }
+        }
+        if let Some(a) = &s.bead_height_law_a {
+            p.bead_height_law.a = self.scalar("process.bead_height_law_a", a)?;
+        }
+        if let Some(b) = &s.bead_height_law_b {
+            p.bead_height_law.b = Some(self.scalar("process.bead_height_law_b", b)?);
         }
         p.validate().map_err(|e| match e {
             crate::process::ProcessError::InvalidParameter { field, reason } => {

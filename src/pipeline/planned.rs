@@ -68,6 +68,11 @@ pub struct PlannedPart {
     pub program: Result<Program, ProgramError>,
     /// Run times.
     pub times: PlanTimes,
+    /// The travel speed of every point of `layers` (mm/s, on the way to the
+    /// point) when the program modulates it (a replanned part,
+    /// [`crate::replan`]); `None`: the constant
+    /// [`PlannedPart::travel_speed_mm_s`] everywhere.
+    pub point_speeds_mm_s: Option<Vec<Vec<f64>>>,
 }
 
 /// The program name for a part: its name in upper case, letters, digits and
@@ -180,6 +185,7 @@ pub fn plan_part_with(
         format,
         plan,
         program,
+        point_speeds_mm_s: None,
     })
 }
 
@@ -297,7 +303,42 @@ impl PlannedPart {
     /// # Errors
     /// I/O errors of `w`.
     pub fn write_joints_csv(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
-        crate::io::joints_csv::write_joints_csv(w, &self.layers, &self.plan, self.has_positioner())
+        crate::io::joints_csv::write_joints_csv(
+            w,
+            &self.layers,
+            &self.plan,
+            self.has_positioner(),
+            &self.point_process(),
+        )
+    }
+
+    /// Per point of `layers`: `[travel speed (mm/s), bead height (mm)]` — the
+    /// speed the program runs on the way to the point and the height the
+    /// plan asks for there (the point's local distance to the layer below,
+    /// `Delta` on the first layer).
+    pub fn point_process(&self) -> Vec<Vec<[f64; 2]>> {
+        let path = &self.sliced.path;
+        self.layers
+            .iter()
+            .enumerate()
+            .map(|(i, lp)| {
+                let speeds = self.point_speeds_mm_s.as_ref().and_then(|s| s.get(i));
+                (0..lp.points.len())
+                    .map(|m| {
+                        let v = speeds
+                            .and_then(|s| s.get(m).copied())
+                            .unwrap_or_else(|| self.travel_speed_mm_s());
+                        let h = path
+                            .layers
+                            .get(lp.layer)
+                            .and_then(|l| l.points.get(m))
+                            .and_then(|p| p.delta)
+                            .unwrap_or(path.delta_mm);
+                        [v, h]
+                    })
+                    .collect()
+            })
+            .collect()
     }
 
     /// The emitted program files in the plan's [`PlannedPart::format`], not

@@ -11,6 +11,7 @@
 
 pub mod bead;
 pub mod estimate;
+pub mod height_law;
 pub mod speed;
 
 #[cfg(test)]
@@ -18,6 +19,7 @@ mod tests;
 
 pub use bead::{bead_area_mm2, xiong_height_mm, xiong_width_mm, Bead, BeadModel};
 pub use estimate::Estimates;
+pub use height_law::{BeadHeightLaw, ResolvedHeightLaw};
 pub use speed::{SpeedLaw, SpeedViolation, WindowSide};
 
 use crate::path::Path;
@@ -107,6 +109,10 @@ pub struct ProcessParameters {
     pub travel_speed_max_mm_s: f64,
     /// Bead height/width model.
     pub bead_model: BeadModel,
+    /// Bead height against travel speed, `ln h = a ln v + b` (mm, mm/s): the
+    /// law the closed loop ([`crate::replan`]) inverts to correct a measured
+    /// layer's height error with the next layer's travel speed.
+    pub bead_height_law: BeadHeightLaw,
 }
 
 impl Default for ProcessParameters {
@@ -137,6 +143,7 @@ impl ProcessParameters {
             bead_model: BeadModel::ConstantWidth {
                 width_mm: bead_area_mm2(d, wfs, ts) / 1.0,
             },
+            bead_height_law: BeadHeightLaw::default(),
         }
     }
 
@@ -158,6 +165,7 @@ impl ProcessParameters {
             travel_speed_min_mm_s: 15.0 * MM_S_PER_CM_MIN,
             travel_speed_max_mm_s: HUMPING_LIMIT_CMT_STEEL_MM_S,
             bead_model: BeadModel::Xiong,
+            bead_height_law: BeadHeightLaw::default(),
         }
     }
 
@@ -176,6 +184,7 @@ impl ProcessParameters {
             travel_speed_min_mm_s: 15.0 * MM_S_PER_CM_MIN,
             travel_speed_max_mm_s: 45.0 * MM_S_PER_CM_MIN,
             bead_model: BeadModel::Xiong,
+            bead_height_law: BeadHeightLaw::default(),
         }
     }
 
@@ -226,6 +235,9 @@ impl ProcessParameters {
                     self.travel_speed_mm_s, self.travel_speed_min_mm_s, self.travel_speed_max_mm_s
                 ),
             );
+        }
+        if let Err((field, reason)) = self.bead_height_law.validate() {
+            return bad(field, reason);
         }
         if let BeadModel::ConstantWidth { width_mm } = self.bead_model {
             if !(width_mm.is_finite() && width_mm > 0.0) {

@@ -168,6 +168,81 @@ impl PyPart {
         PySlicedPart::new(py, host.finish(result)?)
     }
 
+    /// Replans the layers after `after_layer` (K) from the measured top of
+    /// layer K: `measured` is a scan file (CSV with the header `x,y,z` or
+    /// `layer,point,dh_mm`) or an (N, 3) array of points of the deposited
+    /// top, part frame, mm. Corrects the next layers' travel speeds (and
+    /// their geometry where the speed window cannot absorb the error),
+    /// optimises them in `cell` and returns the plan of the remaining
+    /// layers: `write_program` writes the program that resumes the build,
+    /// `summary()["replan"]` gives the outliers and per layer the predicted
+    /// error before and after. A scan of another layer or part raises
+    /// `InputError` naming the distance. Releases the GIL.
+    #[pyo3(signature = (cell, measured, *, after_layer, delta_mm = None, points = None,
+        chord_mm = None, rz = None, max_layers = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn replan(
+        &self,
+        py: Python<'_>,
+        cell: &PyCell,
+        measured: &Bound<'_, PyAny>,
+        after_layer: i64,
+        delta_mm: Option<f64>,
+        points: Option<i64>,
+        chord_mm: Option<f64>,
+        rz: Option<&str>,
+        max_layers: Option<i64>,
+    ) -> PyResult<PyPlannedPart> {
+        use crate::replan::Measured;
+        let measured = if let Ok(path) = measured.extract::<PathBuf>() {
+            Measured::read(&path).map_err(stage_error)?
+        } else {
+            let rows: Vec<Vec<f64>> = measured.extract().map_err(|_| {
+                waam_error("measured: expected a scan file path or an (N, 3) array of points (mm)")
+            })?;
+            let mut pts = Vec::with_capacity(rows.len());
+            for (i, r) in rows.iter().enumerate() {
+                match r[..] {
+                    [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => {
+                        pts.push(crate::math::Point3::new(x, y, z))
+                    }
+                    _ => {
+                        return Err(waam_error(format!(
+                            "measured row {i}: expected 3 finite numbers (x, y, z in mm)"
+                        )))
+                    }
+                }
+            }
+            Measured::Points(pts)
+        };
+        let after_layer = usize::try_from(after_layer)
+            .map_err(|_| waam_error(format!("after_layer = {after_layer}: must be >= 0")))?;
+        let slice = SliceKeywords {
+            strategy: None,
+            delta_mm,
+            points,
+            chord_mm,
+            max_layers,
+            travel_speed_mm_s: None,
+        }
+        .overrides()?;
+        let rz = match rz {
+            None => RzLaw::default(),
+            Some(s) => s
+                .parse()
+                .map_err(|e| waam_error(format!("rz = {s:?}: {e}")))?,
+        };
+        let opts = PlanOptions {
+            slice,
+            ..PlanOptions::default()
+        }
+        .with_rz(rz);
+        let result = py.detach(|| {
+            crate::replan::replan_part(&self.part, &cell.cell, &measured, after_layer, &opts)
+        });
+        PyPlannedPart::from_replan(py, result.map_err(stage_error)?)
+    }
+
     /// Plans the part in `cell`: slice, tool axes, layer-by-layer `R_Z`
     /// optimisation, joint trajectory, program model. An infeasible layer
     /// is data (`feasible`, `violations`), not an exception. Releases the GIL.

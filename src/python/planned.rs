@@ -20,9 +20,21 @@ pub(crate) struct PyPlannedPart {
     layer: Py<PyArray1<i64>>,
     rz_deg: Py<PyArray1<f64>>,
     joints: Py<PyArray2<f64>>,
+    /// A replan's whole summary (with its `replan` object), when this is
+    /// the plan of the remaining layers of a replan.
+    replan_summary: Option<crate::replan::summary::ReplanSummary>,
 }
 
 impl PyPlannedPart {
+    /// The plan of the remaining layers of a replan; its `summary()` is the
+    /// replan's.
+    pub fn from_replan(py: Python<'_>, replanned: crate::replan::ReplannedPart) -> PyResult<Self> {
+        let summary = replanned.summary();
+        let mut me = Self::new(py, replanned.planned)?;
+        me.replan_summary = Some(summary);
+        Ok(me)
+    }
+
     pub fn new(py: Python<'_>, planned: PlannedPart) -> PyResult<Self> {
         let width = if planned.has_positioner() { 8 } else { 6 };
         let n: usize = planned.layers.iter().map(|l| l.points.len()).sum();
@@ -54,6 +66,7 @@ impl PyPlannedPart {
             rz_deg: arrays::floats(py, rz)?,
             joints: arrays::matrix(py, joints, width)?,
             planned,
+            replan_summary: None,
         })
     }
 }
@@ -197,6 +210,9 @@ impl PyPlannedPart {
 
     /// The content of `summary.json` (as the command-line `plan` writes it).
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        if let Some(s) = &self.replan_summary {
+            return json_to_py(py, s);
+        }
         json_to_py(py, &self.planned.summary())
     }
 

@@ -205,6 +205,13 @@ fn joints_csv_round_trips_the_plan() {
         }
         let e = p.positioner.unwrap();
         assert!((r.positioner_deg.unwrap()[1] - e[1].to_degrees()).abs() < 1e-6);
+        // every plan writes the process columns: the programmed speed and
+        // the point's local distance to the layer below (Delta on layer 0)
+        assert!((r.travel_speed_mm_s.unwrap() - planned.travel_speed_mm_s()).abs() < 1e-6);
+        let want = planned.sliced.path.layers[r.layer].points[r.point]
+            .delta
+            .unwrap_or(planned.sliced.path.delta_mm);
+        assert!((r.bead_height_mm.unwrap() - want).abs() < 1e-6);
     }
     // A damaged row is named by its line and column.
     let text = String::from_utf8(buf).unwrap();
