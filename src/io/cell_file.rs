@@ -287,6 +287,7 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
                 convention: JointConvention::of(vendor),
                 limits: [JointLimit::UNLIMITED; 6],
                 max_speed_rad_s: [1.0; 6],
+                max_acceleration_rad_s2: None,
                 encoder_sigma_rad: None,
                 twist_deviation_rad: [0.0; 6],
             }

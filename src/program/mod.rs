@@ -18,6 +18,7 @@
 //! | vendor-neutral words: move kinds, position modes | [`kinds`] | [`MoveKind`], [`PositionMode`] |
 //! | cutting a build into groups within a memory budget | [`split`] | [`split::split_to_budget`], [`split::Budget`] |
 //! | CSV of every point | [`csv`] | [`csv::write_csv`] |
+//! | the build's cycle time (per move, layer, build) | [`cycle`] | [`cycle::cycle_time`] |
 //! | the one checker of decoded steps (file + cell) | [`validate`] | [`validate::check_steps`], [`validate::Step`] |
 //! | approach and retract points | this module | [`build_program_with`], [`ProgramOptions`] |
 //! | arc-off transits against the wall | [`transit`] | [`transit::joint_move_clearance`] |
@@ -39,6 +40,7 @@ pub mod abb;
 pub mod compress;
 pub mod contract;
 pub mod csv;
+pub mod cycle;
 pub mod fanuc;
 pub mod fmt;
 pub mod frames;
