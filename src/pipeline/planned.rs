@@ -364,14 +364,50 @@ impl PlannedPart {
         let mut input = self
             .sliced
             .report_input(&title, substrate, self.sliced.path.delta_mm);
+        let cycle = self.cycle_time();
         input.plan = Some(crate::report::PlanView {
             cell: &self.cell.layout,
             layers: &self.layers,
             plan: &self.plan,
             travel_speed_mm_s: self.travel_speed_mm_s(),
+            cycle: cycle.as_ref(),
         });
         crate::report::write_report(dest, &input)?;
         Ok(())
+    }
+
+    /// The options of the cycle time ([`crate::program::cycle`]) for the
+    /// plan's format: the joint moves' speed as its emitter writes them
+    /// (FANUC `approach_percent`, KUKA `ptp_percent`, ABB `MoveAbsJ` at
+    /// `approach_speed_mm_s`), the assumed path acceleration.
+    pub fn cycle_options(&self) -> crate::program::cycle::CycleOptions {
+        use crate::program::cycle::CycleOptions;
+        let p = &self.cell.program;
+        match self.format {
+            ProgramFormat::Fanuc => CycleOptions {
+                joint_speed_fraction: f64::from(p.fanuc.approach_percent) / 100.0,
+                ..CycleOptions::default()
+            },
+            ProgramFormat::Kuka => CycleOptions {
+                joint_speed_fraction: f64::from(p.kuka.ptp_percent) / 100.0,
+                ..CycleOptions::default()
+            },
+            ProgramFormat::Abb => CycleOptions {
+                joint_speed_fraction: 1.0,
+                joint_move_tcp_speed_mm_s: Some(p.abb.approach_speed_mm_s),
+                ..CycleOptions::default()
+            },
+        }
+    }
+
+    /// The cycle time of the program (s, per move, layer and build;
+    /// [`crate::program::cycle`]); `None` when the program stage refused the plan.
+    pub fn cycle_time(&self) -> Option<crate::program::cycle::CycleTime> {
+        let program = self.program.as_ref().ok()?;
+        Some(crate::program::cycle::cycle_time(
+            program,
+            &self.cycle_options(),
+        ))
     }
 
     /// The content of `plan`'s `summary.json`: the part and cell files, the
@@ -381,12 +417,23 @@ impl PlannedPart {
     /// ([`SlicedPart::path_summary`]).
     pub fn summary(&self) -> Value {
         let plan = &self.plan;
+        let cycle = self.cycle_time();
+        let layer_cycle = |layer: usize| -> Value {
+            cycle
+                .as_ref()
+                .and_then(|c| c.layers.iter().find(|lc| lc.layer == layer))
+                .map_or(Value::Null, |lc| json!(lc.total_s))
+        };
         let layers: Vec<_> = plan
             .layers
             .iter()
             .map(|l| {
                 let q = &l.quality;
                 json!({
+                    // the layer's share of the cycle time (s): the joint
+                    // move into it, dwell, approach, bead, retract; null
+                    // without a program
+                    "cycle_time_s": layer_cycle(l.layer),
                     "layer": l.layer,
                     "status": l.status.to_string(),
                     "feasible": l.status.is_feasible(),
@@ -460,6 +507,30 @@ impl PlannedPart {
                 "start_limit_distance_deg": t.start_limit_distance_rad.to_degrees(),
             })).collect::<Vec<_>>(),
             "program": Value::Null,
+            // the program stage's refusal of a plan whose layers are all
+            // feasible (null: a program was built, or a layer is infeasible)
+            "program_refusal": match &self.program {
+                Err(e) if plan.is_feasible() => json!(e.to_string()),
+                _ => Value::Null,
+            },
+            // the build's cycle time (s; null without a program) and its parts
+            "cycle_time_s": cycle.as_ref().map(|c| c.total_s),
+            "cycle": cycle.as_ref().map(|c| json!({
+                "arc_on_s": c.arc_on_s,
+                "home_return_s": c.home_return_s,
+                "interpass_waits": c.waits,
+                "joint_speed_fraction": self.cycle_options().joint_speed_fraction,
+                "path_acceleration_mm_s2": self.cycle_options().path_acceleration_mm_s2,
+                "layers": c.layers.iter().map(|l| json!({
+                    "layer": l.layer,
+                    "transit_s": l.transit_s,
+                    "dwell_s": l.dwell_s,
+                    "approach_s": l.approach_s,
+                    "bead_s": l.bead_s,
+                    "retract_s": l.retract_s,
+                    "total_s": l.total_s,
+                })).collect::<Vec<_>>(),
+            })),
             "run_time_s": {
                 "slice": self.times.slice,
                 "tool_axes": self.times.tool_axes,

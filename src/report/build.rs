@@ -635,6 +635,25 @@ fn plan_data(input: &ReportInput, pv: &PlanView) -> (String, Vec<String>) {
     .num("points_total", total as f64)
     .num("frame_stride", k as f64)
     .num("duration_s", f_time.last().map_or(0.0, |t| f64::from(*t)))
+    // the program's cycle time (s; null without a program) and each
+    // layer's share, by layer number
+    .num("cycle_time_s", pv.cycle.map_or(f64::NAN, |c| c.total_s))
+    .raw(
+        "cycle_layers",
+        json_nums(
+            &pv.cycle
+                .map(|c| c.layers.iter().map(|l| l.layer as f64).collect::<Vec<_>>())
+                .unwrap_or_default(),
+        ),
+    )
+    .raw(
+        "cycle_layer_s",
+        json_nums(
+            &pv.cycle
+                .map(|c| c.layers.iter().map(|l| l.total_s).collect::<Vec<_>>())
+                .unwrap_or_default(),
+        ),
+    )
     .str("f_layer", &u32s(&f_layer))
     .str("f_point", &u32s(&f_point))
     .str("f_time", &f32s(&f_time))

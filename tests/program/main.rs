@@ -9,6 +9,7 @@ mod budget;
 mod cells;
 mod circular;
 mod contract;
+mod cycle;
 mod fanuc_controller;
 mod fixture;
 mod formats;
