@@ -30,8 +30,11 @@ pub struct PlanTimes {
     pub tool_axes: f64,
     /// `R_Z` optimisation (s).
     pub optimise: f64,
-    /// Joint trajectory and program model (s).
+    /// Joint trajectory and program model, the whole-cell collision check
+    /// included (s).
     pub program: f64,
+    /// The whole-cell collision check alone ([`crate::program::cell_check`]) (s).
+    pub cell_check: f64,
 }
 
 /// A part planned in a cell: the sliced part, the optimised plan (one
@@ -65,6 +68,11 @@ pub struct PlannedPart {
     /// first infeasible layer and its binding constraint, or the check that
     /// failed).
     pub program: Result<Program, ProgramError>,
+    /// The closest approach of the cell's bodies per layer
+    /// ([`crate::program::cell_check`]), when the program was built and
+    /// passed the check (a collision is the program's refusal,
+    /// [`ProgramError::Collision`]).
+    pub clearance: Option<crate::program::cell_check::CellClearance>,
     /// Run times.
     pub times: PlanTimes,
 }
@@ -164,8 +172,12 @@ pub fn plan_part_with(
     control.report("program", 0.95);
     let t = Instant::now();
     let name = program_name(&part.name);
-    let program = build(&name, cell, &sliced, &layers, &plan, &optimise_opts);
+    let built = build(&name, cell, &sliced, &layers, &plan, &optimise_opts);
     let t_program = t.elapsed().as_secs_f64();
+    let (program, clearance, t_check) = match built {
+        Ok((p, c, t)) => (Ok(p), Some(c), t),
+        Err(e) => (Err(e), None, 0.0),
+    };
     control.report("program", 1.0);
     Ok(PlannedPart {
         times: PlanTimes {
@@ -173,6 +185,7 @@ pub fn plan_part_with(
             tool_axes: t_axes,
             optimise: plan.time_s,
             program: t_program,
+            cell_check: t_check,
         },
         sliced,
         cell: cell.clone(),
@@ -182,10 +195,13 @@ pub fn plan_part_with(
         format,
         plan,
         program,
+        clearance,
     })
 }
 
-/// The program model of a plan, refused when a layer is infeasible or lost.
+/// The program model of a plan, refused when a layer is infeasible or lost
+/// or a motion collides in the cell; with the closest approach per layer
+/// and the collision check's run time (s).
 pub(super) fn build(
     name: &str,
     cell: &Cell,
@@ -193,7 +209,7 @@ pub(super) fn build(
     layers: &[LayerPoints],
     plan: &Plan,
     opts: &OptimiseOptions,
-) -> Result<Program, ProgramError> {
+) -> Result<(Program, crate::program::cell_check::CellClearance, f64), ProgramError> {
     check_every_layer(layers, plan)?;
     let inputs = trajectory_inputs(layers, plan);
     let speed = opts.travel_speed_mm_s;
@@ -226,7 +242,13 @@ pub(super) fn build(
             .collect();
         program.set_payloads(common, &masses)?;
     }
-    Ok(program)
+    let t = Instant::now();
+    let scene = crate::program::cell_check::CellScene {
+        keep_out: cell.keep_out.clone(),
+        clearance_mm: common.collision_clearance_mm,
+    };
+    let clearance = crate::program::cell_check::check_cell(&program, &traj, layers, &scene)?;
+    Ok((program, clearance, t.elapsed().as_secs_f64()))
 }
 
 /// No layer may vanish between the plan and the program: each layer of the
@@ -418,6 +440,11 @@ impl PlannedPart {
     pub fn summary(&self) -> Value {
         let plan = &self.plan;
         let cycle = self.cycle_time();
+        let layer_clearance = |layer: usize| {
+            self.clearance
+                .as_ref()
+                .and_then(|c| c.layers.iter().find(|lc| lc.layer == layer))
+        };
         let layer_cycle = |layer: usize| -> Value {
             cycle
                 .as_ref()
@@ -434,6 +461,14 @@ impl PlannedPart {
                     // move into it, dwell, approach, bead, retract; null
                     // without a program
                     "cycle_time_s": layer_cycle(l.layer),
+                    // the closest two bodies of the cell along the layer's
+                    // motions (mm; null without a program, or when every
+                    // pair was culled far apart) and which
+                    "closest_approach_mm": layer_clearance(l.layer)
+                        .map_or(Value::Null, |c| finite_or_null(c.closest_approach_mm)),
+                    "closest_pair": layer_clearance(l.layer)
+                        .and_then(|c| c.closest_pair.as_ref())
+                        .map(|(a, b)| json!([a, b])),
                     "layer": l.layer,
                     "status": l.status.to_string(),
                     "feasible": l.status.is_feasible(),
@@ -513,6 +548,24 @@ impl PlannedPart {
                 Err(e) if plan.is_feasible() => json!(e.to_string()),
                 _ => Value::Null,
             },
+            // a collision in the cell: where, which bodies, how deep
+            "collision": match &self.program {
+                Err(ProgramError::Collision { layer, point, motion, body_a, body_b, distance_mm, clearance_mm }) => json!({
+                    "layer": layer,
+                    "point": point,
+                    "motion": motion,
+                    "bodies": [body_a, body_b],
+                    "distance_mm": distance_mm,
+                    "depth_mm": (-distance_mm).max(0.0),
+                    "clearance_mm": clearance_mm,
+                }),
+                _ => Value::Null,
+            },
+            "cell_check": self.clearance.as_ref().map(|c| json!({
+                "samples": c.samples,
+                "exact_queries": c.exact_queries,
+                "culled": c.culled,
+            })),
             // the build's cycle time (s; null without a program) and its parts
             "cycle_time_s": cycle.as_ref().map(|c| c.total_s),
             "cycle": cycle.as_ref().map(|c| json!({
@@ -536,6 +589,7 @@ impl PlannedPart {
                 "tool_axes": self.times.tool_axes,
                 "optimise": self.times.optimise,
                 "program": self.times.program,
+                "cell_check": self.times.cell_check,
             },
         });
         merge(&mut s, self.sliced.path_summary());

@@ -6,6 +6,7 @@
 mod abb_controller;
 mod api;
 mod budget;
+mod cell_collision;
 mod cells;
 mod circular;
 mod contract;

@@ -215,9 +215,7 @@ pub fn profile_time(segments: &[Segment], a: f64) -> f64 {
     segments
         .iter()
         .enumerate()
-        .map(|(k, s)| {
-            piece_time(s.length_mm, w[k], w[k + 1], s.speed_mm_s, a).max(s.min_time_s)
-        })
+        .map(|(k, s)| piece_time(s.length_mm, w[k], w[k + 1], s.speed_mm_s, a).max(s.min_time_s))
         .sum()
 }
 
@@ -401,7 +399,11 @@ fn bead_time(axes: &Axes, bead: &[ProgramPoint], accel: f64) -> f64 {
             let d2 = Axes::changes(&via.joints, via.positioner, &b.joints, b.positioner);
             let d: [f64; 8] = std::array::from_fn(|j| d1[j] + d2[j]);
             k += 2;
-            (b, arc_length(&a.position_mm, &via.position_mm, &b.position_mm), d)
+            (
+                b,
+                arc_length(&a.position_mm, &via.position_mm, &b.position_mm),
+                d,
+            )
         } else {
             let b = &bead[k];
             k += 1;

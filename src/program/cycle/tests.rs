@@ -7,7 +7,9 @@ use crate::robot::{CellLayout, Configuration};
 
 fn cell(name: &str) -> CellLayout {
     let path = format!("{}/parts/cells/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-    crate::pipeline::Cell::read(path).expect("sample cell").layout
+    crate::pipeline::Cell::read(path)
+        .expect("sample cell")
+        .layout
 }
 
 fn point(layer: usize, k: usize, x: f64, speed: f64, arc: ArcFlag, q: [f64; 6]) -> ProgramPoint {
