@@ -137,7 +137,7 @@ pub struct CycleTime {
 /// speed is reached), else `2·sqrt(d/a)` (a triangle). An infinite `v`
 /// or `a` drops its term; 0 for `d <= 0`.
 pub fn trapezoid_time(d: f64, v: f64, a: f64) -> f64 {
-    if !(d > 0.0) {
+    if d.is_nan() || d <= 0.0 {
         return 0.0;
     }
     match (v.is_finite(), a.is_finite()) {
@@ -171,7 +171,7 @@ pub struct Segment {
 /// cruise speed `v` and acceleration `a` over `l` mm: accelerate to the
 /// peak `min(v, sqrt((2·a·l + w_a² + w_b²)/2))`, cruise, decelerate.
 fn piece_time(l: f64, w_a: f64, w_b: f64, v: f64, a: f64) -> f64 {
-    if !(l > 0.0) {
+    if l.is_nan() || l <= 0.0 {
         return 0.0;
     }
     if !a.is_finite() {
