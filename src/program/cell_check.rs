@@ -42,15 +42,24 @@
 //! home moves, interpolated linearly in joint space (exact for the joint
 //! moves, FANUC `J`, KUKA `PTP`, ABB `MoveAbsJ`; within a fraction of a
 //! millimetre for the short linear moves). Samples are taken **by swept
-//! distance**: a bound on how far any point of the arm can move between two
-//! samples (the sum of each joint's change times the arm's reach, plus the
-//! positioner's) is kept below [`SAMPLE_STEP_MM`], so a contact between
-//! samples is missed by at most half of that.
+//! distance**: a bound on how far any point of the arm, the part or the
+//! table can move between two samples (the sum of each axis's change times
+//! the largest distance from that axis to a body it moves) is kept below
+//! [`SAMPLE_STEP_MM`], so a contact between samples is missed by at most
+//! half of that.
 //!
 //! **Culling**: each pair is first bounded below by the distance between
-//! the bodies' bounding spheres, and skipped when that bound already
-//! exceeds both the clearance and the layer's closest approach so far;
-//! parry's exact distance (GJK) runs only on the pairs left.
+//! the bodies' bounding spheres and by its last exact distance less how far
+//! each of the two bodies has moved since (each body's displacement from
+//! sample to sample: its capsule's ends, or its centre and its turn times
+//! its radius, summed like an odometer), and skipped when that bound
+//! already exceeds the clearance and comes within [`REPORT_TOLERANCE_MM`]
+//! of the layer's closest approach so far; parry's exact distance (GJK)
+//! runs only on the pairs left. The part's hull is built from at most
+//! [`HULL_POINTS_PER_LAYER`] points a layer, its distances lowered by the
+//! largest chord deviation of a dropped point (conservative). So
+//! `closest_approach_mm` is a distance measured at a sample, at most
+//! [`REPORT_TOLERANCE_MM`] above the smallest over the samples.
 
 use std::collections::HashMap;
 
@@ -70,6 +79,10 @@ pub const DEFAULT_CLEARANCE_MM: f64 = 10.0;
 
 /// Largest swept distance between two samples of a motion (mm).
 pub const SAMPLE_STEP_MM: f64 = 5.0;
+
+/// How far above the smallest distance over the samples a layer's reported
+/// closest approach may be (mm): the culling's tolerance.
+pub const REPORT_TOLERANCE_MM: f64 = 1.0;
 
 /// Radius of the positioner's table (mm): not given by the thesis nor the
 /// cell files; 250 mm, the size of a 500 mm face plate, is assumed.
@@ -206,6 +219,66 @@ struct Body<'a> {
     pose: Isometry3,
     centre: Point3,
     radius: f64,
+    margin: f64,
+    /// A capsule's segment ends (base frame), for its displacement.
+    ends: Option<(Point3, Point3)>,
+}
+
+/// What the culling remembers between samples: each body's last place and
+/// odometer (mm), each pair's last exact distance and the two odometers then.
+#[derive(Default)]
+struct Memory {
+    /// Which layer's hull the bodies are for (the part changes with it).
+    layer: Option<usize>,
+    places: Vec<(Point3, Point3, UnitQuaternion)>,
+    odometer: Vec<f64>,
+    pairs: HashMap<(usize, usize), (f64, f64, f64)>,
+}
+
+impl Memory {
+    /// Moves each body's odometer on by its displacement since the last
+    /// sample; forgets everything when the bodies are others.
+    fn advance(&mut self, layer: usize, bodies: &[Body]) {
+        if self.layer != Some(layer) || self.places.len() != bodies.len() {
+            self.layer = Some(layer);
+            self.places = bodies.iter().map(place_of).collect();
+            self.odometer = vec![0.0; bodies.len()];
+            self.pairs.clear();
+            return;
+        }
+        for (i, b) in bodies.iter().enumerate() {
+            let now = place_of(b);
+            let was = self.places[i];
+            let moved = match b.ends {
+                Some(_) => (now.0 - was.0).norm().max((now.1 - was.1).norm()),
+                None => (now.0 - was.0).norm() + b.radius * was.2.angle_to(&now.2),
+            };
+            self.odometer[i] += moved;
+            self.places[i] = now;
+        }
+    }
+
+    /// The pair's last exact distance less how far its bodies moved since.
+    fn lower_bound(&self, i: usize, j: usize) -> f64 {
+        self.pairs
+            .get(&(i, j))
+            .map_or(f64::NEG_INFINITY, |(d, oi, oj)| {
+                d - (self.odometer[i] - oi) - (self.odometer[j] - oj)
+            })
+    }
+
+    fn remember(&mut self, i: usize, j: usize, d: f64) {
+        let (oi, oj) = (self.odometer[i], self.odometer[j]);
+        self.pairs.insert((i, j), (d, oi, oj));
+    }
+}
+
+/// A body's place: a capsule's ends, else its centre (twice) and rotation.
+fn place_of(b: &Body) -> (Point3, Point3, UnitQuaternion) {
+    match b.ends {
+        Some((a, e)) => (a, e, UnitQuaternion::identity()),
+        None => (b.centre, b.centre, b.pose.rotation),
+    }
 }
 
 const COLUMN: &str = "J1 column";
@@ -245,6 +318,8 @@ fn capsule_body<'a>(name: &'a str, c: &'a Capsule) -> Body<'a> {
         pose: Isometry3::identity(),
         centre,
         radius: 0.5 * (c.segment.b - c.segment.a).norm() + c.radius,
+        margin: 0.0,
+        ends: Some((c.segment.a, c.segment.b)),
     }
 }
 
@@ -253,6 +328,8 @@ struct Local {
     shape: Box<dyn Shape>,
     centre: Point3,
     radius: f64,
+    /// Lowered from every distance to it (mm): the part's thinning.
+    margin: f64,
 }
 
 impl Local {
@@ -263,6 +340,8 @@ impl Local {
             pose,
             centre: pose * self.centre,
             radius: self.radius,
+            margin: self.margin,
+            ends: None,
         }
     }
 }
@@ -282,19 +361,60 @@ fn hull(points: &[Point3]) -> Option<Local> {
         shape: Box::new(h),
         centre,
         radius,
+        margin: 0.0,
     })
+}
+
+/// Most points of a layer that enter the part's hull; a longer layer keeps
+/// every `k`-th point (and its last), and the hull's distances are lowered
+/// by the largest distance of a dropped point from the chord between its
+/// kept neighbours, so that the check stays conservative.
+pub const HULL_POINTS_PER_LAYER: usize = 24;
+
+/// A layer's points thinned to at most [`HULL_POINTS_PER_LAYER`], and the
+/// largest distance of a dropped point from its kept neighbours' chord (mm).
+fn thin_layer(points: &[Point3]) -> (Vec<Point3>, f64) {
+    let n = points.len();
+    if n <= HULL_POINTS_PER_LAYER {
+        return (points.to_vec(), 0.0);
+    }
+    let k = n.div_ceil(HULL_POINTS_PER_LAYER);
+    let mut kept: Vec<usize> = (0..n).step_by(k).collect();
+    if kept.last() != Some(&(n - 1)) {
+        kept.push(n - 1);
+    }
+    let mut margin: f64 = 0.0;
+    for w in kept.windows(2) {
+        let (a, b) = (points[w[0]], points[w[1]]);
+        let ab = b - a;
+        let len2 = ab.norm_squared();
+        for p in &points[w[0] + 1..w[1]] {
+            let t = if len2 > 0.0 {
+                ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            margin = margin.max((p - (a + ab * t)).norm());
+        }
+    }
+    (kept.into_iter().map(|i| points[i]).collect(), margin)
 }
 
 /// The convex hull of layers `0..=k` for each `k` (part frame), built
 /// incrementally (each from the previous hull's vertices and the layer's
-/// points); a layer whose hull is degenerate (a flat first layer) keeps a
-/// thin slab: its points lifted by 0.01 mm are added.
+/// points thinned by [`thin_layer`]), with the margin (mm) its distances
+/// are lowered by; a layer whose hull is degenerate (a flat first layer)
+/// keeps a thin slab: its points lifted by 0.01 mm are added.
 fn wall_hulls(layers: &[LayerPoints]) -> Vec<Option<Local>> {
     let mut out: Vec<Option<Local>> = Vec::with_capacity(layers.len());
     let mut vertices: Vec<Point3> = Vec::new();
+    let mut margin: f64 = 0.0;
     for l in layers {
+        let raw: Vec<Point3> = l.points.iter().map(|p| p.position_mm).collect();
+        let (thin, m) = thin_layer(&raw);
+        margin = margin.max(m);
         let mut pts = vertices.clone();
-        pts.extend(l.points.iter().map(|p| p.position_mm));
+        pts.extend(thin);
         let mut h = hull(&pts);
         if h.is_none() {
             let lifted: Vec<Point3> = pts
@@ -304,10 +424,11 @@ fn wall_hulls(layers: &[LayerPoints]) -> Vec<Option<Local>> {
                 .collect();
             h = hull(&lifted);
         }
-        if let Some(local) = &h {
+        if let Some(local) = &mut h {
             if let Some(c) = local.shape.as_convex_polyhedron() {
                 vertices = c.points().to_vec();
             }
+            local.margin = margin;
         }
         out.push(h);
     }
@@ -337,7 +458,9 @@ struct Checker<'a> {
     tilt: Local,
     hulls: Vec<Option<Local>>,
     clearance: f64,
-    reach: f64,
+    /// Per axis (the arm's six, the positioner's two), the largest distance
+    /// from the axis to a point of a body it moves (mm).
+    lever: [f64; 8],
 }
 
 /// Where a sample is, for a refusal.
@@ -366,16 +489,41 @@ impl<'a> Checker<'a> {
                     shape: Box::new(Cuboid::new(half)),
                     centre: Point3::from(centre.coords),
                     radius: half.norm(),
+                    margin: 0.0,
                 }
             })
             .collect();
         let g = &cell.robot().geometry;
-        let reach = g.shoulder_offset_mm.abs()
-            + g.lateral_offset_mm.abs()
-            + g.upper_arm_mm.abs()
-            + g.elbow_offset_mm.abs()
-            + g.forearm_mm.abs()
-            + g.wrist_to_flange_mm.abs();
+        // how far from each axis a point of a body it moves can be: the
+        // links beyond it plus what the flange carries (the part, or the
+        // torch), or for the positioner the table and the part on it
+        let part_extent = layers
+            .iter()
+            .flat_map(|l| &l.points)
+            .map(|p| p.position_mm.coords.norm())
+            .fold(0.0, f64::max);
+        let carried = match cell {
+            CellLayout::PartCarried(c) => {
+                c.flange_from_part.translation.vector.norm() + part_extent
+            }
+            CellLayout::TorchCarried(c) => c.flange_from_tcp.translation.vector.norm(),
+        };
+        let wrist = g.wrist_to_flange_mm.abs() + carried;
+        let fore = g.elbow_offset_mm.abs() + g.forearm_mm.abs() + wrist;
+        let upper = g.upper_arm_mm.abs() + fore;
+        let reach = g.shoulder_offset_mm.abs() + g.lateral_offset_mm.abs() + upper;
+        let (tilt_arm, turn_arm) = match cell {
+            CellLayout::TorchCarried(c) => {
+                let table_to_part = c.table_from_part.translation.vector.norm() + part_extent;
+                let turn = TABLE_RADIUS_MM.max(table_to_part) + TABLE_THICKNESS_MM;
+                (
+                    c.positioner.tilt_to_table_mm.abs() + turn + TILT_BODY_RADIUS_MM,
+                    turn,
+                )
+            }
+            CellLayout::PartCarried(_) => (0.0, 0.0),
+        };
+        let lever = [reach, upper, fore, wrist, wrist, wrist, tilt_arm, turn_arm];
         // the table: a cylinder (parry's axis is Y) turned onto Z, below
         // the table frame's origin
         let half_t = 0.5 * TABLE_THICKNESS_MM;
@@ -383,6 +531,7 @@ impl<'a> Checker<'a> {
             shape: Box::new(Cylinder::new(half_t, TABLE_RADIUS_MM)),
             centre: Point3::origin(),
             radius: (TABLE_RADIUS_MM.powi(2) + half_t.powi(2)).sqrt(),
+            margin: 0.0,
         };
         let tilt = Local {
             shape: Box::new(Capsule::new(
@@ -392,6 +541,7 @@ impl<'a> Checker<'a> {
             )),
             centre: Point3::origin(),
             radius: TABLE_RADIUS_MM + TILT_BODY_RADIUS_MM,
+            margin: 0.0,
         };
         Self {
             cell,
@@ -402,21 +552,23 @@ impl<'a> Checker<'a> {
             tilt,
             hulls: wall_hulls(layers),
             clearance: scene.clearance_mm,
-            reach,
+            lever,
         }
     }
 
     /// Largest distance any point of the arm (or the part) moves between
     /// two samples (mm, a bound).
     fn swept_mm(&self, a: &Sample, b: &Sample) -> f64 {
-        let arm: f64 = a.q.iter().zip(b.q).map(|(x, y)| (x - y).abs()).sum();
+        let arm: f64 = (0..6)
+            .map(|j| (a.q[j] - b.q[j]).abs() * self.lever[j])
+            .sum();
         let pos = match (a.qp, b.qp) {
-            (Some(x), Some(y)) => (x[0] - y[0]).abs() + (x[1] - y[1]).abs(),
+            (Some(x), Some(y)) => {
+                (x[0] - y[0]).abs() * self.lever[6] + (x[1] - y[1]).abs() * self.lever[7]
+            }
             _ => 0.0,
         };
-        // the part on the table reaches at most the table's radius plus
-        // the tilt arm from the positioner's axes; the arm its reach
-        arm * self.reach + pos * (TABLE_RADIUS_MM + self.reach)
+        arm + pos
     }
 
     /// Checks one sample; updates `best`; the first pair closer than the
@@ -424,8 +576,9 @@ impl<'a> Checker<'a> {
     fn check(
         &self,
         s: &Sample,
-        hull: Option<&Local>,
+        (layer, hull): (usize, Option<&Local>),
         best: &mut Closest,
+        memory: &mut Memory,
         stats: &mut CellClearance,
     ) -> Option<(String, String, f64)> {
         stats.samples += 1;
@@ -443,6 +596,8 @@ impl<'a> Checker<'a> {
                 ),
                 centre: k.centre,
                 radius: k.radius,
+                margin: 0.0,
+                ends: None,
             });
         }
         let mut pairs: Vec<(usize, usize)> = Vec::new(); // indices into `all`
@@ -507,11 +662,14 @@ impl<'a> Checker<'a> {
                 }
             }
         }
+        memory.advance(layer, &all);
         let mut hit: Option<(String, String, f64)> = None;
         for (i, j) in pairs {
             let (a, b) = (&all[i], &all[j]);
-            let bound = (a.centre - b.centre).norm() - a.radius - b.radius;
-            if bound > self.clearance && bound > best.distance_mm {
+            let margin = a.margin + b.margin;
+            let bound = ((a.centre - b.centre).norm() - a.radius - b.radius - margin)
+                .max(memory.lower_bound(i, j));
+            if bound > self.clearance && bound >= best.distance_mm - REPORT_TOLERANCE_MM {
                 stats.culled += 1;
                 continue;
             }
@@ -525,6 +683,8 @@ impl<'a> Checker<'a> {
                     d = c.dist.min(0.0);
                 }
             }
+            d -= margin;
+            memory.remember(i, j, d);
             if d < best.distance_mm {
                 best.distance_mm = d;
                 best.pair = Some((a.name.to_string(), b.name.to_string()));
@@ -559,6 +719,7 @@ pub fn check_cell(
         .map(|(i, l)| (l.layer, i))
         .collect();
     let mut stats = CellClearance::default();
+    let mut memory = Memory::default();
     let mut per_layer: Vec<(usize, Closest)> = Vec::new();
     let mut slot: HashMap<usize, usize> = HashMap::new();
     let mut best_of = |layer: usize, per_layer: &mut Vec<(usize, Closest)>| -> usize {
@@ -589,6 +750,7 @@ pub fn check_cell(
                    skip_first: bool,
                    place: &Place,
                    per_layer: &mut Vec<(usize, Closest)>,
+                   memory: &mut Memory,
                    stats: &mut CellClearance|
      -> Result<(), ProgramError> {
         let k = best_of(place.layer, per_layer);
@@ -605,7 +767,13 @@ pub fn check_cell(
                 (a, b) => a.or(b),
             };
             let sample = Sample { q: &q, qp };
-            if let Some(hit) = checker.check(&sample, hull, &mut per_layer[k].1, stats) {
+            if let Some(hit) = checker.check(
+                &sample,
+                (place.layer, hull),
+                &mut per_layer[k].1,
+                memory,
+                stats,
+            ) {
                 return Err(refuse(place, hit, checker.clearance));
             }
         }
@@ -650,6 +818,7 @@ pub fn check_cell(
                 last_sampled.is_some(),
                 &place,
                 &mut per_layer,
+                &mut memory,
                 &mut stats,
             )?;
             last_sampled = Some(s);
@@ -679,6 +848,7 @@ pub fn check_cell(
                 motion: "home move",
             },
             &mut per_layer,
+            &mut memory,
             &mut stats,
         )?;
     }
@@ -709,6 +879,7 @@ pub fn check_cell(
                 motion,
             },
             &mut per_layer,
+            &mut memory,
             &mut stats,
         )?;
     }
@@ -729,6 +900,7 @@ pub fn check_cell(
                 motion: "home move",
             },
             &mut per_layer,
+            &mut memory,
             &mut stats,
         )?;
     }
