@@ -10,7 +10,7 @@
 //!
 //! **Bodies** (robot base frame):
 //! * the arm's links as capsules between its joint frame origins
-//!   ([`arm_chain`](crate::report::cell_view::arm_chain): the kinematic
+//!   ([`arm_chain`]: the kinematic
 //!   lengths of the preset): the J1 column (base origin → J2 height), the
 //!   upper arm (J2 axis → J3 axis), the forearm (J3 offset point → the
 //!   wrist unit) and the wrist (two capsules: the wrist unit behind the

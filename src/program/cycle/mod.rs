@@ -16,7 +16,7 @@
 //!   (FANUC `J … 10%`, KUKA `BAS (#VEL_PTP, 10)`) and its maximum
 //!   acceleration ([`RobotModel::max_acceleration`](crate::robot::RobotModel::max_acceleration);
 //!   the positioner's: its maximum speed over
-//!   [`ASSUMED_RAMP_S`](crate::robot::model::ASSUMED_RAMP_S)); the move takes
+//!   [`ASSUMED_RAMP_S`]); the move takes
 //!   the longest axis's time ([`trapezoid_time`]). Where the emitter gives
 //!   joint moves a TCP speed (ABB `MoveAbsJ` with `speeddata`), the move
 //!   also takes at least the flange's path length, sampled along the joint
@@ -189,7 +189,7 @@ fn piece_time(l: f64, w_a: f64, w_b: f64, v: f64, a: f64) -> f64 {
 /// speed changing at `a` (mm/s², > 0): the speed at each junction is the
 /// lower of the two pieces' speeds, then lowered by a forward pass (what
 /// the path can reach from the start) and a backward pass (what it can
-/// stop from before the end); each piece then runs as [`piece_time`].
+/// stop from before the end); each piece then accelerates to its peak, cruises and decelerates.
 /// One piece of length `L` at speed `v` gives [`trapezoid_time`]`(L, v, a)`.
 pub fn profile_time(segments: &[Segment], a: f64) -> f64 {
     let n = segments.len();
