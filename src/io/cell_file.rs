@@ -95,6 +95,9 @@ pub struct CellFile {
     /// coordination, and `[program.fanuc]`, `[program.kuka]`,
     /// `[program.abb]`): defaults where absent.
     pub program: ProgramSettings,
+    /// The `[[keep_out]]` tables: boxes the arm, the positioner and the
+    /// part must keep out of (robot base frame, mm; [`crate::program::cell_check`]).
+    pub keep_out: Vec<crate::program::cell_check::KeepOut>,
 }
 
 /// The `[placement]` table of a cell file: the bounds of the placement
@@ -155,6 +158,8 @@ struct FileDoc {
     torch_carried: Option<TorchCarriedSection>,
     placement: Option<PlacementSpec>,
     program: Option<toml::Table>,
+    #[serde(default)]
+    keep_out: Vec<crate::program::cell_check::KeepOut>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -287,6 +292,7 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
                 convention: JointConvention::of(vendor),
                 limits: [JointLimit::UNLIMITED; 6],
                 max_speed_rad_s: [1.0; 6],
+                max_acceleration_rad_s2: None,
                 encoder_sigma_rad: None,
                 twist_deviation_rad: [0.0; 6],
             }
@@ -487,6 +493,10 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
         Some(t) => program_settings(origin, t, cell.as_ref())?,
         None => ProgramSettings::default(),
     };
+    for (i, k) in doc.keep_out.iter().enumerate() {
+        k.validate()
+            .map_err(|reason| invalid(&format!("keep_out[{i}]"), &reason))?;
+    }
     Ok(CellFile {
         name: doc.name,
         source: doc.source,
@@ -494,6 +504,7 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
         cell,
         placement: doc.placement,
         program,
+        keep_out: doc.keep_out,
     })
 }
 

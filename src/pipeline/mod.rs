@@ -96,6 +96,10 @@ pub struct Cell {
     /// payload updates, transit check, coordination, and each vendor's
     /// emitter options (defaults where absent).
     pub program: crate::program::ProgramSettings,
+    /// The file's `[[keep_out]]` boxes (robot base frame, mm), checked
+    /// against the arm, the positioner and the part along every motion
+    /// ([`crate::program::cell_check`]).
+    pub keep_out: Vec<crate::program::cell_check::KeepOut>,
     /// The file's text as read (a placed copy keeps its other keys).
     pub text: String,
 }
@@ -144,6 +148,7 @@ impl Cell {
             layout,
             placement: file.placement,
             program: file.program,
+            keep_out: file.keep_out,
             text: String::new(),
         })
     }

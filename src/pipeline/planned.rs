@@ -9,8 +9,9 @@ use serde::ser::SerializeMap;
 use serde::Serialize;
 
 use super::summary::{
-    deg6, finite, LayerSummary, ObjectiveSummary, PlanSummary, PositionerSummary, QualitySummary,
-    SolverSummary, TransitionSummary, UnbuildableLayer, UnbuildableProof,
+    deg6, finite, CellCheckSummary, CollisionSummary, CycleSummary, LayerSummary, ObjectiveSummary,
+    PlanSummary, PositionerSummary, QualitySummary, SolverSummary, TransitionSummary,
+    UnbuildableLayer, UnbuildableProof,
 };
 use super::{slice_part_with, Cell, Control, Part, PlanOptions, ProgramFormat, RzLaw, SlicedPart};
 use crate::optimise::{
@@ -31,8 +32,11 @@ pub struct PlanTimes {
     pub tool_axes: f64,
     /// `R_Z` optimisation (s).
     pub optimise: f64,
-    /// Joint trajectory and program model (s).
+    /// Joint trajectory and program model, the whole-cell collision check
+    /// included (s).
     pub program: f64,
+    /// The whole-cell collision check alone ([`crate::program::cell_check`]) (s).
+    pub cell_check: f64,
 }
 
 /// A part planned in a cell: the sliced part, the optimised plan (one
@@ -66,6 +70,11 @@ pub struct PlannedPart {
     /// first infeasible layer and its binding constraint, or the check that
     /// failed).
     pub program: Result<Program, ProgramError>,
+    /// The closest approach of the cell's bodies per layer
+    /// ([`crate::program::cell_check`]), when the program was built and
+    /// passed the check (a collision is the program's refusal,
+    /// [`ProgramError::Collision`]).
+    pub clearance: Option<crate::program::cell_check::CellClearance>,
     /// Run times.
     pub times: PlanTimes,
     /// The travel speed of every point of `layers` (mm/s, on the way to the
@@ -167,8 +176,12 @@ pub fn plan_part_with(
     control.report("program", 0.95);
     let t = Instant::now();
     let name = program_name(&part.name);
-    let program = build(&name, cell, &sliced, &layers, &plan, &optimise_opts);
+    let built = build(&name, cell, &sliced, &layers, &plan, &optimise_opts, true);
     let t_program = t.elapsed().as_secs_f64();
+    let (program, clearance, t_check) = match built {
+        Ok((p, c, t)) => (Ok(p), Some(c), t),
+        Err(e) => (Err(e), None, 0.0),
+    };
     control.report("program", 1.0);
     Ok(PlannedPart {
         times: PlanTimes {
@@ -176,6 +189,7 @@ pub fn plan_part_with(
             tool_axes: t_axes,
             optimise: plan.time_s,
             program: t_program,
+            cell_check: t_check,
         },
         sliced,
         cell: cell.clone(),
@@ -186,10 +200,14 @@ pub fn plan_part_with(
         plan,
         program,
         point_speeds_mm_s: None,
+        clearance,
     })
 }
 
-/// The program model of a plan, refused when a layer is infeasible or lost.
+/// The program model of a plan, refused when a layer is infeasible or lost
+/// or (with `whole_cell`) a motion collides in the cell; with the closest
+/// approach per layer (empty without `whole_cell`) and the collision check's
+/// run time (s).
 pub(super) fn build(
     name: &str,
     cell: &Cell,
@@ -197,7 +215,8 @@ pub(super) fn build(
     layers: &[LayerPoints],
     plan: &Plan,
     opts: &OptimiseOptions,
-) -> Result<Program, ProgramError> {
+    whole_cell: bool,
+) -> Result<(Program, crate::program::cell_check::CellClearance, f64), ProgramError> {
     check_every_layer(layers, plan)?;
     let inputs = trajectory_inputs(layers, plan);
     let speed = opts.travel_speed_mm_s;
@@ -230,7 +249,16 @@ pub(super) fn build(
             .collect();
         program.set_payloads(common, &masses)?;
     }
-    Ok(program)
+    if !whole_cell {
+        return Ok((program, Default::default(), 0.0));
+    }
+    let t = Instant::now();
+    let scene = crate::program::cell_check::CellScene {
+        keep_out: cell.keep_out.clone(),
+        clearance_mm: common.collision_clearance_mm,
+    };
+    let clearance = crate::program::cell_check::check_cell(&program, &traj, layers, &scene)?;
+    Ok((program, clearance, t.elapsed().as_secs_f64()))
 }
 
 /// No layer may vanish between the plan and the program: each layer of the
@@ -399,14 +427,50 @@ impl PlannedPart {
         let mut input = self
             .sliced
             .report_input(&title, substrate, self.sliced.path.delta_mm);
+        let cycle = self.cycle_time();
         input.plan = Some(crate::report::PlanView {
             cell: &self.cell.layout,
             layers: &self.layers,
             plan: &self.plan,
             travel_speed_mm_s: self.travel_speed_mm_s(),
+            cycle: cycle.as_ref(),
         });
         crate::report::write_report(dest, &input)?;
         Ok(())
+    }
+
+    /// The options of the cycle time ([`crate::program::cycle`]) for the
+    /// plan's format: the joint moves' speed as its emitter writes them
+    /// (FANUC `approach_percent`, KUKA `ptp_percent`, ABB `MoveAbsJ` at
+    /// `approach_speed_mm_s`), the assumed path acceleration.
+    pub fn cycle_options(&self) -> crate::program::cycle::CycleOptions {
+        use crate::program::cycle::CycleOptions;
+        let p = &self.cell.program;
+        match self.format {
+            ProgramFormat::Fanuc => CycleOptions {
+                joint_speed_fraction: f64::from(p.fanuc.approach_percent) / 100.0,
+                ..CycleOptions::default()
+            },
+            ProgramFormat::Kuka => CycleOptions {
+                joint_speed_fraction: f64::from(p.kuka.ptp_percent) / 100.0,
+                ..CycleOptions::default()
+            },
+            ProgramFormat::Abb => CycleOptions {
+                joint_speed_fraction: 1.0,
+                joint_move_tcp_speed_mm_s: Some(p.abb.approach_speed_mm_s),
+                ..CycleOptions::default()
+            },
+        }
+    }
+
+    /// The cycle time of the program (s, per move, layer and build;
+    /// [`crate::program::cycle`]); `None` when the program stage refused the plan.
+    pub fn cycle_time(&self) -> Option<crate::program::cycle::CycleTime> {
+        let program = self.program.as_ref().ok()?;
+        Some(crate::program::cycle::cycle_time(
+            program,
+            &self.cycle_options(),
+        ))
     }
 
     /// The content of `plan`'s `summary.json`: the part and cell files, the
@@ -416,6 +480,8 @@ impl PlannedPart {
     /// ([`SlicedPart::path_summary`]); `serde_json::to_value` gives the JSON.
     pub fn summary(&self) -> PlanSummary {
         let plan = &self.plan;
+        let cycle = self.cycle_time();
+        let options = self.cycle_options();
         PlanSummary {
             part: self.sliced.part_name.clone(),
             part_file: self.sliced.part_file.clone(),
@@ -426,7 +492,26 @@ impl PlannedPart {
             infeasible_layers: plan.infeasible_layers().map(|l| l.layer).collect(),
             unbuildable_layers: plan.layers.iter().filter_map(unbuildable).collect(),
             violations: plan.violations().map(|v| v.to_string()).collect(),
-            layer_plans: plan.layers.iter().map(layer_summary).collect(),
+            layer_plans: plan
+                .layers
+                .iter()
+                .map(|l| {
+                    let mut summary = layer_summary(l);
+                    summary.cycle_time_s = cycle
+                        .as_ref()
+                        .and_then(|c| c.layers.iter().find(|lc| lc.layer == l.layer))
+                        .map(|lc| lc.total_s);
+                    if let Some(lc) = self
+                        .clearance
+                        .as_ref()
+                        .and_then(|c| c.layers.iter().find(|lc| lc.layer == l.layer))
+                    {
+                        summary.closest_approach_mm = finite(lc.closest_approach_mm);
+                        summary.closest_pair = lc.closest_pair.clone().map(|(a, b)| [a, b]);
+                    }
+                    summary
+                })
+                .collect(),
             transitions: plan
                 .transitions
                 .iter()
@@ -439,6 +524,44 @@ impl PlannedPart {
                 })
                 .collect(),
             program: None,
+            program_refusal: match &self.program {
+                Err(e) if plan.is_feasible() => Some(e.to_string()),
+                _ => None,
+            },
+            collision: match &self.program {
+                Err(ProgramError::Collision {
+                    layer,
+                    point,
+                    motion,
+                    body_a,
+                    body_b,
+                    distance_mm,
+                    clearance_mm,
+                }) => Some(CollisionSummary {
+                    layer: *layer,
+                    point: *point,
+                    motion,
+                    bodies: [body_a.clone(), body_b.clone()],
+                    distance_mm: *distance_mm,
+                    depth_mm: (-distance_mm).max(0.0),
+                    clearance_mm: *clearance_mm,
+                }),
+                _ => None,
+            },
+            cell_check: self.clearance.as_ref().map(|c| CellCheckSummary {
+                samples: c.samples,
+                exact_queries: c.exact_queries,
+                culled: c.culled,
+            }),
+            cycle_time_s: cycle.as_ref().map(|c| c.total_s),
+            cycle: cycle.map(|c| CycleSummary {
+                arc_on_s: c.arc_on_s,
+                home_return_s: c.home_return_s,
+                interpass_waits: c.waits,
+                joint_speed_fraction: options.joint_speed_fraction,
+                path_acceleration_mm_s2: options.path_acceleration_mm_s2,
+                layers: c.layers,
+            }),
             run_time_s: self.times,
             path: self.sliced.path_summary(),
         }
@@ -492,6 +615,9 @@ fn layer_summary(l: &LayerPlan) -> LayerSummary {
             max_hose_torsion_deg: q.max_hose_torsion_rad.to_degrees(),
         },
         positioner: l.positioner.as_ref().map(PositionerSummary::from),
+        cycle_time_s: None,
+        closest_approach_mm: None,
+        closest_pair: None,
         solver: SolverSummary {
             iterations: l.solver.iterations,
             qp_solves: l.solver.qp_solves,

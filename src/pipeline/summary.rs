@@ -148,11 +148,74 @@ pub struct PlanSummary {
     pub transitions: Vec<TransitionSummary>,
     /// Filled by the writer of the program files (`null` here).
     pub program: Option<()>,
+    /// The program stage's refusal of a plan whose layers are all feasible
+    /// (`None`: a program was built, or a layer is infeasible).
+    pub program_refusal: Option<String>,
+    /// A collision in the cell: where, which bodies, how deep.
+    pub collision: Option<CollisionSummary>,
+    /// What the whole-cell collision check measured (`None` without a
+    /// program).
+    pub cell_check: Option<CellCheckSummary>,
+    /// The build's cycle time (s; `None` without a program).
+    pub cycle_time_s: Option<f64>,
+    /// The cycle time's parts (`None` without a program).
+    pub cycle: Option<CycleSummary>,
     /// Run time of each stage (s).
     pub run_time_s: super::PlanTimes,
     /// The path, process, tool axes and distances.
     #[serde(flatten)]
     pub path: PathSummary,
+}
+
+/// A collision found by the whole-cell check
+/// ([`crate::program::cell_check`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CollisionSummary {
+    /// The layer the motion belongs to.
+    pub layer: usize,
+    /// The point (bead point, or the point a move goes to); `None` for a
+    /// home move.
+    pub point: Option<usize>,
+    /// The motion: `bead`, `approach`, `retract`, `arc-off transit`, `home
+    /// move`.
+    pub motion: &'static str,
+    /// The two bodies (arm links, `part`, the positioner's table or tilt
+    /// body, a keep-out box by its name).
+    pub bodies: [String; 2],
+    /// Their distance (mm; negative: penetration).
+    pub distance_mm: f64,
+    /// The penetration depth (mm, ≥ 0).
+    pub depth_mm: f64,
+    /// The clearance asked for (mm).
+    pub clearance_mm: f64,
+}
+
+/// The whole-cell check's counts.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CellCheckSummary {
+    /// Arm poses checked.
+    pub samples: usize,
+    /// Pair distances computed exactly.
+    pub exact_queries: usize,
+    /// Pairs culled by their bounds.
+    pub culled: usize,
+}
+
+/// The program's cycle time, in parts ([`crate::program::cycle`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CycleSummary {
+    /// Time with the arc on, summed over the beads (s).
+    pub arc_on_s: f64,
+    /// The joint move back home after the last bead (s).
+    pub home_return_s: f64,
+    /// Waits for the interpass input, counted as 0 s each.
+    pub interpass_waits: usize,
+    /// Fraction of each joint's maximum speed the joint moves run at.
+    pub joint_speed_fraction: f64,
+    /// The TCP's acceleration along linear moves (mm/s²).
+    pub path_acceleration_mm_s2: f64,
+    /// Per bead, in program order.
+    pub layers: Vec<crate::program::cycle::LayerCycle>,
 }
 
 /// A layer proven unbuildable from the geometry.
@@ -205,6 +268,14 @@ pub struct LayerSummary {
     pub quality: QualitySummary,
     /// The positioner's laws (torch-carried cell).
     pub positioner: Option<PositionerSummary>,
+    /// The layer's share of the cycle time (s): the joint move into it,
+    /// dwell, approach, bead, retract; `None` without a program.
+    pub cycle_time_s: Option<f64>,
+    /// The closest two bodies of the cell along the layer's motions (mm;
+    /// `None` without a program, or when every pair was culled far apart).
+    pub closest_approach_mm: Option<f64>,
+    /// The two bodies at that approach.
+    pub closest_pair: Option<[String; 2]>,
     /// The solver's counts.
     pub solver: SolverSummary,
 }

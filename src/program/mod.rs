@@ -18,6 +18,8 @@
 //! | vendor-neutral words: move kinds, position modes | [`kinds`] | [`MoveKind`], [`PositionMode`] |
 //! | cutting a build into groups within a memory budget | [`split`] | [`split::split_to_budget`], [`split::Budget`] |
 //! | CSV of every point | [`csv`] | [`csv::write_csv`] |
+//! | the whole cell against collisions along every motion | [`cell_check`] | [`cell_check::check_cell`] |
+//! | the build's cycle time (per move, layer, build) | [`cycle`] | [`cycle::cycle_time`] |
 //! | the one checker of decoded steps (file + cell) | [`validate`] | [`validate::check_steps`], [`validate::Step`] |
 //! | approach and retract points | this module | [`build_program_with`], [`ProgramOptions`] |
 //! | arc-off transits against the wall | [`transit`] | [`transit::joint_move_clearance`] |
@@ -36,9 +38,11 @@
 //! rename).
 
 pub mod abb;
+pub mod cell_check;
 pub mod compress;
 pub mod contract;
 pub mod csv;
+pub mod cycle;
 pub mod fanuc;
 pub mod fmt;
 pub mod frames;
@@ -135,6 +139,32 @@ pub enum ProgramError {
         /// What its group alone needs, in `unit`.
         size: usize,
     },
+    /// Two bodies of the cell come closer than `[program]
+    /// collision_clearance_mm` along a motion ([`cell_check`]).
+    #[error(
+        "layer {layer}{}, {motion}: the {body_a} and the {body_b} come {} (clearance {clearance_mm} mm)",
+        point.map_or(String::new(), |p| format!(", point {p}")),
+        if *distance_mm < 0.0 { format!("{:.1} mm into each other", -distance_mm) } else { format!("within {distance_mm:.1} mm") }
+    )]
+    Collision {
+        /// The layer the motion belongs to.
+        layer: usize,
+        /// The point (bead point, or the point a move goes to); `None` for
+        /// a home move.
+        point: Option<usize>,
+        /// The motion: `bead`, `approach`, `retract`, `arc-off transit`,
+        /// `home move`.
+        motion: &'static str,
+        /// One body (an arm link, `part`).
+        body_a: String,
+        /// The other (an arm link, the positioner's table or tilt body, a
+        /// keep-out box by its name, `part`).
+        body_b: String,
+        /// Their distance (mm; negative: the penetration depth).
+        distance_mm: f64,
+        /// The clearance asked for (mm).
+        clearance_mm: f64,
+    },
     /// A file could not be written.
     #[error("{path}: cannot write: {source}")]
     Io {
@@ -227,6 +257,7 @@ impl ProgramError {
         match self {
             ProgramError::InfeasibleLayer { layer, .. } => vec![*layer],
             ProgramError::Infeasible { layers, .. } => layers.clone(),
+            ProgramError::Collision { layer, .. } => vec![*layer],
             _ => Vec::new(),
         }
     }
@@ -596,6 +627,10 @@ pub struct ProgramOptions {
     /// that takes fewer positions than linear moves (a circular move writes
     /// two: its via and its end). Default on.
     pub circular_moves: bool,
+    /// Smallest distance two bodies of the cell may come to along any
+    /// motion (mm, ≥ 0; [`cell_check`]): arm links, positioner, keep-out
+    /// boxes, the part. Default 10 mm.
+    pub collision_clearance_mm: f64,
 }
 
 impl Default for ProgramOptions {
@@ -618,6 +653,7 @@ impl Default for ProgramOptions {
             path_tolerance_mm: 0.05,
             orientation_tolerance_deg: 0.5,
             circular_moves: true,
+            collision_clearance_mm: cell_check::DEFAULT_CLEARANCE_MM,
         }
     }
 }
@@ -704,6 +740,13 @@ impl ProgramOptions {
                 "transit_max_clearance_mm",
                 self.transit_max_clearance_mm.to_string(),
                 "must be finite and >= clearance_mm",
+            );
+        }
+        if !(self.collision_clearance_mm.is_finite() && self.collision_clearance_mm >= 0.0) {
+            return bad(
+                "collision_clearance_mm",
+                self.collision_clearance_mm.to_string(),
+                "must be finite and >= 0",
             );
         }
         if !(self.bead_radius_mm.is_finite() && self.bead_radius_mm > 0.0) {

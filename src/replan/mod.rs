@@ -52,6 +52,7 @@ use crate::pipeline::{
     ProgramFormat, RzLaw, SlicedPart,
 };
 use crate::process::{PointProcess, ResolvedHeightLaw};
+use crate::program::cell_check::{check_cell, CellClearance, CellScene};
 use crate::program::{
     build_program_with, check_vendor, LayerRefusal, Program, ProgramError, TravelSpeed,
 };
@@ -887,7 +888,7 @@ fn replan_core(
     let point_speeds: Vec<Vec<f64>> = corrections.iter().map(|c| c.speed_mm_s.clone()).collect();
     let name = program_name_for(&part.name, k);
     let resume_payload = resume_payload(cell, &sliced, k);
-    let program = resumed_program(
+    let checked = resumed_program(
         &name,
         cell,
         &remaining,
@@ -898,6 +899,10 @@ fn replan_core(
         &process_plan.layer_masses_kg(&new_path, process),
     );
     times.program = t.elapsed().as_secs_f64();
+    let (program, clearance, cell_check_s) = match checked {
+        Ok((p, c, s)) => (Ok(p), Some(c), s),
+        Err(e) => (Err(e), None, 0.0),
+    };
 
     let sliced = SlicedPart {
         path: new_path,
@@ -912,6 +917,7 @@ fn replan_core(
             tool_axes: times.tool_axes,
             optimise: times.optimise,
             program: times.program,
+            cell_check: cell_check_s,
         },
         sliced,
         cell: cell.clone(),
@@ -922,6 +928,7 @@ fn replan_core(
         plan,
         program,
         point_speeds_mm_s: Some(point_speeds),
+        clearance,
     };
     Ok(ReplannedPart {
         planned,
@@ -1012,7 +1019,7 @@ fn resumed_program(
     v_nom: f64,
     payload: Option<(f64, Point3)>,
     layer_masses_kg: &[f64],
-) -> Result<Program, ProgramError> {
+) -> Result<(Program, CellClearance, f64), ProgramError> {
     let infeasible: Vec<_> = plan.infeasible_layers().collect();
     if let Some(first) = infeasible.first() {
         return Err(ProgramError::InfeasibleLayer {
@@ -1059,5 +1066,13 @@ fn resumed_program(
             .collect();
         program.set_payloads(&common, &masses)?;
     }
-    Ok(program)
+    // the whole cell along every motion; the part's model holds the
+    // remaining layers only (the wall below layer K+1 is not in the scene)
+    let t = Instant::now();
+    let scene = CellScene {
+        keep_out: cell.keep_out.clone(),
+        clearance_mm: common.collision_clearance_mm,
+    };
+    let clearance = check_cell(&program, &traj, layers, &scene)?;
+    Ok((program, clearance, t.elapsed().as_secs_f64()))
 }

@@ -442,6 +442,11 @@ struct PlanData<'a> {
     points_total: usize,
     frame_stride: usize,
     duration_s: f64,
+    /// The program's cycle time (s; `null` without a program).
+    cycle_time_s: Option<f64>,
+    /// Each bead's layer number and its share of the cycle time (s).
+    cycle_layers: Vec<usize>,
+    cycle_layer_s: Vec<f64>,
     f_layer: String,
     f_point: String,
     f_time: String,
@@ -670,6 +675,15 @@ fn plan_data<'a>(input: &ReportInput<'a>, pv: &PlanView<'a>) -> (PlanData<'a>, V
         points_total: total,
         frame_stride: k,
         duration_s: f_time.last().map_or(0.0, |t| f64::from(*t)),
+        cycle_time_s: pv.cycle.map(|c| c.total_s),
+        cycle_layers: pv
+            .cycle
+            .map(|c| c.layers.iter().map(|l| l.layer).collect())
+            .unwrap_or_default(),
+        cycle_layer_s: pv
+            .cycle
+            .map(|c| c.layers.iter().map(|l| l.total_s).collect())
+            .unwrap_or_default(),
         f_layer: u32s(&f_layer),
         f_point: u32s(&f_point),
         f_time: f32s(&f_time),

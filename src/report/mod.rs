@@ -99,6 +99,9 @@ pub struct PlanView<'a> {
     /// Programmed travel speed (mm/s), for the animation's clock where the
     /// report has no per-point process speeds.
     pub travel_speed_mm_s: f64,
+    /// The program's cycle time (s, per layer and for the build), shown
+    /// beside the animation's clock; `None` without a program.
+    pub cycle: Option<&'a crate::program::cycle::CycleTime>,
 }
 
 /// Everything a report shows. Geometry is in the part frame (mm) except the

@@ -716,7 +716,14 @@
     }
     row('R_Z', F.rz[f], '', NaN);
     $('frame-label').textContent = 'frame ' + (f + 1) + ' of ' + F.n + ': layer ' + F.layer[f] + ', point ' + F.point[f] +
-      ', t = ' + fmt(F.time[f], 1) + ' s of ' + fmt(P.duration_s, 1) + ' s';
+      ', t = ' + fmt(F.time[f], 1) + ' s of ' + fmt(P.duration_s, 1) + ' s under the arc' + cycleText(F.layer[f]);
+  }
+  // the program's cycle time, and the shown layer's share of it
+  function cycleText(layer) {
+    if (P.cycle_time_s === null || P.cycle_time_s === undefined) return '';
+    var k = P.cycle_layers.indexOf(layer);
+    return '; cycle time ' + fmt(P.cycle_time_s, 1) + ' s' +
+      (k >= 0 ? ' (layer ' + layer + ': ' + fmt(P.cycle_layer_s[k], 1) + ' s)' : '');
   }
   function focusMark(m) {
     if (F) {

@@ -254,6 +254,12 @@ pub struct RobotModel {
     pub limits: [JointLimit; 6],
     /// Maximum joint speed per joint (rad/s).
     pub max_speed_rad_s: [f64; 6],
+    /// Maximum joint acceleration per joint (rad/s²), used for the cycle
+    /// time's trapezoidal profiles ([`crate::program::cycle`]). `None`: each
+    /// joint reaches its maximum speed in [`ASSUMED_RAMP_S`]
+    /// ([`RobotModel::max_acceleration`]).
+    #[serde(default)]
+    pub max_acceleration_rad_s2: Option<[f64; 6]>,
     /// Angular resolution (standard deviation) per joint (rad), if published
     /// [thesis table 4.2].
     pub encoder_sigma_rad: Option<[f64; 6]>,
@@ -262,6 +268,22 @@ pub struct RobotModel {
     /// (§3.2.2.5) the kinematics use the nominal twists so that the IK stays
     /// analytic.
     pub twist_deviation_rad: [f64; 6],
+}
+
+/// Time (s) in which a joint is assumed to reach its maximum speed from rest
+/// at full acceleration, where the vendor publishes no joint acceleration:
+/// 0.5 s. FANUC, KUKA and ABB publish maximum joint speeds in their data
+/// sheets but no joint accelerations (these depend on the payload and are
+/// computed by the controller's dynamic model: FANUC's acceleration
+/// override `ACC`, KUKA `$ACC_AXIS`, ABB `AccSet`); 0.5 s is an assumption of
+/// the order seen on arms of this size at moderate payload, not a vendor
+/// figure. The presets' accelerations are `max_speed / ASSUMED_RAMP_S`.
+pub const ASSUMED_RAMP_S: f64 = 0.5;
+
+/// `max_speed / ASSUMED_RAMP_S` per joint (rad/s²): the presets'
+/// assumed joint accelerations (see [`ASSUMED_RAMP_S`]).
+fn ramp_accelerations(max_speed_rad_s: [f64; 6]) -> Option<[f64; 6]> {
+    Some(max_speed_rad_s.map(|v| v / ASSUMED_RAMP_S))
 }
 
 fn deg6(a: [f64; 6]) -> [f64; 6] {
@@ -298,6 +320,10 @@ impl RobotModel {
                 JointLimit::UNLIMITED,
             ],
             max_speed_rad_s: deg6([195.0, 175.0, 180.0, 360.0, 360.0, 550.0]),
+            // not published (thesis, FANUC data sheet): assumed, ASSUMED_RAMP_S
+            max_acceleration_rad_s2: ramp_accelerations(deg6([
+                195.0, 175.0, 180.0, 360.0, 360.0, 550.0,
+            ])),
             encoder_sigma_rad: Some(deg6(ARCMATE_120IC_ENCODER_SIGMA_DEG)),
             twist_deviation_rad: [0.0; 6],
         }
@@ -358,6 +384,10 @@ impl RobotModel {
                 JointLimit::symmetric_deg(350.0),
             ],
             max_speed_rad_s: deg6([156.0, 156.0, 156.0, 330.0, 330.0, 615.0]),
+            // not in the URDF nor the KUKA data sheet: assumed, ASSUMED_RAMP_S
+            max_acceleration_rad_s2: ramp_accelerations(deg6([
+                156.0, 156.0, 156.0, 330.0, 330.0, 615.0,
+            ])),
             encoder_sigma_rad: None,
             twist_deviation_rad: [0.0; 6],
         }
@@ -392,9 +422,21 @@ impl RobotModel {
                 JointLimit { lower_rad: -6.981, upper_rad: 6.981 },
             ],
             max_speed_rad_s: [3.054, 3.054, 3.054, 6.283, 6.283, 8.727],
+            // not in the URDF nor the ABB product specification: assumed,
+            // ASSUMED_RAMP_S
+            max_acceleration_rad_s2: ramp_accelerations([
+                3.054, 3.054, 3.054, 6.283, 6.283, 8.727,
+            ]),
             encoder_sigma_rad: None,
             twist_deviation_rad: [0.0; 6],
         }
+    }
+
+    /// Maximum joint accelerations (rad/s²): [`RobotModel::max_acceleration_rad_s2`],
+    /// else `max_speed_rad_s / ASSUMED_RAMP_S` per joint.
+    pub fn max_acceleration(&self) -> [f64; 6] {
+        self.max_acceleration_rad_s2
+            .unwrap_or_else(|| self.max_speed_rad_s.map(|v| v / ASSUMED_RAMP_S))
     }
 
     /// The model of a named preset.
@@ -490,6 +532,17 @@ impl RobotModel {
                     v.to_degrees(),
                     "must be finite and > 0",
                 ));
+            }
+        }
+        if let Some(a) = &self.max_acceleration_rad_s2 {
+            for v in a {
+                if !(v.is_finite() && *v > 0.0) {
+                    return Err(bad(
+                        "max_acceleration_deg_s2",
+                        v.to_degrees(),
+                        "must be finite and > 0",
+                    ));
+                }
             }
         }
         if let Some(s) = &self.encoder_sigma_rad {

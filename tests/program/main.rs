@@ -6,9 +6,11 @@
 mod abb_controller;
 mod api;
 mod budget;
+mod cell_collision;
 mod cells;
 mod circular;
 mod contract;
+mod cycle;
 mod fanuc_controller;
 mod fixture;
 mod formats;

@@ -289,6 +289,7 @@ fn planned_report(
             layers: &layers,
             plan: &plan,
             travel_speed_mm_s: opts.travel_speed_mm_s,
+            cycle: None,
         }),
         ..ReportInput::new(&part.name, &path, &axes.frames, &map, path.delta_mm)
     };

@@ -1,0 +1,947 @@
+//! **The whole cell checked for collisions** along a program's motions.
+//! Takes a [`Program`] (its approach, retract, transit and home moves), the
+//! planned joints of every bead point (a [`JointTrajectory`]: what the
+//! thinned moves stay within `path_tolerance_mm` of), the layers (part
+//! frame, mm: the part's wall so far) and the cell's [`CellScene`] (robot
+//! base frame, mm); returns a [`CellClearance`] (the closest approach per
+//! layer and which pair) or refuses the program
+//! ([`ProgramError::Collision`] naming the layer, the point or the move,
+//! the two bodies and the depth).
+//!
+//! **Bodies** (robot base frame):
+//! * the arm's links as capsules between its joint frame origins
+//!   ([`arm_chain`]: the kinematic
+//!   lengths of the preset): the J1 column (base origin → J2 height), the
+//!   upper arm (J2 axis → J3 axis), the forearm (J3 offset point → the
+//!   wrist unit) and the wrist (two capsules: the wrist unit behind the
+//!   wrist centre → the wrist centre → the flange), with the radii and wrist-unit length of
+//!   [`LinkRadii::for_robot`];
+//! * the cell file's `[[keep_out]]` boxes (fixtures, fences, a second
+//!   machine: axis-aligned, base frame);
+//! * torch-carried cell: the positioner's table (a disc of
+//!   [`TABLE_RADIUS_MM`] × [`TABLE_THICKNESS_MM`] under the table frame's
+//!   origin) and its tilt body (a capsule along the tilt axis through the
+//!   tilt centre C7, [`TILT_BODY_RADIUS_MM`]), both moving with the
+//!   positioner's joints;
+//! * the part: the layers deposited so far (the layer being deposited
+//!   included) as the union of the convex hulls of bands of
+//!   [`LAYERS_PER_BAND`] consecutive layers (each band also holding the
+//!   previous band's last layer, so that the wall between them is inside a
+//!   hull), on the flange (part-carried) or on the table (torch-carried).
+//!
+//! **Pairs** checked: link vs link two or more apart (column–forearm,
+//! column–wrist, upper arm–wrist); every link vs every keep-out box, the
+//! table and the tilt body; the part vs the column, upper arm and forearm
+//! (part-carried: the part is on the flange, the wrist holds it) or vs the
+//! upper arm, forearm and wrist (torch-carried); the part vs every keep-out
+//! box. Not checked (see the crate README): the torch against the arm and
+//! the table (the torch against the wall is [`super::transit`]'s check),
+//! the positioner's base below the tilt body, the substrate beyond the
+//! hull of the layers.
+//!
+//! **Motions**: every bead point's planned joints; the linear moves into
+//! and out of each bead, the arc-off joint moves between beads and the
+//! home moves, interpolated linearly in joint space (exact for the joint
+//! moves, FANUC `J`, KUKA `PTP`, ABB `MoveAbsJ`; within a fraction of a
+//! millimetre for the short linear moves). Samples are taken **by swept
+//! distance**: a bound on how far any point of the arm, the part or the
+//! table can move between two samples (the sum of each axis's change times
+//! the largest distance from that axis to a body it moves) is kept below
+//! [`SAMPLE_STEP_MM`], so a contact between samples is missed by at most
+//! half of that.
+//!
+//! **Culling**: each pair is first bounded below by the distance between
+//! the bodies' bounding spheres and by its last exact distance less how far
+//! each of the two bodies has moved since (each body's displacement from
+//! sample to sample: its capsule's ends, or its centre and its turn times
+//! its radius, summed like an odometer), and skipped when that bound
+//! already exceeds the clearance and comes within [`REPORT_TOLERANCE_MM`]
+//! of the layer's closest approach so far; parry's exact distance (GJK)
+//! runs only on the pairs left. The part's hulls are built from at most
+//! [`HULL_POINTS_PER_LAYER`] points a layer, its distances lowered by the
+//! largest chord deviation of a dropped point (conservative). So
+//! `closest_approach_mm` is a distance measured at a sample, at most
+//! [`REPORT_TOLERANCE_MM`] above the smallest over the samples.
+
+use std::collections::HashMap;
+
+use parry3d_f64::query;
+use parry3d_f64::shape::{Capsule, ConvexPolyhedron, Cuboid, Cylinder, Shape};
+use serde::{Deserialize, Serialize};
+
+use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use crate::optimise::LayerPoints;
+use crate::program::{ArcFlag, Program, ProgramError};
+use crate::report::cell_view::arm_chain;
+use crate::robot::trajectory::JointTrajectory;
+use crate::robot::{CellLayout, Joints, RobotModel, Vendor};
+
+/// Default `[program] collision_clearance_mm` (mm).
+pub const DEFAULT_CLEARANCE_MM: f64 = 10.0;
+
+/// Largest swept distance between two samples of a motion (mm).
+pub const SAMPLE_STEP_MM: f64 = 5.0;
+
+/// How far above the smallest distance over the samples a layer's reported
+/// closest approach may be (mm): the culling's tolerance.
+pub const REPORT_TOLERANCE_MM: f64 = 1.0;
+
+/// Radius of the positioner's table (mm): not given by the thesis nor the
+/// cell files; 250 mm, the size of a 500 mm face plate, is assumed.
+pub const TABLE_RADIUS_MM: f64 = 250.0;
+/// Thickness of the positioner's table below its face (mm), assumed.
+pub const TABLE_THICKNESS_MM: f64 = 40.0;
+/// Radius of the positioner's tilt body about its tilt axis (mm), assumed.
+pub const TILT_BODY_RADIUS_MM: f64 = 80.0;
+
+/// An axis-aligned box the arm, the part and the positioner must keep out
+/// of: a cell file's `[[keep_out]]` table. Robot base frame (mm).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeepOut {
+    /// Its name, as refusals name it (`fence`, `fixture`).
+    pub name: String,
+    /// Lower corner, robot base frame (mm).
+    pub min_mm: [f64; 3],
+    /// Upper corner, robot base frame (mm), above `min_mm` on every axis.
+    pub max_mm: [f64; 3],
+}
+
+impl KeepOut {
+    /// Checks the corners.
+    ///
+    /// # Errors
+    /// A message naming the field when a corner is not finite or `max_mm`
+    /// is not above `min_mm` on every axis.
+    pub fn validate(&self) -> Result<(), String> {
+        if !self
+            .min_mm
+            .iter()
+            .chain(&self.max_mm)
+            .all(|v| v.is_finite())
+        {
+            return Err(format!("keep_out `{}`: corners must be finite", self.name));
+        }
+        if (0..3).any(|i| self.max_mm[i] <= self.min_mm[i]) {
+            return Err(format!(
+                "keep_out `{}`: max_mm {:?} must be above min_mm {:?} on every axis",
+                self.name, self.max_mm, self.min_mm
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Radii of the arm's link capsules (mm).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LinkRadii {
+    /// J1 column, base origin → J2 height (mm).
+    pub column_mm: f64,
+    /// Upper arm, J2 → J3 (mm).
+    pub upper_arm_mm: f64,
+    /// Forearm, J3 offset point → the wrist unit (mm).
+    pub forearm_mm: f64,
+    /// Wrist unit, from [`LinkRadii::wrist_unit_mm`] before the wrist
+    /// centre on the forearm's axis through the wrist centre to the flange (mm).
+    pub wrist_mm: f64,
+    /// Length of the wrist unit (the J5 housing and the slimmer end of the
+    /// J4 tube) behind the wrist centre, along the forearm (mm). The wrist
+    /// is adjacent to the flange: it is not checked against the part the
+    /// flange holds (part-carried) — the cell's J5 travel stands for that
+    /// contact, as the thesis's ±135° does (table A.1 note 1: "to avoid
+    /// substrate/robot collisions").
+    pub wrist_unit_mm: f64,
+}
+
+impl LinkRadii {
+    /// The radii for `robot` (mm). Half the widths of the links on the
+    /// vendors' outline drawings, rounded down to 10 mm — **estimates**,
+    /// read off the published dimension drawings of arms of this class
+    /// (FANUC ArcMate 120iC / M-20iA, KUKA KR 16-2, ABB IRB 2600: upper
+    /// arm about 200 mm wide, forearm about 160 mm at its J3 housing, the
+    /// J4 tube and wrist unit about 120 mm wide over the last 250 mm behind
+    /// the J5 axis),
+    /// not measured; a cell whose arm is bulkier should say so with
+    /// `[[keep_out]]` margins. The J1 column is the base housing above
+    /// the floor (about 300 mm across).
+    pub fn for_robot(robot: &RobotModel) -> Self {
+        match robot.vendor {
+            Vendor::Fanuc | Vendor::Kuka | Vendor::Abb => Self {
+                column_mm: 150.0,
+                upper_arm_mm: 100.0,
+                forearm_mm: 80.0,
+                wrist_mm: 60.0,
+                wrist_unit_mm: 250.0,
+            },
+        }
+    }
+}
+
+/// The static and moving obstacles of a cell, besides the arm (robot base
+/// frame, mm).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CellScene {
+    /// Keep-out boxes (fixtures, fences).
+    pub keep_out: Vec<KeepOut>,
+    /// Clearance every pair must keep (mm, ≥ 0).
+    pub clearance_mm: f64,
+}
+
+/// The closest approach of one layer's motions.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LayerClearance {
+    /// Layer index.
+    pub layer: usize,
+    /// Smallest distance between two bodies of a checked pair along the
+    /// layer's motions (mm; negative: penetration depth). `inf` when no
+    /// pair was measured (every one culled far away).
+    pub closest_approach_mm: f64,
+    /// The two bodies at that approach.
+    pub closest_pair: Option<(String, String)>,
+}
+
+/// What [`check_cell`] measured.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct CellClearance {
+    /// One entry per layer, in program order.
+    pub layers: Vec<LayerClearance>,
+    /// Samples (arm poses) checked.
+    pub samples: usize,
+    /// Pair distances computed exactly (the rest were culled).
+    pub exact_queries: usize,
+    /// Pairs culled by their bounding spheres.
+    pub culled: usize,
+}
+
+/// A body of the scene at one sample: its name, shape, pose (base frame)
+/// and bounding sphere (centre, radius; base frame, mm).
+struct Body<'a> {
+    name: &'a str,
+    shape: &'a dyn Shape,
+    pose: Isometry3,
+    centre: Point3,
+    radius: f64,
+    margin: f64,
+    /// A capsule's segment ends (base frame), for its displacement.
+    ends: Option<(Point3, Point3)>,
+}
+
+/// What the culling remembers between samples: each body's last place and
+/// odometer (mm), each pair's last exact distance and the two odometers then.
+#[derive(Default)]
+struct Memory {
+    /// Which layer's hull the bodies are for (the part changes with it).
+    layer: Option<usize>,
+    places: Vec<(Point3, Point3, UnitQuaternion)>,
+    odometer: Vec<f64>,
+    pairs: HashMap<(usize, usize), (f64, f64, f64)>,
+}
+
+impl Memory {
+    /// Moves each body's odometer on by its displacement since the last
+    /// sample; forgets everything when the bodies are others.
+    fn advance(&mut self, layer: usize, bodies: &[Body]) {
+        if self.layer != Some(layer) || self.places.len() != bodies.len() {
+            self.layer = Some(layer);
+            self.places = bodies.iter().map(place_of).collect();
+            self.odometer = vec![0.0; bodies.len()];
+            self.pairs.clear();
+            return;
+        }
+        for (i, b) in bodies.iter().enumerate() {
+            let now = place_of(b);
+            let was = self.places[i];
+            let moved = match b.ends {
+                Some(_) => (now.0 - was.0).norm().max((now.1 - was.1).norm()),
+                None => (now.0 - was.0).norm() + b.radius * was.2.angle_to(&now.2),
+            };
+            self.odometer[i] += moved;
+            self.places[i] = now;
+        }
+    }
+
+    /// The pair's last exact distance less how far its bodies moved since.
+    fn lower_bound(&self, i: usize, j: usize) -> f64 {
+        self.pairs
+            .get(&(i, j))
+            .map_or(f64::NEG_INFINITY, |(d, oi, oj)| {
+                d - (self.odometer[i] - oi) - (self.odometer[j] - oj)
+            })
+    }
+
+    fn remember(&mut self, i: usize, j: usize, d: f64) {
+        let (oi, oj) = (self.odometer[i], self.odometer[j]);
+        self.pairs.insert((i, j), (d, oi, oj));
+    }
+}
+
+/// A body's place: a capsule's ends, else its centre (twice) and rotation.
+fn place_of(b: &Body) -> (Point3, Point3, UnitQuaternion) {
+    match b.ends {
+        Some((a, e)) => (a, e, UnitQuaternion::identity()),
+        None => (b.centre, b.centre, b.pose.rotation),
+    }
+}
+
+const COLUMN: &str = "J1 column";
+const UPPER_ARM: &str = "upper arm";
+const FOREARM: &str = "forearm";
+const WRIST: &str = "wrist";
+const TABLE: &str = "positioner table";
+const TILT: &str = "positioner tilt body";
+const PART: &str = "part";
+
+/// The arm's four link capsules at `q` (base frame): the forearm stops
+/// [`LinkRadii::wrist_unit_mm`] before the wrist centre, where the wrist
+/// unit (J5 housing) begins, which is the wrist capsule up to the flange.
+fn links(robot: &RobotModel, r: &LinkRadii, q: &Joints) -> [(&'static str, Capsule); 5] {
+    let c = arm_chain(robot, q);
+    let along = c[5] - c[4];
+    let len = along.norm();
+    let cut = if len > 0.0 {
+        c[5] - along * (r.wrist_unit_mm.min(len) / len)
+    } else {
+        c[5]
+    };
+    [
+        (COLUMN, Capsule::new(c[0], c[1], r.column_mm)),
+        (UPPER_ARM, Capsule::new(c[2], c[3], r.upper_arm_mm)),
+        (FOREARM, Capsule::new(c[4], cut, r.forearm_mm)),
+        (WRIST, Capsule::new(cut, c[5], r.wrist_mm)),
+        (WRIST, Capsule::new(c[5], c[6], r.wrist_mm)),
+    ]
+}
+
+fn capsule_body<'a>(name: &'a str, c: &'a Capsule) -> Body<'a> {
+    let centre = Point3::from((c.segment.a.coords + c.segment.b.coords) * 0.5);
+    Body {
+        name,
+        shape: c,
+        pose: Isometry3::identity(),
+        centre,
+        radius: 0.5 * (c.segment.b - c.segment.a).norm() + c.radius,
+        margin: 0.0,
+        ends: Some((c.segment.a, c.segment.b)),
+    }
+}
+
+/// A convex shape in its local frame with its bounding sphere there.
+struct Local {
+    shape: Box<dyn Shape>,
+    centre: Point3,
+    radius: f64,
+    /// Lowered from every distance to it (mm): the part's thinning.
+    margin: f64,
+}
+
+impl Local {
+    fn at(&self, name: &'static str, pose: Isometry3) -> Body<'_> {
+        Body {
+            name,
+            shape: self.shape.as_ref(),
+            pose,
+            centre: pose * self.centre,
+            radius: self.radius,
+            margin: self.margin,
+            ends: None,
+        }
+    }
+}
+
+/// The hull of `points` (part frame) with its bounding sphere; `None` for
+/// a degenerate set (fewer than four points off a plane).
+fn hull(points: &[Point3]) -> Option<Local> {
+    let h = ConvexPolyhedron::from_convex_hull(points)?;
+    let n = h.points().len().max(1) as f64;
+    let centre = Point3::from(h.points().iter().map(|p| p.coords).sum::<Vector3>() / n);
+    let radius = h
+        .points()
+        .iter()
+        .map(|p| (p - centre).norm())
+        .fold(0.0, f64::max);
+    Some(Local {
+        shape: Box::new(h),
+        centre,
+        radius,
+        margin: 0.0,
+    })
+}
+
+/// Most points of a layer that enter the part's hull; a longer layer keeps
+/// every `k`-th point (and its last), and the hull's distances are lowered
+/// by the largest distance of a dropped point from the chord between its
+/// kept neighbours, so that the check stays conservative.
+pub const HULL_POINTS_PER_LAYER: usize = 24;
+
+/// A layer's points thinned to at most [`HULL_POINTS_PER_LAYER`], and the
+/// largest distance of a dropped point from its kept neighbours' chord (mm).
+fn thin_layer(points: &[Point3]) -> (Vec<Point3>, f64) {
+    let n = points.len();
+    if n <= HULL_POINTS_PER_LAYER {
+        return (points.to_vec(), 0.0);
+    }
+    let k = n.div_ceil(HULL_POINTS_PER_LAYER);
+    let mut kept: Vec<usize> = (0..n).step_by(k).collect();
+    if kept.last() != Some(&(n - 1)) {
+        kept.push(n - 1);
+    }
+    let mut margin: f64 = 0.0;
+    for w in kept.windows(2) {
+        let (a, b) = (points[w[0]], points[w[1]]);
+        let ab = b - a;
+        let len2 = ab.norm_squared();
+        for p in &points[w[0] + 1..w[1]] {
+            let t = if len2 > 0.0 {
+                ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            margin = margin.max((p - (a + ab * t)).norm());
+        }
+    }
+    (kept.into_iter().map(|i| points[i]).collect(), margin)
+}
+
+/// Layers per band of the part's model: the wall so far is the union of
+/// the convex hulls of bands of this many consecutive layers (tight on bent
+/// tubes, where one hull of the whole wall would fill the bend).
+pub const LAYERS_PER_BAND: usize = 4;
+
+/// The hull of `pts` (part frame), or of a thin slab over them when they are
+/// flat (a first layer): lifted by 0.01 mm.
+fn hull_or_slab(pts: &[Point3], margin: f64) -> Option<Local> {
+    let mut h = hull(pts);
+    if h.is_none() {
+        let lifted: Vec<Point3> = pts
+            .iter()
+            .map(|p| p + Vector3::z() * 0.01)
+            .chain(pts.iter().copied())
+            .collect();
+        h = hull(&lifted);
+    }
+    if let Some(local) = &mut h {
+        local.margin = margin;
+    }
+    h
+}
+
+/// The part's model per layer (part frame): the complete bands of
+/// [`LAYERS_PER_BAND`] layers before it, each one convex hull, and the hull
+/// of its own band up to and including it; each from the layers' points
+/// thinned by [`thin_layer`], with the margin (mm) its distances are
+/// lowered by. Returns the complete bands and, per layer, how many of them
+/// come before it and its partial band.
+fn wall_bands(layers: &[LayerPoints]) -> (Vec<Local>, Vec<(usize, Option<Local>)>) {
+    let mut bands: Vec<Local> = Vec::new();
+    let mut per_layer: Vec<(usize, Option<Local>)> = Vec::with_capacity(layers.len());
+    let mut pts: Vec<Point3> = Vec::new();
+    let mut margin: f64 = 0.0;
+    for (k, l) in layers.iter().enumerate() {
+        let raw: Vec<Point3> = l.points.iter().map(|p| p.position_mm).collect();
+        let (thin, m) = thin_layer(&raw);
+        margin = margin.max(m);
+        pts.extend(thin.iter().copied());
+        per_layer.push((bands.len(), hull_or_slab(&pts, margin)));
+        if (k + 1) % LAYERS_PER_BAND == 0 {
+            if let Some(band) = hull_or_slab(&pts, margin) {
+                bands.push(band);
+            }
+            // the next band starts from this layer, so that the wall
+            // between two bands' layers is inside a hull
+            pts = thin;
+            margin = m;
+        }
+    }
+    (bands, per_layer)
+}
+
+/// The refusal or the closest approach of one pair.
+struct Closest {
+    distance_mm: f64,
+    pair: Option<(String, String)>,
+}
+
+/// One sample of a motion: joints, positioner joints, and where it is.
+#[derive(Clone, Copy)]
+struct Sample<'a> {
+    q: &'a Joints,
+    qp: Option<[f64; 2]>,
+}
+
+/// The checker: the scene's fixed shapes and the per-layer hulls.
+struct Checker<'a> {
+    cell: &'a CellLayout,
+    radii: LinkRadii,
+    keep_out: Vec<Local>,
+    keep_out_names: Vec<&'a str>,
+    table: Local,
+    tilt: Local,
+    bands: Vec<Local>,
+    partial: Vec<(usize, Option<Local>)>,
+    clearance: f64,
+    /// Per axis (the arm's six, the positioner's two), the largest distance
+    /// from the axis to a point of a body it moves (mm).
+    lever: [f64; 8],
+}
+
+/// Where a sample is, for a refusal.
+#[derive(Clone)]
+struct Place {
+    layer: usize,
+    point: Option<usize>,
+    motion: &'static str,
+}
+
+impl<'a> Checker<'a> {
+    fn new(cell: &'a CellLayout, scene: &'a CellScene, layers: &[LayerPoints]) -> Self {
+        let keep_out = scene
+            .keep_out
+            .iter()
+            .map(|k| {
+                let half = Vector3::from(std::array::from_fn::<f64, 3, _>(|i| {
+                    0.5 * (k.max_mm[i] - k.min_mm[i]).max(0.0)
+                }));
+                let centre = Point3::from(std::array::from_fn::<f64, 3, _>(|i| {
+                    0.5 * (k.max_mm[i] + k.min_mm[i])
+                }));
+                // the cuboid is centred on its local origin: the pose puts
+                // it at `centre`; the sphere is kept in the local frame
+                Local {
+                    shape: Box::new(Cuboid::new(half)),
+                    centre: Point3::from(centre.coords),
+                    radius: half.norm(),
+                    margin: 0.0,
+                }
+            })
+            .collect();
+        let g = &cell.robot().geometry;
+        // how far from each axis a point of a body it moves can be: the
+        // links beyond it plus what the flange carries (the part, or the
+        // torch), or for the positioner the table and the part on it
+        let part_extent = layers
+            .iter()
+            .flat_map(|l| &l.points)
+            .map(|p| p.position_mm.coords.norm())
+            .fold(0.0, f64::max);
+        let carried = match cell {
+            CellLayout::PartCarried(c) => {
+                c.flange_from_part.translation.vector.norm() + part_extent
+            }
+            CellLayout::TorchCarried(c) => c.flange_from_tcp.translation.vector.norm(),
+        };
+        let wrist = g.wrist_to_flange_mm.abs() + carried;
+        let fore = g.elbow_offset_mm.abs() + g.forearm_mm.abs() + wrist;
+        let upper = g.upper_arm_mm.abs() + fore;
+        let reach = g.shoulder_offset_mm.abs() + g.lateral_offset_mm.abs() + upper;
+        let (tilt_arm, turn_arm) = match cell {
+            CellLayout::TorchCarried(c) => {
+                let table_to_part = c.table_from_part.translation.vector.norm() + part_extent;
+                let turn = TABLE_RADIUS_MM.max(table_to_part) + TABLE_THICKNESS_MM;
+                (
+                    c.positioner.tilt_to_table_mm.abs() + turn + TILT_BODY_RADIUS_MM,
+                    turn,
+                )
+            }
+            CellLayout::PartCarried(_) => (0.0, 0.0),
+        };
+        let lever = [reach, upper, fore, wrist, wrist, wrist, tilt_arm, turn_arm];
+        // the table: a cylinder (parry's axis is Y) turned onto Z, below
+        // the table frame's origin
+        let half_t = 0.5 * TABLE_THICKNESS_MM;
+        let table = Local {
+            shape: Box::new(Cylinder::new(half_t, TABLE_RADIUS_MM)),
+            centre: Point3::origin(),
+            radius: (TABLE_RADIUS_MM.powi(2) + half_t.powi(2)).sqrt(),
+            margin: 0.0,
+        };
+        let tilt = Local {
+            shape: Box::new(Capsule::new(
+                Point3::new(0.0, -TABLE_RADIUS_MM, 0.0),
+                Point3::new(0.0, TABLE_RADIUS_MM, 0.0),
+                TILT_BODY_RADIUS_MM,
+            )),
+            centre: Point3::origin(),
+            radius: TABLE_RADIUS_MM + TILT_BODY_RADIUS_MM,
+            margin: 0.0,
+        };
+        let (bands, partial) = wall_bands(layers);
+        Self {
+            cell,
+            radii: LinkRadii::for_robot(cell.robot()),
+            keep_out,
+            keep_out_names: scene.keep_out.iter().map(|k| k.name.as_str()).collect(),
+            table,
+            tilt,
+            bands,
+            partial,
+            clearance: scene.clearance_mm,
+            lever,
+        }
+    }
+
+    /// Largest distance any point of the arm (or the part) moves between
+    /// two samples (mm, a bound).
+    fn swept_mm(&self, a: &Sample, b: &Sample) -> f64 {
+        let arm: f64 = (0..6)
+            .map(|j| (a.q[j] - b.q[j]).abs() * self.lever[j])
+            .sum();
+        let pos = match (a.qp, b.qp) {
+            (Some(x), Some(y)) => {
+                (x[0] - y[0]).abs() * self.lever[6] + (x[1] - y[1]).abs() * self.lever[7]
+            }
+            _ => 0.0,
+        };
+        arm + pos
+    }
+
+    /// Checks one sample; updates `best`; the first pair closer than the
+    /// clearance is returned.
+    fn check(
+        &self,
+        s: &Sample,
+        (layer, hull): (usize, &[&Local]),
+        best: &mut Closest,
+        memory: &mut Memory,
+        stats: &mut CellClearance,
+    ) -> Option<(String, String, f64)> {
+        stats.samples += 1;
+        let robot = self.cell.robot();
+        let capsules = links(robot, &self.radii, s.q);
+        let arm: Vec<Body> = capsules.iter().map(|(n, c)| capsule_body(n, c)).collect();
+        let mut others: Vec<Body> = Vec::new();
+        for (k, name) in self.keep_out.iter().zip(&self.keep_out_names) {
+            others.push(Body {
+                name,
+                shape: k.shape.as_ref(),
+                pose: Isometry3::from_parts(
+                    Translation3::from(k.centre.coords),
+                    UnitQuaternion::identity(),
+                ),
+                centre: k.centre,
+                radius: k.radius,
+                margin: 0.0,
+                ends: None,
+            });
+        }
+        let mut pairs: Vec<(usize, usize)> = Vec::new(); // indices into `all`
+        let mut all: Vec<Body> = arm;
+        let (column, upper, fore, wrist, flange) = (0, 1, 2, 3, 4);
+        pairs.extend([
+            (column, fore),
+            (column, wrist),
+            (column, flange),
+            (upper, wrist),
+            (upper, flange),
+        ]);
+        let first_other = all.len();
+        all.extend(others);
+        for o in first_other..all.len() {
+            for l in 0..5 {
+                pairs.push((l, o));
+            }
+        }
+        let keep_outs: Vec<usize> = (first_other..all.len()).collect();
+        match self.cell {
+            CellLayout::TorchCarried(c) => {
+                if let Some(qp) = s.qp {
+                    let base_from_positioner = c.base_from_positioner;
+                    let base_from_table =
+                        base_from_positioner * c.positioner.positioner_from_table(&qp);
+                    let table_pose = base_from_table
+                        * Isometry3::translation(0.0, 0.0, -0.5 * TABLE_THICKNESS_MM)
+                        * Isometry3::rotation(Vector3::x() * std::f64::consts::FRAC_PI_2);
+                    // the tilt axis is the positioner frame's Y, turned by q7
+                    let tilt_pose = base_from_positioner;
+                    let t = all.len();
+                    all.push(self.table.at(TABLE, table_pose));
+                    all.push(self.tilt.at(TILT, tilt_pose));
+                    for l in 0..5 {
+                        pairs.push((l, t));
+                        pairs.push((l, t + 1));
+                    }
+                    let pose = c.base_from_part(&qp);
+                    for h in hull {
+                        let p = all.len();
+                        all.push(h.at(PART, pose));
+                        for l in [upper, fore, wrist, flange] {
+                            pairs.push((l, p));
+                        }
+                        for &k in &keep_outs {
+                            pairs.push((p, k));
+                        }
+                    }
+                }
+            }
+            CellLayout::PartCarried(c) => {
+                let pose = robot.flange_pose(s.q) * c.flange_from_part;
+                for h in hull {
+                    let p = all.len();
+                    all.push(h.at(PART, pose));
+                    for l in [column, upper, fore] {
+                        pairs.push((l, p));
+                    }
+                    for &k in &keep_outs {
+                        pairs.push((p, k));
+                    }
+                }
+            }
+        }
+        memory.advance(layer, &all);
+        let mut hit: Option<(String, String, f64)> = None;
+        for (i, j) in pairs {
+            let (a, b) = (&all[i], &all[j]);
+            let margin = a.margin + b.margin;
+            let bound = ((a.centre - b.centre).norm() - a.radius - b.radius - margin)
+                .max(memory.lower_bound(i, j));
+            if bound > self.clearance && bound >= best.distance_mm - REPORT_TOLERANCE_MM {
+                stats.culled += 1;
+                continue;
+            }
+            stats.exact_queries += 1;
+            let Ok(mut d) = query::distance(&a.pose, a.shape, &b.pose, b.shape) else {
+                continue;
+            };
+            if d <= 0.0 {
+                // penetrating: the depth from the contact query
+                if let Ok(Some(c)) = query::contact(&a.pose, a.shape, &b.pose, b.shape, 0.0) {
+                    d = c.dist.min(0.0);
+                }
+            }
+            d -= margin;
+            memory.remember(i, j, d);
+            if d < best.distance_mm {
+                best.distance_mm = d;
+                best.pair = Some((a.name.to_string(), b.name.to_string()));
+            }
+            if d < self.clearance && hit.as_ref().is_none_or(|h| d < h.2) {
+                hit = Some((a.name.to_string(), b.name.to_string(), d));
+            }
+        }
+        hit
+    }
+}
+
+/// Checks every motion of `program` against the whole cell (module doc).
+///
+/// `trajectory` holds the planned joints of every bead point (the program's
+/// beads may be thinned); `layers` the layers in the same order, part frame.
+///
+/// # Errors
+/// [`ProgramError::Collision`] at the first sample (in program order) where
+/// a pair comes closer than `scene.clearance_mm`, naming its layer, point
+/// or move, the two bodies and the distance (negative: the depth).
+pub fn check_cell(
+    program: &Program,
+    trajectory: &JointTrajectory,
+    layers: &[LayerPoints],
+    scene: &CellScene,
+) -> Result<CellClearance, ProgramError> {
+    let checker = Checker::new(&program.cell, scene, layers);
+    let index: HashMap<usize, usize> = layers
+        .iter()
+        .enumerate()
+        .map(|(i, l)| (l.layer, i))
+        .collect();
+    let mut stats = CellClearance::default();
+    let mut memory = Memory::default();
+    let mut per_layer: Vec<(usize, Closest)> = Vec::new();
+    let mut slot: HashMap<usize, usize> = HashMap::new();
+    let mut best_of = |layer: usize, per_layer: &mut Vec<(usize, Closest)>| -> usize {
+        *slot.entry(layer).or_insert_with(|| {
+            per_layer.push((
+                layer,
+                Closest {
+                    distance_mm: f64::INFINITY,
+                    pair: None,
+                },
+            ));
+            per_layer.len() - 1
+        })
+    };
+    let refuse =
+        |place: &Place, hit: (String, String, f64), clearance: f64| ProgramError::Collision {
+            layer: place.layer,
+            point: place.point,
+            motion: place.motion,
+            body_a: hit.0,
+            body_b: hit.1,
+            distance_mm: hit.2,
+            clearance_mm: clearance,
+        };
+    // a motion sampled by swept distance, both ends included
+    let mut run = |from: Sample,
+                   to: Sample,
+                   skip_first: bool,
+                   place: &Place,
+                   per_layer: &mut Vec<(usize, Closest)>,
+                   memory: &mut Memory,
+                   stats: &mut CellClearance|
+     -> Result<(), ProgramError> {
+        let k = best_of(place.layer, per_layer);
+        let hull: Vec<&Local> = match index
+            .get(&place.layer)
+            .and_then(|&i| checker.partial.get(i))
+        {
+            Some((before, own)) => checker.bands[..*before]
+                .iter()
+                .chain(own.as_ref())
+                .collect(),
+            None => Vec::new(),
+        };
+        let n = ((checker.swept_mm(&from, &to) / SAMPLE_STEP_MM).ceil() as usize).clamp(1, 100_000);
+        for i in usize::from(skip_first)..=n {
+            let s = i as f64 / n as f64;
+            let q: Joints = std::array::from_fn(|j| from.q[j] + s * (to.q[j] - from.q[j]));
+            let qp = match (from.qp, to.qp) {
+                (Some(a), Some(b)) => Some([a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])]),
+                (a, b) => a.or(b),
+            };
+            let sample = Sample { q: &q, qp };
+            if let Some(hit) = checker.check(
+                &sample,
+                (place.layer, &hull),
+                &mut per_layer[k].1,
+                memory,
+                stats,
+            ) {
+                return Err(refuse(place, hit, checker.clearance));
+            }
+        }
+        Ok(())
+    };
+
+    // the beads: every planned point, sampled by swept distance between
+    // consecutive points of a layer
+    let tp = &trajectory.points;
+    let mut prev: Option<(usize, Sample)> = None;
+    let mut last_sampled: Option<Sample> = None;
+    let mut swept = 0.0;
+    for (i, jp) in tp.iter().enumerate() {
+        let Some(q) = jp.joints.as_ref() else {
+            continue;
+        };
+        let s = Sample {
+            q,
+            qp: jp.positioner,
+        };
+        let new_layer = prev.as_ref().is_none_or(|(l, _)| *l != jp.layer);
+        if new_layer {
+            swept = 0.0;
+            last_sampled = None;
+        } else if let Some((_, p)) = &prev {
+            swept += checker.swept_mm(p, &s);
+        }
+        // the first point of a layer, then whenever the swept distance
+        // since the last sample reaches the step (the motion between the
+        // two sampled points sampled in turn), and the layer's last point
+        let is_last = tp.get(i + 1).is_none_or(|n| n.layer != jp.layer);
+        if last_sampled.is_none() || swept >= SAMPLE_STEP_MM || is_last {
+            let place = Place {
+                layer: jp.layer,
+                point: Some(jp.point),
+                motion: "bead",
+            };
+            let from = last_sampled.unwrap_or(s);
+            run(
+                from,
+                s,
+                last_sampled.is_some(),
+                &place,
+                &mut per_layer,
+                &mut memory,
+                &mut stats,
+            )?;
+            last_sampled = Some(s);
+            swept = 0.0;
+        }
+        prev = Some((jp.layer, s));
+    }
+
+    // every other motion of the program: home → first point, approach →
+    // first point, last point → retract, the transits, last → home
+    let pts = &program.points;
+    let home = program.home.as_ref();
+    if let (Some(h), Some(first)) = (home, pts.first()) {
+        run(
+            Sample {
+                q: &h.joints,
+                qp: h.positioner,
+            },
+            Sample {
+                q: &first.joints,
+                qp: first.positioner,
+            },
+            false,
+            &Place {
+                layer: first.layer,
+                point: None,
+                motion: "home move",
+            },
+            &mut per_layer,
+            &mut memory,
+            &mut stats,
+        )?;
+    }
+    for w in pts.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        let same_bead = a.arc.is_bead() && b.arc.is_bead() && a.layer == b.layer;
+        if same_bead {
+            continue;
+        }
+        let motion = match (a.arc, b.arc) {
+            (ArcFlag::Approach, ArcFlag::Start) => "approach",
+            (ArcFlag::End, ArcFlag::Retract) => "retract",
+            _ => "arc-off transit",
+        };
+        run(
+            Sample {
+                q: &a.joints,
+                qp: a.positioner,
+            },
+            Sample {
+                q: &b.joints,
+                qp: b.positioner,
+            },
+            false,
+            &Place {
+                layer: b.layer,
+                point: Some(b.point),
+                motion,
+            },
+            &mut per_layer,
+            &mut memory,
+            &mut stats,
+        )?;
+    }
+    if let (Some(h), Some(last)) = (home, pts.last()) {
+        run(
+            Sample {
+                q: &last.joints,
+                qp: last.positioner,
+            },
+            Sample {
+                q: &h.joints,
+                qp: h.positioner,
+            },
+            false,
+            &Place {
+                layer: last.layer,
+                point: None,
+                motion: "home move",
+            },
+            &mut per_layer,
+            &mut memory,
+            &mut stats,
+        )?;
+    }
+    stats.layers = per_layer
+        .into_iter()
+        .map(|(layer, c)| LayerClearance {
+            layer,
+            closest_approach_mm: c.distance_mm,
+            closest_pair: c.pair,
+        })
+        .collect();
+    stats.layers.sort_by_key(|l| l.layer);
+    Ok(stats)
+}
