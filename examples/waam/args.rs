@@ -51,7 +51,8 @@ pub enum Command {
     Place(PlaceArgs),
     /// Fit a part to a tubular mesh (binary or ASCII STL: the mid-surface, or the inner and outer
     /// skins of the wall): a spline guide and a radius law from end to end; writes part.toml
-    /// (which slice, plan and place take) and fit.json (the residuals) in --out.
+    /// (which slice, plan and place take), fit.json (the residuals) and report.html (the mesh
+    /// coloured by its distance to the fitted tube) in --out.
     /// Exit 0 fitted, 1 bad input or not a tube.
     Fit(FitArgs),
     /// Replan the layers after a measured layer K: reads the scan of layer K's top (points x,y,z or
@@ -299,6 +300,13 @@ pub struct FitArgs {
     /// Name of the written part (default: the mesh file's stem).
     #[arg(long)]
     pub name: Option<String>,
+    /// An STL mesh of the substrate the start end stands on: the written part's substrate
+    /// (by its absolute path) instead of the start end's plane.
+    #[arg(long, value_name = "SUB.stl")]
+    pub substrate: Option<PathBuf>,
+    /// Refuse a start end further than this from the --substrate mesh (mm).
+    #[arg(long, value_name = "MM", default_value_t = 1.0)]
+    pub substrate_tolerance: f64,
 }
 
 fn parse_start(s: &str) -> Result<waam_slicer::StartEnd, String> {

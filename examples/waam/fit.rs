@@ -9,10 +9,13 @@ pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
         max_rms_mm: a.max_rms,
         template: a.template.clone(),
         name: a.name.clone(),
+        substrate: a.substrate.clone(),
+        substrate_tolerance_mm: a.substrate_tolerance,
         ..FitOptions::default()
     };
     let fitted = Part::from_mesh(&a.mesh, &opts).map_err(|e| e.to_string())?;
-    let files = fitted.write(&a.out).map_err(|e| e.to_string())?;
+    let mut files = fitted.write(&a.out).map_err(|e| e.to_string())?;
+    files.push(fitted.write_report(&a.out).map_err(|e| e.to_string())?);
     if !quiet {
         let r = fitted.report();
         println!(
@@ -42,6 +45,9 @@ pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
             "residual    {:.4} mm RMS, {:.4} mm at most (vertices to the fitted surface)",
             r.rms_mm, r.max_mm
         );
+        if let Some(d) = r.substrate_distance_mm {
+            println!("substrate   the start end's rim within {d:.4} mm of the substrate mesh");
+        }
         for f in files {
             println!("wrote       {}", f.display());
         }

@@ -43,6 +43,11 @@ pub struct TubeFit {
     /// Parameter range needed below `t = 0` for the substrate to cut the
     /// tube when the start end is not normal to the guide (mm).
     pub extend_before_mm: f64,
+    /// Distance (mm) of each vertex of the mesh (same order as
+    /// [`TubeMesh::vertices`]) to the fitted surface, as in the report's
+    /// RMS and largest distance; `None` for a vertex left out of the fit
+    /// (a flat cap, a stray piece).
+    pub vertex_distance_mm: Vec<Option<f64>>,
     /// What the fit found and how well it fits.
     pub report: FitReport,
 }
@@ -62,6 +67,14 @@ impl TubeFit {
     pub fn radius(&self, t: f64) -> f64 {
         let m = smooth::natural_second_derivatives(&self.knots, &self.radius_mm);
         smooth::eval(&self.knots, &self.radius_mm, &m, t)
+    }
+
+    /// The wall thickness law (mm), when two skins were fitted.
+    pub fn wall_thickness(&self, t: f64) -> Option<f64> {
+        self.thickness_mm.as_ref().map(|e| {
+            let m = smooth::natural_second_derivatives(&self.knots, e);
+            smooth::eval(&self.knots, e, &m, t)
+        })
     }
 }
 
@@ -217,6 +230,7 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
         thickness_mm,
         substrate_normal: normal,
         extend_before_mm,
+        vertex_distance_mm: Vec::new(),
         report: FitReport::default(),
     };
     let ctx = report::Context {
@@ -234,7 +248,7 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
         last_move_mm: last_move,
         check_surface: opts.check_surface,
     };
-    fit.report = report::build(&ctx, &fit);
+    (fit.report, fit.vertex_distance_mm) = report::build(&ctx, &fit);
     if fit.report.rms_mm > opts.max_rms_mm {
         let worst = fit
             .report

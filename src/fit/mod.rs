@@ -3,7 +3,9 @@
 //! frame, mm): its mid-surface, or the inner and outer skins of its wall, and
 //! gives a [`TubeFit`]: a cubic-spline guide `Mg(t)` (`t` = chord length, mm),
 //! a smooth radius law `A(t)` (mm) from end to end, the wall thickness when
-//! two skins are given, the start end's plane as a flat substrate, and a
+//! two skins are given, the start end's plane as a flat substrate (or, with
+//! [`FitOptions::substrate`], a substrate mesh the start end must stand
+//! on), the distance of every mesh vertex to the fitted surface, and a
 //! [`FitReport`] (distances of the mesh to the fitted surface, per-station
 //! radius errors). [`TubeFit::part_spec`] writes it as a part file that the
 //! later stages take unchanged; the front door is
@@ -124,6 +126,19 @@ pub enum FitError {
         t_mm: f64,
         /// Its RMS (mm).
         station_rms_mm: f64,
+    },
+    /// The tube's start end is further from the substrate mesh than
+    /// [`FitOptions::substrate_tolerance_mm`].
+    #[error("{file}: the start end is {distance_mm:.3} mm from the substrate {substrate} (its rim's largest distance; at most {tolerance_mm} mm allowed, substrate_tolerance_mm): the tube does not stand on it")]
+    SubstrateFar {
+        /// The mesh file.
+        file: String,
+        /// The substrate's STL file.
+        substrate: String,
+        /// Largest distance of the start end's rim to the substrate (mm).
+        distance_mm: f64,
+        /// The bound (mm).
+        tolerance_mm: f64,
     },
     /// The fit could not be computed (too few points at a station, a
     /// singular system, no convergence to a usable guide).

@@ -99,6 +99,15 @@ pub struct FitOptions {
     pub template: Option<PathBuf>,
     /// The written part's name; `None`: the mesh file's stem.
     pub name: Option<String>,
+    /// An STL mesh of the substrate (binary or ASCII, mesh frame = part
+    /// frame, mm) that the tube's start end stands on; the written part's
+    /// `[substrate]` is this mesh (by its absolute path) instead of the
+    /// start end's plane. `None`: the start end's plane.
+    pub substrate: Option<PathBuf>,
+    /// Largest distance (mm) of the start end's rim (its fitted circle) to
+    /// the [`substrate`](Self::substrate) mesh; a start end further away is
+    /// refused ([`FitError::SubstrateFar`]).
+    pub substrate_tolerance_mm: f64,
 }
 
 impl Default for FitOptions {
@@ -117,6 +126,8 @@ impl Default for FitOptions {
             check_surface: true,
             template: None,
             name: None,
+            substrate: None,
+            substrate_tolerance_mm: 1.0,
         }
     }
 }
@@ -143,6 +154,7 @@ impl FitOptions {
         positive("max_section_rms_ratio", self.max_section_rms_ratio)?;
         positive("tolerance_mm", self.tolerance_mm)?;
         positive("constant_radius_tol_mm", self.constant_radius_tol_mm)?;
+        positive("substrate_tolerance_mm", self.substrate_tolerance_mm)?;
         if let Some(s) = self.station_spacing_mm {
             positive("station_spacing_mm", s)?;
         }

@@ -107,6 +107,10 @@ pub struct FitReport {
     /// Largest distance of a sample of the fitted surface to the mesh (mm;
     /// parry3d), when measured.
     pub surface_to_mesh_max_mm: Option<f64>,
+    /// Largest distance (mm) of the start end's rim (its fitted circle) to
+    /// the substrate mesh, when one was given
+    /// ([`FitOptions::substrate`](super::FitOptions::substrate)).
+    pub substrate_distance_mm: Option<f64>,
     /// Wall thickness, for two skins.
     pub wall: Option<WallReport>,
     /// The stations.
@@ -139,8 +143,10 @@ fn end(e: &EndRing) -> EndReport {
     }
 }
 
-/// Builds the report of `fit` (whose `report` is not read).
-pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> FitReport {
+/// Builds the report of `fit` (whose `report` is not read), and the
+/// distance (mm) of every mesh vertex to the fitted surface (`None` for a
+/// vertex of no skin: a cap, a stray piece).
+pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> (FitReport, Vec<Option<f64>>) {
     let guide = fit.guide();
     let len = fit.length();
     let m_r = smooth::natural_second_derivatives(&fit.knots, &fit.radius_mm);
@@ -164,6 +170,14 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> FitReport {
         .zip(cx.samples_skin.par_iter())
         .map(|((p, &t), &skin)| ((p - guide.point(t)).norm() - skin_radius(skin, t)).abs())
         .collect();
+    // The samples are the skins' vertices, skin after skin (`driver::samples`).
+    let mut per_vertex = vec![None; cx.mesh.vertices.len()];
+    let skin_vertices = cx.surfaces.skins.iter().flat_map(|s| s.vertices.iter());
+    for (&v, &d) in skin_vertices.zip(&dist) {
+        if let Some(slot) = per_vertex.get_mut(v as usize) {
+            *slot = Some(d);
+        }
+    }
     let n = cx.stations.len();
     let step = len / (n - 1).max(1) as f64;
     let mut sums = vec![(0.0, 0usize); n];
@@ -217,7 +231,7 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> FitReport {
         .check_surface
         .then(|| surface_to_mesh(cx, &guide, &stations, &skin_radius))
         .flatten();
-    FitReport {
+    let report = FitReport {
         file: cx.mesh.file.clone(),
         triangles: cx.mesh.triangles.len(),
         vertices: cx.samples_pos.len(),
@@ -248,9 +262,11 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> FitReport {
             .get(imax)
             .map_or([0.0; 3], |p| p.coords.into()),
         surface_to_mesh_max_mm: surface,
+        substrate_distance_mm: None,
         wall,
         stations,
-    }
+    };
+    (report, per_vertex)
 }
 
 /// Largest distance (parry3d) from samples of the fitted surface (every

@@ -170,6 +170,17 @@ impl MeshSubstrate {
     pub fn num_triangles(&self) -> usize {
         self.mesh.num_triangles()
     }
+
+    /// The triangles by their corners (part frame, mm).
+    pub fn triangles(&self) -> Vec<[Point3; 3]> {
+        self.mesh.triangles().map(|t| [t.a, t.b, t.c]).collect()
+    }
+
+    /// Distance (mm) of `p` (part frame) to the mesh's surface.
+    pub fn distance_mm(&self, p: &Point3) -> f64 {
+        use parry3d_f64::query::PointQuery;
+        self.mesh.distance_to_local_point(p, true)
+    }
 }
 
 /// The surface the first layer is deposited on (part frame, mm).

@@ -347,6 +347,7 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
                 diverging: f.diverging,
                 min_half_range: f.min_half_range,
                 data: f32s(&f.values),
+                mesh: false,
             })
             .collect(),
         substrate: substrate.map(|t| f32s(&t)),
@@ -365,6 +366,7 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
         marks_total,
         plan,
         notes,
+        fit: None,
     };
     script_safe_json(&data)
 }
@@ -372,51 +374,60 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
 /// The page's data object (`report.html`'s embedded JSON): the path drawn
 /// (part frame, mm; base64 typed arrays), its colour fields, marks, notes
 /// and the plan's animation data.
+/// A fit page (`fit_page`) fills the same object: its path is the fitted
+/// guide (one layer) and `fit` holds the mesh.
 #[derive(Serialize)]
-struct PageData<'a> {
-    version: u32,
-    title: &'a str,
-    strategy: &'static str,
-    delta_mm: f64,
-    bead_width_mm: f64,
-    points_total: usize,
-    points_shown: usize,
-    stride: usize,
-    length_mm: f64,
-    layer_slice: Vec<usize>,
-    layer_closed: Vec<u8>,
-    layer_points: Vec<usize>,
+pub(super) struct PageData<'a> {
+    pub version: u32,
+    pub title: &'a str,
+    pub strategy: &'static str,
+    pub delta_mm: f64,
+    pub bead_width_mm: f64,
+    pub points_total: usize,
+    pub points_shown: usize,
+    pub stride: usize,
+    pub length_mm: f64,
+    pub layer_slice: Vec<usize>,
+    pub layer_closed: Vec<u8>,
+    pub layer_points: Vec<usize>,
     /// Base64 `Uint32Array`: each layer's first drawn point, then the total.
-    layer_start: String,
+    pub layer_start: String,
     /// Base64 `Float32Array`: drawn points, xyz (mm).
-    pos: String,
+    pub pos: String,
     /// Base64 `Int8Array`s: unit vectors × 127.
-    tool: String,
-    normal: String,
-    build: String,
-    fields: Vec<FieldData>,
+    pub tool: String,
+    pub normal: String,
+    pub build: String,
+    pub fields: Vec<FieldData>,
     /// Base64 `Float32Array` of the substrate's triangles, `null` if none.
-    substrate: Option<String>,
-    marks: Vec<MarkData<'a>>,
-    marks_total: usize,
-    plan: Option<PlanData<'a>>,
-    notes: Vec<String>,
+    pub substrate: Option<String>,
+    pub marks: Vec<MarkData<'a>>,
+    pub marks_total: usize,
+    pub plan: Option<PlanData<'a>>,
+    pub notes: Vec<String>,
+    /// The mesh of a fit page (absent from a path's page).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fit: Option<super::fit_page::FitData<'a>>,
 }
 
-/// A colour field: one value per drawn point (base64 `Float32Array`).
+/// A colour field: one value per drawn point (base64 `Float32Array`), or
+/// with `mesh` one per vertex of a fit page's mesh.
 #[derive(Serialize)]
-struct FieldData {
-    key: &'static str,
-    name: &'static str,
-    unit: &'static str,
-    diverging: bool,
-    min_half_range: f64,
-    data: String,
+pub(super) struct FieldData {
+    pub key: &'static str,
+    pub name: &'static str,
+    pub unit: &'static str,
+    pub diverging: bool,
+    pub min_half_range: f64,
+    pub data: String,
+    /// The values colour the fit page's mesh vertices, not the path.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub mesh: bool,
 }
 
 /// A marked point (a violation).
 #[derive(Serialize)]
-struct MarkData<'a> {
+pub(super) struct MarkData<'a> {
     layer: usize,
     point: usize,
     text: &'a str,
@@ -427,7 +438,7 @@ struct MarkData<'a> {
 /// The plan's part of the page data: the cell, limits (deg) and the cell at
 /// every animation frame (base64 typed arrays).
 #[derive(Serialize)]
-struct PlanData<'a> {
+pub(super) struct PlanData<'a> {
     cell_kind: &'static str,
     cell: &'a str,
     robot: &'a str,
@@ -490,7 +501,7 @@ pub(crate) fn limit_margin_rad(robot: &crate::robot::model::RobotModel, q: &[f64
 
 /// Triangles (part frame, mm, 9 floats each) of the substrate around the
 /// drawn points `pos` (xyz triples), and a note when it is not drawn.
-fn substrate_triangles(
+pub(super) fn substrate_triangles(
     substrate: Option<&Substrate>,
     pos: &[f32],
 ) -> (Option<Vec<f32>>, Option<&'static str>) {

@@ -19,6 +19,13 @@
 //! with live joint values and limit margins, and the plan's violations
 //! marked on the path.
 //!
+//! A second page shows a tube fitted to a mesh ([`write_fit_report`],
+//! [`FitReportInput`]): the mesh with its vertices coloured by their
+//! distance to the fitted tube (mm, with a legend), the fitted tube as a
+//! translucent surface, the substrate, and the fit's figures (RMS and
+//! largest distance, radius error per station, wall thickness). Same
+//! template, viewer and encodings; `waam fit` writes it.
+//!
 //! Above [`ReportOptions::max_points`] displayed points (and
 //! [`ReportOptions::max_frames`] animation frames) the data is decimated
 //! evenly along each layer, and the page says so.
@@ -46,6 +53,7 @@
 mod build;
 pub mod cell_view;
 mod encode;
+mod fit_page;
 
 use crate::geometry::Substrate;
 use crate::optimise::{LayerPoints, Plan};
@@ -56,6 +64,7 @@ use crate::toolaxis::LocalFrame;
 use std::io::Write;
 
 use build::report_data;
+pub use fit_page::FitReportInput;
 
 const TEMPLATE: &str = include_str!("template.html");
 const VIEWER_JS: &str = include_str!("viewer.js");
@@ -195,6 +204,24 @@ pub enum ReportError {
     /// The path has no point.
     #[error("report: the path has no point")]
     EmptyPath,
+    /// A fit's distances do not match its mesh's vertices.
+    #[error("report: {file}: the fit has {distances} vertex distances where the mesh has {vertices} vertices")]
+    FitMismatch {
+        /// The mesh file.
+        file: String,
+        /// Vertices of the mesh.
+        vertices: usize,
+        /// Distances of the fit.
+        distances: usize,
+    },
+    /// A mesh vertex that is not finite.
+    #[error("report: {file}: vertex {vertex} is not finite")]
+    NonFiniteVertex {
+        /// The mesh file.
+        file: String,
+        /// Index of the vertex.
+        vertex: usize,
+    },
     /// The page data could not be encoded as JSON.
     #[error("report: encoding the page data: {0}")]
     Encode(#[source] std::sync::Arc<serde_json::Error>),
@@ -247,6 +274,37 @@ pub fn report_html(input: &ReportInput) -> Result<String, ReportError> {
 /// As [`write_report_html`]; [`ReportError::Io`] names `dest`.
 pub fn write_report(dest: &std::path::Path, input: &ReportInput) -> Result<(), ReportError> {
     let data = report_data(input)?;
+    crate::util::atomic::write_atomic(dest, |w| write_page(w, input.title, &data)).map_err(
+        |source| ReportError::Io {
+            file: dest.display().to_string(),
+            source,
+        },
+    )
+}
+
+/// Writes the page of a mesh fit to `w`: the mesh coloured by the distance
+/// of its vertices to the fitted tube, the fitted tube, the substrate and
+/// the fit's figures (see [`FitReportInput`]).
+///
+/// # Errors
+/// [`ReportError::FitMismatch`], [`ReportError::NonFiniteVertex`],
+/// [`ReportError::InvalidOption`] for bad input (nothing is written then);
+/// [`ReportError::Io`] if `w` fails.
+pub fn write_fit_report_html(w: &mut dyn Write, input: &FitReportInput) -> Result<(), ReportError> {
+    let data = fit_page::fit_data(input)?;
+    write_page(w, input.title, &data).map_err(|source| ReportError::Io {
+        file: "<writer>".into(),
+        source,
+    })
+}
+
+/// Writes the page of a mesh fit to `dest` atomically (temporary file, then
+/// rename): bad input leaves no file and an old page untouched.
+///
+/// # Errors
+/// As [`write_fit_report_html`]; [`ReportError::Io`] names `dest`.
+pub fn write_fit_report(dest: &std::path::Path, input: &FitReportInput) -> Result<(), ReportError> {
+    let data = fit_page::fit_data(input)?;
     crate::util::atomic::write_atomic(dest, |w| write_page(w, input.title, &data)).map_err(
         |source| ReportError::Io {
             file: dest.display().to_string(),

@@ -54,15 +54,17 @@
 
   var D = JSON.parse(document.getElementById('report-data').textContent);
   var P = D.plan;
+  // a fit page: the path is the fitted guide (one layer), FIT holds the mesh
+  var FIT = D.fit || null;
   var pos = f32(D.pos), tool = i8(D.tool), nrm = i8(D.normal), bld = i8(D.build);
   var layerStart = u32(D.layer_start);
   var L = D.layer_slice.length, N = pos.length / 3;
   var layerOf = new Float32Array(N);
   for (var l0 = 0; l0 < L; l0++) for (var j0 = layerStart[l0]; j0 < layerStart[l0 + 1]; j0++) layerOf[j0] = l0;
   var fields = D.fields.map(function (f) {
-    return { key: f.key, name: f.name, unit: f.unit, diverging: f.diverging, min_half_range: f.min_half_range, data: f32(f.data) };
+    return { key: f.key, name: f.name, unit: f.unit, diverging: f.diverging, min_half_range: f.min_half_range, data: f32(f.data), mesh: !!f.mesh };
   });
-  fields.push({ key: 'layer', name: 'layer', unit: '', diverging: false, data: layerOf });
+  if (!FIT) fields.push({ key: 'layer', name: 'layer', unit: '', diverging: false, data: layerOf });
   fields.forEach(function (f) {
     var lo = Infinity, hi = -Infinity;
     for (var i = 0; i < f.data.length; i++) {
@@ -112,8 +114,24 @@
   var $ = function (id) { return document.getElementById(id); };
   function line(parent, text) { var d = document.createElement('div'); d.textContent = text; parent.appendChild(d); return d; }
   var summary = $('summary');
-  line(summary, D.strategy + ' path, Delta = ' + D.delta_mm + ' mm, bead width ' + fmt(D.bead_width_mm) + ' mm');
-  line(summary, L + ' layers, ' + D.points_total + ' points, ' + fmt(D.length_mm / 1000, 2) + ' m of bead');
+  if (FIT) {
+    var R = FIT.report;
+    line(summary, 'tube fitted to ' + FIT.file);
+    line(summary, FIT.triangles_total + ' triangles, ' + FIT.vertices_total + ' vertices, ' + R.skins + (R.skins === 1 ? ' skin (mid-surface)' : ' skins (wall)'));
+    line(summary, 'guide ' + fmt(R.length_mm, 2) + ' mm through ' + R.guide_points + ' points, ' + R.iterations + ' iterations' + (R.converged ? '' : ' (not converged)'));
+    line(summary, 'radius ' + fmt(R.radius_min_mm) + ' to ' + fmt(R.radius_max_mm) + ' mm');
+    var fr = line(summary, 'vertices to the fitted surface: RMS ' + fmt(R.rms_mm, 4) + ' mm, max ' + fmt(R.max_mm, 4) + ' mm');
+    fr.style.fontWeight = 'bold';
+    if (R.surface_to_mesh_max_mm !== null) line(summary, 'fitted surface to the mesh: max ' + fmt(R.surface_to_mesh_max_mm, 4) + ' mm');
+    if (R.wall) line(summary, 'wall thickness ' + fmt(R.wall.mean_mm) + ' mm (' + fmt(R.wall.min_mm) + ' to ' + fmt(R.wall.max_mm) + ')');
+    if (R.substrate_distance_mm !== null && R.substrate_distance_mm !== undefined) line(summary, 'start end within ' + fmt(R.substrate_distance_mm, 4) + ' mm of the substrate mesh');
+    ['show-axes', 'show-wall', 'show-marks'].forEach(function (id) { $(id).parentNode.hidden = true; });
+    $('layer-controls').hidden = true;
+    $('fit-controls').hidden = false;
+  } else {
+    line(summary, D.strategy + ' path, Delta = ' + D.delta_mm + ' mm, bead width ' + fmt(D.bead_width_mm) + ' mm');
+    line(summary, L + ' layers, ' + D.points_total + ' points, ' + fmt(D.length_mm / 1000, 2) + ' m of bead');
+  }
   if (P) {
     line(summary, P.cell_kind + ' cell: ' + P.cell);
     line(summary, 'robot: ' + P.robot);
@@ -133,7 +151,7 @@
   loSlider.max = hiSlider.max = String(L - 1);
   hiSlider.value = String(L - 1);
   var state = { field: 0, lo: 0, hi: L - 1, axes: false, wall: false, substrate: true, marks: true,
-    cell: !!P, frame: 0, playing: false, speed: 100, clock: 0, only: null };
+    cell: !!P, frame: 0, playing: false, speed: 100, clock: 0, only: null, mesh: true, tube: true, unlit: false };
   if (marks.length) {
     $('marks-section').hidden = false;
     marks.slice(0, 500).forEach(function (m) {
@@ -294,10 +312,12 @@
   segSrc.forEach(function (s, k) { segPos[3 * k] = pos[3 * s]; segPos[3 * k + 1] = pos[3 * s + 1]; segPos[3 * k + 2] = pos[3 * s + 2]; });
   var pathMesh = mesh([segPos, new Float32Array(segPos.length)]);
   var pointColours = new Float32Array(3 * N);
+  var GUIDE_COLOUR = [0.95, 0.95, 0.95], MESH_COLOUR = [0.72, 0.74, 0.78];
   function recolour() {
     var f = fields[state.field];
+    if (fitMesh) recolourMesh(f);
     for (var i = 0; i < N; i++) {
-      var c = colourOf(f, f.data[i]);
+      var c = f.mesh ? GUIDE_COLOUR : colourOf(f, f.data[i]);
       pointColours[3 * i] = c[0]; pointColours[3 * i + 1] = c[1]; pointColours[3 * i + 2] = c[2];
     }
     var cols = new Float32Array(segPos.length);
@@ -323,9 +343,9 @@
   // local distance along the build direction) swept along each layer
   var wallStride = Math.max(1, Math.ceil(N / 40000));
   var wStart = new Uint32Array(L + 1), wP = [], wN = [];
-  var devField = fields[0];
+  var devField = FIT ? null : fields[0];
   function section(j) {
-    var p = vtx(j), n = dir(nrm, j), bd = dir(bld, j), dv = devField.data[j];
+    var p = vtx(j), n = dir(nrm, j), bd = dir(bld, j), dv = devField ? devField.data[j] : NaN;
     var h = isFinite(dv) ? Math.max(0, Math.min(3 * delta, delta + dv)) : delta;
     var o = scale(n, bead / 2), down = scale(bd, h);
     return { c: [add(p, o), sub(p, o), sub(sub(p, o), down), sub(add(p, o), down)], n: n, b: bd };
@@ -365,6 +385,46 @@
       for (var v = 0; v < 9; v += 3) { sn[j + v] = fn[0]; sn[j + v + 1] = fn[1]; sn[j + v + 2] = fn[2]; sc[j + v] = 0.6; sc[j + v + 1] = 0.68; sc[j + v + 2] = 0.8; }
     }
     subMesh = mesh([sp, sc, sn]);
+  }
+  // the fit: the mesh (one vertex triple per drawn triangle, face normals),
+  // coloured per vertex, and the fitted tube
+  var fitMesh = null, tubeMesh = null, fitVerts = null, fitCorner = null;
+  if (FIT) {
+    fitVerts = f32(FIT.vertices);
+    fitCorner = u32(FIT.triangles);
+    var mp = new Float32Array(3 * fitCorner.length), mn = new Float32Array(3 * fitCorner.length);
+    for (j = 0; j < fitCorner.length; j += 3) {
+      var c0 = fitCorner[j], c1 = fitCorner[j + 1], c2 = fitCorner[j + 2];
+      var q0 = [fitVerts[3 * c0], fitVerts[3 * c0 + 1], fitVerts[3 * c0 + 2]];
+      var q1 = [fitVerts[3 * c1], fitVerts[3 * c1 + 1], fitVerts[3 * c1 + 2]];
+      var q2 = [fitVerts[3 * c2], fitVerts[3 * c2 + 1], fitVerts[3 * c2 + 2]];
+      var fnrm = unit(cross(sub(q1, q0), sub(q2, q0)));
+      [q0, q1, q2].forEach(function (q, k) {
+        mp.set(q, 3 * (j + k));
+        mn.set(fnrm, 3 * (j + k));
+      });
+    }
+    fitMesh = mesh([mp, new Float32Array(mp.length), mn]);
+    var tp = f32(FIT.tube), tn = new Float32Array(tp.length), tc = new Float32Array(tp.length);
+    for (j = 0; j < tp.length; j += 9) {
+      var tf = unit(cross(sub([tp[j + 3], tp[j + 4], tp[j + 5]], [tp[j], tp[j + 1], tp[j + 2]]),
+        sub([tp[j + 6], tp[j + 7], tp[j + 8]], [tp[j], tp[j + 1], tp[j + 2]])));
+      for (var tv = 0; tv < 9; tv += 3) { tn.set(tf, j + tv); tc[j + tv] = 0.35; tc[j + tv + 1] = 0.85; tc[j + tv + 2] = 0.95; }
+    }
+    tubeMesh = mesh([tp, tc, tn]);
+  }
+  function recolourMesh(f) {
+    var nv = fitVerts.length / 3, vc = new Float32Array(3 * nv), k;
+    for (k = 0; k < nv; k++) {
+      var c = f.mesh ? colourOf(f, f.data[k]) : MESH_COLOUR;
+      vc[3 * k] = c[0]; vc[3 * k + 1] = c[1]; vc[3 * k + 2] = c[2];
+    }
+    var cols = new Float32Array(3 * fitCorner.length);
+    for (k = 0; k < fitCorner.length; k++) {
+      var v = fitCorner[k];
+      cols[3 * k] = vc[3 * v]; cols[3 * k + 1] = vc[3 * v + 1]; cols[3 * k + 2] = vc[3 * v + 2];
+    }
+    setColours(fitMesh, cols);
   }
   // violation marks (rebuilt when the layer range changes)
   var marksMesh = null;
@@ -439,6 +499,7 @@
   var partBox = (function () {
     var lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
     for (var i = 0; i < N; i++) for (var k = 0; k < 3; k++) { var v = pos[3 * i + k]; if (v < lo[k]) lo[k] = v; if (v > hi[k]) hi[k] = v; }
+    if (fitVerts) for (i = 0; i < fitVerts.length; i++) { k = i % 3; v = fitVerts[i]; if (v < lo[k]) lo[k] = v; if (v > hi[k]) hi[k] = v; }
     return { lo: lo, hi: hi };
   })();
   var cellBox = null;
@@ -509,9 +570,13 @@
     var vp = mul(proj, view), model = partMatrix(), mvp = mul(vp, model);
     var light = unit(sub(eye(), cam.target));
     var only = state.only;
+    if (fitMesh && state.mesh && (!only || only === 'mesh')) {
+      if (state.unlit) draw(flat, fitMesh, gl.TRIANGLES, 0, fitMesh.count, mvp, {});
+      else draw(lit, fitMesh, gl.TRIANGLES, 0, fitMesh.count, mvp, { model: model, light: light });
+    }
     if (!only || only === 'path') {
       draw(flat, pathMesh, gl.LINES, segStart[state.lo], segStart[state.hi + 1] - segStart[state.lo], mvp, {});
-      if (state.axes) draw(flat, axesMesh, gl.LINES, axStart[state.lo], axStart[state.hi + 1] - axStart[state.lo], mvp, {});
+      if (state.axes && !FIT) draw(flat, axesMesh, gl.LINES, axStart[state.lo], axStart[state.hi + 1] - axStart[state.lo], mvp, {});
       if (state.marks && marksMesh) draw(flat, marksMesh, gl.POINTS, 0, marksMesh.count, mvp, { size: 9 });
       if (hoverMesh) draw(flat, hoverMesh, gl.POINTS, 0, 1, mvp, { size: 13 });
     }
@@ -525,7 +590,8 @@
       gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
       gl.depthMask(false);
       if (state.substrate && subMesh) draw(lit, subMesh, gl.TRIANGLES, 0, subMesh.count, mvp, { model: model, light: light, alpha: 0.35 });
-      if (state.wall) draw(lit, wallMesh, gl.TRIANGLES, wStart[state.lo], wStart[state.hi + 1] - wStart[state.lo], mvp, { model: model, light: light, alpha: 0.45 });
+      if (FIT && state.tube) draw(lit, tubeMesh, gl.TRIANGLES, 0, tubeMesh.count, mvp, { model: model, light: light, alpha: 0.3 });
+      if (state.wall && !FIT) draw(lit, wallMesh, gl.TRIANGLES, wStart[state.lo], wStart[state.hi + 1] - wStart[state.lo], mvp, { model: model, light: light, alpha: 0.45 });
       gl.depthMask(true);
       gl.disable(gl.BLEND);
       drawTriad();
@@ -580,7 +646,32 @@
     if (c[3] <= 0) return null;
     return [(c[0] / c[3] * 0.5 + 0.5) * s[0], (0.5 - c[1] / c[3] * 0.5) * s[1], c[2] / c[3]];
   }
+  // on a fit page: the nearest mesh vertex on screen
+  function pickVertex(x, y) {
+    updateMatrices();
+    var m = mul(proj, view), s = cssSize(), best = -1, bestD = 64, nv = fitVerts.length / 3;
+    for (var i = 0; i < nv; i++) {
+      var q = project(m, [fitVerts[3 * i], fitVerts[3 * i + 1], fitVerts[3 * i + 2]], s);
+      if (!q || q[2] < -1 || q[2] > 1) continue;
+      var d = (q[0] - x) * (q[0] - x) + (q[1] - y) * (q[1] - y);
+      if (d < bestD) { bestD = d; best = i; }
+    }
+    var tip = $('tip');
+    if (best < 0) { tip.hidden = true; hoverMesh = null; requestRender(); return null; }
+    var p = [fitVerts[3 * best], fitVerts[3 * best + 1], fitVerts[3 * best + 2]];
+    var text = 'mesh vertex ' + best + ' of ' + nv +
+      '\nx ' + fmt(p[0], 2) + ', y ' + fmt(p[1], 2) + ', z ' + fmt(p[2], 2) + ' mm (part frame)';
+    fields.forEach(function (f) { if (f.mesh) text += '\n' + f.name + ': ' + fmt(f.data[best], 4) + ' ' + f.unit; });
+    tip.textContent = text;
+    tip.hidden = false;
+    tip.style.left = Math.min(x + 14, cssSize()[0] - tip.offsetWidth - 4) + 'px';
+    tip.style.top = Math.max(4, y - tip.offsetHeight - 8) + 'px';
+    hoverMesh = mesh([new Float32Array(p), new Float32Array([1, 1, 1])]);
+    requestRender();
+    return { vertex: best, text: text };
+  }
   function pickAt(x, y) {
+    if (FIT) return pickVertex(x, y);
     updateMatrices();
     var m = mul(mul(proj, view), partMatrix()), s = cssSize(), best = -1, bestD = 64;
     for (var i = layerStart[state.lo]; i < layerStart[state.hi + 1]; i++) {
@@ -644,7 +735,8 @@
 
   // ---- controls ----
   fieldSel.addEventListener('change', function () { state.field = +fieldSel.value; recolour(); requestRender(); });
-  [['show-axes', 'axes'], ['show-wall', 'wall'], ['show-substrate', 'substrate'], ['show-marks', 'marks'], ['show-cell', 'cell']].forEach(function (c) {
+  [['show-axes', 'axes'], ['show-wall', 'wall'], ['show-substrate', 'substrate'], ['show-marks', 'marks'], ['show-cell', 'cell'],
+    ['show-mesh', 'mesh'], ['show-tube', 'tube']].forEach(function (c) {
     var el = $(c[0]);
     el.addEventListener('change', function () {
       state[c[1]] = el.checked;
@@ -750,6 +842,41 @@
     updateJoints();
   }
 
+  // ---- fit page: radius error (and wall thickness) per station ----
+  function drawFitPlot() {
+    var c = $('fit-plot'), g = c.getContext('2d'), st = FIT.report.stations;
+    var W = c.width, H = c.height, x0 = 40, x1 = W - 8, y0 = 8, y1 = H - 22;
+    g.clearRect(0, 0, W, H);
+    var ts = [], es = [], ws = [];
+    st.forEach(function (s) {
+      ts.push(s.t_mm);
+      es.push(s.radius_error_mm === null ? NaN : s.radius_error_mm);
+      ws.push(s.wall_thickness_mm === null || s.law_thickness_mm === null ? NaN : s.law_thickness_mm - s.wall_thickness_mm);
+    });
+    var tlo = Math.min.apply(null, ts), thi = Math.max.apply(null, ts), m = 1e-6;
+    es.concat(ws).forEach(function (v) { if (isFinite(v)) m = Math.max(m, Math.abs(v)); });
+    var X = function (t) { return x0 + (x1 - x0) * (t - tlo) / Math.max(thi - tlo, 1e-9); };
+    var Y = function (v) { return y0 + (y1 - y0) * (0.5 - 0.5 * v / m); };
+    g.strokeStyle = '#bbb'; g.beginPath(); g.moveTo(x0, Y(0)); g.lineTo(x1, Y(0)); g.stroke();
+    [[es, '#c03030'], [ws, '#3060c0']].forEach(function (sv) {
+      g.strokeStyle = sv[1]; g.beginPath();
+      var pen = false;
+      sv[0].forEach(function (v, k) {
+        if (!isFinite(v)) { pen = false; return; }
+        if (pen) g.lineTo(X(ts[k]), Y(v)); else g.moveTo(X(ts[k]), Y(v));
+        pen = true;
+      });
+      g.stroke();
+    });
+    g.fillStyle = '#222'; g.font = '10px sans-serif'; g.textAlign = 'right';
+    g.fillText('+' + fmt(m, 4), x0 - 2, y0 + 8); g.fillText('0', x0 - 2, Y(0) + 3); g.fillText('−' + fmt(m, 4), x0 - 2, y1);
+    g.textAlign = 'left';
+    g.fillText('t = ' + fmt(tlo, 1) + ' … ' + fmt(thi, 1) + ' mm along the guide', x0, H - 4);
+    $('fit-plot-label').textContent = 'radius law − section radius per station (red, mm)' +
+      (FIT.report.wall ? '; wall law − section wall (blue, mm)' : '') + '; largest |error| ' + fmt(m, 4) + ' mm';
+  }
+  if (FIT) drawFitPlot();
+
   recolour();
   setRange(0, L - 1);
   resetView();
@@ -778,6 +905,17 @@
       render();
       out.first = countDrawn();
       fields.forEach(function (f, k) { state.field = k; recolour(); render(); out.fields.push([f.key, countDrawn().colours]); });
+      if (FIT) {
+        // the mesh alone, unshaded: its colours are the distance field's
+        // (and one colour under a field of the guide)
+        state.only = 'mesh'; state.unlit = true;
+        state.field = 0; recolour(); render();
+        out.mesh_only = countDrawn();
+        out.mesh_field = fields[0].key;
+        state.field = 1; recolour(); render();
+        out.mesh_plain = countDrawn();
+        state.only = null; state.unlit = false;
+      }
       state.field = 0; recolour();
       state.axes = state.wall = state.substrate = state.marks = true;
       render();
@@ -787,7 +925,9 @@
       out.some_layers = countDrawn();
       var mid = layerStart[Math.floor(L / 2)], s = cssSize();
       updateMatrices();
-      var q = project(mul(mul(proj, view), partMatrix()), vtx(mid), s);
+      var at = vtx(mid);
+      if (FIT) { mid = Math.floor(fitVerts.length / 6); at = [fitVerts[3 * mid], fitVerts[3 * mid + 1], fitVerts[3 * mid + 2]]; }
+      var q = project(mul(mul(proj, view), partMatrix()), at, s);
       var pick = q ? pickAt(q[0], q[1]) : null;
       out.pick = pick ? { vertex: pick.vertex, wanted: mid, layer: pick.layer, text: pick.text } : null;
       setRange(0, L - 1);

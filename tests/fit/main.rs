@@ -4,6 +4,8 @@
 //! written part sliced like the true part.
 
 mod cli;
+mod page;
+mod substrate;
 #[path = "../common/mod.rs"]
 mod common;
 mod gen;

@@ -3,12 +3,20 @@
 //! which must run the page without a script error, draw the canvas (the page
 //! reads its own pixels back), load nothing (the page lists the resources the
 //! browser fetched; every host name resolves to nothing), and animate the
-//! robot of the plan. Without WebGL the page must say so.
+//! robot of the plan. Without WebGL the page must say so. The page of a
+//! tube fitted to a mesh (`fit_page.rs`) draws the mesh coloured by the
+//! distance of its vertices to the fitted tube.
 //!
 //! Chromium comes from the system's packages (`.ci/run` installs Debian's
 //! `chromium`). If it is missing the tests fail saying so, unless
 //! `WAAM_SKIP_BROWSER=1` is set; `WAAM_CHROMIUM` names another binary.
 //! `WAAM_REPORT_KEEP=<folder>` keeps the reports and screenshots there.
+
+mod fit_page;
+// The fit tests' independent tube-mesh generator.
+#[allow(dead_code)]
+#[path = "../fit/gen.rs"]
+mod gen;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
