@@ -183,8 +183,9 @@ impl Part {
             let before = fit.extend_before_mm.max(2.0 * d + 1.0);
             spec.range.extend_before = Some(Scalar::Number(before));
             spec.substrate = SubstrateSpec::Mesh { file: file.clone() };
-            spec.description
-                .push_str(&format!("; stands on the substrate mesh {file} (start end within {d:.3} mm)"));
+            spec.description.push_str(&format!(
+                "; stands on the substrate mesh {file} (start end within {d:.3} mm)"
+            ));
         }
         let toml = toml::to_string(&spec).map_err(|e| crate::fit::FitError::Degenerate {
             file: mesh.file.clone(),

@@ -80,7 +80,9 @@ fn tube_triangles(fit: &TubeFit) -> Vec<f32> {
     let guide = fit.guide();
     let (t0, t1) = (fit.t_min, fit.t_max);
     let r_mean = 0.5 * (fit.report.radius_min_mm + fit.report.radius_max_mm);
-    let rings = ((t1 - t0) / (0.5 * r_mean).max(0.5)).ceil().clamp(16.0, 400.0) as usize;
+    let rings = ((t1 - t0) / (0.5 * r_mean).max(0.5))
+        .ceil()
+        .clamp(16.0, 400.0) as usize;
     let mut frames: Vec<(f64, Point3, Vector3, Vector3)> = Vec::with_capacity(rings + 1);
     for i in 0..=rings {
         let t = t0 + (t1 - t0) * i as f64 / rings as f64;
@@ -221,7 +223,13 @@ pub(super) fn fit_data(input: &FitReportInput) -> Result<String, ReportError> {
     }
     let total = mesh.triangles.len();
     let k = super::build::stride(total, input.max_triangles);
-    let drawn: Vec<u32> = mesh.triangles.iter().step_by(k).flatten().copied().collect();
+    let drawn: Vec<u32> = mesh
+        .triangles
+        .iter()
+        .step_by(k)
+        .flatten()
+        .copied()
+        .collect();
     let mut notes = vec![];
     if k > 1 {
         notes.push(format!(

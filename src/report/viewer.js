@@ -845,7 +845,7 @@
   // ---- fit page: radius error (and wall thickness) per station ----
   function drawFitPlot() {
     var c = $('fit-plot'), g = c.getContext('2d'), st = FIT.report.stations;
-    var W = c.width, H = c.height, x0 = 40, x1 = W - 8, y0 = 8, y1 = H - 22;
+    var W = c.width, H = c.height, x0 = 50, x1 = W - 8, y0 = 8, y1 = H - 22;
     g.clearRect(0, 0, W, H);
     var ts = [], es = [], ws = [];
     st.forEach(function (s) {

@@ -4,11 +4,11 @@
 //! written part sliced like the true part.
 
 mod cli;
-mod page;
-mod substrate;
 #[path = "../common/mod.rs"]
 mod common;
 mod gen;
+mod page;
+mod substrate;
 
 use gen::Truth;
 use waam_slicer::fit::{FitError, TubeMesh};

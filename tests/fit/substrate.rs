@@ -97,7 +97,11 @@ fn an_elbow_on_a_flat_and_on_a_cylindrical_stl_substrate_slices() {
     let elsewhere = tempfile::tempdir().unwrap();
 
     fit(&stl, &d.join("plane"), &[]);
-    let on_plane = slice_layers(&d.join("plane/part.toml"), &d.join("s-plane"), elsewhere.path());
+    let on_plane = slice_layers(
+        &d.join("plane/part.toml"),
+        &d.join("s-plane"),
+        elsewhere.path(),
+    );
 
     fit(
         &stl,
@@ -112,7 +116,11 @@ fn an_elbow_on_a_flat_and_on_a_cylindrical_stl_substrate_slices() {
         serde_json::from_str(&std::fs::read_to_string(d.join("plate/fit.json")).unwrap()).unwrap();
     let gap = report["substrate_distance_mm"].as_f64().unwrap();
     assert!(gap < 0.1, "the start end stands on the plate: {report}");
-    let on_plate = slice_layers(&d.join("plate/part.toml"), &d.join("s-plate"), elsewhere.path());
+    let on_plate = slice_layers(
+        &d.join("plate/part.toml"),
+        &d.join("s-plate"),
+        elsewhere.path(),
+    );
     assert!(
         on_plate.abs_diff(on_plane) <= 1,
         "{on_plate} layers on the plate, {on_plane} on the plane"
@@ -129,7 +137,11 @@ fn an_elbow_on_a_flat_and_on_a_cylindrical_stl_substrate_slices() {
     // The flat start end's rim lies above the drum by up to
     // 150 - sqrt(150² - 12²) = 0.48 mm at x = ±12.
     assert!(drum_gap > 0.3 && drum_gap < 0.6, "{report}");
-    let on_drum = slice_layers(&d.join("drum/part.toml"), &d.join("s-drum"), elsewhere.path());
+    let on_drum = slice_layers(
+        &d.join("drum/part.toml"),
+        &d.join("s-drum"),
+        elsewhere.path(),
+    );
     assert!(on_drum > 0);
     assert!(d.join("drum/report.html").exists());
     eprintln!(

@@ -33,11 +33,15 @@ fn fit_report_draws_the_mesh_coloured_by_distance_in_chromium() {
     assert!(colours > 2, "mesh drawn in {colours} colours: {r}");
     // Under a field of the guide the mesh is one colour (and its edges).
     let plain = r["mesh_plain"]["colours"].as_u64().unwrap();
-    assert!(plain < colours, "plain mesh {plain} colours, by distance {colours}: {r}");
+    assert!(
+        plain < colours,
+        "plain mesh {plain} colours, by distance {colours}: {r}"
+    );
     // Hovering a vertex shows its distance.
     let text = r["pick"]["text"].as_str().unwrap_or_default();
     assert!(
-        text.starts_with("mesh vertex ") && text.contains("distance of the mesh to the fitted tube"),
+        text.starts_with("mesh vertex ")
+            && text.contains("distance of the mesh to the fitted tube"),
         "{r}"
     );
 }
