@@ -31,8 +31,8 @@
 //! | 7. robot programs (FANUC `.ls`, KUKA `.src`/`.dat`, ABB `.mod`, CSV), read-back and validation | [`program`] | §8 |
 //! | 8. placement of the part in the cell: an outer search over 6 and 7 (the optimiser as its oracle, the program stage's checks in certification) | [`place`] | — |
 //! | files at the edges: part and cell files read into the stages' types, CSV and STL written | [`io`] | §2, §6 |
-//! | 0a. a tube from a mesh: guide spline and radius law fitted to a tubular STL, written as a part | [`fit`] | §2 |
-//! | the interactive 3-D report | [`report`] | |
+//! | 0a. a tube from a mesh: guide spline and radius law fitted to a tubular STL (on a flat or an STL substrate), written as a part | [`fit`] | §2 |
+//! | the interactive 3-D report (of a path or plan, and of a fit: the mesh coloured by its distance to the fitted tube) | [`report`] | |
 //! | the front door: one call per job | [`pipeline`] | |
 //!
 //! A module imports only modules above it in this table (the leaf helpers
