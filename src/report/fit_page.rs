@@ -34,7 +34,8 @@ pub struct FitReportInput<'a> {
     /// one distance per mesh vertex, report.
     pub fit: &'a TubeFit,
     /// The substrate the written part stands on (a plane as a square, a
-    /// cylinder as a band, a mesh as its triangles); `None`: not drawn.
+    /// cylinder as a band, a mesh as its triangles); `None`: the fit's
+    /// start plane ([`TubeFit::substrate_point`], [`TubeFit::substrate_normal`]).
     pub substrate: Option<&'a Substrate>,
     /// Most mesh triangles drawn; above it every `k`-th triangle is drawn
     /// (the page says so). Every vertex and its distance are embedded.

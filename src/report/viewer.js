@@ -590,7 +590,14 @@
       gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
       gl.depthMask(false);
       if (state.substrate && subMesh) draw(lit, subMesh, gl.TRIANGLES, 0, subMesh.count, mvp, { model: model, light: light, alpha: 0.35 });
-      if (FIT && state.tube) draw(lit, tubeMesh, gl.TRIANGLES, 0, tubeMesh.count, mvp, { model: model, light: light, alpha: 0.3 });
+      if (FIT && state.tube) {
+        // pushed back a little: it shows where it stands out of the mesh,
+        // not in stripes where the two coincide
+        gl.enable(gl.POLYGON_OFFSET_FILL);
+        gl.polygonOffset(2, 2);
+        draw(lit, tubeMesh, gl.TRIANGLES, 0, tubeMesh.count, mvp, { model: model, light: light, alpha: 0.3 });
+        gl.disable(gl.POLYGON_OFFSET_FILL);
+      }
       if (state.wall && !FIT) draw(lit, wallMesh, gl.TRIANGLES, wStart[state.lo], wStart[state.hi + 1] - wStart[state.lo], mvp, { model: model, light: light, alpha: 0.45 });
       gl.depthMask(true);
       gl.disable(gl.BLEND);
