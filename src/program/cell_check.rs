@@ -185,6 +185,12 @@ pub struct CellScene {
     pub keep_out: Vec<KeepOut>,
     /// Clearance every pair must keep (mm, ≥ 0).
     pub clearance_mm: f64,
+    /// Check the motions between beads (arc-off transits, home moves) as
+    /// well as the beads with their approach and retract. `false` where
+    /// the program's layers are a subsample of the build (a placement's
+    /// screening): its transits join layers far apart, motions the build
+    /// never makes.
+    pub transits: bool,
 }
 
 /// The closest approach of one layer's motions.
@@ -861,7 +867,7 @@ pub fn check_cell(
     // first point, last point → retract, the transits, last → home
     let pts = &program.points;
     let home = program.home.as_ref();
-    if let (Some(h), Some(first)) = (home, pts.first()) {
+    if let (Some(h), Some(first)) = (home.filter(|_| scene.transits), pts.first()) {
         run(
             Sample {
                 q: &h.joints,
@@ -891,6 +897,7 @@ pub fn check_cell(
         let motion = match (a.arc, b.arc) {
             (ArcFlag::Approach, ArcFlag::Start) => "approach",
             (ArcFlag::End, ArcFlag::Retract) => "retract",
+            _ if !scene.transits => continue,
             _ => "arc-off transit",
         };
         run(
@@ -913,7 +920,7 @@ pub fn check_cell(
             &mut stats,
         )?;
     }
-    if let (Some(h), Some(last)) = (home, pts.last()) {
+    if let (Some(h), Some(last)) = (home.filter(|_| scene.transits), pts.last()) {
         run(
             Sample {
                 q: &last.joints,

@@ -1072,6 +1072,7 @@ fn resumed_program(
     let scene = CellScene {
         keep_out: cell.keep_out.clone(),
         clearance_mm: common.collision_clearance_mm,
+        transits: true,
     };
     let clearance = check_cell(&program, &traj, layers, &scene)?;
     Ok((program, clearance, t.elapsed().as_secs_f64()))
