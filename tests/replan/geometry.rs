@@ -53,8 +53,10 @@ fn replan_and_check(
     for c in r.corrections.iter().take_while(|c| c.layer <= rejoined) {
         assert_eq!(c.nominal_layer, c.layer + skipped);
         let tol = if c.layer == k + 1 { 0.08 } else { 1e-6 };
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
         for (m, pt) in path.layers[c.layer].points.iter().enumerate() {
             let h = distance_to_closed(&pt.position, &below);
+            (lo, hi) = (lo.min(h), hi.max(h));
             assert!(
                 h > h_lo - tol && h < h_hi + tol,
                 "layer {}: bead {h:.3} mm outside the window [{h_lo:.3}, {h_hi:.3}]",
@@ -64,6 +66,11 @@ fn replan_and_check(
             let v = c.speed_mm_s[m];
             assert!(v >= p.travel_speed_min_mm_s - 1e-9 && v <= p.travel_speed_max_mm_s + 1e-9);
         }
+        // what was measured (`cargo test -- --nocapture`)
+        eprintln!(
+            "after layer {k}, field {field:?}: layer {} (nominal {}) beads {lo:.3}..{hi:.3} mm, window [{h_lo:.3}, {h_hi:.3}]",
+            c.layer, c.nominal_layer
+        );
         if c.clamped.iter().any(|x| *x) {
             clamped_layers += 1;
         }
