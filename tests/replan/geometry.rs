@@ -303,3 +303,51 @@ fn a_wall_still_too_high_at_the_top_drops_the_layers_that_no_longer_fit() {
     assert_eq!(beads, vec![k + 1]);
     assert_eq!(r.summary().replan.layers_dropped_from, Some(k + 2));
 }
+
+#[test]
+fn from_the_nominal_plan_a_skip_reuses_the_renumbered_layers_and_gives_the_same_replan() {
+    // differential: replan_planned (reusing the nominal plan's layers, now
+    // renumbered after the skipped one) against replan_part
+    let part = part("elbow.toml");
+    let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
+    let opts = elbow_opts(96, 16);
+    let sliced = nominal(&part, &opts);
+    let field = Field {
+        high: 2.0,
+        low: -0.5,
+    };
+    let (scan, _) = synthetic_scan(&sliced, K, &field, 3);
+    let fresh =
+        waam_slicer::replan_part(&part, &cell, &Measured::Points(scan.clone()), K, &opts).unwrap();
+    let planned = waam_slicer::plan_part(&part, &cell, &opts).unwrap();
+    let fast = waam_slicer::replan_planned(
+        &part,
+        &planned,
+        &Measured::Points(scan),
+        K,
+        &ReplanOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(fast.skipped, vec![K + 1]);
+    assert_eq!(fast.corrections, fresh.corrections);
+    assert!(fast.is_feasible(), "{:?}", fast.planned.refusal());
+    let layers: Vec<usize> = fast.planned.plan.layers.iter().map(|l| l.layer).collect();
+    assert_eq!(layers, (K + 1..15).collect::<Vec<_>>());
+    for (a, b) in fast
+        .planned
+        .plan
+        .layers
+        .iter()
+        .zip(&fresh.planned.plan.layers)
+    {
+        assert_eq!(a.layer, b.layer);
+        for (p, q) in a.points.iter().zip(&b.points) {
+            let (p, q) = (p.joints.unwrap(), q.joints.unwrap());
+            assert!(p.iter().zip(&q).all(|(x, y)| (x - y).abs() < 1e-9));
+        }
+    }
+    // the reused layers are the nominal plan's, one layer further on
+    let last = fast.planned.plan.layers.last().unwrap();
+    let nominal_last = planned.plan.layers.iter().find(|l| l.layer == 15).unwrap();
+    assert_eq!(last.points, nominal_last.points);
+}
