@@ -290,6 +290,9 @@ fn planned_report(
             plan: &plan,
             travel_speed_mm_s: opts.travel_speed_mm_s,
             cycle: None,
+            keep_out: &[],
+            clearance: None,
+            refusal: None,
         }),
         ..ReportInput::new(&part.name, &path, &axes.frames, &map, path.delta_mm)
     };
