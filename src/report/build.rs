@@ -277,6 +277,19 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             text: v.to_string(),
         }));
     }
+    // a collision refusal marks its point (the layer's first for a home move)
+    if let Some(pv) = &input.plan {
+        if let Some(e @ ProgramError::Collision { layer, point, .. }) = pv.refusal {
+            if let Some(l) = pv.layers.iter().position(|lp| lp.layer == *layer) {
+                let n = path.layers[l].points.len();
+                marks.push(Mark {
+                    layer: l,
+                    point: point.unwrap_or(0).min(n.saturating_sub(1)),
+                    text: format!("collision: {e}"),
+                });
+            }
+        }
+    }
     if let Some(pr) = input.process {
         marks.extend(pr.violations.iter().map(|v| Mark {
             layer: v.layer,
