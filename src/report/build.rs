@@ -670,7 +670,7 @@ fn plan_data<'a>(input: &ReportInput<'a>, pv: &PlanView<'a>) -> (PlanData<'a>, V
         fixed_bodies.push(tilt);
     }
     fixed_bodies.extend(keep_out_outlines(pv.keep_out));
-    let moving_names: Vec<String> = moving_bodies.iter().map(|b| b.name.clone()).collect();
+    let arm_bodies = arm_outlines(robot, &q0).len();
     let mut f_bodies: Vec<f32> = vec![];
     let mut clock = 0.0;
     let mut prev: Option<Point3> = None;
@@ -721,20 +721,21 @@ fn plan_data<'a>(input: &ReportInput<'a>, pv: &PlanView<'a>) -> (PlanData<'a>, V
                     }
                     None => f_table.extend([f32::NAN; 9]),
                 }
-                let mut moving = q.map(|q| arm_outlines(robot, &q)).unwrap_or_default();
-                if let (CellLayout::TorchCarried(c), Some(e)) = (pv.cell, positioner.as_ref()) {
-                    let [table, _] = positioner_outlines(c, e);
-                    moving.push(table);
-                }
-                for k in 0..moving_names.len() {
-                    match moving.get(k) {
-                        Some(o) if o.name == moving_names[k] => {
-                            f_bodies.extend(
-                                [o.a, o.b].iter().flat_map(|p| p.iter().map(|v| *v as f32)),
-                            );
-                        }
-                        _ => f_bodies.extend([f32::NAN; 6]),
+                // the moving bodies in the order of `moving_bodies`: the arm's
+                // capsules (NaN without joints), the table (NaN without a pose)
+                let mut put = |o: Option<&BodyOutline>| match o {
+                    Some(o) => {
+                        f_bodies.extend([o.a, o.b].iter().flat_map(|p| p.iter().map(|v| *v as f32)))
                     }
+                    None => f_bodies.extend([f32::NAN; 6]),
+                };
+                let arm = q.map(|q| arm_outlines(robot, &q));
+                for k in 0..arm_bodies {
+                    put(arm.as_ref().and_then(|a| a.get(k)));
+                }
+                if let CellLayout::TorchCarried(c) = pv.cell {
+                    let table = positioner.as_ref().map(|e| positioner_outlines(c, e));
+                    put(table.as_ref().map(|[t, _]| t));
                 }
                 match s.base_from_part {
                     Some(t) => {

@@ -98,8 +98,9 @@
     var li = F.layer[f], c = P.collision;
     if (c && c.layer_index === li) {
       return { names: [c.body_a, c.body_b], collision: true,
-        text: 'COLLISION (program refused): ' + c.body_a + '\u2013' + c.body_b + ' ' + fmt(c.distance_mm, 1) +
-          ' mm, clearance ' + fmt(c.clearance_mm, 1) + ' mm (' + c.motion + ')' };
+        text: 'COLLISION (program refused): ' + c.body_a + '\u2013' + c.body_b + ' ' +
+          (c.distance_mm < 0 ? fmt(-c.distance_mm, 1) + ' mm into each other' : fmt(c.distance_mm, 1) + ' mm') +
+          ', clearance ' + fmt(c.clearance_mm, 1) + ' mm (' + c.motion + ')' };
     }
     var k = P.closest[li];
     if (k && k.pair) {
