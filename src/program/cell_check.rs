@@ -39,6 +39,11 @@
 //! the positioner's base below the tilt body, the substrate beyond the
 //! hull of the layers.
 //!
+//! **Drawn as checked**: the report's 3-D view ([`crate::report`]) draws
+//! the arm's capsules, the table, the tilt body and the keep-out boxes from
+//! this module's body outlines (the same capsules, poses and radii), and
+//! highlights each layer's [`LayerClearance::closest_pair`].
+//!
 //! **Motions**: every bead point's planned joints; the linear moves into
 //! and out of each bead, the arc-off joint moves between beads and the
 //! home moves, interpolated linearly in joint space (exact for the joint
