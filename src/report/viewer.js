@@ -622,10 +622,12 @@
         gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
         gl.depthMask(false);
         if (bodyMesh) draw(lit, bodyMesh, gl.TRIANGLES, 0, bodyMesh.count, vp, { light: light, alpha: 0.16 });
-        // the part's wall so far when it is one of the pair
+        // the part's wall so far when it is one of the pair, on top too
         if (partHighlighted) {
           var upto = Math.min(L - 1, F.layer[state.frame]);
+          gl.disable(gl.DEPTH_TEST);
           draw(lit, wallMesh, gl.TRIANGLES, 0, wStart[upto + 1], mvp, { model: model, light: light, alpha: 0.8, tint: [HIGHLIGHT[0], HIGHLIGHT[1], HIGHLIGHT[2], 1] });
+          gl.enable(gl.DEPTH_TEST);
         }
         gl.depthMask(true);
         gl.disable(gl.BLEND);
