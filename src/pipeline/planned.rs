@@ -434,6 +434,9 @@ impl PlannedPart {
             plan: &self.plan,
             travel_speed_mm_s: self.travel_speed_mm_s(),
             cycle: cycle.as_ref(),
+            keep_out: &self.cell.keep_out,
+            clearance: self.clearance.as_ref(),
+            refusal: self.refusal(),
         });
         crate::report::write_report(dest, &input)?;
         Ok(())
