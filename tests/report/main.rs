@@ -560,6 +560,7 @@ fn refused_part() -> waam_slicer::PlannedPart {
     let scene = CellScene {
         keep_out: vec![keep.clone()],
         clearance_mm: 10.0,
+        transits: true,
     };
     let e = check_cell(&program, &traj, &p.layers, &scene).unwrap_err();
     p.cell.keep_out = vec![keep];
