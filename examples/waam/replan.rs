@@ -119,9 +119,15 @@ fn replan(a: &ReplanArgs, quiet: bool) -> Result<bool, (u8, String)> {
             replanned.scan.inliers,
             replanned.scan.outlier_count,
             corrected,
-            match replanned.rejoined_at {
-                Some(l) => format!("nominal again from layer {l}"),
-                None => "the nominal layers are not rejoined".into(),
+            match (replanned.rejoined_at, replanned.skipped.as_slice()) {
+                (Some(l), []) => format!("nominal again from layer {l}"),
+                (Some(l), skipped) => format!(
+                    "nominal again from layer {l} (nominal layer {}; nominal layers {}..={} skipped, the rest renumbered)",
+                    l + skipped.len(),
+                    skipped[0],
+                    skipped[skipped.len() - 1]
+                ),
+                (None, _) => "the nominal layers are not rejoined".into(),
             },
             if feasible { "feasible" } else { "INFEASIBLE" },
             replanned.times.total,

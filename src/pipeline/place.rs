@@ -138,9 +138,9 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
     };
     // A candidate feasible on every layer must also pass the program stage
     // (the arc-off transits against the deposited wall, the set-up), as
-    // `plan` will check it. The whole cell is checked on every layer only
-    // (certification): on the screening subsample the wall is a few layers
-    // and the transits join layers far apart, motions the build never makes.
+    // `plan` will check it. On the screening subsample the whole-cell check
+    // leaves out the motions between beads: they join layers far apart,
+    // motions the build never makes (certification checks every one).
     let name = super::program_name(&part.name);
     let every_layer = layers.len();
     let accept = |layout: &crate::robot::CellLayout,
@@ -150,8 +150,8 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
             layout: layout.clone(),
             ..cell.clone()
         };
-        let whole_cell = layers.len() == every_layer;
-        super::planned::build(&name, &c, &sliced, layers, plan, &optimise, whole_cell).map(|_| ())
+        let whole_build = layers.len() == every_layer;
+        super::planned::build(&name, &c, &sliced, layers, plan, &optimise, whole_build).map(|_| ())
     };
     let placement = place_with(
         &cell.layout,

@@ -205,9 +205,11 @@ pub fn plan_part_with(
 }
 
 /// The program model of a plan, refused when a layer is infeasible or lost
-/// or (with `whole_cell`) a motion collides in the cell; with the closest
-/// approach per layer (empty without `whole_cell`) and the collision check's
-/// run time (s).
+/// or a motion collides in the cell; with the closest approach per layer
+/// and the collision check's run time (s). `every_layer`: `layers` are the
+/// whole build; `false` for a subsample (a placement's screening), whose
+/// transits between beads the cell check leaves out
+/// ([`CellScene::transits`](crate::program::cell_check::CellScene::transits)).
 pub(super) fn build(
     name: &str,
     cell: &Cell,
@@ -215,7 +217,7 @@ pub(super) fn build(
     layers: &[LayerPoints],
     plan: &Plan,
     opts: &OptimiseOptions,
-    whole_cell: bool,
+    every_layer: bool,
 ) -> Result<(Program, crate::program::cell_check::CellClearance, f64), ProgramError> {
     check_every_layer(layers, plan)?;
     let inputs = trajectory_inputs(layers, plan);
@@ -249,13 +251,11 @@ pub(super) fn build(
             .collect();
         program.set_payloads(common, &masses)?;
     }
-    if !whole_cell {
-        return Ok((program, Default::default(), 0.0));
-    }
     let t = Instant::now();
     let scene = crate::program::cell_check::CellScene {
         keep_out: cell.keep_out.clone(),
         clearance_mm: common.collision_clearance_mm,
+        transits: every_layer,
     };
     let clearance = crate::program::cell_check::check_cell(&program, &traj, layers, &scene)?;
     Ok((program, clearance, t.elapsed().as_secs_f64()))
@@ -434,6 +434,9 @@ impl PlannedPart {
             plan: &self.plan,
             travel_speed_mm_s: self.travel_speed_mm_s(),
             cycle: cycle.as_ref(),
+            keep_out: &self.cell.keep_out,
+            clearance: self.clearance.as_ref(),
+            refusal: self.refusal(),
         });
         crate::report::write_report(dest, &input)?;
         Ok(())

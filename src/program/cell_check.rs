@@ -39,6 +39,11 @@
 //! the positioner's base below the tilt body, the substrate beyond the
 //! hull of the layers.
 //!
+//! **Drawn as checked**: the report's 3-D view ([`crate::report`]) draws
+//! the arm's capsules, the table, the tilt body and the keep-out boxes from
+//! this module's body outlines (the same capsules, poses and radii), and
+//! highlights each layer's [`LayerClearance::closest_pair`].
+//!
 //! **Motions**: every bead point's planned joints; the linear moves into
 //! and out of each bead, the arc-off joint moves between beads and the
 //! home moves, interpolated linearly in joint space (exact for the joint
@@ -185,6 +190,12 @@ pub struct CellScene {
     pub keep_out: Vec<KeepOut>,
     /// Clearance every pair must keep (mm, ≥ 0).
     pub clearance_mm: f64,
+    /// Check the motions between beads (arc-off transits, home moves) as
+    /// well as the beads with their approach and retract. `false` where
+    /// the program's layers are a subsample of the build (a placement's
+    /// screening): its transits join layers far apart, motions the build
+    /// never makes.
+    pub transits: bool,
 }
 
 /// The closest approach of one layer's motions.
@@ -311,6 +322,130 @@ fn links(robot: &RobotModel, r: &LinkRadii, q: &Joints) -> [(&'static str, Capsu
         (WRIST, Capsule::new(c[5], c[6], r.wrist_mm)),
     ]
 }
+
+/// The positioner's table as the check models it: a cylinder of
+/// [`TABLE_RADIUS_MM`] × [`TABLE_THICKNESS_MM`] (parry's axis is its local
+/// Y; [`positioner_poses`] turns it onto the table's Z).
+fn table_cylinder() -> Cylinder {
+    Cylinder::new(0.5 * TABLE_THICKNESS_MM, TABLE_RADIUS_MM)
+}
+
+/// The positioner's tilt body as the check models it: a capsule of
+/// [`TILT_BODY_RADIUS_MM`] along the tilt axis (the positioner frame's Y),
+/// ±[`TABLE_RADIUS_MM`] about the tilt centre C7 (positioner frame).
+fn tilt_capsule() -> Capsule {
+    Capsule::new(
+        Point3::new(0.0, -TABLE_RADIUS_MM, 0.0),
+        Point3::new(0.0, TABLE_RADIUS_MM, 0.0),
+        TILT_BODY_RADIUS_MM,
+    )
+}
+
+/// Poses (robot base frame) of the table's cylinder ([`table_cylinder`])
+/// and of the tilt body ([`tilt_capsule`]) at positioner joints `qp` (rad):
+/// the table's cylinder below the table frame's origin, its axis on the
+/// table's Z; the tilt body on the positioner frame (it is round about the
+/// tilt axis, so `q7` does not move it).
+fn positioner_poses(c: &crate::robot::TorchCarriedCell, qp: &[f64; 2]) -> (Isometry3, Isometry3) {
+    let base_from_table = c.base_from_positioner * c.positioner.positioner_from_table(qp);
+    let table_pose = base_from_table
+        * Isometry3::translation(0.0, 0.0, -0.5 * TABLE_THICKNESS_MM)
+        * Isometry3::rotation(Vector3::x() * std::f64::consts::FRAC_PI_2);
+    (table_pose, c.base_from_positioner)
+}
+
+/// What kind of solid a [`BodyOutline`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub(crate) enum OutlineKind {
+    /// A capsule: the segment `a`–`b` swept by a ball of `radius_mm`.
+    Capsule,
+    /// A cylinder (flat ends) of `radius_mm` about the axis `a`–`b`.
+    Cylinder,
+    /// An axis-aligned box, lower corner `a`, upper corner `b`.
+    Box,
+}
+
+/// One body of the whole-cell check as the check models it, for drawing
+/// (the report's 3-D view): robot base frame, mm.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct BodyOutline {
+    /// The body's name, as [`LayerClearance::closest_pair`] and
+    /// [`ProgramError::Collision`] name it.
+    pub name: String,
+    /// Its solid.
+    pub kind: OutlineKind,
+    /// First segment end (capsule, cylinder) or lower corner (box), base frame (mm).
+    pub a: Point3,
+    /// Second segment end or upper corner, base frame (mm).
+    pub b: Point3,
+    /// Radius (mm; 0 for a box).
+    pub radius_mm: f64,
+}
+
+/// The arm's link capsules at controller joints `q` (rad), as [`check_cell`]
+/// checks them (robot base frame, mm): the J1 column, upper arm, forearm
+/// and the wrist's two capsules, with [`LinkRadii::for_robot`].
+pub(crate) fn arm_outlines(robot: &RobotModel, q: &Joints) -> Vec<BodyOutline> {
+    links(robot, &LinkRadii::for_robot(robot), q)
+        .iter()
+        .map(|(name, c)| BodyOutline {
+            name: (*name).to_string(),
+            kind: OutlineKind::Capsule,
+            a: c.segment.a,
+            b: c.segment.b,
+            radius_mm: c.radius,
+        })
+        .collect()
+}
+
+/// The positioner's table (a cylinder, moving with `qp`, rad) and its tilt
+/// body (a capsule, fixed) as [`check_cell`] checks them (robot base
+/// frame, mm).
+pub(crate) fn positioner_outlines(
+    c: &crate::robot::TorchCarriedCell,
+    qp: &[f64; 2],
+) -> [BodyOutline; 2] {
+    let (table_pose, tilt_pose) = positioner_poses(c, qp);
+    let table = table_cylinder();
+    let tilt = tilt_capsule();
+    // the cylinder's local axis is Y
+    let h = table.half_height;
+    [
+        BodyOutline {
+            name: TABLE.to_string(),
+            kind: OutlineKind::Cylinder,
+            a: table_pose * Point3::new(0.0, -h, 0.0),
+            b: table_pose * Point3::new(0.0, h, 0.0),
+            radius_mm: table.radius,
+        },
+        BodyOutline {
+            name: TILT.to_string(),
+            kind: OutlineKind::Capsule,
+            a: tilt_pose * tilt.segment.a,
+            b: tilt_pose * tilt.segment.b,
+            radius_mm: tilt.radius,
+        },
+    ]
+}
+
+/// The cell's keep-out boxes as [`check_cell`] checks them (robot base
+/// frame, mm).
+pub(crate) fn keep_out_outlines(keep_out: &[KeepOut]) -> Vec<BodyOutline> {
+    keep_out
+        .iter()
+        .map(|k| BodyOutline {
+            name: k.name.clone(),
+            kind: OutlineKind::Box,
+            a: Point3::from(k.min_mm),
+            b: Point3::from(k.max_mm),
+            radius_mm: 0.0,
+        })
+        .collect()
+}
+
+/// The name [`check_cell`] gives the part's hulls.
+pub(crate) const PART_NAME: &str = PART;
 
 fn capsule_body<'a>(name: &'a str, c: &'a Capsule) -> Body<'a> {
     let centre = Point3::from((c.segment.a.coords + c.segment.b.coords) * 0.5);
@@ -549,17 +684,13 @@ impl<'a> Checker<'a> {
         // the table frame's origin
         let half_t = 0.5 * TABLE_THICKNESS_MM;
         let table = Local {
-            shape: Box::new(Cylinder::new(half_t, TABLE_RADIUS_MM)),
+            shape: Box::new(table_cylinder()),
             centre: Point3::origin(),
             radius: (TABLE_RADIUS_MM.powi(2) + half_t.powi(2)).sqrt(),
             margin: 0.0,
         };
         let tilt = Local {
-            shape: Box::new(Capsule::new(
-                Point3::new(0.0, -TABLE_RADIUS_MM, 0.0),
-                Point3::new(0.0, TABLE_RADIUS_MM, 0.0),
-                TILT_BODY_RADIUS_MM,
-            )),
+            shape: Box::new(tilt_capsule()),
             centre: Point3::origin(),
             radius: TABLE_RADIUS_MM + TILT_BODY_RADIUS_MM,
             margin: 0.0,
@@ -644,14 +775,7 @@ impl<'a> Checker<'a> {
         match self.cell {
             CellLayout::TorchCarried(c) => {
                 if let Some(qp) = s.qp {
-                    let base_from_positioner = c.base_from_positioner;
-                    let base_from_table =
-                        base_from_positioner * c.positioner.positioner_from_table(&qp);
-                    let table_pose = base_from_table
-                        * Isometry3::translation(0.0, 0.0, -0.5 * TABLE_THICKNESS_MM)
-                        * Isometry3::rotation(Vector3::x() * std::f64::consts::FRAC_PI_2);
-                    // the tilt axis is the positioner frame's Y, turned by q7
-                    let tilt_pose = base_from_positioner;
+                    let (table_pose, tilt_pose) = positioner_poses(c, &qp);
                     let t = all.len();
                     all.push(self.table.at(TABLE, table_pose));
                     all.push(self.tilt.at(TILT, tilt_pose));
@@ -861,7 +985,7 @@ pub fn check_cell(
     // first point, last point → retract, the transits, last → home
     let pts = &program.points;
     let home = program.home.as_ref();
-    if let (Some(h), Some(first)) = (home, pts.first()) {
+    if let (Some(h), Some(first)) = (home.filter(|_| scene.transits), pts.first()) {
         run(
             Sample {
                 q: &h.joints,
@@ -891,6 +1015,7 @@ pub fn check_cell(
         let motion = match (a.arc, b.arc) {
             (ArcFlag::Approach, ArcFlag::Start) => "approach",
             (ArcFlag::End, ArcFlag::Retract) => "retract",
+            _ if !scene.transits => continue,
             _ => "arc-off transit",
         };
         run(
@@ -913,7 +1038,7 @@ pub fn check_cell(
             &mut stats,
         )?;
     }
-    if let (Some(h), Some(last)) = (home, pts.last()) {
+    if let (Some(h), Some(last)) = (home.filter(|_| scene.transits), pts.last()) {
         run(
             Sample {
                 q: &last.joints,

@@ -21,7 +21,11 @@
 //!    §3.1.4, started from the measured layer instead of the substrate);
 //!    the next layer is built on that one, and so on until a layer lands on
 //!    its nominal layer at every point: from there on the nominal layers
-//!    and speed are kept.
+//!    and speed are kept. Where the wall stands half a layer high or more,
+//!    the layers may instead aim at a later nominal layer (layer `K+1` at
+//!    nominal `K+2`, ..), when that rejoins in fewer layers: the skipped
+//!    nominal layers are named ([`ReplannedPart::skipped`]) and the layers
+//!    after them renumbered so that the build's numbering has no gap.
 //!
 //! The predicted error of a layer is its predicted top minus its nominal top
 //! along the column (mm, + high); "before" is what the nominal plan would
@@ -90,6 +94,14 @@ pub struct ReplanOptions {
     /// Fewest points of layer `K` with scan data of their own, as a fraction
     /// (relative); fewer: refused, too little of the layer was seen.
     pub min_coverage: f64,
+    /// Whether the rebuilt layers may rejoin a later nominal layer than
+    /// `K+1` (skipping nominal layers) when that rejoins in fewer layers.
+    /// At most as many nominal layers are skipped as the highest point of
+    /// the measured top stands above its nominal, in layers, rounded (none
+    /// while the wall is nowhere half a layer high, so that the speed
+    /// correction of layer `K+1` stays as it is). `false`: always aim at
+    /// `K+1, K+2, ..`.
+    pub skip_nominal_layers: bool,
 }
 
 impl Default for ReplanOptions {
@@ -101,6 +113,7 @@ impl Default for ReplanOptions {
             max_wall_offset_mm: None,
             min_inlier_fraction: 0.5,
             min_coverage: 0.5,
+            skip_nominal_layers: true,
         }
     }
 }
@@ -325,6 +338,9 @@ impl ErrorStats {
 pub struct LayerCorrection {
     /// Layer index (the build's numbering).
     pub layer: usize,
+    /// The nominal layer it stands for: `layer` plus the nominal layers
+    /// skipped ([`ReplannedPart::skipped`]).
+    pub nominal_layer: usize,
     /// Whether its points or speeds differ from the nominal plan's.
     pub corrected: bool,
     /// Per point: the travel speed (mm/s).
@@ -384,6 +400,11 @@ pub struct ReplannedPart {
     /// The first layer that lands on its nominal layer at every point
     /// (`None`: none of the remaining layers does).
     pub rejoined_at: Option<usize>,
+    /// The nominal layers never laid, `K+1..=K+s` (empty: none): the
+    /// rebuilt layers rejoin nominal layer `rejoined_at + s`, and every
+    /// layer from there on is the nominal layer `s` further on, renumbered
+    /// so that the build's numbering runs on without a gap.
+    pub skipped: Vec<usize>,
     /// The first nominal layer dropped because the rebuilt layers reach the
     /// part's end before it (a wall still too high near the top); `None`:
     /// every layer is kept.
@@ -511,6 +532,7 @@ impl ReplannedPart {
                 let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
                 CorrectionSummary {
                     layer: c.layer,
+                    nominal_layer: c.nominal_layer,
                     corrected: c.corrected,
                     clamped_points: c.clamped.iter().filter(|x| **x).count(),
                     speed_min_mm_s: min(&c.speed_mm_s),
@@ -551,6 +573,8 @@ impl ReplannedPart {
                 speed_window_mm_s: self.speed_window_mm_s,
                 height_window_mm: self.height_window_mm,
                 rejoined_at_layer: self.rejoined_at,
+                rejoined_at_nominal_layer: self.rejoined_at.map(|l| l + self.skipped.len()),
+                nominal_layers_skipped: self.skipped.clone(),
                 layers_dropped_from: self.dropped_from,
                 corrected_layers: self.corrections.iter().filter(|c| c.corrected).count(),
                 resume_payload: self.resume_payload.map(|(mass_kg, c)| PayloadSummary {
@@ -737,7 +761,8 @@ fn replan_core(
         speed_max_mm_s: process.travel_speed_max_mm_s,
     };
     let t_meas = rebuild::measured_t(&part.tube, path, frames, k, &scan.error_mm);
-    let (rebuilt, ended_at) = rebuild::rebuild(&part.tube, path, k, &cols, &t_meas, &window)?;
+    let chosen = rebuild_fewest(part, path, k, &cols, &t_meas, &window, &scan, ropts)?;
+    let (rebuilt, ended_at, s) = (chosen.layers, chosen.ended_at, chosen.skip);
     if ended_at == Some(k + 1) {
         return Err(ReplanError::NoRoot {
             layer: k + 1,
@@ -748,19 +773,27 @@ fn replan_core(
         .into());
     }
     // a wall still too high near the top: the layers from `ended_at` on no
-    // longer fit below the part's end and are dropped
-    let end = ended_at.unwrap_or(nlayers);
+    // longer fit below the part's end and are dropped; the nominal layers
+    // K+1..=K+s are skipped, the others renumbered (nominal l + s is layer l)
+    let end = ended_at.unwrap_or(nlayers - s);
     let rejoined_at = rebuilt
         .last()
         .filter(|l| l.clamped.iter().all(|c| !c))
         .map(|l| l.layer);
+    let mut new_path = path.clone();
+    new_path.layers.truncate(end + s);
+    new_path.layers.drain(k + 1..k + 1 + s);
+    for l in &mut new_path.layers[k + 1..] {
+        l.slice -= s;
+    }
     // Per remaining layer: before / after errors, speeds, heights.
     let corrections: Vec<LayerCorrection> = (k + 1..end)
         .map(|l| {
-            let before: Vec<f64> = cols[l - k].iter().map(|&c| scan.error_mm[c]).collect();
+            let before: Vec<f64> = cols[l + s - k].iter().map(|&c| scan.error_mm[c]).collect();
             match rebuilt.iter().find(|r| r.layer == l) {
                 Some(r) => LayerCorrection {
                     layer: l,
+                    nominal_layer: r.nominal,
                     corrected: true,
                     speed_mm_s: r.speed_mm_s.clone(),
                     height_mm: r.height_mm.clone(),
@@ -769,9 +802,10 @@ fn replan_core(
                     error_after_mm: r.error_after_mm.clone(),
                 },
                 None => {
-                    let pts = &path.layers[l].points;
+                    let pts = &new_path.layers[l].points;
                     LayerCorrection {
                         layer: l,
+                        nominal_layer: l + s,
                         corrected: false,
                         speed_mm_s: vec![v_nom; pts.len()],
                         height_mm: pts
@@ -787,8 +821,6 @@ fn replan_core(
         })
         .collect();
     // The new path: the corrected layers' points, their heights as deltas.
-    let mut new_path = path.clone();
-    new_path.layers.truncate(end);
     for r in &rebuilt {
         for (m, p) in new_path.layers[r.layer].points.iter_mut().enumerate() {
             p.t = r.t[m];
@@ -811,7 +843,8 @@ fn replan_core(
         source: Box::new(e.into()),
     })?;
     let mut process_plan = sliced.process_plan.clone();
-    process_plan.points.truncate(end);
+    process_plan.points.truncate(end + s);
+    process_plan.points.drain(k + 1..k + 1 + s);
     for r in &rebuilt {
         process_plan.points[r.layer] = r
             .speed_mm_s
@@ -858,14 +891,15 @@ fn replan_core(
     let reused: Option<Vec<_>> = nominal.and_then(|(layers, plan)| {
         rest.iter()
             .map(|lp| {
-                let i = layers.iter().position(|n| n.layer == lp.layer)?;
+                // the nominal layer it stands for (renumbered after a skip)
+                let i = layers.iter().position(|n| n.layer == lp.layer + s)?;
                 let same = layers[i].points.len() == lp.points.len()
                     && layers[i].points.iter().zip(&lp.points).all(|(a, b)| {
                         (a.position_mm - b.position_mm).norm() <= 1e-9
                             && (a.tool_axis.into_inner() - b.tool_axis.into_inner()).norm() <= 1e-9
                     });
-                let pl = plan.layers.get(i).filter(|p| p.layer == lp.layer)?;
-                same.then(|| pl.clone())
+                let pl = plan.layers.get(i).filter(|p| p.layer == lp.layer + s)?;
+                same.then(|| renumbered(pl, lp.layer))
             })
             .collect()
     });
@@ -940,10 +974,60 @@ fn replan_core(
         speed_window_mm_s: [window.speed_min_mm_s, window.speed_max_mm_s],
         height_window_mm: [window.height_min_mm(), window.height_max_mm()],
         rejoined_at,
+        skipped: (k + 1..=k + s).collect(),
         dropped_from: ended_at,
         resume_payload,
         times,
     })
+}
+
+/// The rebuild that rejoins the nominal layers in the fewest layers: the
+/// march aimed at `K+1, K+2, ..` and, when `ropts` allows it and the wall
+/// stands half a layer high or more somewhere, the marches aimed `s` nominal
+/// layers further on, `s` up to the highest point's height in layers
+/// (rounded). A skip is taken only when it rejoins in strictly fewer layers
+/// (or the march without it never rejoins); a march with a skip that fails
+/// or does not rejoin is left aside.
+#[allow(clippy::too_many_arguments)]
+fn rebuild_fewest(
+    part: &Part,
+    path: &crate::path::Path,
+    k: usize,
+    cols: &[Vec<usize>],
+    t_meas: &[f64],
+    window: &Window,
+    scan: &ScanEstimate,
+    ropts: &ReplanOptions,
+) -> Result<rebuild::Rebuilt, ReplanError> {
+    let mut best = rebuild::rebuild(&part.tube, path, k, cols, t_meas, window, 0)?;
+    if !ropts.skip_nominal_layers {
+        return Ok(best);
+    }
+    let highest = scan.error_mm.iter().copied().fold(0.0, f64::max);
+    let room = path.layers.len().saturating_sub(k + 2);
+    let max_skip = ((highest / path.delta_mm).round() as usize).min(room);
+    for skip in 1..=max_skip {
+        let Ok(r) = rebuild::rebuild(&part.tube, path, k, cols, t_meas, window, skip) else {
+            continue;
+        };
+        if let Some(j) = r.layers_to_rejoin() {
+            if best.layers_to_rejoin().is_none_or(|b| j < b) {
+                best = r;
+            }
+        }
+    }
+    Ok(best)
+}
+
+/// A nominal layer's plan as the replanned layer `layer` (renumbered after
+/// skipped nominal layers).
+fn renumbered(plan: &crate::optimise::LayerPlan, layer: usize) -> crate::optimise::LayerPlan {
+    let mut p = plan.clone();
+    p.layer = layer;
+    for v in &mut p.violations {
+        v.layer = layer;
+    }
+    p
 }
 
 /// Arc-off moves between consecutive planned layers (as the optimiser
@@ -1072,6 +1156,7 @@ fn resumed_program(
     let scene = CellScene {
         keep_out: cell.keep_out.clone(),
         clearance_mm: common.collision_clearance_mm,
+        transits: true,
     };
     let clearance = check_cell(&program, &traj, layers, &scene)?;
     Ok((program, clearance, t.elapsed().as_secs_f64()))

@@ -5,6 +5,11 @@
 //! allows) from the layer below as it will stand — the constant-distance
 //! march [SPEC §3.1.4] started from the measured layer (geometry
 //! correction) — until a layer lands on the nominal one everywhere.
+//!
+//! The march may aim at a later nominal layer ([`rebuild`]'s `skip`): the
+//! `i`-th layer laid after `K` then aims at nominal layer `K + skip + i`,
+//! and the nominal layers `K+1..=K+skip` are never laid (a wall that stands
+//! a layer high over part of its length is already, there, the next layer).
 //! Part frame, mm, mm/s.
 
 use rayon::prelude::*;
@@ -50,8 +55,12 @@ impl Window {
 /// One layer as replanned, its points in the path's order.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct RebuiltLayer {
-    /// Layer index in the path.
+    /// Layer index in the replanned path (the build's numbering: `K + i`
+    /// for the `i`-th layer laid after `K`).
     pub layer: usize,
+    /// The nominal layer it aims at and takes its point order from (`layer
+    /// + skip`).
+    pub nominal: usize,
     /// Guide parameter of each point.
     pub t: Vec<f64>,
     /// Position of each point (part frame, mm).
@@ -70,6 +79,36 @@ pub(super) struct RebuiltLayer {
 /// One rebuilt point: its guide parameter, its bead height (mm) and
 /// whether the height was clamped to the window.
 type Solved = (f64, f64, bool);
+
+/// The layers rebuilt from the measured top, aiming at the nominal layers
+/// `skip` layers further on.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Rebuilt {
+    /// Nominal layers skipped: the `i`-th layer laid after `K` aims at
+    /// nominal layer `K + skip + i`.
+    pub skip: usize,
+    /// The rebuilt layers, in order, the last one the first back on its
+    /// nominal layer at every point when [`Rebuilt::rejoined`].
+    pub layers: Vec<RebuiltLayer>,
+    /// The first layer (replanned numbering) that no longer fits below the
+    /// part's end, if the rebuild stopped there.
+    pub ended_at: Option<usize>,
+}
+
+impl Rebuilt {
+    /// Whether the last rebuilt layer lands on its nominal layer at every
+    /// point.
+    pub fn rejoined(&self) -> bool {
+        self.layers
+            .last()
+            .is_some_and(|l| l.clamped.iter().all(|c| !c))
+    }
+
+    /// The layers laid until the nominal ones are rejoined (`None`: never).
+    pub fn layers_to_rejoin(&self) -> Option<usize> {
+        self.rejoined().then_some(self.layers.len())
+    }
+}
 
 /// For every layer from `k` on, the column (point index of layer `k`) of
 /// each of its points, matched by profile angle `v`.
@@ -188,7 +227,11 @@ fn signed_error(
 /// point (that one included), and the first layer that no longer fits
 /// below the part's end (`t_max`), if the rebuild stopped there (a wall
 /// still too high near the top: the part is finished one or more layers
-/// early). `cols` from [`columns`].
+/// early). The `i`-th layer laid aims at nominal layer `k + skip + i`
+/// (each point the nominal point where the window lays it, else the
+/// nearest height the window allows); the rebuild stops without rejoining
+/// when the nominal layers run out. `cols` from [`columns`].
+#[allow(clippy::too_many_arguments)]
 pub(super) fn rebuild(
     tube: &Tube,
     path: &Path,
@@ -196,15 +239,17 @@ pub(super) fn rebuild(
     cols: &[Vec<usize>],
     t_measured: &[f64],
     window: &Window,
-) -> Result<(Vec<RebuiltLayer>, Option<usize>), ReplanError> {
+    skip: usize,
+) -> Result<Rebuilt, ReplanError> {
     let n = t_measured.len();
     let vs: Vec<f64> = path.layers[k].points.iter().map(|p| p.v).collect();
     let t_hi = tube.range().t_max;
     let (h_lo, h_hi) = (window.height_min_mm(), window.height_max_mm());
     let mut t_below = t_measured.to_vec();
     let mut out = Vec::new();
-    for (offset, layer) in path.layers.iter().enumerate().skip(k + 1) {
-        let col_of = &cols[offset - k];
+    for (nominal, layer) in path.layers.iter().enumerate().skip(k + 1 + skip) {
+        let offset = nominal - skip;
+        let col_of = &cols[nominal - k];
         // nominal t per column
         let mut t_nom = vec![0.0; n];
         for (m, &c) in col_of.iter().enumerate() {
@@ -248,16 +293,21 @@ pub(super) fn rebuild(
             .collect();
         let solved: Vec<Option<(f64, f64, bool)>> = solved.into_iter().collect::<Result<_, _>>()?;
         let Some(solved) = solved.into_iter().collect::<Option<Vec<_>>>() else {
-            return Ok((out, Some(offset)));
+            return Ok(Rebuilt {
+                skip,
+                layers: out,
+                ended_at: Some(offset),
+            });
         };
         // the nominal layer in column order, to measure the error after
-        let nominal = SegmentIndex::new(vec![(
+        let nominal_index = SegmentIndex::new(vec![(
             (0..n).map(|c| tube.point(t_nom[c], vs[c])).collect(),
             true,
         )]);
         // back to the layer's own point order
         let mut rl = RebuiltLayer {
             layer: offset,
+            nominal,
             t: Vec::with_capacity(n),
             position: Vec::with_capacity(n),
             height_mm: Vec::with_capacity(n),
@@ -277,7 +327,7 @@ pub(super) fn rebuild(
                 segment: c,
             };
             rl.error_after_mm
-                .push(signed_error(tube, &nominal, hint, vs[c], t, t_nom[c]));
+                .push(signed_error(tube, &nominal_index, hint, vs[c], t, t_nom[c]));
         }
         let rejoined = rl.clamped.iter().all(|c| !c);
         out.push(rl);
@@ -288,5 +338,9 @@ pub(super) fn rebuild(
             t_below[c] = s.0;
         }
     }
-    Ok((out, None))
+    Ok(Rebuilt {
+        skip,
+        layers: out,
+        ended_at: None,
+    })
 }

@@ -34,8 +34,16 @@ pub struct ReplanDetails {
     pub speed_window_mm_s: [f64; 2],
     /// The bead heights that window gives (mm).
     pub height_window_mm: [f64; 2],
-    /// The first layer back on its nominal layer.
+    /// The first layer back on its nominal layer (the build's numbering).
     pub rejoined_at_layer: Option<usize>,
+    /// The nominal layer it lands on: `rejoined_at_layer` plus the nominal
+    /// layers skipped.
+    pub rejoined_at_nominal_layer: Option<usize>,
+    /// Nominal layers never laid (empty: none): the wall already stood a
+    /// layer high over part of layer K, so the rebuilt layers rejoin a later
+    /// nominal layer, and the layers after them are renumbered (nominal
+    /// layer `l + skipped` is laid as layer `l`).
+    pub nominal_layers_skipped: Vec<usize>,
     /// Nominal layers from this one on no longer fit below the part's end.
     pub layers_dropped_from: Option<usize>,
     /// Layers whose speed or geometry was corrected.
@@ -105,8 +113,10 @@ pub struct PayloadSummary {
 /// One remaining layer's correction.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CorrectionSummary {
-    /// The layer.
+    /// The layer (the build's numbering).
     pub layer: usize,
+    /// The nominal layer it stands for (`layer` plus the layers skipped).
+    pub nominal_layer: usize,
     /// Its speed or geometry was corrected.
     pub corrected: bool,
     /// Points whose speed was clamped to the window.

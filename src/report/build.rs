@@ -9,6 +9,10 @@ use super::encode::{f32s, i8s, u32s, unit_i8};
 use super::{PlanView, ReportError, ReportInput};
 use crate::geometry::Substrate;
 use crate::math::{Point3, Vector3};
+use crate::program::cell_check::{
+    arm_outlines, keep_out_outlines, positioner_outlines, BodyOutline, OutlineKind, PART_NAME,
+};
+use crate::program::ProgramError;
 use crate::robot::CellLayout;
 
 /// Indices kept of a run of `n` points with stride `k`: `0, k, 2k, ...` and `n − 1`.
@@ -273,6 +277,19 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             text: v.to_string(),
         }));
     }
+    // a collision refusal marks its point (the layer's first for a home move)
+    if let Some(pv) = &input.plan {
+        if let Some(e @ ProgramError::Collision { layer, point, .. }) = pv.refusal {
+            if let Some(l) = pv.layers.iter().position(|lp| lp.layer == *layer) {
+                let n = path.layers[l].points.len();
+                marks.push(Mark {
+                    layer: l,
+                    point: point.unwrap_or(0).min(n.saturating_sub(1)),
+                    text: format!("collision: {e}"),
+                });
+            }
+        }
+    }
     if let Some(pr) = input.process {
         marks.extend(pr.violations.iter().map(|v| Mark {
             layer: v.layer,
@@ -467,6 +484,62 @@ pub(super) struct PlanData<'a> {
     f_torch: String,
     f_table: String,
     f_part: String,
+    /// The whole-cell check's bodies (robot base frame, mm), as
+    /// [`crate::program::cell_check`] models them: the moving ones first
+    /// (their ends per frame in `f_bodies`), then the fixed ones.
+    bodies: Vec<BodyData>,
+    /// Base64 `Float32Array`: per frame, the ends `a`, `b` of every moving
+    /// body of `bodies` (6 floats a body; NaN without joints), base frame (mm).
+    f_bodies: String,
+    /// Per plan layer (the index of `f_layer`): the whole-cell check's
+    /// closest approach and pair; empty when the check did not run.
+    closest: Vec<ClosestData>,
+    /// The program's collision refusal, `null` without one.
+    collision: Option<CollisionData>,
+    /// The name the check gives the part (its wall so far).
+    part_body: &'static str,
+}
+
+/// One body of the whole-cell check (robot base frame, mm).
+#[derive(Serialize)]
+struct BodyData {
+    name: String,
+    kind: OutlineKind,
+    radius_mm: f64,
+    /// `true`: its ends are per frame in `f_bodies`; else in `a`, `b`.
+    moving: bool,
+    /// Segment end or lower corner of a fixed body (mm).
+    a: Option<[f64; 3]>,
+    /// Segment end or upper corner of a fixed body (mm).
+    b: Option<[f64; 3]>,
+}
+
+/// A layer's closest approach (`CellClearance`'s `LayerClearance`).
+#[derive(Serialize, Debug, Clone, PartialEq)]
+pub(crate) struct ClosestData {
+    /// The layer's number (`LayerPoints::layer`).
+    pub layer: usize,
+    /// Closest approach (mm; `null` when no pair was measured).
+    pub distance_mm: Option<f64>,
+    /// The two bodies, as the check names them.
+    pub pair: Option<[String; 2]>,
+}
+
+/// A collision refusal (`ProgramError::Collision`).
+#[derive(Serialize)]
+struct CollisionData {
+    /// Index of the layer in the plan (`f_layer`'s numbering), `null` if
+    /// the refused layer is not one of the plan's.
+    layer_index: Option<usize>,
+    layer: usize,
+    point: Option<usize>,
+    motion: &'static str,
+    body_a: String,
+    body_b: String,
+    distance_mm: f64,
+    clearance_mm: f64,
+    /// The refusal's message.
+    text: String,
 }
 
 /// `value` as JSON text that can sit inside a `<script>` element: `<`, `>`,
@@ -597,6 +670,19 @@ fn plan_data<'a>(input: &ReportInput<'a>, pv: &PlanView<'a>) -> (PlanData<'a>, V
     let (mut f_layer, mut f_point, mut f_time, mut f_rz) = (vec![], vec![], vec![], vec![]);
     let (mut f_joints, mut f_chain, mut f_torch, mut f_table, mut f_part) =
         (vec![], vec![], vec![], vec![], vec![]);
+    // the check's bodies: the arm's capsules and the table move, the tilt
+    // body and the keep-out boxes do not
+    let q0 = [0.0; 6];
+    let mut moving_bodies = arm_outlines(robot, &q0);
+    let mut fixed_bodies: Vec<BodyOutline> = Vec::new();
+    if let CellLayout::TorchCarried(c) = pv.cell {
+        let [table, tilt] = positioner_outlines(c, &[0.0, 0.0]);
+        moving_bodies.push(table);
+        fixed_bodies.push(tilt);
+    }
+    fixed_bodies.extend(keep_out_outlines(pv.keep_out));
+    let arm_bodies = arm_outlines(robot, &q0).len();
+    let mut f_bodies: Vec<f32> = vec![];
     let mut clock = 0.0;
     let mut prev: Option<Point3> = None;
     let mut g = 0usize;
@@ -645,6 +731,22 @@ fn plan_data<'a>(input: &ReportInput<'a>, pv: &PlanView<'a>) -> (PlanData<'a>, V
                         }
                     }
                     None => f_table.extend([f32::NAN; 9]),
+                }
+                // the moving bodies in the order of `moving_bodies`: the arm's
+                // capsules (NaN without joints), the table (NaN without a pose)
+                let mut put = |o: Option<&BodyOutline>| match o {
+                    Some(o) => {
+                        f_bodies.extend([o.a, o.b].iter().flat_map(|p| p.iter().map(|v| *v as f32)))
+                    }
+                    None => f_bodies.extend([f32::NAN; 6]),
+                };
+                let arm = q.map(|q| arm_outlines(robot, &q));
+                for k in 0..arm_bodies {
+                    put(arm.as_ref().and_then(|a| a.get(k)));
+                }
+                if let CellLayout::TorchCarried(c) = pv.cell {
+                    let table = positioner.as_ref().map(|e| positioner_outlines(c, e));
+                    put(table.as_ref().map(|[t, _]| t));
                 }
                 match s.base_from_part {
                     Some(t) => {
@@ -704,6 +806,15 @@ fn plan_data<'a>(input: &ReportInput<'a>, pv: &PlanView<'a>) -> (PlanData<'a>, V
         f_torch: f32s(&f_torch),
         f_table: f32s(&f_table),
         f_part: f32s(&f_part),
+        bodies: moving_bodies
+            .into_iter()
+            .map(|o| body_data(o, true))
+            .chain(fixed_bodies.into_iter().map(|o| body_data(o, false)))
+            .collect(),
+        f_bodies: f32s(&f_bodies),
+        closest: closest_per_layer(pv),
+        collision: collision_data(pv),
+        part_body: PART_NAME,
     };
     let mut notes = vec![];
     if k > 1 {
@@ -712,4 +823,66 @@ fn plan_data<'a>(input: &ReportInput<'a>, pv: &PlanView<'a>) -> (PlanData<'a>, V
         ));
     }
     (data, notes)
+}
+
+fn body_data(o: BodyOutline, moving: bool) -> BodyData {
+    let xyz = |p: Point3| [p.x, p.y, p.z];
+    BodyData {
+        name: o.name,
+        kind: o.kind,
+        radius_mm: o.radius_mm,
+        moving,
+        a: (!moving).then(|| xyz(o.a)),
+        b: (!moving).then(|| xyz(o.b)),
+    }
+}
+
+/// The whole-cell check's closest approach and pair of every layer of the
+/// plan, in the plan's order (empty without a check).
+pub(crate) fn closest_per_layer(pv: &PlanView) -> Vec<ClosestData> {
+    let Some(c) = pv.clearance else {
+        return Vec::new();
+    };
+    pv.layers
+        .iter()
+        .map(|l| {
+            let lc = c.layers.iter().find(|lc| lc.layer == l.layer);
+            ClosestData {
+                layer: l.layer,
+                distance_mm: lc
+                    .map(|lc| lc.closest_approach_mm)
+                    .filter(|d| d.is_finite()),
+                pair: lc
+                    .and_then(|lc| lc.closest_pair.clone())
+                    .map(|(a, b)| [a, b]),
+            }
+        })
+        .collect()
+}
+
+fn collision_data(pv: &PlanView) -> Option<CollisionData> {
+    let e = pv.refusal?;
+    let ProgramError::Collision {
+        layer,
+        point,
+        motion,
+        body_a,
+        body_b,
+        distance_mm,
+        clearance_mm,
+    } = e
+    else {
+        return None;
+    };
+    Some(CollisionData {
+        layer_index: pv.layers.iter().position(|l| l.layer == *layer),
+        layer: *layer,
+        point: *point,
+        motion,
+        body_a: body_a.clone(),
+        body_b: body_b.clone(),
+        distance_mm: *distance_mm,
+        clearance_mm: *clearance_mm,
+        text: e.to_string(),
+    })
 }

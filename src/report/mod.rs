@@ -17,7 +17,13 @@
 //! and [`RobotModel::flange_pose`](crate::robot::model::RobotModel), so the
 //! script only draws), the torch and positioner, animated along the plan
 //! with live joint values and limit margins, and the plan's violations
-//! marked on the path.
+//! marked on the path. The whole-cell check's bodies
+//! ([`crate::program::cell_check`]: the arm's link capsules, the
+//! positioner's table and tilt body, the keep-out boxes) are drawn as the
+//! check models them, translucent, moving with the animation; the layer's
+//! closest pair is drawn in red (the part's wall when it is one of them)
+//! and named with its distance; a collision refusal marks its layer and
+//! names its bodies.
 //!
 //! A second page shows a tube fitted to a mesh ([`write_fit_report`],
 //! [`FitReportInput`]): the mesh with its vertices coloured by their
@@ -111,6 +117,17 @@ pub struct PlanView<'a> {
     /// The program's cycle time (s, per layer and for the build), shown
     /// beside the animation's clock; `None` without a program.
     pub cycle: Option<&'a crate::program::cycle::CycleTime>,
+    /// The cell's `[[keep_out]]` boxes (robot base frame, mm), drawn with
+    /// the check's other bodies ([`crate::program::cell_check`]).
+    pub keep_out: &'a [crate::program::cell_check::KeepOut],
+    /// The whole-cell check's closest approach per layer, shown per layer
+    /// with its two bodies highlighted; `None` when the check did not run
+    /// or refused the program.
+    pub clearance: Option<&'a crate::program::cell_check::CellClearance>,
+    /// The program stage's refusal, if any: a
+    /// [`ProgramError::Collision`](crate::program::ProgramError::Collision)
+    /// marks its layer and highlights its two bodies.
+    pub refusal: Option<&'a crate::program::ProgramError>,
 }
 
 /// Everything a report shows. Geometry is in the part frame (mm) except the

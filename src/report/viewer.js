@@ -86,8 +86,30 @@
   if (P) {
     F = {
       n: P.frames, layer: u32(P.f_layer), point: u32(P.f_point), time: f32(P.f_time), rz: f32(P.f_rz),
-      joints: f32(P.f_joints), chain: f32(P.f_chain), torch: f32(P.f_torch), table: f32(P.f_table), part: f32(P.f_part)
+      joints: f32(P.f_joints), chain: f32(P.f_chain), torch: f32(P.f_torch), table: f32(P.f_table), part: f32(P.f_part),
+      bodies: f32(P.f_bodies)
     };
+  }
+  // the whole-cell check's bodies: the moving ones' ends are per frame
+  var BODIES = P ? P.bodies : [], movingBodies = 0;
+  BODIES.forEach(function (b) { if (b.moving) movingBodies += 1; });
+  // the pair to highlight at frame f: the refused collision on its layer,
+  // else the layer's closest pair; with the HUD's text
+  function closestAt(f) {
+    if (!F) return null;
+    var li = F.layer[f], c = P.collision;
+    if (c && c.layer_index === li) {
+      return { names: [c.body_a, c.body_b], collision: true,
+        text: 'COLLISION (program refused): ' + c.body_a + '\u2013' + c.body_b + ' ' +
+          (c.distance_mm < 0 ? fmt(-c.distance_mm, 1) + ' mm into each other' : fmt(c.distance_mm, 1) + ' mm') +
+          ', clearance ' + fmt(c.clearance_mm, 1) + ' mm (' + c.motion + ')' };
+    }
+    var k = P.closest[li];
+    if (k && k.pair) {
+      return { names: k.pair, collision: false,
+        text: 'closest: ' + k.pair[0] + '\u2013' + k.pair[1] + ' ' + (k.distance_mm === null ? '\u2014' : fmt(k.distance_mm, 1)) + ' mm' };
+    }
+    return null;
   }
 
   // ---- colour maps ----
@@ -138,6 +160,12 @@
     var fe = line(summary, P.feasible ? 'plan feasible' : 'plan INFEASIBLE (layers ' + P.infeasible_layers.join(', ') + ')');
     fe.style.fontWeight = 'bold';
     fe.style.color = P.feasible ? '#17692c' : '#b00020';
+    if (P.collision) {
+      var co = line(summary, 'program REFUSED, collision on layer ' + P.collision.layer + ': ' + P.collision.body_a +
+        ' \u2013 ' + P.collision.body_b + ' (' + P.collision.text + ')');
+      co.style.fontWeight = 'bold';
+      co.style.color = '#b00020';
+    }
   }
   D.notes.forEach(function (n) { line($('notes'), n); });
   var fieldSel = $('field');
@@ -151,7 +179,8 @@
   loSlider.max = hiSlider.max = String(L - 1);
   hiSlider.value = String(L - 1);
   var state = { field: 0, lo: 0, hi: L - 1, axes: false, wall: false, substrate: true, marks: true,
-    cell: !!P, frame: 0, playing: false, speed: 100, clock: 0, only: null, mesh: true, tube: true, unlit: false };
+    cell: !!P, frame: 0, playing: false, speed: 100, clock: 0, only: null, bodies: true, highlight: true,
+    mesh: true, tube: true, unlit: false };
   if (marks.length) {
     $('marks-section').hidden = false;
     marks.slice(0, 500).forEach(function (m) {
@@ -219,7 +248,7 @@
     gl.linkProgram(p);
     if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error('program: ' + gl.getProgramInfoLog(p));
     var u = {};
-    ['u_mvp', 'u_model', 'u_alpha', 'u_size', 'u_light'].forEach(function (n) { u[n] = gl.getUniformLocation(p, n); });
+    ['u_mvp', 'u_model', 'u_alpha', 'u_size', 'u_light', 'u_tint'].forEach(function (n) { u[n] = gl.getUniformLocation(p, n); });
     return { p: p, u: u, n: attribs.length };
   }
   var flat = program(
@@ -232,8 +261,9 @@
     'varying vec3 v_col; varying vec3 v_n;' +
     'void main() { gl_Position = u_mvp * vec4(a_pos, 1.0); v_n = (u_model * vec4(a_nrm, 0.0)).xyz; v_col = a_col; }',
     'precision mediump float; varying vec3 v_col; varying vec3 v_n; uniform float u_alpha; uniform vec3 u_light;' +
+    ' uniform vec4 u_tint;' +
     'void main() { vec3 n = normalize(v_n); float d = abs(dot(n, u_light));' +
-    ' gl_FragColor = vec4(v_col * (0.35 + 0.65 * d), u_alpha); }', ['a_pos', 'a_col', 'a_nrm']);
+    ' gl_FragColor = vec4(mix(v_col, u_tint.rgb, u_tint.a) * (0.35 + 0.65 * d), u_alpha); }', ['a_pos', 'a_col', 'a_nrm']);
 
   function buffer(data) {
     var b = gl.createBuffer();
@@ -257,6 +287,7 @@
     if (prog.u.u_size) gl.uniform1f(prog.u.u_size, opts.size || 1);
     if (prog.u.u_model) gl.uniformMatrix4fv(prog.u.u_model, false, opts.model || IDENTITY);
     if (prog.u.u_light) gl.uniform3fv(prog.u.u_light, opts.light || [0, 0, 1]);
+    if (prog.u.u_tint) gl.uniform4fv(prog.u.u_tint, opts.tint || [0, 0, 0, 0]);
     gl.drawArrays(mode, first, count);
     for (var a = 0; a < prog.n; a++) gl.disableVertexAttribArray(a);
   }
@@ -461,6 +492,68 @@
       put(b, z); put(b0, z); put(b1, z);
     }
   }
+  function sphere(outP, outC, outN, c, r, col) {
+    var S = 12, T = 8;
+    function at(i, j) {
+      var th = Math.PI * i / T, ph = 2 * Math.PI * j / S;
+      return [Math.sin(th) * Math.cos(ph), Math.sin(th) * Math.sin(ph), Math.cos(th)];
+    }
+    function put(u) { outP.push(c[0] + r * u[0], c[1] + r * u[1], c[2] + r * u[2]); outC.push(col[0], col[1], col[2]); outN.push(u[0], u[1], u[2]); }
+    for (var i = 0; i < T; i++) for (var j = 0; j < S; j++) {
+      var a = at(i, j), b = at(i + 1, j), cc = at(i + 1, j + 1), d = at(i, j + 1);
+      put(a); put(b); put(cc); put(a); put(cc); put(d);
+    }
+  }
+  function boxMesh(outP, outC, outN, lo, hi, col) {
+    function put(p, n) { outP.push(p[0], p[1], p[2]); outC.push(col[0], col[1], col[2]); outN.push(n[0], n[1], n[2]); }
+    for (var ax = 0; ax < 3; ax++) for (var side = 0; side < 2; side++) {
+      var u = (ax + 1) % 3, v = (ax + 2) % 3, n = [0, 0, 0];
+      n[ax] = side ? 1 : -1;
+      var q = [];
+      [[0, 0], [1, 0], [1, 1], [0, 1]].forEach(function (t) {
+        var p = [0, 0, 0];
+        p[ax] = side ? hi[ax] : lo[ax]; p[u] = t[0] ? hi[u] : lo[u]; p[v] = t[1] ? hi[v] : lo[v];
+        q.push(p);
+      });
+      put(q[0], n); put(q[1], n); put(q[2], n); put(q[0], n); put(q[2], n); put(q[3], n);
+    }
+  }
+  // one body of the check at frame f into the arrays `o` ({p, c, n})
+  function bodyAt(f, k, m) {
+    var b = BODIES[k];
+    if (!b.moving) return [b.a, b.b];
+    var o = 6 * (movingBodies * f + m), a = F.bodies;
+    return [[a[o], a[o + 1], a[o + 2]], [a[o + 3], a[o + 4], a[o + 5]]];
+  }
+  function addBody(o, b, ends, col) {
+    var a = ends[0], e = ends[1];
+    if (!isFinite(a[0]) || !isFinite(e[0])) return;
+    if (b.kind === 'box') boxMesh(o.p, o.c, o.n, a, e, col);
+    else if (b.kind === 'cylinder') cylinder(o.p, o.c, o.n, a, e, b.radius_mm, b.radius_mm, col);
+    else {
+      cylinder(o.p, o.c, o.n, a, e, b.radius_mm, b.radius_mm, col);
+      sphere(o.p, o.c, o.n, a, b.radius_mm, col);
+      sphere(o.p, o.c, o.n, e, b.radius_mm, col);
+    }
+  }
+  var BODY = [0.55, 0.75, 0.95], HIGHLIGHT = [1.0, 0.08, 0.04];
+  var bodyMesh = null, hiMesh = null, partHighlighted = false, highlighted = [];
+  function buildBodies(f) {
+    var plain = { p: [], c: [], n: [] }, hi = { p: [], c: [], n: [] }, cl = closestAt(f), names = cl && state.highlight ? cl.names : [];
+    var m = 0;
+    highlighted = [];
+    BODIES.forEach(function (b, k) {
+      var ends = bodyAt(f, k, m);
+      if (b.moving) m += 1;
+      var h = names.indexOf(b.name) >= 0;
+      if (h && highlighted.indexOf(b.name) < 0) highlighted.push(b.name);
+      addBody(h ? hi : plain, b, ends, h ? HIGHLIGHT : BODY);
+    });
+    partHighlighted = names.indexOf(P.part_body) >= 0;
+    if (partHighlighted) highlighted.push(P.part_body);
+    function mk(o) { return o.p.length ? mesh([new Float32Array(o.p), new Float32Array(o.c), new Float32Array(o.n)]) : null; }
+    bodyMesh = mk(plain); hiMesh = mk(hi);
+  }
   var cellMesh = null, cellMeshFrame = -1;
   function buildCell(f) {
     var R = P.reach_mm, cp = [], cc = [], cn = [];
@@ -492,6 +585,7 @@
       cylinder(cp, cc, cn, sub(c7, [0, 0, 0.05 * R]), [c7[0], c7[1], Math.min(c7[2], -0.02 * R) - 0.3 * R], 0.07 * R, 0.07 * R, DARK);
     }
     cellMesh = cp.length ? mesh([new Float32Array(cp), new Float32Array(cc), new Float32Array(cn)]) : null;
+    buildBodies(f);
     cellMeshFrame = f;
   }
 
@@ -583,6 +677,27 @@
     if (F && state.cell && (!only || only === 'cell')) {
       if (cellMeshFrame !== state.frame) buildCell(state.frame);
       draw(lit, cellMesh, gl.TRIANGLES, 0, cellMesh ? cellMesh.count : 0, vp, { light: light });
+      if (state.bodies) {
+        // the highlighted pair on top of everything, the other bodies translucent
+        if (hiMesh) {
+          gl.disable(gl.DEPTH_TEST);
+          draw(lit, hiMesh, gl.TRIANGLES, 0, hiMesh.count, vp, { light: light });
+          gl.enable(gl.DEPTH_TEST);
+        }
+        gl.enable(gl.BLEND);
+        gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
+        gl.depthMask(false);
+        if (bodyMesh) draw(lit, bodyMesh, gl.TRIANGLES, 0, bodyMesh.count, vp, { light: light, alpha: 0.16 });
+        // the part's wall so far when it is one of the pair, on top too
+        if (partHighlighted) {
+          var upto = Math.min(L - 1, F.layer[state.frame]);
+          gl.disable(gl.DEPTH_TEST);
+          draw(lit, wallMesh, gl.TRIANGLES, 0, wStart[upto + 1], mvp, { model: model, light: light, alpha: 0.8, tint: [HIGHLIGHT[0], HIGHLIGHT[1], HIGHLIGHT[2], 1] });
+          gl.enable(gl.DEPTH_TEST);
+        }
+        gl.depthMask(true);
+        gl.disable(gl.BLEND);
+      }
     }
     if (!only) {
       // translucent surfaces last, without depth writes
@@ -644,6 +759,12 @@
     if (F && state.cell && !isFinite(F.chain[24 * state.frame])) {
       g.fillStyle = '#ff6b6b';
       g.fillText('no joint solution at this point', 8, 18);
+    }
+    var cl = F && state.cell ? closestAt(state.frame) : null;
+    if (cl) {
+      g.font = 'bold 13px sans-serif';
+      g.fillStyle = cl.collision ? '#ff4d4d' : '#ffb199';
+      g.fillText(cl.text, 8, 36);
     }
   }
 
@@ -742,7 +863,7 @@
 
   // ---- controls ----
   fieldSel.addEventListener('change', function () { state.field = +fieldSel.value; recolour(); requestRender(); });
-  [['show-axes', 'axes'], ['show-wall', 'wall'], ['show-substrate', 'substrate'], ['show-marks', 'marks'], ['show-cell', 'cell'],
+  [['show-axes', 'axes'], ['show-wall', 'wall'], ['show-substrate', 'substrate'], ['show-marks', 'marks'], ['show-cell', 'cell'], ['show-bodies', 'bodies'],
     ['show-mesh', 'mesh'], ['show-tube', 'tube']].forEach(function (c) {
     var el = $(c[0]);
     el.addEventListener('change', function () {
@@ -816,6 +937,10 @@
     row('R_Z', F.rz[f], '', NaN);
     $('frame-label').textContent = 'frame ' + (f + 1) + ' of ' + F.n + ': layer ' + F.layer[f] + ', point ' + F.point[f] +
       ', t = ' + fmt(F.time[f], 1) + ' s of ' + fmt(P.duration_s, 1) + ' s under the arc' + cycleText(F.layer[f]);
+    var cl = closestAt(f), ce = $('closest');
+    ce.textContent = cl ? cl.text : (P.closest.length ? 'closest: \u2014' : 'closest: not checked');
+    ce.className = cl && cl.collision ? 'collision' : '';
+    document.body.setAttribute('data-closest', ce.textContent);
   }
   // the program's cycle time, and the shown layer's share of it
   function cycleText(layer) {
@@ -891,6 +1016,13 @@
 
   // ---- self-test (opened with #selftest): exercises every control once and
   // writes what it saw, for the browser test ----
+  // pixels in the highlight colour: red well above green and blue
+  function countHighlight() {
+    var w = canvas.width, h = canvas.height, px = new Uint8Array(4 * w * h), n = 0;
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    for (var i = 0; i < px.length; i += 4) if (px[i] > 120 && px[i] > 2.5 * px[i + 1] && px[i] > 2.5 * px[i + 2]) n++;
+    return n;
+  }
   function countDrawn() {
     var w = canvas.width, h = canvas.height, px = new Uint8Array(4 * w * h), colours = {}, n = 0;
     gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
@@ -954,6 +1086,26 @@
         out.played_to_frame = state.frame;
         out.joint_rows = $('joints').rows.length;
         state.playing = false;
+        // the closest pair: the first frame whose layer has one, drawn
+        // alone (the cell only), with and without the highlight
+        out.bodies = BODIES.map(function (b) { return b.name; });
+        var hf = -1;
+        for (var f2 = 0; f2 < F.n && hf < 0; f2++) if (closestAt(f2)) hf = f2;
+        if (hf >= 0) {
+          state.only = 'cell';
+          setFrame(hf);
+          cellMeshFrame = -1;
+          render();
+          var on = countHighlight(), names = highlighted.slice();
+          state.highlight = false; cellMeshFrame = -1;
+          render();
+          var off = countHighlight();
+          state.highlight = true; cellMeshFrame = -1;
+          state.only = null;
+          var c3 = closestAt(hf);
+          out.closest = { frame: hf, layer: P.closest.length ? P.closest[F.layer[hf]] : null, pair: c3.names, collision: c3.collision,
+            text: c3.text, hud: $('closest').textContent, highlighted: names, highlight_pixels: on, highlight_pixels_off: off };
+        }
       }
       state.cell = cellWas;
       resetView();

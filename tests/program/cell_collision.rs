@@ -45,6 +45,7 @@ fn scene(keep_out: Vec<KeepOut>) -> CellScene {
     CellScene {
         keep_out,
         clearance_mm: 10.0,
+        transits: true,
     }
 }
 

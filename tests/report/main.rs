@@ -298,6 +298,9 @@ fn planned_report(
             plan: &plan,
             travel_speed_mm_s: opts.travel_speed_mm_s,
             cycle: None,
+            keep_out: &[],
+            clearance: None,
+            refusal: None,
         }),
         ..ReportInput::new(&part.name, &path, &axes.frames, &map, path.delta_mm)
     };
@@ -399,4 +402,302 @@ fn page_without_webgl_says_so() {
     let tag = &dom[dom[..at].rfind('<').unwrap()..at + dom[at..].find('>').unwrap()];
     assert!(!tag.contains("hidden"), "{tag}");
     assert!(dom.contains("WebGL is not available in this browser"));
+}
+
+// ---- the whole-cell check's bodies and closest pair (issue 30) ----
+
+/// `hemisphere.toml` planned through the front door in `parts/cells/{cell}.toml`
+/// on a coarse grid (60 points a layer, 3 layers): program built and checked.
+fn planned_part(cell: &str) -> waam_slicer::PlannedPart {
+    let part = waam_slicer::Part::read(repo("parts/hemisphere.toml")).unwrap();
+    let name = cell;
+    let cell = waam_slicer::Cell::read(repo(&format!("parts/cells/{name}.toml"))).unwrap();
+    let opts = waam_slicer::PlanOptions {
+        slice: waam_slicer::SliceOverrides {
+            discretisation: Some(Discretisation::Points(60)),
+            max_layers: Some(3),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let p = waam_slicer::plan_part(&part, &cell, &opts).unwrap();
+    assert!(p.is_feasible(), "{name}: {:?}", p.refusal());
+    p
+}
+
+/// The page's data object, read back from the written page.
+fn page_data(html: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(html).unwrap();
+    let open = "id=\"report-data\">";
+    let start = text.find(open).unwrap() + open.len();
+    let end = start + text[start..].find("</script>").unwrap();
+    serde_json::from_str(&text[start..end]).unwrap()
+}
+
+/// Decoded length (bytes) of a base64 text.
+fn b64_len(s: &str) -> usize {
+    s.len() / 4 * 3 - s.chars().rev().take_while(|c| *c == '=').count()
+}
+
+/// Little-endian `f32`s of a base64 text.
+fn b64_f32(s: &str) -> Vec<f32> {
+    let val = |c: u8| -> u32 {
+        match c {
+            b'A'..=b'Z' => u32::from(c - b'A'),
+            b'a'..=b'z' => u32::from(c - b'a') + 26,
+            b'0'..=b'9' => u32::from(c - b'0') + 52,
+            b'+' => 62,
+            _ => 63,
+        }
+    };
+    let mut bytes = vec![];
+    for chunk in s.as_bytes().chunks(4) {
+        let pad = chunk.iter().filter(|c| **c == b'=').count();
+        let n = chunk
+            .iter()
+            .filter(|c| **c != b'=')
+            .fold(0u32, |n, c| (n << 6) | val(*c))
+            << (6 * pad);
+        bytes.extend(&n.to_be_bytes()[1..4 - pad]);
+    }
+    bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
+/// The page data holds, per layer, the whole-cell check's closest approach
+/// and pair, and the check's bodies: the arm's five capsules (the forearm's
+/// first end the chain's J3 offset point, as the check builds it), with a
+/// positioner the table (moving) and the tilt body (fixed).
+#[test]
+fn report_data_holds_the_closest_pair_of_every_layer() {
+    let (dir, _keep) = out_dir();
+    for cell in ["robowam_part_carried", "robowam_torch_carried"] {
+        let p = planned_part(cell);
+        let html = dir.join(format!("closest-{cell}.html"));
+        p.write_report(&html, None).unwrap();
+        let d = page_data(&html);
+        let plan = &d["plan"];
+        let clearance = p.clearance.as_ref().unwrap();
+        let closest = plan["closest"].as_array().unwrap();
+        assert_eq!(closest.len(), p.layers.len(), "{cell}");
+        for (lp, c) in p.layers.iter().zip(closest) {
+            let lc = clearance
+                .layers
+                .iter()
+                .find(|l| l.layer == lp.layer)
+                .unwrap();
+            assert_eq!(c["layer"], lp.layer, "{cell}");
+            let (a, b) = lc.closest_pair.clone().expect("a pair measured");
+            assert_eq!(c["pair"], serde_json::json!([a, b]), "{cell}: {c}");
+            assert!(
+                (c["distance_mm"].as_f64().unwrap() - lc.closest_approach_mm).abs() < 1e-9,
+                "{cell}: {c}"
+            );
+        }
+        assert!(plan["collision"].is_null());
+        let bodies: Vec<(&str, &str, bool)> = plan["bodies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| {
+                (
+                    b["name"].as_str().unwrap(),
+                    b["kind"].as_str().unwrap(),
+                    b["moving"].as_bool().unwrap(),
+                )
+            })
+            .collect();
+        let mut want = vec![
+            ("J1 column", "capsule", true),
+            ("upper arm", "capsule", true),
+            ("forearm", "capsule", true),
+            ("wrist", "capsule", true),
+            ("wrist", "capsule", true),
+        ];
+        if cell.contains("torch") {
+            want.push(("positioner table", "cylinder", true));
+            want.push(("positioner tilt body", "capsule", false));
+        }
+        assert_eq!(bodies, want, "{cell}");
+        let moving = want.iter().filter(|b| b.2).count();
+        let frames = plan["frames"].as_u64().unwrap() as usize;
+        let f_bodies = plan["f_bodies"].as_str().unwrap();
+        assert_eq!(b64_len(f_bodies), frames * moving * 6 * 4, "{cell}");
+        let ends = b64_f32(f_bodies);
+        let chain = b64_f32(plan["f_chain"].as_str().unwrap());
+        for f in [0, frames - 1] {
+            let forearm = &ends[6 * (moving * f + 2)..][..3];
+            assert_eq!(forearm, &chain[24 * f + 12..][..3], "{cell}, frame {f}");
+            let column = &ends[6 * moving * f..][..6];
+            assert_eq!(&column[..3], &chain[24 * f..][..3], "{cell}, frame {f}");
+        }
+    }
+}
+
+/// A plan refused for a collision (a keep-out box around the wrist at the
+/// last bead point): the page names the two bodies, marks the layer and
+/// draws the box.
+fn refused_part() -> waam_slicer::PlannedPart {
+    use waam_slicer::program::cell_check::{check_cell, CellScene, KeepOut};
+    use waam_slicer::report::cell_view::arm_chain;
+    use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions};
+    let mut p = planned_part("robowam_part_carried");
+    let inputs = waam_slicer::optimise::trajectory_inputs(&p.layers, &p.plan);
+    let traj = joint_trajectory(
+        &p.cell.layout,
+        &inputs,
+        p.travel_speed_mm_s(),
+        &TrajectoryOptions::default(),
+    )
+    .unwrap();
+    let program = p.program.clone().unwrap();
+    let last = traj
+        .points
+        .iter()
+        .rev()
+        .find(|j| j.joints.is_some())
+        .unwrap();
+    let w = arm_chain(program.cell.robot(), &last.joints.unwrap())[5];
+    let keep = KeepOut {
+        name: "fixture clamp".into(),
+        min_mm: [w.x - 5.0, w.y - 5.0, w.z - 5.0],
+        max_mm: [w.x + 5.0, w.y + 5.0, w.z + 5.0],
+    };
+    let scene = CellScene {
+        keep_out: vec![keep.clone()],
+        clearance_mm: 10.0,
+        transits: true,
+    };
+    let e = check_cell(&program, &traj, &p.layers, &scene).unwrap_err();
+    p.cell.keep_out = vec![keep];
+    p.program = Err(e);
+    p.clearance = None;
+    p
+}
+
+#[test]
+fn a_collision_refusal_is_named_and_marked_in_the_report() {
+    let (dir, _keep) = out_dir();
+    let p = refused_part();
+    let html = dir.join("collision.html");
+    p.write_report(&html, None).unwrap();
+    let d = page_data(&html);
+    let c = &d["plan"]["collision"];
+    let Some(waam_slicer::program::ProgramError::Collision {
+        layer,
+        body_a,
+        body_b,
+        ..
+    }) = p.refusal()
+    else {
+        panic!("not a collision: {:?}", p.refusal())
+    };
+    assert_eq!(c["layer"], *layer);
+    assert_eq!(
+        c["layer_index"].as_u64(),
+        p.layers
+            .iter()
+            .position(|l| l.layer == *layer)
+            .map(|i| i as u64)
+    );
+    assert_eq!((&c["body_a"], &c["body_b"]), (&json(body_a), &json(body_b)));
+    assert!([body_a, body_b].contains(&&"fixture clamp".to_string()));
+    // the layer is marked, the message names both bodies
+    let marks = d["marks"].as_array().unwrap();
+    let mark = marks
+        .iter()
+        .find(|m| m["text"].as_str().unwrap().starts_with("collision:"))
+        .expect("the collision is marked");
+    let text = mark["text"].as_str().unwrap();
+    assert!(
+        text.contains(body_a.as_str()) && text.contains(body_b.as_str()),
+        "{text}"
+    );
+    // the box is drawn where the cell file puts it
+    let k = &p.cell.keep_out[0];
+    let b = d["plan"]["bodies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|b| b["name"] == "fixture clamp")
+        .unwrap();
+    assert_eq!(b["kind"], "box");
+    assert_eq!(b["a"], json(k.min_mm));
+    assert_eq!(b["b"], json(k.max_mm));
+    assert!(d["plan"]["closest"].as_array().unwrap().is_empty());
+}
+
+fn json(v: impl serde::Serialize) -> serde_json::Value {
+    serde_json::to_value(v).unwrap()
+}
+
+/// In Chromium, a planned part-carried and torch-carried report, and a
+/// refused one, load without a script error and draw the closest pair (or
+/// the colliding pair) in the highlight colour, named in the HUD.
+#[test]
+fn the_closest_pair_is_highlighted_in_chromium() {
+    let Some(browser) = chromium() else { return };
+    let (dir, _keep) = out_dir();
+    for cell in ["robowam_part_carried", "robowam_torch_carried", "refused"] {
+        let p = if cell == "refused" {
+            refused_part()
+        } else {
+            planned_part(cell)
+        };
+        let html = dir.join(format!("highlight-{cell}.html"));
+        p.write_report(&html, None).unwrap();
+        let r = open_and_check(&browser, &html);
+        let c = &r["closest"];
+        assert!(c.is_object(), "{cell}: no closest pair shown: {r}");
+        let pair: Vec<&str> = c["pair"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap())
+            .collect();
+        let hud = c["hud"].as_str().unwrap();
+        assert_eq!(hud, c["text"].as_str().unwrap(), "{cell}");
+        assert!(
+            hud.contains(&format!("{}\u{2013}{}", pair[0], pair[1])) && hud.contains(" mm"),
+            "{cell}: {hud}"
+        );
+        if cell == "refused" {
+            assert_eq!(c["collision"], true, "{r}");
+            assert!(hud.starts_with("COLLISION"), "{hud}");
+        } else {
+            assert!(hud.starts_with("closest: "), "{hud}");
+            let shown = c["layer"]["layer"].as_u64().unwrap() as usize;
+            let lc = p
+                .clearance
+                .as_ref()
+                .unwrap()
+                .layers
+                .iter()
+                .find(|l| l.layer == shown)
+                .unwrap();
+            let (a, b) = lc.closest_pair.clone().unwrap();
+            assert_eq!(pair, [a.as_str(), b.as_str()], "{cell}");
+        }
+        // both bodies (an arm link, a box, or the part's wall) are drawn
+        // in the highlight colour, and nothing is without the highlight
+        let mut named: Vec<&str> = c["highlighted"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap())
+            .collect();
+        named.sort();
+        let mut want = pair.clone();
+        want.sort();
+        want.dedup();
+        assert_eq!(named, want, "{cell}: {r}");
+        let on = c["highlight_pixels"].as_u64().unwrap();
+        let off = c["highlight_pixels_off"].as_u64().unwrap();
+        assert!(
+            on > 200 && off * 20 < on,
+            "{cell}: {on} highlighted pixels, {off} without: {r}"
+        );
+    }
 }
