@@ -15,6 +15,15 @@ use crate::math::tol;
 /// at the edge.
 const MIN_REACH_STEP_RAD: f64 = 1e-6;
 
+/// Consecutive degrees that gained less than the stop criterion after which
+/// the loop ends whatever the Gauss–Newton model predicts: the model is
+/// unconstrained, and where a constraint holds the law (a torch-carried
+/// part of revolution: the table turns the part, the arm stands still) it
+/// keeps predicting a gain that no degree realises. Two, as the look-ahead
+/// of [`raise_again`]: an odd degree that adds nothing before an even one
+/// that does is still solved.
+pub(super) const STALLED_DEGREES: usize = 2;
+
 /// Records `best` (with the objective of every degree solved, `history`)
 /// as `outcome`'s law and evaluation.
 pub(super) fn record(
@@ -56,6 +65,7 @@ pub(super) fn degree_loop(
     let mut history = Vec::new();
     let mut best: Option<Best> = None;
     let mut at_c: Option<Evaluation> = e0;
+    let mut stalled = 0;
     for degree in degrees.start..=degrees.max.max(degrees.start) {
         let gain = match sqp::solve(
             problem,
@@ -80,19 +90,26 @@ pub(super) fn degree_loop(
                 Some(_) => break,
             },
         };
+        stalled = if gain < degrees.stop_relative_gain {
+            stalled + 1
+        } else {
+            0
+        };
         let Some(raised) = basis.raised() else {
             break;
         };
         let last = Best::key(&best);
-        if !raise_again(
-            problem,
-            at_c.as_ref(),
-            &raised,
-            degree + 1,
-            gain,
-            degrees,
-            last,
-        ) {
+        if stalled >= STALLED_DEGREES
+            || !raise_again(
+                problem,
+                at_c.as_ref(),
+                &raised,
+                degree + 1,
+                gain,
+                degrees,
+                last,
+            )
+        {
             break;
         }
         basis = raised;

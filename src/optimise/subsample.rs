@@ -24,7 +24,7 @@
 //! computed on every point by the caller.
 
 use super::branch_types::{Best, BranchOutcome, Degrees};
-use super::degree::{raise_again, record};
+use super::degree::{raise_again, record, STALLED_DEGREES};
 use super::parameterisation::Basis;
 use super::problem::{LayerProblem, SOLVER_MARGIN};
 use super::setup::LayerSetup;
@@ -138,6 +138,7 @@ fn degree_loop(
     };
     let mut history = Vec::new();
     let mut best: Option<Best> = None;
+    let mut stalled = 0;
     for degree in degrees.start..=degrees.max.max(degrees.start) {
         let Some(done) = certify(problem, samples, &full_basis, c, scale, setup, counts) else {
             // not certified: the whole layer decides
@@ -151,21 +152,28 @@ fn degree_loop(
         c = sub_c;
         history.push((degree, res.objective));
         let gain = Best::offer(&mut best, degree, &c, &full_basis, res);
+        stalled = if gain < degrees.stop_relative_gain {
+            stalled + 1
+        } else {
+            0
+        };
         let Some(raised) = full_basis.raised() else {
             break;
         };
         let sub = problem.restricted(&samples.idx, &samples.points);
         let last = Best::key(&best);
         let sub_raised = raised.restricted(&samples.idx)?;
-        if !raise_again(
-            &sub,
-            Some(&sub_eval),
-            &sub_raised,
-            degree + 1,
-            gain,
-            degrees,
-            last,
-        ) {
+        if stalled >= STALLED_DEGREES
+            || !raise_again(
+                &sub,
+                Some(&sub_eval),
+                &sub_raised,
+                degree + 1,
+                gain,
+                degrees,
+                last,
+            )
+        {
             break;
         }
         full_basis = raised;
