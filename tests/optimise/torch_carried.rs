@@ -395,3 +395,50 @@ fn every_sample_part_at_its_own_grid_in_every_torch_carried_cell() {
         eprintln!("{what}: {layers} layers, {bad} infeasible, {proven} proven");
     }
 }
+
+/// The `R_Z` law's degree loop ends after two consecutive degrees that gain
+/// less than the stop criterion, whatever the unconstrained Gauss–Newton
+/// model predicts: on the hemisphere in the ROBOWAM torch-carried cell the
+/// table turns the part under a still arm, no degree gains, and each layer
+/// used to solve every degree 0…4 with one objective. Now at most three,
+/// and the law kept is the lowest degree of that objective.
+#[test]
+fn a_law_whose_degrees_gain_nothing_stops_raising() {
+    use waam_slicer::optimise::RzLaw;
+    let part = Part::read(part_path("hemisphere.toml")).unwrap();
+    let cell = Cell::read(part_path("cells/robowam_torch_carried.toml")).unwrap();
+    let opts = PlanOptions {
+        slice: SliceOverrides {
+            delta_mm: Some(5.0),
+            max_layers: Some(4),
+            ..SliceOverrides::default()
+        },
+        ..PlanOptions::default()
+    };
+    let p = plan_part(&part, &cell, &opts).unwrap();
+    assert!(p.is_feasible(), "{:?}", p.refusal());
+    for l in &p.plan.layers {
+        let RzLaw::Polynomial {
+            degree,
+            objective_per_degree,
+            ..
+        } = &l.law
+        else {
+            panic!("layer {}: {:?}", l.layer, l.law);
+        };
+        assert!(
+            objective_per_degree.len() <= 3,
+            "layer {}: {objective_per_degree:?}",
+            l.layer
+        );
+        let best = objective_per_degree
+            .iter()
+            .map(|(_, f)| *f)
+            .fold(f64::INFINITY, f64::min);
+        let first = objective_per_degree
+            .iter()
+            .find(|(_, f)| *f <= best)
+            .unwrap();
+        assert_eq!(*degree, first.0, "layer {}", l.layer);
+    }
+}
