@@ -531,26 +531,7 @@ impl PlannedPart {
                 Err(e) if plan.is_feasible() => Some(e.to_string()),
                 _ => None,
             },
-            collision: match &self.program {
-                Err(ProgramError::Collision {
-                    layer,
-                    point,
-                    motion,
-                    body_a,
-                    body_b,
-                    distance_mm,
-                    clearance_mm,
-                }) => Some(CollisionSummary {
-                    layer: *layer,
-                    point: *point,
-                    motion,
-                    bodies: [body_a.clone(), body_b.clone()],
-                    distance_mm: *distance_mm,
-                    depth_mm: (-distance_mm).max(0.0),
-                    clearance_mm: *clearance_mm,
-                }),
-                _ => None,
-            },
+            collision: self.program.as_ref().err().and_then(CollisionSummary::of),
             cell_check: self.clearance.as_ref().map(|c| CellCheckSummary {
                 samples: c.samples,
                 exact_queries: c.exact_queries,

@@ -190,6 +190,34 @@ pub struct CollisionSummary {
     pub clearance_mm: f64,
 }
 
+impl CollisionSummary {
+    /// The collision `e` names, if it is one
+    /// ([`ProgramError::Collision`](crate::program::ProgramError::Collision)).
+    pub fn of(e: &crate::program::ProgramError) -> Option<Self> {
+        let crate::program::ProgramError::Collision {
+            layer,
+            point,
+            motion,
+            body_a,
+            body_b,
+            distance_mm,
+            clearance_mm,
+        } = e
+        else {
+            return None;
+        };
+        Some(Self {
+            layer: *layer,
+            point: *point,
+            motion,
+            bodies: [body_a.clone(), body_b.clone()],
+            distance_mm: *distance_mm,
+            depth_mm: (-distance_mm).max(0.0),
+            clearance_mm: *clearance_mm,
+        })
+    }
+}
+
 /// The whole-cell check's counts.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CellCheckSummary {

@@ -862,27 +862,17 @@ pub(crate) fn closest_per_layer(pv: &PlanView) -> Vec<ClosestData> {
 
 fn collision_data(pv: &PlanView) -> Option<CollisionData> {
     let e = pv.refusal?;
-    let ProgramError::Collision {
-        layer,
-        point,
-        motion,
+    let c = crate::pipeline::summary::CollisionSummary::of(e)?;
+    let [body_a, body_b] = c.bodies;
+    Some(CollisionData {
+        layer_index: pv.layers.iter().position(|l| l.layer == c.layer),
+        layer: c.layer,
+        point: c.point,
+        motion: c.motion,
         body_a,
         body_b,
-        distance_mm,
-        clearance_mm,
-    } = e
-    else {
-        return None;
-    };
-    Some(CollisionData {
-        layer_index: pv.layers.iter().position(|l| l.layer == *layer),
-        layer: *layer,
-        point: *point,
-        motion,
-        body_a: body_a.clone(),
-        body_b: body_b.clone(),
-        distance_mm: *distance_mm,
-        clearance_mm: *clearance_mm,
+        distance_mm: c.distance_mm,
+        clearance_mm: c.clearance_mm,
         text: e.to_string(),
     })
 }
