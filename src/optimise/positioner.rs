@@ -39,7 +39,10 @@
 //! that turns the layer's mean `b` vertical; a lazy follower that holds its
 //! pose while `b` stays within 70 % of the cone and moves just enough where
 //! it would leave it; and the thesis's pose that turns every point's `b`
-//! exactly vertical (each fitted by the law). A law is solved on
+//! exactly vertical (each fitted by the law). The knots are uniform in the
+//! abscissa first; where no seed keeps the cone, the seeds are solved again
+//! with knots crowding where `b` turns (`following_turning`), the better
+//! law kept. A law is solved on
 //! at most [`PositionerOptions::sample_points`] points, then checked on every
 //! point; the worst violated points join the samples and it is solved again.
 
@@ -817,6 +820,8 @@ pub fn unreachable_point(
     let mut t_anchor = 0.0;
     let mut t = 0.0;
     let mut reach = vec![true; n7 * n8];
+    // the anchor's reached tilt rows, first and last
+    let mut band: (usize, usize) = (0, n7 - 1);
     let mut next = vec![false; n7 * n8];
     let mut count: Vec<usize> = Vec::with_capacity(3 * n8.max(n7) + 1);
     let (v7, v8) = (positioner.max_speed_rad_s[0], positioner.max_speed_rad_s[1]);
@@ -832,8 +837,13 @@ pub fn unreachable_point(
                 }
             };
             let (d7, d8) = (cells(v7, h7), cells(v8, h8));
+            // only the tilts the anchor reaches, dilated, can be reached
+            let (lo, hi) = band;
+            let (out_lo, out_hi) = (lo.saturating_sub(d7), hi.saturating_add(d7).min(n7 - 1));
+            reach[..out_lo * n8].fill(false);
+            reach[(out_hi + 1) * n8..].fill(false);
             // sliding windows by prefix counts: the turn is periodic
-            for i in 0..n7 {
+            for i in lo..=hi {
                 let row = &anchor[i * n8..(i + 1) * n8];
                 if d8 >= n8 / 2 {
                     let any = row.iter().any(|&x| x);
@@ -853,27 +863,35 @@ pub fn unreachable_point(
                 }
             }
             for j in 0..n8 {
+                // count[i − lo]: reached rows lo..i of column j
                 count.clear();
                 count.push(0);
-                for i in 0..n7 {
-                    let c = count[i] + usize::from(next[i * n8 + j]);
+                for i in lo..=hi {
+                    let c = count[i - lo] + usize::from(next[i * n8 + j]);
                     count.push(c);
                 }
-                for i in 0..n7 {
-                    let a = i.saturating_sub(d7);
-                    let z = i.saturating_add(d7).min(n7 - 1) + 1;
-                    reach[i * n8 + j] = count[z] > count[a];
+                for i in out_lo..=out_hi {
+                    let a = i.saturating_sub(d7).max(lo) - lo;
+                    let z = i.saturating_add(d7).min(hi) + 1 - lo;
+                    reach[i * n8 + j] = z > a && count[z] > count[a];
                 }
             }
         }
         let mut any = false;
+        let mut rows = (usize::MAX, 0);
         for (i, t) in tilted.iter().enumerate() {
+            if !reach[i * n8..(i + 1) * n8].contains(&true) {
+                continue;
+            }
             for (j, (s, c)) in turns.iter().enumerate() {
                 let k = i * n8 + j;
                 if reach[k] {
                     let w = Vector3::new(c * bm.x - s * bm.y, s * bm.x + c * bm.y, bm.z);
                     reach[k] = t.dot(&w) >= min_cos;
-                    any |= reach[k];
+                    if reach[k] {
+                        any = true;
+                        rows = (rows.0.min(i), rows.1.max(i));
+                    }
                 }
             }
         }
@@ -883,10 +901,47 @@ pub fn unreachable_point(
         let moved = |v: f64, h: f64| !v.is_finite() || v * (t - t_anchor) >= 4.0 * h;
         if m == 0 || (moved(v7, h7) && moved(v8, h8)) {
             anchor.copy_from_slice(&reach);
+            band = rows;
             t_anchor = t;
         }
     }
     None
+}
+
+/// The grids of positioner poses [`unreachable_point`] searches, coarse to
+/// fine (deg): each is tried where the coarser one proved nothing. The
+/// finest costs about 0.3 s a 400-point layer (16 times the coarsest) and is
+/// run only on a layer whose law failed.
+const GRID_CELLS_DEG: [f64; 3] = [2.0, 1.0, 0.5];
+
+/// Share of the spline's abscissa given to the turning of `b` (unitless):
+/// the knots, uniform in the blended abscissa, crowd where `b` turns fast.
+const TURNING_SHARE: f64 = 0.5;
+
+/// The spline's abscissa: `x` (point index or cylindrical angle) scaled to
+/// `[0, 1]`, blended with the cumulative angle `b` turns through along the
+/// layer, also scaled to `[0, 1]` ([`TURNING_SHARE`] of it). A bent tube's
+/// layer turns `b` through most of its swing in a few points (a corner of the
+/// constant-distance layer); uniform knots in the point index leave those few
+/// points one span, too stiff for the table to follow `b` there. On a part
+/// of revolution `b` turns evenly with the angle and nothing changes.
+fn following_turning(x: &[f64], b: &[Vector3]) -> Vec<f64> {
+    let n = x.len();
+    let span = x[n - 1] - x[0];
+    let mut turned = Vec::with_capacity(n);
+    let mut sum = 0.0;
+    for m in 0..n {
+        if m > 0 {
+            sum += b[m - 1].angle(&b[m]);
+        }
+        turned.push(sum);
+    }
+    if !(span.abs() > 0.0 && sum > tol::DEGENERATE) {
+        return x.to_vec();
+    }
+    (0..n)
+        .map(|m| (1.0 - TURNING_SHARE) * (x[m] - x[0]) / span + TURNING_SHARE * turned[m] / sum)
+        .collect()
 }
 
 /// Positioner laws of one layer [module doc]. `travel_speed_mm_s`: the
@@ -959,46 +1014,137 @@ pub fn positioner_law(
     } else {
         (0..n).map(|m| m as f64).collect()
     };
-    let basis = Basis::spline(&abscissa, opts.spans.min(n / 4).max(1));
+    let spans = opts.spans.min(n / 4).max(1);
+    // uniform knots first; where their law fails, knots that crowd where b
+    // turns (a corner), each start solved again
+    let mut iterations = 0;
+    let mut best = solve_seeds(
+        &pb,
+        &Basis::spline(&abscissa, spans),
+        follow.as_deref(),
+        q8_hint,
+        &mut iterations,
+    );
+    if !best.feasible {
+        let turning = solve_seeds(
+            &pb,
+            &Basis::spline(&following_turning(&abscissa, &pb.b), spans),
+            follow.as_deref(),
+            q8_hint,
+            &mut iterations,
+        );
+        if turning.better_than(&best) {
+            best = turning;
+        }
+    }
+    // where no smooth law keeps the cone (a corner of b), the thesis's
+    // exact vertical does by construction: kept when its speeds hold (an
+    // unlimited positioner), so that the arm is judged on it
+    if let (false, Some(f)) = (best.feasible, follow) {
+        if check(&pb, &f).binding.is_none() {
+            let per_point = Basis::PerPoint { points: n };
+            let x: Vec<f64> = f
+                .iter()
+                .map(|q| q[0])
+                .chain(f.iter().map(|q| q[1]))
+                .collect();
+            let model = build_model(&pb, &per_point, &(0..n).collect::<Vec<_>>(), &x);
+            let objective = 0.5 * model.r.iter().map(|v| v * v).sum::<f64>();
+            best = Solved {
+                feasible: true,
+                violation: 0.0,
+                objective,
+                seed: PositionerSeed::Vertical,
+                joints: f,
+                samples: n,
+            };
+        }
+    }
+    finish(
+        &pb,
+        best.joints,
+        best.seed,
+        iterations,
+        best.samples,
+        best.objective,
+    )
+}
+
+/// The best law of a layer's starts on one basis.
+struct Solved {
+    feasible: bool,
+    /// The worst violation left (constraint units scaled to rad; 0 feasible).
+    violation: f64,
+    /// `½|r|²` over every point.
+    objective: f64,
+    seed: PositionerSeed,
+    joints: Vec<PositionerJoints>,
+    samples: usize,
+}
+
+impl Solved {
+    /// Feasible beats infeasible; then the lower objective, or the lower
+    /// violation.
+    fn better_than(&self, other: &Solved) -> bool {
+        match (self.feasible, other.feasible) {
+            (true, false) => true,
+            (false, true) => false,
+            (true, true) => self.objective < other.objective,
+            (false, false) => self.violation < other.violation,
+        }
+    }
+}
+
+/// The starts of [`positioner_law`] (the exact vertical `follow` fitted,
+/// the lazy follower fitted, the hold pose) solved on `basis`, each on
+/// samples grown with its worst points; the best kept. `iterations` counts
+/// the SQP iterations.
+fn solve_seeds(
+    pb: &LawProblem,
+    basis: &Basis,
+    follow: Option<&[PositionerJoints]>,
+    q8_hint: f64,
+    iterations: &mut usize,
+) -> Solved {
+    let n = pb.b.len();
     // the hold seed: the pose turning the mean b vertical
     let mean_b = pb.b.iter().fold(Vector3::zeros(), |a, b| a + b);
     let hold = UnitVector3::try_new(mean_b, MIN_BUILD_SUM)
         .and_then(|b| {
-            let up = cell.base_from_positioner.rotation.inverse() * Vector3::z_axis();
-            pos.angles_for_vertical(&b, &up, q8_hint, std::f64::consts::PI)
+            let up = pb.cell.base_from_positioner.rotation.inverse() * Vector3::z_axis();
+            pb.cell
+                .positioner
+                .angles_for_vertical(&b, &up, q8_hint, std::f64::consts::PI)
                 .ok()
         })
         .unwrap_or([0.0, q8_hint]);
     let k = basis.len();
+    let fitted = |q: &[PositionerJoints]| {
+        let c7 = basis.fit(&q.iter().map(|q| q[0]).collect::<Vec<_>>());
+        let c8 = basis.fit(&q.iter().map(|q| q[1]).collect::<Vec<_>>());
+        [c7, c8].concat()
+    };
     let mut seeds: Vec<(PositionerSeed, Vec<f64>)> = Vec::new();
     let mut x_hold = vec![0.0; 2 * k];
     x_hold[0] = hold[0];
     x_hold[k] = hold[1];
     seeds.push((PositionerSeed::Hold, x_hold));
-    let start = follow
-        .as_ref()
-        .and_then(|f| f.first().copied())
-        .unwrap_or(hold);
-    if let Some(l) = lazy_joints(&pb, start, 0.7 * pb.cone) {
-        let c7 = basis.fit(&l.iter().map(|q| q[0]).collect::<Vec<_>>());
-        let c8 = basis.fit(&l.iter().map(|q| q[1]).collect::<Vec<_>>());
-        seeds.push((PositionerSeed::Lazy, [c7, c8].concat()));
+    let start = follow.and_then(|f| f.first().copied()).unwrap_or(hold);
+    if let Some(l) = lazy_joints(pb, start, 0.7 * pb.cone) {
+        seeds.push((PositionerSeed::Lazy, fitted(&l)));
     }
-    if let Some(f) = &follow {
-        let c7 = basis.fit(&f.iter().map(|q| q[0]).collect::<Vec<_>>());
-        let c8 = basis.fit(&f.iter().map(|q| q[1]).collect::<Vec<_>>());
-        seeds.push((PositionerSeed::Follow, [c7, c8].concat()));
+    if let Some(f) = follow {
+        seeds.push((PositionerSeed::Follow, fitted(f)));
     }
-    let mut iterations = 0;
-    let mut best: Option<(bool, f64, f64, PositionerSeed, Vec<PositionerJoints>, usize)> = None;
-    let target = opts.sample_points.min(n);
+    let mut best: Option<Solved> = None;
+    let target = pb.opts.sample_points.min(n);
     // the thesis's follower first: on a part of revolution it is exact and
     // costs nothing, and no other seed can do better than nothing
     seeds.reverse();
     for (seed, x0) in seeds {
         if best
             .as_ref()
-            .is_some_and(|(feasible, _, objective, ..)| *feasible && *objective <= ZERO_OBJECTIVE)
+            .is_some_and(|b| b.feasible && b.objective <= ZERO_OBJECTIVE)
         {
             break;
         }
@@ -1016,15 +1162,15 @@ pub fn positioner_law(
         let mut joints = Vec::new();
         let mut chk = None;
         for _round in 0..4 {
-            let (xs, it, left) = sqp(&pb, &basis, &idx, x);
-            iterations += it;
+            let (xs, it, left) = sqp(pb, basis, &idx, x);
+            *iterations += it;
             x = xs;
             // violated on the samples already: more samples cannot help
             let stuck = left > STUCK_VIOLATION;
             let (c7, c8) = x.split_at(k);
             let (q7, q8) = (basis.eval(c7), basis.eval(c8));
             joints = q7.into_iter().zip(q8).map(|(a, b)| [a, b]).collect();
-            let c = check(&pb, &joints);
+            let c = check(pb, &joints);
             let done = stuck
                 || c.binding.is_none()
                 || c.worst.iter().all(|m| idx.binary_search(m).is_ok());
@@ -1045,41 +1191,20 @@ pub fn positioner_law(
             }
         }
         let c = chk.expect("at least one round");
-        let feasible = c.binding.is_none();
-        let violation = c.binding.map_or(0.0, |(v, _)| v);
-        let model = build_model(&pb, &basis, &(0..n).collect::<Vec<_>>(), &x);
-        let objective = 0.5 * model.r.iter().map(|v| v * v).sum::<f64>();
-        let better = match &best {
-            None => true,
-            Some((bf, bv, bo, ..)) => match (feasible, *bf) {
-                (true, false) => true,
-                (false, true) => false,
-                (true, true) => objective < *bo,
-                (false, false) => violation < *bv,
-            },
+        let model = build_model(pb, basis, &(0..n).collect::<Vec<_>>(), &x);
+        let solved = Solved {
+            feasible: c.binding.is_none(),
+            violation: c.binding.map_or(0.0, |(v, _)| v),
+            objective: 0.5 * model.r.iter().map(|v| v * v).sum::<f64>(),
+            seed,
+            joints,
+            samples: idx.len(),
         };
-        if better {
-            best = Some((feasible, violation, objective, seed, joints, idx.len()));
+        if best.as_ref().is_none_or(|b| solved.better_than(b)) {
+            best = Some(solved);
         }
     }
-    // where no smooth law keeps the cone (a corner of b), the thesis's
-    // exact vertical does by construction: kept when its speeds hold (an
-    // unlimited positioner), so that the arm is judged on it
-    if let (Some((false, ..)), Some(f)) = (&best, follow) {
-        if check(&pb, &f).binding.is_none() {
-            let per_point = Basis::PerPoint { points: n };
-            let x: Vec<f64> = f
-                .iter()
-                .map(|q| q[0])
-                .chain(f.iter().map(|q| q[1]))
-                .collect();
-            let model = build_model(&pb, &per_point, &(0..n).collect::<Vec<_>>(), &x);
-            let objective = 0.5 * model.r.iter().map(|v| v * v).sum::<f64>();
-            best = Some((true, 0.0, objective, PositionerSeed::Vertical, f, n));
-        }
-    }
-    let (_, _, objective, seed, joints, samples) = best.expect("the hold seed is always solved");
-    finish(&pb, joints, seed, iterations, samples, objective)
+    best.expect("the hold seed is always solved")
 }
 
 fn finish(
@@ -1093,20 +1218,26 @@ fn finish(
     let c = check(pb, &joints);
     let (required, between) = required_rotation_rate(&pb.b, &pb.dt, pb.cone);
     let available = pb.max_speed[0] + pb.max_speed[1];
-    // a law that leaves the cone, not proven by the rate: search every
-    // positioner path on a grid (only where a speed is bounded: an
-    // unlimited positioner reaches any pose at every point)
-    let left_cone = matches!(c.binding, Some((_, PositionerBinding::Cone { .. })));
+    // a law that leaves the cone, or keeps it only faster than the axes
+    // go, not proven by the rate: search every positioner path on a grid
+    // (only where a speed is bounded: an unlimited positioner reaches any
+    // pose at every point)
+    let failed = c.binding.is_some();
     let unreachable =
-        if left_cone && required <= available && pb.max_speed.iter().any(|v| v.is_finite()) {
-            unreachable_point(
-                &pb.cell.positioner,
-                &pb.r0,
-                &pb.b,
-                &pb.dt,
-                pb.cone,
-                2f64.to_radians(),
-            )
+        if failed && required <= available && pb.max_speed.iter().any(|v| v.is_finite()) {
+            // coarse first (cheap, proves the clear cases), then finer:
+            // the relaxation's slack is a cell, so a finer grid proves a
+            // layer that misses the cone by less
+            GRID_CELLS_DEG.iter().find_map(|cell_deg| {
+                unreachable_point(
+                    &pb.cell.positioner,
+                    &pb.r0,
+                    &pb.b,
+                    &pb.dt,
+                    pb.cone,
+                    cell_deg.to_radians(),
+                )
+            })
         } else {
             None
         };

@@ -220,6 +220,9 @@ fn the_place_command_exits_0_1_or_2() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("placement.tilt_x_deg"));
 
+    // the general tube at this coarse grid: refused as given in the KUKA
+    // torch-carried cell before the laws' knots followed the turning of `b`
+    // (exit 2, the cone); placed now, and its placed cell plans
     let tube = part_path("general-tube.toml");
     let torch = part_path("cells/kuka_kr16_2_torch_carried.toml");
     let mut args = vec![
@@ -231,6 +234,48 @@ fn the_place_command_exits_0_1_or_2() {
     args.extend(grid);
     args.extend(["--out", out.to_str().unwrap()]);
     let o = run(&args);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let o = run(&[
+        "plan",
+        tube.to_str().unwrap(),
+        "--cell",
+        placed.to_str().unwrap(),
+        "--delta",
+        "8",
+        "--points",
+        "16",
+        "--out",
+        plan_out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+
+    // the quarter torus with 120 points a layer: its top layer turns `b`
+    // faster than the cone lets any placement follow (exit 2, named)
+    let torus = part_path("quarter-torus.toml");
+    let o = run(&[
+        "place",
+        torus.to_str().unwrap(),
+        "--cell",
+        torch.to_str().unwrap(),
+        "--delta",
+        "8",
+        "--points",
+        "120",
+        "--samples",
+        "8",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     // the binding constraint is named: the build direction's cone (the
