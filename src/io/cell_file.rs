@@ -750,8 +750,9 @@ pub fn placed_cell_file(
 /// searched; the rotation, fixture (tilts, offsets, rotation on the table)
 /// and torch-mount ranges relative to the mount written (exact for the
 /// offsets alone or one free tilt axis; with several, placing again
-/// searches a slightly different box about the found mount); the fixed
-/// variables; the keep-out box.
+/// searches a slightly different box about the found mount; a
+/// torch-carried cell's offset on the table is written even when fixed,
+/// since its default is searched); the fixed variables; the keep-out box.
 fn placement_table(
     spec: &mut toml_edit::Table,
     p: &crate::place::Placement,
@@ -780,8 +781,11 @@ fn placement_table(
             ("fixture_rotation_deg", found.fixture_rotation, true),
         ),
     ];
+    // A torch-carried cell searches the offset on its table by default: kept
+    // fixed, it is written `[0, 0]` so that placing again keeps it.
+    let torch = matches!(p.cell, CellLayout::TorchCarried(_));
     for (var, (key, x, degrees)) in extra {
-        if var.is_free() {
+        if var.is_free() || (torch && key.starts_with("offset_")) {
             let (lo, hi) = (var.lower - x, var.upper - x);
             let r = if degrees {
                 [lo.to_degrees(), hi.to_degrees()]

@@ -265,3 +265,71 @@ fn bad_table_offset_ranges_name_their_field() {
     let b = waam_slicer::pipeline::placement_bounds(&cell, 400.0).unwrap();
     assert_eq!((b.variables[7].lower, b.variables[7].upper), (-50.0, 50.0));
 }
+
+/// The offset alone does it: with the positioner's pose fixed in
+/// `[placement]`, the search still places the off-centre quarter torus,
+/// by moving it on the table towards the turn axis.
+#[test]
+fn with_the_positioner_fixed_the_offset_alone_places_the_bent_tube() {
+    let text = mounted_text(MOUNT) + "\n[placement]\nfixed = [\"x\", \"y\", \"z\", \"rotation\"]\n";
+    let cell = Cell::from_toml_str(&text, "fixed.toml").unwrap();
+    let part = Part::read(part_path("quarter-torus.toml")).unwrap();
+    let req = PlaceRequest {
+        slice: coarse(),
+        search: PlaceOptions {
+            samples: 8,
+            layers: 4,
+            points_per_layer: 8,
+            refined: 1,
+            refine_evaluations: 6,
+            rounds: 2,
+            ..PlaceOptions::default()
+        },
+        ..PlaceRequest::default()
+    };
+    let placed = place_part(&part, &cell, &req).unwrap();
+    let p = &placed.placement;
+    assert!(p.feasible, "{:#?}", placed.summary());
+    let v = &p.values;
+    let from_axis = (MOUNT[0] + v.offset_x_mm).hypot(MOUNT[1] + v.offset_y_mm);
+    assert!(from_axis < MOUNT[0].hypot(MOUNT[1]) - 20.0, "{v:?}");
+    let (CellLayout::TorchCarried(a), CellLayout::TorchCarried(b)) =
+        (&cell.layout, &placed.cell.layout)
+    else {
+        panic!("torch carried")
+    };
+    assert_eq!(a.base_from_positioner, b.base_from_positioner);
+    // The placed file's [placement] keeps the same box of the part origin
+    // on the table, relative to the mount written.
+    let spec = placed.cell.placement.as_ref().unwrap();
+    let x = spec.offset_x_mm.unwrap();
+    assert!((x[0] - (-400.0 - v.offset_x_mm)).abs() < 1e-6, "{x:?}");
+    assert!((x[1] - (0.0 - v.offset_x_mm)).abs() < 1e-6, "{x:?}");
+
+    // An offset kept at [0, 0] stays kept in the placed file.
+    let text = mounted_text(MOUNT)
+        + "\n[placement]\nfixed = [\"x\", \"y\", \"z\", \"rotation\"]\n\
+           offset_x_mm = [0, 0]\noffset_y_mm = [0, 0]\n";
+    let kept = place_part(
+        &part,
+        &Cell::from_toml_str(&text, "kept.toml").unwrap(),
+        &req,
+    )
+    .unwrap();
+    let spec = kept.cell.placement.as_ref().unwrap();
+    assert_eq!(
+        (spec.offset_x_mm, spec.offset_y_mm),
+        (Some([0.0, 0.0]), Some([0.0, 0.0]))
+    );
+    let again = Cell::from_toml_str(&placed.toml, "placed.toml").unwrap();
+    let opts = PlanOptions {
+        slice: coarse(),
+        ..PlanOptions::default()
+    };
+    let planned = plan_part(&part, &again, &opts).unwrap();
+    assert!(planned.is_feasible(), "{:?}", planned.refusal());
+    eprintln!(
+        "positioner fixed: offset ({:.1}, {:.1}) mm, {from_axis:.1} mm from the turn axis, {:.1} s",
+        v.offset_x_mm, v.offset_y_mm, p.time_s
+    );
+}
