@@ -162,8 +162,10 @@ class Part:
     ) -> "PlacedCell":
         """Searches where the part should sit in `cell` (as `waam place`):
         the deposition point and the part's mount when the arm carries the
-        part, the positioner's pose when it carries the torch; the fixture
-        tilt, part offset and torch clamp rotation when the cell file's
+        part, the positioner's pose and the part's offset on the table
+        (within 150 mm of the turn axis unless [placement] says otherwise)
+        when it carries the torch; the fixture tilt, other part offsets and
+        rotations and the torch clamp rotation when the cell file's
         [placement] table gives their ranges; so that every layer is
         feasible and the program stage accepts the plan, with the widest
         worst-layer margins. The cell as given is kept when it is as good.

@@ -116,7 +116,18 @@ pub struct CellFile {
 /// tilt_y_deg = [-30, 30]        #   flange (part carried) or on the table (torch carried)
 /// offset_mm = [0, 100]          # part carried: the part's mount along the flange axis
 /// torch_rotation_deg = [-90, 90]  # torch carried: the torch in its clamp, about the flange axis
+/// fixture_rotation_deg = [-180, 180]  # torch carried: the part on the table about its normal
+/// # the part's offset in its mount's plane: on the table (torch carried, table frame x, y;
+/// # searched by default: the part origin within ±150 mm of the turn axis) or on the flange
+/// # (part carried, flange frame x, y; kept unless given); [0, 0] keeps it
+/// offset_x_mm = [-150, 150]
+/// offset_y_mm = [-150, 150]
 /// ```
+///
+/// The mount ranges (tilts, offsets, rotations of the fixture or torch) are
+/// relative to the file's own mount (`flange_from_part_xyzwpr`,
+/// `table_from_part_xyzwpr`, `tool_xyzwpr`), composed as
+/// [`PlacementValues::apply`](crate::place::PlacementValues::apply) says.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlacementSpec {
@@ -145,6 +156,18 @@ pub struct PlacementSpec {
     /// Torch carried: range of the torch's rotation in its clamp about the
     /// flange axis (deg), at most a turn wide. Absent: kept.
     pub torch_rotation_deg: Option<[f64; 2]>,
+    /// Range of the part's offset along x in its mount's plane (mm), within
+    /// ±1000 mm of the file's mount: table frame x (torch carried), flange
+    /// frame x (part carried). Absent: torch carried, the part origin within
+    /// ±[`TABLE_OFFSET_MM`](crate::place::TABLE_OFFSET_MM) of the turn axis
+    /// (and the file's mount); part carried, kept.
+    pub offset_x_mm: Option<[f64; 2]>,
+    /// As `offset_x_mm`, along the table (flange) frame y (mm).
+    pub offset_y_mm: Option<[f64; 2]>,
+    /// Torch carried: range of the part's rotation on the table about the
+    /// table normal (deg), at most a turn wide. Absent: kept (with an
+    /// endless turn it only matters against the turn stroke).
+    pub fixture_rotation_deg: Option<[f64; 2]>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -465,6 +488,14 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
                 360.0,
                 Some(false),
             ),
+            ("placement.offset_x_mm", p.offset_x_mm, 1000.0, None),
+            ("placement.offset_y_mm", p.offset_y_mm, 1000.0, None),
+            (
+                "placement.fixture_rotation_deg",
+                p.fixture_rotation_deg,
+                360.0,
+                Some(false),
+            ),
         ];
         for (field, range, limit, only_part_carried) in ranges {
             let Some([lo, hi]) = range else { continue };
@@ -476,7 +507,7 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
                 ));
             }
             let ok = lo.is_finite() && hi.is_finite() && lo <= hi;
-            let within = if field.ends_with("torch_rotation_deg") {
+            let within = if field.ends_with("rotation_deg") {
                 hi - lo <= limit
             } else {
                 lo >= -limit && hi <= limit
@@ -635,9 +666,16 @@ pub fn placed_cell_file(
         CellLayout::PartCarried(c) => {
             let mut t = table(&doc, "part_carried")?;
             t["deposition_point_mm"] = toml_floats(c.deposition_point_mm.coords.as_slice());
-            let mount_moved = [v.rotation, v.tilt_x, v.tilt_y, v.offset_mm]
-                .iter()
-                .any(|x| *x != 0.0);
+            let mount_moved = [
+                v.rotation,
+                v.tilt_x,
+                v.tilt_y,
+                v.offset_mm,
+                v.offset_x_mm,
+                v.offset_y_mm,
+            ]
+            .iter()
+            .any(|x| *x != 0.0);
             if mount_moved || t.contains_key("flange_from_part_xyzwpr") {
                 let pose = FanucPose::from_isometry(&c.flange_from_part).to_xyzwpr_deg();
                 t["flange_from_part_xyzwpr"] = toml_floats(&pose);
@@ -648,7 +686,16 @@ pub fn placed_cell_file(
             let mut t = table(&doc, "torch_carried")?;
             let pose = FanucPose::from_isometry(&c.base_from_positioner).to_xyzwpr_deg();
             t["positioner_pose_xyzwpr"] = toml_floats(&pose);
-            if v.tilt_x != 0.0 || v.tilt_y != 0.0 || t.contains_key("table_from_part_xyzwpr") {
+            let mount_moved = [
+                v.tilt_x,
+                v.tilt_y,
+                v.offset_x_mm,
+                v.offset_y_mm,
+                v.fixture_rotation,
+            ]
+            .iter()
+            .any(|x| *x != 0.0);
+            if mount_moved || t.contains_key("table_from_part_xyzwpr") {
                 let pose = FanucPose::from_isometry(&c.table_from_part).to_xyzwpr_deg();
                 t["table_from_part_xyzwpr"] = toml_floats(&pose);
             }
@@ -700,10 +747,12 @@ pub fn placed_cell_file(
 
 /// Fills the `[placement]` table `spec` with the bounds searched, around
 /// the placement found: the box of the deposition point (positioner) as
-/// searched; the rotation, fixture and torch-mount ranges relative to the
-/// mount written (exact for one free tilt axis; with both, placing again
-/// searches a slightly different box about the found mount); the fixed
-/// variables; the keep-out box.
+/// searched; the rotation, fixture (tilts, offsets, rotation on the table)
+/// and torch-mount ranges relative to the mount written (exact for the
+/// offsets alone or one free tilt axis; with several, placing again
+/// searches a slightly different box about the found mount; a
+/// torch-carried cell's offset on the table is written even when fixed,
+/// since its default is searched); the fixed variables; the keep-out box.
 fn placement_table(
     spec: &mut toml_edit::Table,
     p: &crate::place::Placement,
@@ -725,9 +774,18 @@ fn placement_table(
         (&v[4], ("tilt_x_deg", found.tilt_x, true)),
         (&v[5], ("tilt_y_deg", found.tilt_y, true)),
         (&v[6], mount),
+        (&v[7], ("offset_x_mm", found.offset_x_mm, false)),
+        (&v[8], ("offset_y_mm", found.offset_y_mm, false)),
+        (
+            &v[9],
+            ("fixture_rotation_deg", found.fixture_rotation, true),
+        ),
     ];
+    // A torch-carried cell searches the offset on its table by default: kept
+    // fixed, it is written `[0, 0]` so that placing again keeps it.
+    let torch = matches!(p.cell, CellLayout::TorchCarried(_));
     for (var, (key, x, degrees)) in extra {
-        if var.is_free() {
+        if var.is_free() || (torch && key.starts_with("offset_")) {
             let (lo, hi) = (var.lower - x, var.upper - x);
             let r = if degrees {
                 [lo.to_degrees(), hi.to_degrees()]

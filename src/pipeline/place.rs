@@ -87,14 +87,19 @@ pub fn placement_bounds(cell: &Cell, half_box_mm: f64) -> Result<PlacementBounds
     if let (Some(lo), Some(hi)) = (spec.keep_out_min_mm, spec.keep_out_max_mm) {
         b.keep_out = Some((lo, hi));
     }
-    // Fixture and torch mount: searched only when the table gives a range
-    // (the cell file reader has checked them and their cell kind).
+    // Fixture and torch mount: the table's range where it gives one (the
+    // cell file reader has checked them and their cell kind), else the
+    // default's (the offset on a torch-carried cell's table searched, the
+    // rest kept).
     let part_carried = matches!(cell.layout, crate::robot::CellLayout::PartCarried(_));
     let extra = [
         (4, spec.tilt_x_deg, true),
         (5, spec.tilt_y_deg, true),
         (6, spec.offset_mm.filter(|_| part_carried), false),
         (6, spec.torch_rotation_deg.filter(|_| !part_carried), true),
+        (7, spec.offset_x_mm, false),
+        (8, spec.offset_y_mm, false),
+        (9, spec.fixture_rotation_deg.filter(|_| !part_carried), true),
     ];
     for (k, range, degrees) in extra {
         if let Some([lo, hi]) = range {

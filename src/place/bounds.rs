@@ -12,10 +12,19 @@ use crate::optimise::OptimiseError;
 use crate::robot::CellLayout;
 
 /// Number of placement variables (see the module doc's table).
-pub const VARIABLES: usize = 7;
+pub const VARIABLES: usize = 10;
+
+/// Default half-width (mm) of the square, centred on the table's turn axis,
+/// within which the search moves the part frame's origin on a
+/// torch-carried cell's table when the cell file gives no
+/// `offset_x_mm`/`offset_y_mm` range (table frame x and y). The table is
+/// assumed Ø500 mm ([`TABLE_RADIUS_MM`](crate::program::cell_check::TABLE_RADIUS_MM)
+/// = 250 mm): 150 mm leaves 100 mm of face plate around a part origin at
+/// the square's edge, and its corners (212 mm out) stay on the plate.
+pub const TABLE_OFFSET_MM: f64 = 150.0;
 
 /// A point of the search space: the [`VARIABLES`] coordinates in the
-/// order of the module doc's table (mm for positions and the offset, rad
+/// order of the module doc's table (mm for positions and offsets, rad
 /// for rotations and tilts).
 pub(crate) type Coords = [f64; VARIABLES];
 
@@ -23,11 +32,12 @@ pub(crate) type Coords = [f64; VARIABLES];
 const ANGLE_SLACK_RAD: f64 = 1e-9;
 
 /// One placement variable: its name, its bounds and the cell's current value
-/// (mm for positions and the offset, rad for rotations and tilts).
+/// (mm for positions and offsets, rad for rotations and tilts).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlacementVariable {
     /// Name, e.g. `deposition_point_mm.x`, `flange_rotation`, `positioner.x`,
-    /// `fixture.tilt_x`, `fixture.offset`, `torch_rotation`.
+    /// `fixture.tilt_x`, `fixture.offset`, `torch_rotation`,
+    /// `fixture.offset_x`, `fixture.rotation`.
     pub name: &'static str,
     /// `true` for an angle (rad), `false` for a length (mm).
     pub angle: bool,
@@ -60,9 +70,17 @@ pub struct PlacementBounds {
 impl PlacementBounds {
     /// Default bounds around `cell`'s placement: ±`half_box_mm` on each
     /// coordinate of the deposition point (positioner), the full turn on the
-    /// rotation, the fixture and torch mount fixed as given, and the robot's
-    /// base keep-out: a vertical cylinder's bounding box of half-width 250 mm
-    /// about the base axis below the shoulder.
+    /// rotation, the fixture tilts, the torch mount and the part-carried
+    /// mount fixed as given, and the robot's base keep-out: a vertical
+    /// cylinder's bounding box of half-width 250 mm about the base axis
+    /// below the shoulder.
+    ///
+    /// Torch carried, the part's offset on the table is searched: the part
+    /// frame's origin within ±[`TABLE_OFFSET_MM`] of the turn axis in table
+    /// x and y, the range widened to hold the file's own mount (so that the
+    /// cell as given is a candidate); the part's rotation on the table stays
+    /// as given (with an endless turn it only matters against a turn
+    /// stroke).
     pub fn around(cell: &CellLayout, half_box_mm: f64) -> Self {
         let names_pc = [
             "deposition_point_mm.x",
@@ -72,6 +90,9 @@ impl PlacementBounds {
             "fixture.tilt_x",
             "fixture.tilt_y",
             "fixture.offset",
+            "fixture.offset_x",
+            "fixture.offset_y",
+            "fixture.rotation",
         ];
         let names_tc = [
             "positioner.x",
@@ -81,12 +102,19 @@ impl PlacementBounds {
             "fixture.tilt_x",
             "fixture.tilt_y",
             "torch_rotation",
+            "fixture.offset_x",
+            "fixture.offset_y",
+            "fixture.rotation",
         ];
-        let (p, names): (Point3, [&'static str; VARIABLES]) = match cell {
-            CellLayout::PartCarried(c) => (c.deposition_point_mm, names_pc),
+        // Part origin in the mount's plane (table frame, mm), when its
+        // offset is searched by default (torch carried).
+        let (p, names, on_table): (Point3, [&'static str; VARIABLES], Option<Vector3>) = match cell
+        {
+            CellLayout::PartCarried(c) => (c.deposition_point_mm, names_pc, None),
             CellLayout::TorchCarried(c) => (
                 Point3::from(c.base_from_positioner.translation.vector),
                 names_tc,
+                Some(c.table_from_part.translation.vector),
             ),
         };
         let fixed = |name, angle| PlacementVariable {
@@ -95,6 +123,17 @@ impl PlacementBounds {
             lower: 0.0,
             upper: 0.0,
             current: 0.0,
+        };
+        // The offset moving the part origin, now at `o` on the table, within
+        // ±TABLE_OFFSET_MM of the turn axis, widened to hold 0 (the mount
+        // as given).
+        let table_offset = |name, o: Option<f64>| match o {
+            Some(o) => PlacementVariable {
+                lower: (-TABLE_OFFSET_MM - o).min(0.0),
+                upper: (TABLE_OFFSET_MM - o).max(0.0),
+                ..fixed(name, false)
+            },
+            None => fixed(name, false),
         };
         let position = |k: usize| PlacementVariable {
             name: names[k],
@@ -115,6 +154,9 @@ impl PlacementBounds {
             fixed(names[4], true),
             fixed(names[5], true),
             fixed(names[6], matches!(cell, CellLayout::TorchCarried(_))),
+            table_offset(names[7], on_table.map(|o| o.x)),
+            table_offset(names[8], on_table.map(|o| o.y)),
+            fixed(names[9], true),
         ];
         Self {
             variables,
@@ -206,6 +248,17 @@ pub struct PlacementValues {
     /// Torch carried: the torch's rotation in its clamp about the flange
     /// axis (rad); 0 part carried.
     pub torch_rotation: f64,
+    /// The part's offset along x in its mount's plane (mm): table frame x
+    /// (torch carried), flange frame x (part carried). See
+    /// [`PlacementValues::apply`] for the order of composition.
+    pub offset_x_mm: f64,
+    /// As [`PlacementValues::offset_x_mm`], along table (flange) frame y (mm).
+    pub offset_y_mm: f64,
+    /// Torch carried: the part's rotation on the table about the table
+    /// normal (the turn axis) through the table centre (rad); 0 part
+    /// carried (there the mount's rotation about the flange axis is
+    /// [`PlacementValues::rotation`]).
+    pub fixture_rotation: f64,
 }
 
 impl PlacementValues {
@@ -219,6 +272,9 @@ impl PlacementValues {
             tilt_y: x[5],
             offset_mm: if torch { 0.0 } else { x[6] },
             torch_rotation: if torch { x[6] } else { 0.0 },
+            offset_x_mm: x[7],
+            offset_y_mm: x[8],
+            fixture_rotation: if torch { x[9] } else { 0.0 },
         }
     }
 
@@ -239,12 +295,25 @@ impl PlacementValues {
             self.tilt_x,
             self.tilt_y,
             mount,
+            self.offset_x_mm,
+            self.offset_y_mm,
+            self.fixture_rotation,
         ]
     }
 
     /// The cell with this placement: the deposition point (positioner
-    /// origin) set; the rotation, tilts, offset and torch rotation composed
-    /// onto the cell's own mounts.
+    /// origin) set; the rotation, tilts, offsets and torch rotation composed
+    /// onto the cell's own mounts, on the left (in the flange or table
+    /// frame, about its origin):
+    ///
+    /// * part carried: `flange_from_part = T(offset_x, offset_y, offset) ·
+    ///   Rz(rotation) · Rx(tilt_x) · Ry(tilt_y) · flange_from_part₀`
+    ///   (flange frame, mm);
+    /// * torch carried: `table_from_part = T(offset_x, offset_y, 0) ·
+    ///   Rz(fixture_rotation) · Rx(tilt_x) · Ry(tilt_y) · table_from_part₀`
+    ///   (table frame: origin at the table centre C8 on the turn axis, z the
+    ///   table normal; mm). The offset moves the part in the table plane
+    ///   after it is tilted and turned about the table centre.
     pub fn apply(&self, cell: &CellLayout) -> CellLayout {
         let rot = |axis: &UnitVector3, a: f64| UnitQuaternion::from_axis_angle(axis, a);
         let tilt = rot(&Vector3::x_axis(), self.tilt_x) * rot(&Vector3::y_axis(), self.tilt_y);
@@ -254,7 +323,7 @@ impl PlacementValues {
             CellLayout::PartCarried(c) => {
                 c.deposition_point_mm = p;
                 let mount = Isometry3::from_parts(
-                    Translation3::new(0.0, 0.0, self.offset_mm),
+                    Translation3::new(self.offset_x_mm, self.offset_y_mm, self.offset_mm),
                     rot(&Vector3::z_axis(), self.rotation) * tilt,
                 );
                 c.flange_from_part = mount * c.flange_from_part;
@@ -264,8 +333,10 @@ impl PlacementValues {
                     Translation3::new(p.x, p.y, p.z),
                     rot(&Vector3::z_axis(), self.rotation) * c.base_from_positioner.rotation,
                 );
-                c.table_from_part =
-                    Isometry3::from_parts(Translation3::identity(), tilt) * c.table_from_part;
+                c.table_from_part = Isometry3::from_parts(
+                    Translation3::new(self.offset_x_mm, self.offset_y_mm, 0.0),
+                    rot(&Vector3::z_axis(), self.fixture_rotation) * tilt,
+                ) * c.table_from_part;
                 c.flange_from_tcp = Isometry3::from_parts(
                     Translation3::identity(),
                     rot(&Vector3::z_axis(), self.torch_rotation),

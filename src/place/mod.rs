@@ -20,8 +20,8 @@
 //! | margins and score | [`score`] |
 //! | what the search gives back | [`outcome`] |
 //!
-//! The variables (robot base frame; mm, rad), each searched only where its
-//! bounds differ:
+//! The variables (robot base frame unless said; mm, rad), each searched
+//! only where its bounds differ:
 //!
 //! | | part carried | torch carried |
 //! |---|---|---|
@@ -29,6 +29,17 @@
 //! | 3 | part mount about the flange axis | positioner about the vertical |
 //! | 4, 5 | fixture tilt of the part on the flange about X, Y | fixture tilt of the part on the table about X, Y |
 //! | 6 | part mount offset along the flange axis (mm) | torch in its clamp about the flange axis |
+//! | 7, 8 | part mount offset in the flange plane, flange x, y (mm) | part offset on the table, table x, y (mm) |
+//! | 9 | — (fixed at 0: variable 3 turns the mount) | part rotation on the table about its normal |
+//!
+//! By default ([`PlacementBounds::around`]) variables 0–3 are searched, and
+//! in a torch-carried cell also the part's offset on the table (7, 8: the
+//! part origin within ±[`TABLE_OFFSET_MM`] of the turn axis): a layer far
+//! from the turn axis orbits it as the table turns, and moving the part on
+//! the table is what a cell operator does. The others are searched when
+//! the bounds give them a range (the cell file's `[placement]` table).
+//! [`PlacementValues::apply`] gives the order in which the mount variables
+//! compose.
 //!
 //! The search:
 //! 1. **Screening**: a coarse global sampling of the free variables (a
@@ -74,7 +85,7 @@ mod screen;
 #[cfg(test)]
 mod tests;
 
-pub use bounds::{PlacementBounds, PlacementValues, PlacementVariable, VARIABLES};
+pub use bounds::{PlacementBounds, PlacementValues, PlacementVariable, TABLE_OFFSET_MM, VARIABLES};
 pub use certify::KEEP_MARGIN;
 pub use outcome::{Binding, Limit, Margins, PlaceTimes, Placement};
 pub use score::{margins, REACH_COMFORT_MM};

@@ -23,7 +23,7 @@ const SCORE_REFUSED_CELL: f64 = -3.0;
 const SCORE_SCREEN_REFUSAL: f64 = -0.05;
 
 /// Bases of the Halton sequence, one per variable.
-const HALTON_BASES: [usize; VARIABLES] = [2, 3, 5, 7, 11, 13, 17];
+const HALTON_BASES: [usize; VARIABLES] = [2, 3, 5, 7, 11, 13, 17, 19, 23, 29];
 
 /// A candidate judged on the subsample.
 #[derive(Clone)]

@@ -165,15 +165,20 @@ fn a_refusal_names_its_layers_from_typed_fields_only() {
 
 /// Typed values and the table's order agree, for both cell kinds: the
 /// seventh variable is the mount offset (mm) part carried, the torch's
-/// rotation in its clamp (rad) torch carried; and the placed cell puts the
-/// deposition point (positioner origin) at the values' position.
+/// rotation in its clamp (rad) torch carried; the eighth and ninth the
+/// part's offset in its mount's plane (mm) for both; the tenth the part's
+/// rotation on the table (rad) torch carried, none part carried; and the
+/// placed cell puts the deposition point (positioner origin) at the
+/// values' position.
 #[test]
 fn placement_values_follow_the_table_for_both_cell_kinds() {
     use super::bounds::{placed_cell, PlacementValues};
     use crate::io::cell_file::parse_cell_file;
     use crate::math::Point3;
     use crate::robot::CellLayout;
-    let x = [1000.0, -200.0, 500.0, 0.5, 0.1, -0.2, 30.0];
+    let x = [
+        1000.0, -200.0, 500.0, 0.5, 0.1, -0.2, 30.0, 40.0, -60.0, 0.3,
+    ];
     for file in [
         "parts/cells/robowam_part_carried.toml",
         "parts/cells/kuka_kr16_2_torch_carried.toml",
@@ -182,7 +187,13 @@ fn placement_values_follow_the_table_for_both_cell_kinds() {
         let text = std::fs::read_to_string(&path).unwrap();
         let cell = parse_cell_file(&text, file).unwrap().cell.unwrap();
         let v = PlacementValues::from_coords(&cell, &x);
-        assert_eq!(v.in_table_order(&cell), x);
+        let mut table = x;
+        if matches!(cell, CellLayout::PartCarried(_)) {
+            // part carried, the mount's rotation is variable 3 alone
+            table[9] = 0.0;
+        }
+        assert_eq!(v.in_table_order(&cell), table);
+        assert_eq!((v.offset_x_mm, v.offset_y_mm), (40.0, -60.0));
         assert_eq!(v.position_mm, Point3::new(1000.0, -200.0, 500.0));
         let placed = placed_cell(&cell, &x);
         match (&cell, &placed) {
@@ -192,6 +203,7 @@ fn placement_values_follow_the_table_for_both_cell_kinds() {
             }
             (CellLayout::TorchCarried(_), CellLayout::TorchCarried(c)) => {
                 assert_eq!((v.offset_mm, v.torch_rotation), (0.0, 30.0));
+                assert_eq!(v.fixture_rotation, 0.3);
                 assert_eq!(
                     Point3::from(c.base_from_positioner.translation.vector),
                     v.position_mm
@@ -200,4 +212,146 @@ fn placement_values_follow_the_table_for_both_cell_kinds() {
             _ => panic!("{file}: the cell kind changed"),
         }
     }
+}
+
+/// The default bounds of a torch-carried cell search the part's offset on
+/// the table: the part origin within ±`TABLE_OFFSET_MM` of the turn axis,
+/// widened to hold the file's mount (offset 0); a part-carried cell keeps
+/// its mount.
+#[test]
+fn the_default_bounds_search_the_offset_on_the_table_torch_carried_only() {
+    use super::bounds::{PlacementBounds, TABLE_OFFSET_MM};
+    use crate::io::cell_file::parse_cell_file;
+    use crate::robot::CellLayout;
+    let read = |file: &str| {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        parse_cell_file(&text, file).unwrap().cell.unwrap()
+    };
+    let pc = PlacementBounds::around(&read("parts/cells/robowam_part_carried.toml"), 400.0);
+    assert!(pc.variables[6..].iter().all(|v| !v.is_free()));
+    let mut tc = read("parts/cells/kuka_kr16_2_torch_carried.toml");
+    let b = PlacementBounds::around(&tc, 400.0);
+    let v = &b.variables;
+    assert_eq!(
+        (v[7].name, v[8].name, v[9].name),
+        ("fixture.offset_x", "fixture.offset_y", "fixture.rotation")
+    );
+    assert_eq!(
+        (v[7].lower, v[7].upper),
+        (-TABLE_OFFSET_MM, TABLE_OFFSET_MM)
+    );
+    assert_eq!(
+        (v[8].lower, v[8].upper),
+        (-TABLE_OFFSET_MM, TABLE_OFFSET_MM)
+    );
+    assert!(!v[7].angle && v[9].angle && !v[9].is_free());
+    // Mounted 220 mm off the axis along x, 40 mm along y: back to within
+    // 150 mm of it, or kept.
+    if let CellLayout::TorchCarried(c) = &mut tc {
+        c.table_from_part = Isometry3::translation(220.0, 40.0, 5.0);
+    }
+    let b = PlacementBounds::around(&tc, 400.0);
+    let v = &b.variables;
+    assert_eq!((v[7].lower, v[7].upper), (-370.0, 0.0));
+    assert_eq!((v[8].lower, v[8].upper), (-190.0, 110.0));
+    b.validate().unwrap();
+}
+
+/// `apply` composes the torch-carried mount variables as documented:
+/// `T(offset_x, offset_y, 0) · Rz(fixture_rotation) · Rx(tilt_x) ·
+/// Ry(tilt_y) · table_from_part₀` (table frame), written out here with
+/// explicit matrices; the part-carried offsets likewise in the flange frame.
+#[test]
+fn the_mount_variables_compose_in_the_documented_order() {
+    use super::bounds::PlacementValues;
+    use crate::io::cell_file::parse_cell_file;
+    use crate::math::{Matrix3, Point3};
+    use crate::robot::CellLayout;
+    let (ox, oy, fr, tx, ty): (f64, f64, f64, f64, f64) = (-120.0, 35.0, 0.4, 0.1, -0.2);
+    let rx = Matrix3::new(
+        1.0,
+        0.0,
+        0.0,
+        0.0,
+        tx.cos(),
+        -tx.sin(),
+        0.0,
+        tx.sin(),
+        tx.cos(),
+    );
+    let ry = Matrix3::new(
+        ty.cos(),
+        0.0,
+        ty.sin(),
+        0.0,
+        1.0,
+        0.0,
+        -ty.sin(),
+        0.0,
+        ty.cos(),
+    );
+    let rz = Matrix3::new(
+        fr.cos(),
+        -fr.sin(),
+        0.0,
+        fr.sin(),
+        fr.cos(),
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+    );
+    let v = PlacementValues {
+        tilt_x: tx,
+        tilt_y: ty,
+        offset_x_mm: ox,
+        offset_y_mm: oy,
+        fixture_rotation: fr,
+        ..PlacementValues::default()
+    };
+    let file = "parts/cells/kuka_kr16_2_torch_carried.toml";
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut cell = parse_cell_file(&text, file).unwrap().cell.unwrap();
+    let m0 = Isometry3::translation(220.0, 10.0, 5.0);
+    if let CellLayout::TorchCarried(c) = &mut cell {
+        c.table_from_part = m0;
+    }
+    let v = PlacementValues {
+        position_mm: match &cell {
+            CellLayout::TorchCarried(c) => Point3::from(c.base_from_positioner.translation.vector),
+            _ => unreachable!(),
+        },
+        ..v
+    };
+    let CellLayout::TorchCarried(c) = v.apply(&cell) else {
+        panic!("torch carried")
+    };
+    let p = Point3::new(12.0, -7.0, 30.0);
+    let by_hand =
+        rz * rx * ry * (p.coords + m0.translation.vector) + crate::math::Vector3::new(ox, oy, 0.0);
+    assert!((c.table_from_part * p - Point3::from(by_hand)).norm() < 1e-9);
+
+    // Part carried: the mount's rotation is variable 3, its offset along
+    // the flange axis variable 6.
+    let file = "parts/cells/robowam_part_carried.toml";
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut cell = parse_cell_file(&text, file).unwrap().cell.unwrap();
+    if let CellLayout::PartCarried(c) = &mut cell {
+        c.flange_from_part = m0;
+    }
+    let v = PlacementValues {
+        rotation: fr,
+        fixture_rotation: 0.0,
+        offset_mm: 25.0,
+        ..v
+    };
+    let CellLayout::PartCarried(c) = v.apply(&cell) else {
+        panic!("part carried")
+    };
+    let by_hand =
+        rz * rx * ry * (p.coords + m0.translation.vector) + crate::math::Vector3::new(ox, oy, 25.0);
+    assert!((c.flange_from_part * p - Point3::from(by_hand)).norm() < 1e-9);
 }

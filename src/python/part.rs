@@ -318,8 +318,10 @@ impl PyPart {
 
     /// Searches where the part should sit in `cell` (the deposition point
     /// and the part's mount when the arm carries it, the positioner's pose
-    /// when it carries the torch; fixture tilt, offset and torch clamp when
-    /// the cell file's `[placement]` table gives their ranges) so that every
+    /// and the part's offset on the table (within 150 mm of the turn axis
+    /// unless `[placement]` says otherwise) when it carries the torch;
+    /// fixture tilt, other offsets and rotations and torch clamp when the
+    /// cell file's `[placement]` table gives their ranges) so that every
     /// layer is feasible with the widest margins; the cell as given is kept
     /// when it is as good. `samples`: candidates of the global screening
     /// (default 64); `half_box_mm`: half-width of the box searched around

@@ -11,6 +11,7 @@ mod objectives;
 mod parts;
 mod place;
 mod place_cells;
+mod place_table;
 mod spiral;
 mod subsample;
 mod support;
