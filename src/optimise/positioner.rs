@@ -1357,6 +1357,76 @@ mod tests {
         assert_eq!(unreachable_point(&pos, &r0, &b, &dt, cone, cell), None);
     }
 
+    /// The grid's relaxation keeps a cell of slack on the cone and a cell
+    /// of motion per anchor, so a finer grid proves layers a coarser one
+    /// cannot. The layer of the test above (`b` tilting from −40° to +40° in
+    /// 1 s, a 15° cone): with a 14°/s tilt the 2° grid proves nothing and
+    /// the 1° grid proves it; with 16°/s only the 0.5° grid does; from
+    /// 18°/s none does. The proof falls where `b` crosses the table normal
+    /// (point 25 of 51). The rate bound proves none of them (the turn's
+    /// 1000°/s).
+    #[test]
+    fn a_finer_grid_proves_what_the_coarse_one_cannot() {
+        let mut pos = Positioner::robowam_nominal();
+        pos.limits[0] = crate::robot::model::JointLimit {
+            lower_rad: -135f64.to_radians(),
+            upper_rad: 135f64.to_radians(),
+        };
+        let n = 51;
+        let b: Vec<Vector3> = (0..n)
+            .map(|m| {
+                let a = (-40.0 + 80.0 * m as f64 / (n - 1) as f64).to_radians();
+                Vector3::new(a.sin(), 0.0, a.cos())
+            })
+            .collect();
+        let dt = vec![0.02; n];
+        let cone = 15f64.to_radians();
+        let r0 = Matrix3::identity();
+        let proven = |pos: &Positioner| -> Vec<bool> {
+            GRID_CELLS_DEG
+                .iter()
+                .map(|c| unreachable_point(pos, &r0, &b, &dt, cone, c.to_radians()).is_some())
+                .collect()
+        };
+        for (v7, expected) in [
+            (14.0, [false, true, true]),
+            (16.0, [false, false, true]),
+            (18.0, [false, false, false]),
+        ] {
+            pos.max_speed_rad_s = [f64::to_radians(v7), 1000f64.to_radians()];
+            let (rate, _) = required_rotation_rate(&b, &dt, cone);
+            assert!(rate < pos.max_speed_rad_s[0] + pos.max_speed_rad_s[1]);
+            assert_eq!(proven(&pos), expected, "tilt at {v7}°/s");
+        }
+    }
+
+    /// The spline's abscissa: unchanged where `b` turns evenly along the
+    /// layer; where `b` turns through all of its swing between two points
+    /// (a corner), half the abscissa is spent there.
+    #[test]
+    fn the_knots_crowd_where_b_turns() {
+        let n = 11;
+        let x: Vec<f64> = (0..n).map(|m| m as f64).collect();
+        let even: Vec<Vector3> = (0..n)
+            .map(|m| {
+                let a = (3.0 * m as f64).to_radians();
+                Vector3::new(a.sin(), 0.0, a.cos())
+            })
+            .collect();
+        for (m, s) in following_turning(&x, &even).iter().enumerate() {
+            approx::assert_relative_eq!(*s, m as f64 / 10.0, epsilon = 1e-12);
+        }
+        let corner: Vec<Vector3> = (0..n)
+            .map(|m| if m < 5 { Vector3::z() } else { Vector3::x() })
+            .collect();
+        let s = following_turning(&x, &corner);
+        approx::assert_relative_eq!(s[5] - s[4], 0.5 + 0.05, epsilon = 1e-12);
+        approx::assert_relative_eq!(s[4] - s[3], 0.05, epsilon = 1e-12);
+        approx::assert_relative_eq!(s[10], 1.0, epsilon = 1e-12);
+        // b that does not turn: the abscissa as given
+        assert_eq!(following_turning(&x, &vec![Vector3::z(); n]), x);
+    }
+
     fn cell(cone_deg: f64) -> TorchCarriedCell {
         let mut c = match crate::io::cell_file::read_cell_file(concat!(
             env!("CARGO_MANIFEST_DIR"),
