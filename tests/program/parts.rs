@@ -171,18 +171,15 @@ fn the_validator_accepts_our_programs_for_every_feasible_part_and_cell() {
                 "elbow.toml",
             ][..],
         ),
-        // general tube: J3 speed at layer 4; the helix, first 3 layers only
+        // the parts of revolution only since the cell file gives the
+        // positioner speeds (90°/s tilt, 180°/s turn; unlimited before, when
+        // the table followed b as fast as it turned): quarter torus (layer
+        // 10) and torus on cylinder (layer 4) J4 speed, elbow (layer 19) the
+        // cone by 0.4°, helix (layer 1) J4 speed; general tube: J6 speed
+        // at layer 4
         (
             tc,
-            &[
-                "hemisphere.toml",
-                "nozzle.toml",
-                "half-catenoid.toml",
-                "quarter-torus.toml",
-                "torus-on-cylinder.toml",
-                "elbow.toml",
-                "helix.toml",
-            ][..],
+            &["hemisphere.toml", "nozzle.toml", "half-catenoid.toml"][..],
         ),
         (
             "kuka_kr16_2_torch_carried.toml",
