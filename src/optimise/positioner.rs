@@ -1325,13 +1325,10 @@ mod tests {
         assert!(required_rotation_rate(&corner, &dt2, cone).0.is_infinite());
     }
 
-    /// The grid search proves what the rate bound cannot: `b` tilting from
-    /// −40° to +40° about the table's Y axis in 1 s needs the tilt to move
-    /// by 50° (the turn cannot lessen a tilt from the table normal), which a
-    /// 10°/s tilt cannot, however fast the turn (the rate bound sees
-    /// 10 + 1000°/s); at 100°/s a path exists and none is claimed.
-    #[test]
-    fn the_grid_search_proves_a_tilt_too_slow_for_the_layer() {
+    /// A ROBOWAM positioner with a ±135° tilt, and a layer of 51 points
+    /// whose `b` tilts from −40° to +40° about the table's Y axis in 1 s
+    /// (0.02 s a step).
+    fn tilting_layer() -> (Positioner, Vec<Vector3>, Vec<f64>) {
         let mut pos = Positioner::robowam_nominal();
         pos.limits[0] = crate::robot::model::JointLimit {
             lower_rad: -135f64.to_radians(),
@@ -1344,7 +1341,18 @@ mod tests {
                 Vector3::new(a.sin(), 0.0, a.cos())
             })
             .collect();
-        let dt = vec![0.02; n];
+        (pos, b, vec![0.02; n])
+    }
+
+    /// The grid search proves what the rate bound cannot: `b` tilting from
+    /// −40° to +40° about the table's Y axis in 1 s needs the tilt to move
+    /// by 50° (the turn cannot lessen a tilt from the table normal), which a
+    /// 10°/s tilt cannot, however fast the turn (the rate bound sees
+    /// 10 + 1000°/s); at 100°/s a path exists and none is claimed.
+    #[test]
+    fn the_grid_search_proves_a_tilt_too_slow_for_the_layer() {
+        let (mut pos, b, dt) = tilting_layer();
+        let n = b.len();
         let cone = 15f64.to_radians();
         let r0 = Matrix3::identity();
         let cell = 1f64.to_radians();
@@ -1367,19 +1375,7 @@ mod tests {
     /// 1000°/s).
     #[test]
     fn a_finer_grid_proves_what_the_coarse_one_cannot() {
-        let mut pos = Positioner::robowam_nominal();
-        pos.limits[0] = crate::robot::model::JointLimit {
-            lower_rad: -135f64.to_radians(),
-            upper_rad: 135f64.to_radians(),
-        };
-        let n = 51;
-        let b: Vec<Vector3> = (0..n)
-            .map(|m| {
-                let a = (-40.0 + 80.0 * m as f64 / (n - 1) as f64).to_radians();
-                Vector3::new(a.sin(), 0.0, a.cos())
-            })
-            .collect();
-        let dt = vec![0.02; n];
+        let (mut pos, b, dt) = tilting_layer();
         let cone = 15f64.to_radians();
         let r0 = Matrix3::identity();
         let proven = |pos: &Positioner| -> Vec<bool> {
