@@ -186,6 +186,20 @@ pub enum PositionerBinding {
         /// Value (rad).
         value_rad: f64,
     },
+    /// The endless turn leaves the window of the controller's stroke the
+    /// bead was shifted into ([`TorchCarriedCell::turn_stroke`], less the
+    /// plan's margin, moved by whole turns): the bead turns the table
+    /// through more than the program can hold.
+    Stroke {
+        /// Point index within the layer.
+        point: usize,
+        /// Value (rad).
+        value_rad: f64,
+        /// The window's lower bound (rad).
+        lower_rad: f64,
+        /// The window's upper bound (rad).
+        upper_rad: f64,
+    },
     /// An axis faster than its maximum at the programmed travel speed.
     Speed {
         /// 7 (tilt) or 8 (turn).
@@ -220,6 +234,18 @@ impl std::fmt::Display for PositionerBinding {
                 f,
                 "positioner J{joint} = {:.2}° outside its travel at point {point}",
                 value_rad.to_degrees()
+            ),
+            Self::Stroke {
+                point,
+                value_rad,
+                lower_rad,
+                upper_rad,
+            } => write!(
+                f,
+                "positioner J8 = {:.1}° at point {point} outside the turn's stroke [{:.1}°, {:.1}°] (shifted by whole turns): the bead turns the table through more than the program holds",
+                value_rad.to_degrees(),
+                lower_rad.to_degrees(),
+                upper_rad.to_degrees()
             ),
             Self::Speed {
                 joint,
@@ -358,6 +384,9 @@ struct LawProblem<'a> {
     gamma_arm: f64,
     lower: [f64; 2],
     upper: [f64; 2],
+    /// `true` when `lower[1]..upper[1]` is the controller's stroke window
+    /// ([`stroke_window`]), not the turn's travel.
+    stroke_window: bool,
     max_speed: [f64; 2],
     opts: PositionerOptions,
 }
@@ -381,6 +410,14 @@ struct WorldPoint {
 }
 
 impl LawProblem<'_> {
+    /// Bounds the turn to the controller's stroke window `w` (rad,
+    /// [`stroke_window`]).
+    fn within_stroke(&mut self, w: (f64, f64)) {
+        self.lower[1] = w.0;
+        self.upper[1] = w.1;
+        self.stroke_window = true;
+    }
+
     fn world(&self, m: usize, q: &PositionerJoints) -> WorldPoint {
         let d = self.cell.positioner.positioner_from_table_derivatives(q);
         let f = |k: usize| {
@@ -664,16 +701,21 @@ fn check(pb: &LawProblem, q: &[PositionerJoints]) -> Check {
         );
         for a in 0..2 {
             let over = (pb.lower[a] - qm[a]).max(qm[a] - pb.upper[a]);
-            offer(
-                over,
+            let b = if a == 1 && pb.stroke_window {
+                PositionerBinding::Stroke {
+                    point: m,
+                    value_rad: qm[a],
+                    lower_rad: pb.lower[a],
+                    upper_rad: pb.upper[a],
+                }
+            } else {
                 PositionerBinding::Travel {
                     joint: 7 + a,
                     point: m,
                     value_rad: qm[a],
-                },
-                m,
-                &mut bad,
-            );
+                }
+            };
+            offer(over, b, m, &mut bad);
             if m > 0 && pb.dt[m] > 0.0 && pb.max_speed[a].is_finite() {
                 let speed = (qm[a] - q[m - 1][a]).abs() / pb.dt[m];
                 offer(
@@ -958,7 +1000,7 @@ pub fn positioner_law(
 ) -> PositionerLaw {
     let pos: &Positioner = &cell.positioner;
     let r_tp = cell.table_from_part.rotation;
-    let pb = LawProblem {
+    let mut pb = LawProblem {
         cell,
         m: points
             .iter()
@@ -998,6 +1040,7 @@ pub fn positioner_law(
         },
         lower: std::array::from_fn(|a| pos.limits[a].lower_rad + margin_rad),
         upper: std::array::from_fn(|a| pos.limits[a].upper_rad - margin_rad),
+        stroke_window: false,
         max_speed: pos.max_speed_rad_s,
         opts: *opts,
     };
@@ -1005,6 +1048,9 @@ pub fn positioner_law(
     let follow = vertical_joints(cell, points, q8_hint);
     if opts.mode == PositionerMode::Vertical {
         let joints = follow.unwrap_or_else(|| vec![[0.0, q8_hint]; n]);
+        if let Some(w) = stroke_window(cell, &joints, margin_rad) {
+            pb.within_stroke(w);
+        }
         return finish(&pb, joints, PositionerSeed::Vertical, 0, n, 0.0);
     }
     let positions: Vec<Point3> = points.iter().map(|p| p.position_mm).collect();
@@ -1014,51 +1060,15 @@ pub fn positioner_law(
     } else {
         (0..n).map(|m| m as f64).collect()
     };
-    let spans = opts.spans.min(n / 4).max(1);
-    // uniform knots first; where their law fails, knots that crowd where b
-    // turns (a corner), each start solved again
     let mut iterations = 0;
-    let mut best = solve_seeds(
-        &pb,
-        &Basis::spline(&abscissa, spans),
-        follow.as_deref(),
-        q8_hint,
-        &mut iterations,
-    );
-    if !best.feasible {
-        let turning = solve_seeds(
-            &pb,
-            &Basis::spline(&following_turning(&abscissa, &pb.b), spans),
-            follow.as_deref(),
-            q8_hint,
-            &mut iterations,
-        );
-        if turning.better_than(&best) {
-            best = turning;
-        }
-    }
-    // where no smooth law keeps the cone (a corner of b), the thesis's
-    // exact vertical does by construction: kept when its speeds hold (an
-    // unlimited positioner), so that the arm is judged on it
-    if let (false, Some(f)) = (best.feasible, follow) {
-        if check(&pb, &f).binding.is_none() {
-            let per_point = Basis::PerPoint { points: n };
-            let x: Vec<f64> = f
-                .iter()
-                .map(|q| q[0])
-                .chain(f.iter().map(|q| q[1]))
-                .collect();
-            let model = build_model(&pb, &per_point, &(0..n).collect::<Vec<_>>(), &x);
-            let objective = 0.5 * model.r.iter().map(|v| v * v).sum::<f64>();
-            best = Solved {
-                feasible: true,
-                violation: 0.0,
-                objective,
-                seed: PositionerSeed::Vertical,
-                joints: f,
-                samples: n,
-            };
-        }
+    let mut best = solve_bases(&pb, &abscissa, follow.as_deref(), q8_hint, &mut iterations);
+    // the program shifts each bead by whole turns into the controller's
+    // stroke: a law that turns the table through more is solved again
+    // within the stroke, shifted to its middle (near the pole the turn is
+    // nearly free and the unbounded law may wind it)
+    if let Some(w) = stroke_window(cell, &best.joints, margin_rad) {
+        pb.within_stroke(w);
+        best = solve_bases(&pb, &abscissa, follow.as_deref(), q8_hint, &mut iterations);
     }
     finish(
         &pb,
@@ -1068,6 +1078,100 @@ pub fn positioner_law(
         best.samples,
         best.objective,
     )
+}
+
+/// The window of the controller's stroke a law's turn must stay in (rad),
+/// where `joints` turn the table through more than the stroke holds modulo
+/// whole turns: [`TorchCarriedCell::turn_stroke`] less `margin_rad`, shifted
+/// by whole turns to be centred nearest the law's middle. `None` when the
+/// law fits, when the turn's travel bounds it already, or when the
+/// controller writes an endless turn modulo 360° (no stroke).
+fn stroke_window(
+    cell: &TorchCarriedCell,
+    joints: &[PositionerJoints],
+    margin_rad: f64,
+) -> Option<(f64, f64)> {
+    use crate::robot::JointLimit;
+    let travel = cell.positioner.limits[1];
+    if travel.lower_rad.is_finite() || travel.upper_rad.is_finite() {
+        return None;
+    }
+    let stroke = cell.turn_stroke();
+    if stroke.is_unlimited() {
+        return None;
+    }
+    let inner = JointLimit {
+        lower_rad: stroke.lower_rad + margin_rad,
+        upper_rad: stroke.upper_rad - margin_rad,
+    };
+    let (lo, hi) = joints
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+            (l.min(q[1]), h.max(q[1]))
+        });
+    if !(lo <= hi) || inner.whole_turn_shifts(lo, hi).is_some() {
+        return None;
+    }
+    let k = ((0.5 * (lo + hi) - inner.mid_rad()) / std::f64::consts::TAU).round();
+    let shift = k * std::f64::consts::TAU;
+    Some((inner.lower_rad + shift, inner.upper_rad + shift))
+}
+
+/// The law of a layer's starts ([`solve_seeds`]): on knots uniform in
+/// `abscissa` first; where that law fails, on knots crowding where `b`
+/// turns ([`following_turning`]), the better kept; where neither keeps the
+/// cone (a corner of `b`), the thesis's exact vertical `follow` when it
+/// breaks no constraint (an unlimited positioner), so that the arm is judged
+/// on it.
+fn solve_bases(
+    pb: &LawProblem,
+    abscissa: &[f64],
+    follow: Option<&[PositionerJoints]>,
+    q8_hint: f64,
+    iterations: &mut usize,
+) -> Solved {
+    let n = pb.b.len();
+    let spans = pb.opts.spans.min(n / 4).max(1);
+    let mut best = solve_seeds(
+        pb,
+        &Basis::spline(abscissa, spans),
+        follow,
+        q8_hint,
+        iterations,
+    );
+    if !best.feasible {
+        let turning = solve_seeds(
+            pb,
+            &Basis::spline(&following_turning(abscissa, &pb.b), spans),
+            follow,
+            q8_hint,
+            iterations,
+        );
+        if turning.better_than(&best) {
+            best = turning;
+        }
+    }
+    if let (false, Some(f)) = (best.feasible, follow) {
+        if check(pb, f).binding.is_none() {
+            let per_point = Basis::PerPoint { points: n };
+            let x: Vec<f64> = f
+                .iter()
+                .map(|q| q[0])
+                .chain(f.iter().map(|q| q[1]))
+                .collect();
+            let model = build_model(pb, &per_point, &(0..n).collect::<Vec<_>>(), &x);
+            let objective = 0.5 * model.r.iter().map(|v| v * v).sum::<f64>();
+            best = Solved {
+                feasible: true,
+                violation: 0.0,
+                objective,
+                seed: PositionerSeed::Vertical,
+                joints: f.to_vec(),
+                samples: n,
+            };
+        }
+    }
+    best
 }
 
 /// The best law of a layer's starts on one basis.
@@ -1481,6 +1585,65 @@ mod tests {
         // the turn only trims the tilt (±5° here), it does not follow b round
         let turn = range(&law.joints);
         assert!(turn < 0.2, "the turn moves by {turn} rad");
+        assert!(law.max_tilt_rad <= 15f64.to_radians() + 1e-9);
+    }
+
+    /// A flat circle about the turn axis, `b` vertical: the law turns the
+    /// table the whole turn under a still torch (the arm's motion costs,
+    /// the endless turn does not). With the controller's stroke narrowed to
+    /// ±100° the program could not hold that bead; the law is solved again
+    /// within the stroke and stays within its 200° (the arm takes the rest).
+    #[test]
+    fn the_turn_stays_within_the_controllers_stroke() {
+        let mut c = match crate::io::cell_file::read_cell_file(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/parts/cells/robowam_torch_carried.toml"
+        ))
+        .expect("sample cell")
+        .cell
+        {
+            Some(crate::robot::CellLayout::TorchCarried(c)) => c,
+            other => panic!("not a torch-carried sample cell: {other:?}"),
+        };
+        let n = 120;
+        let points: Vec<CellPoint> = (0..n)
+            .map(|m| {
+                let v = std::f64::consts::TAU * m as f64 / n as f64;
+                CellPoint {
+                    position_mm: Point3::new(100.0 * v.cos(), 100.0 * v.sin(), 20.0),
+                    tool_axis: Vector3::z_axis(),
+                    build_direction: Some(Vector3::z_axis()),
+                    positioner: None,
+                }
+            })
+            .collect();
+        let span = |law: &PositionerLaw| {
+            let (lo, hi) = law
+                .joints
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(v[1]), b.max(v[1]))
+                });
+            (lo, hi)
+        };
+        let free = positioner_law(&c, &points, 6.0, 0.0, 0.0, &PositionerOptions::default());
+        let (lo, hi) = span(&free);
+        assert!(free.feasible, "{:?}", free.binding);
+        assert!(
+            hi - lo > 300f64.to_radians(),
+            "the table turns {} rad",
+            hi - lo
+        );
+        let stroke = 100f64.to_radians();
+        c.positioner.turn_stroke = Some(crate::robot::JointLimit {
+            lower_rad: -stroke,
+            upper_rad: stroke,
+        });
+        let law = positioner_law(&c, &points, 6.0, 0.0, 0.0, &PositionerOptions::default());
+        let (lo, hi) = span(&law);
+        assert!(law.feasible, "{:?}", law.binding);
+        let shifts = c.turn_stroke().whole_turn_shifts(lo, hi);
+        assert!(shifts.is_some(), "[{lo}, {hi}] rad does not fit ±{stroke}");
         assert!(law.max_tilt_rad <= 15f64.to_radians() + 1e-9);
     }
 }

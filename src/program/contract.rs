@@ -36,12 +36,6 @@ pub trait Controller {
     const EMITTER: &'static str;
     /// Extensions of the format's files, lower case without the dot.
     const EXTENSIONS: &'static [&'static str];
-    /// `true` when the controller turns an endless external axis modulo
-    /// 360°, the shortest way, at most 180° a motion (KUKA: infinitely
-    /// rotating axis, KR C2 machine data §2.1.4). An endless positioner
-    /// turn without a stated stroke is then written modulo 360°; on the
-    /// others it is unwound by whole turns into a stroke.
-    const ENDLESS_TURN_MODULO: bool = false;
     /// `true` when the controller always moves the part-carried cell's
     /// linear moves about the fixed torch (KUKA's external TCP, ABB's
     /// stationary tool): the path is linear over the part. `false`: only
@@ -310,31 +304,22 @@ pub fn with_controller<T: ControllerTask>(vendor: Vendor, task: T) -> T::Output 
 }
 
 /// The stroke of `cell`'s positioner turn on its robot's controller
-/// ([`Positioner::turn_stroke`](crate::robot::positioner::Positioner::turn_stroke)
-/// with the controller's [`Controller::ENDLESS_TURN_MODULO`]); `None`
-/// without a positioner. `UNLIMITED` for an endless turn the controller
-/// writes modulo 360°.
+/// ([`TorchCarriedCell::turn_stroke`](crate::robot::cell::TorchCarriedCell::turn_stroke));
+/// `None` without a positioner.
 pub fn turn_stroke(cell: &CellLayout) -> Option<crate::robot::JointLimit> {
     match cell {
-        CellLayout::TorchCarried(c) => Some(c.positioner.turn_stroke(turn_modulo(cell))),
+        CellLayout::TorchCarried(c) => Some(c.turn_stroke()),
         CellLayout::PartCarried(_) => None,
     }
 }
 
 /// `true` when `cell`'s robot controller turns endless axes modulo 360°
-/// ([`Controller::ENDLESS_TURN_MODULO`]) and its positioner's turn is
+/// ([`Vendor::turns_endless_axes_modulo`]) and its positioner's turn is
 /// endless without a stated stroke: the turn is then written modulo 360°.
 pub fn turn_modulo(cell: &CellLayout) -> bool {
-    struct Modulo;
-    impl ControllerTask for Modulo {
-        type Output = bool;
-        fn run<C: Controller>(self) -> bool {
-            C::ENDLESS_TURN_MODULO
-        }
-    }
     match cell {
         CellLayout::TorchCarried(c) => {
-            with_controller(c.robot.vendor, Modulo)
+            c.robot.vendor.turns_endless_axes_modulo()
                 && c.positioner.turn_stroke(true) == crate::robot::JointLimit::UNLIMITED
         }
         CellLayout::PartCarried(_) => false,

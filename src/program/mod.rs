@@ -1103,10 +1103,7 @@ fn unwind_turns(
         };
         let lo = turns.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = turns.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        // Shifts k·2π with stroke.lower <= lo + k·2π and hi + k·2π <= stroke.upper.
-        let k_min = ((stroke.lower_rad - lo) / TAU).ceil();
-        let k_max = ((stroke.upper_rad - hi) / TAU).floor();
-        if k_min > k_max {
+        let Some((k_min, k_max)) = stroke.whole_turn_shifts(lo, hi) else {
             return Err(ProgramError::Infeasible {
                 count: 1,
                 first: format!(
@@ -1120,7 +1117,7 @@ fn unwind_turns(
                 ),
                 layers: vec![points[b.start].layer],
             });
-        }
+        };
         let k = ((at - start) / TAU).round().clamp(k_min, k_max);
         for p in &mut points[b.first..=b.last] {
             if let Some(q) = &mut p.positioner {

@@ -361,6 +361,16 @@ pub struct TorchCarriedCell {
 }
 
 impl TorchCarriedCell {
+    /// The values the positioner's turn may take in a program (rad): its
+    /// travel when finite, else the stated stroke, else none on a controller
+    /// that turns endless axes modulo 360° ([`Vendor::turns_endless_axes_modulo`](crate::robot::Vendor::turns_endless_axes_modulo)),
+    /// else ±1 turn ([`Positioner::turn_stroke`]). Each bead is shifted by
+    /// whole turns into it, so a bead's turn must span less than it holds.
+    pub fn turn_stroke(&self) -> crate::robot::JointLimit {
+        self.positioner
+            .turn_stroke(self.robot.vendor.turns_endless_axes_modulo())
+    }
+
     /// Checks robot, positioner and the hose limit.
     ///
     /// # Errors

@@ -114,6 +114,17 @@ pub enum Vendor {
     Abb,
 }
 
+impl Vendor {
+    /// `true` when the vendor's controller turns an endless external axis
+    /// modulo 360°, the shortest way, at most 180° a motion (KUKA: infinitely
+    /// rotating axis, KR C2 machine data §2.1.4). An endless positioner turn
+    /// without a stated stroke is then written modulo 360°; on the others it
+    /// is unwound by whole turns into a stroke.
+    pub fn turns_endless_axes_modulo(self) -> bool {
+        matches!(self, Vendor::Kuka)
+    }
+}
+
 /// How controller joint values map to the canonical arm (module doc).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct JointConvention {
@@ -212,6 +223,20 @@ impl JointLimit {
     /// Travel `upper - lower` (rad); `inf` if unlimited.
     pub fn range_rad(&self) -> f64 {
         self.upper_rad - self.lower_rad
+    }
+
+    /// The whole turns `k` (as `k_min..=k_max`) that shift values spanning
+    /// `[lo, hi]` (rad) into this travel: `lower <= lo + 2πk` and
+    /// `hi + 2πk <= upper`; `None` when no whole turn fits them (the span
+    /// is too wide, or falls badly against the travel modulo a turn).
+    pub fn whole_turn_shifts(&self, lo: f64, hi: f64) -> Option<(f64, f64)> {
+        use std::f64::consts::TAU;
+        if self.is_unlimited() {
+            return Some((0.0, 0.0));
+        }
+        let k_min = ((self.lower_rad - lo) / TAU).ceil();
+        let k_max = ((self.upper_rad - hi) / TAU).floor();
+        (k_min <= k_max).then_some((k_min, k_max))
     }
 
     /// `true` when `q` (rad) is inside the travel (bounds included).

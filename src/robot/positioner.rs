@@ -61,7 +61,7 @@ impl Positioner {
     /// that needs a stroke: its travel when finite, else the stated
     /// [`turn_stroke`](Self::turn_stroke), else ±[`DEFAULT_TURN_STROKE_RAD`].
     /// `modulo`: the controller turns an endless axis modulo 360° (KUKA's
-    /// infinitely rotating axes, [`Controller::ENDLESS_TURN_MODULO`](crate::program::contract::Controller::ENDLESS_TURN_MODULO)):
+    /// infinitely rotating axes, [`Vendor::turns_endless_axes_modulo`](crate::robot::Vendor::turns_endless_axes_modulo)):
     /// an endless turn without a stated stroke then has none (`UNLIMITED`).
     pub fn turn_stroke(&self, modulo: bool) -> JointLimit {
         let travel = self.limits[1];

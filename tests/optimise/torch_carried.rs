@@ -315,6 +315,16 @@ fn matrix(slice: &SliceOverrides) -> Vec<(String, usize, usize, usize)> {
             let what = format!("{part_file} in {cell_file}");
             let planned = plan_part(&part, &cell, &opts).unwrap_or_else(|e| panic!("{what}: {e}"));
             let checked = fk_check(&d, &planned, &what);
+            // a feasible plan is a program the controller holds: every bead's
+            // turn within the stroke (the general tube at 80 points once wound
+            // the ROBOWAM and ABB tables 649° in a bead, refused here)
+            if planned.plan.is_feasible() {
+                assert!(
+                    planned.refusal().is_none(),
+                    "{what}: the plan is feasible and the program stage refuses it: {}",
+                    planned.refusal().map(|e| e.to_string()).unwrap_or_default()
+                );
+            }
             let mut bad = 0;
             let mut proven = 0;
             for l in &planned.plan.layers {

@@ -1279,7 +1279,6 @@ impl Controller for Kuka {
     const EMITTER: &'static str = EMITTER;
     const EXTENSIONS: &'static [&'static str] = &["src", "dat"];
     const FIXED_TOOL_MOVES: bool = true;
-    const ENDLESS_TURN_MODULO: bool = true;
     type Options = KukaOptions;
     type Read = read::KrlProgram;
 
