@@ -289,6 +289,18 @@ pub fn optimise_with(
                     plan.positioner = Some(law);
                 }
             }
+            // then the other starts' laws that keep the cone, best first
+            if !plan.status.is_feasible() {
+                for alt in &laws[i].alternatives {
+                    let p =
+                        optimise_layer(cell, &given[i].with_positioner(&alt.joints), opts, None).0;
+                    if p.status.is_feasible() {
+                        plan = p;
+                        plan.positioner = Some(alt.clone());
+                        break;
+                    }
+                }
+            }
         }
         if !on_layer(done.fetch_add(1, Ordering::Relaxed) + 1, total) {
             stop.store(true, Ordering::Relaxed);
@@ -397,6 +409,25 @@ fn schedule_positioner(
             if let Some(k) = shift.filter(|k| *k != 0.0) {
                 for q in &mut law.joints {
                     q[1] += k * std::f64::consts::TAU;
+                }
+            }
+        }
+        // the alternatives start by whole turns nearest the law's start
+        if let Some(first) = law.joints.first().map(|q| q[1]) {
+            for alt in &mut law.alternatives {
+                let Some(a) = alt.joints.first().map(|q| q[1]) else {
+                    continue;
+                };
+                let k = ((first - a) / std::f64::consts::TAU).round();
+                if k != 0.0
+                    && alt
+                        .joints
+                        .iter()
+                        .all(|q| turn.contains(q[1] + k * std::f64::consts::TAU))
+                {
+                    for q in &mut alt.joints {
+                        q[1] += k * std::f64::consts::TAU;
+                    }
                 }
             }
         }

@@ -42,7 +42,12 @@
 //! exactly vertical (each fitted by the law). The knots are uniform in the
 //! abscissa first; where no seed keeps the cone, the seeds are solved again
 //! with knots crowding where `b` turns (`following_turning`), the better
-//! law kept. A law is solved on
+//! law kept. The other starts' laws that also keep the cone are returned as
+//! [`PositionerLaw::alternatives`]: where the arm cannot follow the best
+//! one (hose torsion, a joint's speed: the proxy above does not see them),
+//! the layer is planned on them, best first. A bead's turn stays within the
+//! controller's stroke modulo whole turns ([`TorchCarriedCell::turn_stroke`]).
+//! A law is solved on
 //! at most [`PositionerOptions::sample_points`] points, then checked on every
 //! point; the worst violated points join the samples and it is solved again.
 
@@ -83,6 +88,10 @@ const ZERO_OBJECTIVE: f64 = 1e-14;
 /// A violation left on the samples above this (constraint units) means
 /// the SQP is stuck: more samples cannot help.
 const STUCK_VIOLATION: f64 = 1e-9;
+
+/// Two laws within this of each other at every point (rad, each axis) are
+/// the same law (an alternative is kept once).
+const SAME_LAW_RAD: f64 = 1e-6;
 
 /// How the torch-carried cell's positioner moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -320,6 +329,12 @@ pub struct PositionerLaw {
     pub unreachable_point: Option<usize>,
     /// The stretch of the layer `(i, j)` (point indices) where the bound is reached.
     pub required_between: (usize, usize),
+    /// The other starts' laws that also hold cone, travel and speeds, best
+    /// objective first: the positioner sees the arm only through a proxy,
+    /// so where the arm cannot follow the kept law (hose torsion, a joint's
+    /// speed) the layer is planned again on these. Not serialised.
+    #[serde(skip)]
+    pub alternatives: Vec<PositionerLaw>,
 }
 
 /// The slowest rotation (rad/s) of the positioner that can keep every
@@ -1061,23 +1076,29 @@ pub fn positioner_law(
         (0..n).map(|m| m as f64).collect()
     };
     let mut iterations = 0;
-    let mut best = solve_bases(&pb, &abscissa, follow.as_deref(), q8_hint, &mut iterations);
+    let (mut best, mut others) =
+        solve_bases(&pb, &abscissa, follow.as_deref(), q8_hint, &mut iterations);
     // the program shifts each bead by whole turns into the controller's
     // stroke: a law that turns the table through more is solved again
     // within the stroke, shifted to its middle (near the pole the turn is
     // nearly free and the unbounded law may wind it)
     if let Some(w) = stroke_window(cell, &best.joints, margin_rad) {
         pb.within_stroke(w);
-        best = solve_bases(&pb, &abscissa, follow.as_deref(), q8_hint, &mut iterations);
+        (best, others) = solve_bases(&pb, &abscissa, follow.as_deref(), q8_hint, &mut iterations);
     }
-    finish(
+    let mut law = finish(
         &pb,
         best.joints,
         best.seed,
         iterations,
         best.samples,
         best.objective,
-    )
+    );
+    law.alternatives = others
+        .into_iter()
+        .map(|s| finish(&pb, s.joints, s.seed, 0, s.samples, s.objective))
+        .collect();
+    law
 }
 
 /// The window of the controller's stroke a law's turn must stay in (rad),
@@ -1129,29 +1150,26 @@ fn solve_bases(
     follow: Option<&[PositionerJoints]>,
     q8_hint: f64,
     iterations: &mut usize,
-) -> Solved {
+) -> (Solved, Vec<Solved>) {
     let n = pb.b.len();
     let spans = pb.opts.spans.min(n / 4).max(1);
-    let mut best = solve_seeds(
+    let mut all = solve_seeds(
         pb,
         &Basis::spline(abscissa, spans),
         follow,
         q8_hint,
         iterations,
     );
-    if !best.feasible {
-        let turning = solve_seeds(
+    if !all.iter().any(|s| s.feasible) {
+        all.extend(solve_seeds(
             pb,
             &Basis::spline(&following_turning(abscissa, &pb.b), spans),
             follow,
             q8_hint,
             iterations,
-        );
-        if turning.better_than(&best) {
-            best = turning;
-        }
+        ));
     }
-    if let (false, Some(f)) = (best.feasible, follow) {
+    if let (false, Some(f)) = (all.iter().any(|s| s.feasible), follow) {
         if check(pb, f).binding.is_none() {
             let per_point = Basis::PerPoint { points: n };
             let x: Vec<f64> = f
@@ -1161,20 +1179,41 @@ fn solve_bases(
                 .collect();
             let model = build_model(pb, &per_point, &(0..n).collect::<Vec<_>>(), &x);
             let objective = 0.5 * model.r.iter().map(|v| v * v).sum::<f64>();
-            best = Solved {
+            all.push(Solved {
                 feasible: true,
                 violation: 0.0,
                 objective,
                 seed: PositionerSeed::Vertical,
                 joints: f.to_vec(),
                 samples: n,
-            };
+            });
         }
     }
-    best
+    let mut best = 0;
+    for (i, s) in all.iter().enumerate() {
+        if s.better_than(&all[best]) {
+            best = i;
+        }
+    }
+    let best = all.swap_remove(best);
+    // the other feasible laws, best first, each once
+    all.retain(|s| s.feasible);
+    all.sort_by(|a, b| a.objective.total_cmp(&b.objective));
+    let mut others: Vec<Solved> = Vec::new();
+    for s in all {
+        let same = |o: &Solved| {
+            o.joints.iter().zip(&s.joints).all(|(a, b)| {
+                (a[0] - b[0]).abs() <= SAME_LAW_RAD && (a[1] - b[1]).abs() <= SAME_LAW_RAD
+            })
+        };
+        if !same(&best) && !others.iter().any(same) {
+            others.push(s);
+        }
+    }
+    (best, others)
 }
 
-/// The best law of a layer's starts on one basis.
+/// One start's law on one basis.
 struct Solved {
     feasible: bool,
     /// The worst violation left (constraint units scaled to rad; 0 feasible).
@@ -1201,15 +1240,16 @@ impl Solved {
 
 /// The starts of [`positioner_law`] (the exact vertical `follow` fitted,
 /// the lazy follower fitted, the hold pose) solved on `basis`, each on
-/// samples grown with its worst points; the best kept. `iterations` counts
-/// the SQP iterations.
+/// samples grown with its worst points; every start's law returned (the
+/// hold pose always), in the order solved. `iterations` counts the SQP
+/// iterations.
 fn solve_seeds(
     pb: &LawProblem,
     basis: &Basis,
     follow: Option<&[PositionerJoints]>,
     q8_hint: f64,
     iterations: &mut usize,
-) -> Solved {
+) -> Vec<Solved> {
     let n = pb.b.len();
     // the hold seed: the pose turning the mean b vertical
     let mean_b = pb.b.iter().fold(Vector3::zeros(), |a, b| a + b);
@@ -1240,15 +1280,15 @@ fn solve_seeds(
     if let Some(f) = follow {
         seeds.push((PositionerSeed::Follow, fitted(f)));
     }
-    let mut best: Option<Solved> = None;
+    let mut solved_all: Vec<Solved> = Vec::new();
     let target = pb.opts.sample_points.min(n);
     // the thesis's follower first: on a part of revolution it is exact and
     // costs nothing, and no other seed can do better than nothing
     seeds.reverse();
     for (seed, x0) in seeds {
-        if best
-            .as_ref()
-            .is_some_and(|b| b.feasible && b.objective <= ZERO_OBJECTIVE)
+        if solved_all
+            .iter()
+            .any(|b| b.feasible && b.objective <= ZERO_OBJECTIVE)
         {
             break;
         }
@@ -1304,11 +1344,9 @@ fn solve_seeds(
             joints,
             samples: idx.len(),
         };
-        if best.as_ref().is_none_or(|b| solved.better_than(b)) {
-            best = Some(solved);
-        }
+        solved_all.push(solved);
     }
-    best.expect("the hold seed is always solved")
+    solved_all
 }
 
 fn finish(
@@ -1351,6 +1389,7 @@ fn finish(
         proven_infeasible: required > available || unreachable.is_some(),
         unreachable_point: unreachable,
         required_between: between,
+        alternatives: Vec::new(),
         max_tilt_rad: c.max_tilt.0,
         max_tilt_point: c.max_tilt.1,
         feasible: c.binding.is_none(),

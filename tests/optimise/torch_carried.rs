@@ -452,3 +452,70 @@ fn a_law_whose_degrees_gain_nothing_stops_raising() {
         assert_eq!(*degree, first.0, "layer {}", l.layer);
     }
 }
+
+/// The positioner's laws see the arm only through a proxy. On the KUKA
+/// helix at its own grid, layer 85's best law (the exact vertical fitted)
+/// keeps `b` in the cone but leaves the arm's hose wound past its 120°
+/// bound at the layer's end; the hold start's law, also in the cone, lets
+/// the arm build the layer. The plan keeps that alternative (before, the
+/// layer was refused, not proven). Hose torsion `|J4 + J6|` recomputed here
+/// from the planned joints.
+#[test]
+fn where_the_arm_cannot_follow_the_best_law_another_in_the_cone_builds_the_layer() {
+    use waam_slicer::optimise::positioner::{positioner_law, PositionerSeed};
+    use waam_slicer::optimise::{layer_points, optimise, OptimiseOptions};
+    use waam_slicer::robot::CellLayout;
+    let part = Part::read(part_path("helix.toml")).unwrap();
+    let sliced = waam_slicer::slice_part(&part).unwrap();
+    let layers = layer_points(&sliced.path, &sliced.axes.frames);
+    let layer = &layers[85];
+    let cell = Cell::read(part_path("cells/kuka_kr16_2_torch_carried.toml")).unwrap();
+    let CellLayout::TorchCarried(tc) = &cell.layout else {
+        panic!("a torch-carried cell")
+    };
+    let opts = OptimiseOptions {
+        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
+        ..OptimiseOptions::default()
+    };
+    let law = positioner_law(
+        tc,
+        &layer.points,
+        opts.travel_speed_mm_s,
+        opts.joint_limit_margin_rad,
+        0.0,
+        &opts.positioner,
+    );
+    assert!(law.feasible, "{:?}", law.binding);
+    let hose = |joints: &[waam_slicer::robot::Joints]| {
+        joints
+            .iter()
+            .map(|q| (q[3] + q[5]).abs().to_degrees())
+            .fold(0.0, f64::max)
+    };
+    let on = |joints: &[[f64; 2]]| {
+        let plan = optimise(&cell.layout, &[layer.with_positioner(joints)], &opts).unwrap();
+        plan.layers.into_iter().next().unwrap()
+    };
+    let best = on(&law.joints);
+    assert!(!best.status.is_feasible(), "the best law builds the layer");
+    assert!(best.status.to_string().contains("hose"), "{}", best.status);
+    let alt = law
+        .alternatives
+        .iter()
+        .find(|a| a.seed == PositionerSeed::Hold)
+        .expect("the hold start's law is an alternative");
+    assert!(alt.feasible && alt.max_tilt_rad <= tc.max_vertical_error_rad + 1e-9);
+    let built = on(&alt.joints);
+    assert!(built.status.is_feasible(), "{}", built.status);
+    let joints: Vec<_> = built
+        .points
+        .iter()
+        .map(|p| p.joints.expect("joints at every point"))
+        .collect();
+    assert!(hose(&joints) <= 120.0 + 1e-6, "hose {}°", hose(&joints));
+    // and the whole pipeline keeps it
+    let planned = optimise(&cell.layout, std::slice::from_ref(layer), &opts).unwrap();
+    let l = &planned.layers[0];
+    assert!(l.status.is_feasible(), "{}", l.status);
+    assert_eq!(l.positioner.as_ref().unwrap().seed, PositionerSeed::Hold);
+}
