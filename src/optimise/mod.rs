@@ -301,6 +301,14 @@ pub fn optimise_with(
                     }
                 }
             }
+            // then the law solved again under the arm's own limits
+            let law_holds = plan.positioner.as_ref().is_some_and(|l| l.feasible);
+            if !plan.status.is_feasible() && law_holds {
+                if let Some((p, law)) = arm_coupled(c, cell, &given[i], &plan, opts) {
+                    plan = p;
+                    plan.positioner = Some(law);
+                }
+            }
         }
         if !on_layer(done.fetch_add(1, Ordering::Relaxed) + 1, total) {
             stop.store(true, Ordering::Relaxed);
@@ -355,6 +363,144 @@ fn vertical_alternative(
     }
     let plan = optimise_layer(cell, &layer.with_positioner(&alt.joints), opts, None).0;
     plan.status.is_feasible().then_some((plan, alt))
+}
+
+/// Rounds of [`arm_coupled`]: each adds the arm's rows at the points where
+/// the last plan broke or neared its limits.
+const ARM_ROUNDS: usize = 3;
+
+/// The arm's quantities within this of their bound get a row (rad).
+const ARM_BAND_RAD: f64 = 0.05;
+
+/// At most this many rows a round, the nearest their bounds first.
+const ARM_ROWS_MAX: usize = 24;
+
+/// Finite-difference step of the positioner joints for the arm's
+/// derivatives (rad).
+const ARM_FD_RAD: f64 = 1e-6;
+
+/// The arm in the positioner's loop: where the arm cannot follow a layer's
+/// positioner law (hose torsion, a joint's travel), the law is solved again
+/// ([`positioner::positioner_law_for_arm`]) with rows that hold the arm's
+/// hose and joints at the points where `plan` broke or neared them,
+/// linearised through the arm's inverse kinematics at the planned `R_Z`
+/// (finite differences of the positioner joints), and the layer planned
+/// again on it; a few rounds, the rows accumulating. Returns the first
+/// feasible plan with its law.
+fn arm_coupled(
+    c: &crate::robot::cell::TorchCarriedCell,
+    cell: &CellLayout,
+    layer: &LayerPoints,
+    plan: &LayerPlan,
+    opts: &OptimiseOptions,
+) -> Option<(LayerPlan, positioner::PositionerLaw)> {
+    let mut rows: Vec<positioner::ArmRow> = Vec::new();
+    let mut current = plan.clone();
+    for _ in 0..ARM_ROUNDS {
+        let new = arm_rows(c, layer, &current, opts);
+        if new.is_empty() {
+            return None;
+        }
+        rows.extend(new);
+        let start: Vec<_> = current
+            .points
+            .iter()
+            .map(|p| p.positioner)
+            .collect::<Option<_>>()?;
+        let law = positioner::positioner_law_for_arm(
+            c,
+            &layer.points,
+            opts.travel_speed_mm_s,
+            opts.joint_limit_margin_rad,
+            &opts.positioner,
+            &rows,
+            &start,
+        );
+        if !law.feasible {
+            return None;
+        }
+        let p = optimise_layer(cell, &layer.with_positioner(&law.joints), opts, None).0;
+        if p.status.is_feasible() {
+            return Some((p, law));
+        }
+        current = p;
+    }
+    None
+}
+
+/// The arm's rows of [`arm_coupled`] for `plan`: at the points where the
+/// hose torsion `|q4 + q6|` or a joint is within [`ARM_BAND_RAD`] of its
+/// bound (or past it), the nearest [`ARM_ROWS_MAX`] first.
+fn arm_rows(
+    c: &crate::robot::cell::TorchCarriedCell,
+    layer: &LayerPoints,
+    plan: &LayerPlan,
+    opts: &OptimiseOptions,
+) -> Vec<positioner::ArmRow> {
+    // which quantity: the hose (with the sign of q4 + q6), or joint j's
+    // upper (+1) or lower (-1) bound
+    enum Near {
+        Hose(f64),
+        Joint(usize, f64),
+    }
+    let robot = &c.robot;
+    let hose_max = c.max_hose_torsion_rad;
+    let mut near: Vec<(f64, usize, Near)> = Vec::new();
+    for (m, pp) in plan.points.iter().enumerate() {
+        let (Some(q), Some(_)) = (pp.joints, pp.positioner) else {
+            continue;
+        };
+        let h = q[3] + q[5];
+        if hose_max.is_finite() && hose_max - h.abs() < ARM_BAND_RAD {
+            near.push((hose_max - h.abs(), m, Near::Hose(h.signum())));
+        }
+        for (j, l) in robot.limits.iter().enumerate() {
+            let (lo, hi) = (
+                l.lower_rad + opts.joint_limit_margin_rad,
+                l.upper_rad - opts.joint_limit_margin_rad,
+            );
+            if hi.is_finite() && hi - q[j] < ARM_BAND_RAD {
+                near.push((hi - q[j], m, Near::Joint(j, 1.0)));
+            }
+            if lo.is_finite() && q[j] - lo < ARM_BAND_RAD {
+                near.push((q[j] - lo, m, Near::Joint(j, -1.0)));
+            }
+        }
+    }
+    near.sort_by(|a, b| a.0.total_cmp(&b.0));
+    near.truncate(ARM_ROWS_MAX);
+    let cfg = plan.configuration.chosen;
+    near.into_iter()
+        .filter_map(|(slack, m, what)| {
+            let pp = &plan.points[m];
+            let (q, qp) = (pp.joints?, pp.positioner?);
+            // the arm's joints' derivatives in q7, q8 at the planned R_Z
+            let mut d = [[0.0; 6]; 2];
+            for (k, dk) in d.iter_mut().enumerate() {
+                let mut moved = qp;
+                moved[k] += ARM_FD_RAD;
+                let cp = CellPoint {
+                    positioner: Some(moved),
+                    ..layer.points[m]
+                };
+                let pose = c.pose(&cp, pp.r_z, moved[1]).ok()?;
+                let q1 = robot.inverse_near(&pose.base_from_flange, cfg, &q).ok()?;
+                for j in 0..6 {
+                    dk[j] = (q1[j] - q[j]) / ARM_FD_RAD;
+                }
+            }
+            let grad = match what {
+                Near::Hose(s) => [s * (d[0][3] + d[0][5]), s * (d[1][3] + d[1][5])],
+                Near::Joint(j, s) => [s * d[0][j], s * d[1][j]],
+            };
+            Some(positioner::ArmRow {
+                point: m,
+                q0: qp,
+                grad,
+                slack_rad: slack,
+            })
+        })
+        .collect()
 }
 
 /// The positioner's laws of every layer (torch-carried cell, points without

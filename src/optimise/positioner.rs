@@ -45,7 +45,10 @@
 //! law kept. The other starts' laws that also keep the cone are returned as
 //! [`PositionerLaw::alternatives`]: where the arm cannot follow the best
 //! one (hose torsion, a joint's speed: the proxy above does not see them),
-//! the layer is planned on them, best first. A bead's turn stays within the
+//! the layer is planned on them, best first; where none serves, the law is
+//! solved again under the arm's own hose and joint limits, linearised
+//! through its inverse kinematics at the points where it broke them
+//! ([`ArmRow`], [`positioner_law_for_arm`]). A bead's turn stays within the
 //! controller's stroke modulo whole turns ([`TorchCarriedCell::turn_stroke`]).
 //! A law is solved on
 //! at most [`PositionerOptions::sample_points`] points, then checked on every
@@ -92,6 +95,10 @@ const STUCK_VIOLATION: f64 = 1e-9;
 /// Two laws within this of each other at every point (rad, each axis) are
 /// the same law (an alternative is kept once).
 const SAME_LAW_RAD: f64 = 1e-6;
+
+/// Laws whose violations of the arm's rows differ by less than this are
+/// ranked by their objective (rad).
+const ARM_TIE_RAD: f64 = 1e-4;
 
 /// How the torch-carried cell's positioner moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -286,6 +293,37 @@ pub enum PositionerSeed {
     /// [`PositionerMode::Vertical`], or where no smooth law keeps the cone
     /// (a corner of `b`) and the positioner's speeds allow it.
     Vertical,
+    /// The law the arm could not follow, solved again under the arm's
+    /// linearised constraints ([`ArmRow`], [`positioner_law_for_arm`]).
+    Arm,
+}
+
+/// A linearised constraint of the arm on one point's positioner joints:
+/// `grad · (q − q0) ≤ slack` (rad). At `q0` the arm, with the `R_Z` planned
+/// there, has a quantity (hose torsion, a joint) `slack` from its bound;
+/// `grad` is that quantity's derivative in `[q7, q8]` (unitless), through
+/// the arm's inverse kinematics. The positioner's laws see the arm only
+/// through a proxy; these rows put the arm's own limits into them where
+/// the arm could not follow a law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArmRow {
+    /// Point index within the layer.
+    pub point: usize,
+    /// The positioner joints the row is linearised at (rad).
+    pub q0: PositionerJoints,
+    /// Derivative of the bounded quantity in `q7`, `q8` (unitless).
+    pub grad: [f64; 2],
+    /// How far the quantity is inside its bound at `q0` (rad; negative
+    /// when violated).
+    pub slack_rad: f64,
+}
+
+impl ArmRow {
+    /// How far `q` breaks the row (rad; 0 when it holds).
+    fn violation(&self, q: &PositionerJoints) -> f64 {
+        let d = self.grad[0] * (q[0] - self.q0[0]) + self.grad[1] * (q[1] - self.q0[1]);
+        (d - self.slack_rad).max(0.0)
+    }
 }
 
 /// The positioner's laws of one layer and how they were found.
@@ -402,6 +440,8 @@ struct LawProblem<'a> {
     /// `true` when `lower[1]..upper[1]` is the controller's stroke window
     /// ([`stroke_window`]), not the turn's travel.
     stroke_window: bool,
+    /// The arm's linearised constraints ([`positioner_law_for_arm`]).
+    arm: Vec<ArmRow>,
     max_speed: [f64; 2],
     opts: PositionerOptions,
 }
@@ -425,6 +465,15 @@ struct WorldPoint {
 }
 
 impl LawProblem<'_> {
+    /// The largest violation of the arm's rows by `joints` (rad; 0 without
+    /// rows).
+    fn arm_violation(&self, joints: &[PositionerJoints]) -> f64 {
+        self.arm
+            .iter()
+            .filter_map(|a| joints.get(a.point).map(|q| a.violation(q)))
+            .fold(0.0, f64::max)
+    }
+
     /// Bounds the turn to the controller's stroke window `w` (rad,
     /// [`stroke_window`]).
     fn within_stroke(&mut self, w: (f64, f64)) {
@@ -547,6 +596,12 @@ fn build_model(pb: &LawProblem, basis: &Basis, idx: &[usize], x: &[f64]) -> Mode
             if pb.lower[a].is_finite() {
                 push_row(&mut rows, sparse(&g, -1.0), q[a] - pb.lower[a]);
             }
+        }
+        // the arm's rows at this point: grad·(q + δ − q0) ≤ slack
+        for a in pb.arm.iter().filter(|a| a.point == m) {
+            let g = grad(a.grad[0], a.grad[1]);
+            let at = a.grad[0] * (q[0] - a.q0[0]) + a.grad[1] * (q[1] - a.q0[1]);
+            push_row(&mut rows, sparse(&g, 1.0), a.slack_rad - at);
         }
         if let Some((mp, wp, rowp)) = &prev {
             let gap = (m - mp) as f64;
@@ -1013,6 +1068,57 @@ pub fn positioner_law(
     q8_hint: f64,
     opts: &PositionerOptions,
 ) -> PositionerLaw {
+    solve_law(
+        cell,
+        points,
+        travel_speed_mm_s,
+        margin_rad,
+        q8_hint,
+        opts,
+        &[],
+        None,
+    )
+}
+
+/// [`positioner_law`] under the arm's linearised constraints `arm`, with
+/// `start` (the law the arm could not follow, rad per point) as one more
+/// start ([`PositionerSeed::Arm`]). Of the laws that keep cone, travel and
+/// speeds, the one that breaks the arm's rows least is kept, then the
+/// lowest objective.
+#[allow(clippy::too_many_arguments)]
+pub fn positioner_law_for_arm(
+    cell: &TorchCarriedCell,
+    points: &[CellPoint],
+    travel_speed_mm_s: f64,
+    margin_rad: f64,
+    opts: &PositionerOptions,
+    arm: &[ArmRow],
+    start: &[PositionerJoints],
+) -> PositionerLaw {
+    let hint = start.first().map_or(0.0, |q| q[1]);
+    solve_law(
+        cell,
+        points,
+        travel_speed_mm_s,
+        margin_rad,
+        hint,
+        opts,
+        arm,
+        (start.len() == points.len()).then_some(start),
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn solve_law(
+    cell: &TorchCarriedCell,
+    points: &[CellPoint],
+    travel_speed_mm_s: f64,
+    margin_rad: f64,
+    q8_hint: f64,
+    opts: &PositionerOptions,
+    arm: &[ArmRow],
+    start: Option<&[PositionerJoints]>,
+) -> PositionerLaw {
     let pos: &Positioner = &cell.positioner;
     let r_tp = cell.table_from_part.rotation;
     let mut pb = LawProblem {
@@ -1056,6 +1162,7 @@ pub fn positioner_law(
         lower: std::array::from_fn(|a| pos.limits[a].lower_rad + margin_rad),
         upper: std::array::from_fn(|a| pos.limits[a].upper_rad - margin_rad),
         stroke_window: false,
+        arm: arm.to_vec(),
         max_speed: pos.max_speed_rad_s,
         opts: *opts,
     };
@@ -1076,15 +1183,28 @@ pub fn positioner_law(
         (0..n).map(|m| m as f64).collect()
     };
     let mut iterations = 0;
-    let (mut best, mut others) =
-        solve_bases(&pb, &abscissa, follow.as_deref(), q8_hint, &mut iterations);
+    let (mut best, mut others) = solve_bases(
+        &pb,
+        &abscissa,
+        follow.as_deref(),
+        start,
+        q8_hint,
+        &mut iterations,
+    );
     // the program shifts each bead by whole turns into the controller's
     // stroke: a law that turns the table through more is solved again
     // within the stroke, shifted to its middle (near the pole the turn is
     // nearly free and the unbounded law may wind it)
     if let Some(w) = stroke_window(cell, &best.joints, margin_rad) {
         pb.within_stroke(w);
-        (best, others) = solve_bases(&pb, &abscissa, follow.as_deref(), q8_hint, &mut iterations);
+        (best, others) = solve_bases(
+            &pb,
+            &abscissa,
+            follow.as_deref(),
+            start,
+            q8_hint,
+            &mut iterations,
+        );
     }
     let mut law = finish(
         &pb,
@@ -1148,6 +1268,7 @@ fn solve_bases(
     pb: &LawProblem,
     abscissa: &[f64],
     follow: Option<&[PositionerJoints]>,
+    start: Option<&[PositionerJoints]>,
     q8_hint: f64,
     iterations: &mut usize,
 ) -> (Solved, Vec<Solved>) {
@@ -1157,6 +1278,7 @@ fn solve_bases(
         pb,
         &Basis::spline(abscissa, spans),
         follow,
+        start,
         q8_hint,
         iterations,
     );
@@ -1165,6 +1287,7 @@ fn solve_bases(
             pb,
             &Basis::spline(&following_turning(abscissa, &pb.b), spans),
             follow,
+            start,
             q8_hint,
             iterations,
         ));
@@ -1182,6 +1305,7 @@ fn solve_bases(
             all.push(Solved {
                 feasible: true,
                 violation: 0.0,
+                arm: pb.arm_violation(f),
                 objective,
                 seed: PositionerSeed::Vertical,
                 joints: f.to_vec(),
@@ -1218,6 +1342,8 @@ struct Solved {
     feasible: bool,
     /// The worst violation left (constraint units scaled to rad; 0 feasible).
     violation: f64,
+    /// The worst violation of the arm's rows (rad; 0 without rows).
+    arm: f64,
     /// `½|r|²` over every point.
     objective: f64,
     seed: PositionerSeed,
@@ -1226,12 +1352,13 @@ struct Solved {
 }
 
 impl Solved {
-    /// Feasible beats infeasible; then the lower objective, or the lower
-    /// violation.
+    /// Feasible beats infeasible; then the one that breaks the arm's rows
+    /// less, then the lower objective; or the lower violation.
     fn better_than(&self, other: &Solved) -> bool {
         match (self.feasible, other.feasible) {
             (true, false) => true,
             (false, true) => false,
+            (true, true) if (self.arm - other.arm).abs() > ARM_TIE_RAD => self.arm < other.arm,
             (true, true) => self.objective < other.objective,
             (false, false) => self.violation < other.violation,
         }
@@ -1247,6 +1374,7 @@ fn solve_seeds(
     pb: &LawProblem,
     basis: &Basis,
     follow: Option<&[PositionerJoints]>,
+    arm_start: Option<&[PositionerJoints]>,
     q8_hint: f64,
     iterations: &mut usize,
 ) -> Vec<Solved> {
@@ -1285,6 +1413,9 @@ fn solve_seeds(
     // the thesis's follower first: on a part of revolution it is exact and
     // costs nothing, and no other seed can do better than nothing
     seeds.reverse();
+    if let Some(s) = arm_start {
+        seeds.insert(0, (PositionerSeed::Arm, fitted(s)));
+    }
     for (seed, x0) in seeds {
         if solved_all
             .iter()
@@ -1301,6 +1432,9 @@ fn solve_seeds(
                 }
             })
             .collect();
+        // the arm's rows' points are always sampled
+        idx.extend(pb.arm.iter().map(|a| a.point).filter(|&m| m < n));
+        idx.sort_unstable();
         idx.dedup();
         let mut x = x0;
         let mut joints = Vec::new();
@@ -1339,6 +1473,7 @@ fn solve_seeds(
         let solved = Solved {
             feasible: c.binding.is_none(),
             violation: c.binding.map_or(0.0, |(v, _)| v),
+            arm: pb.arm_violation(&joints),
             objective: 0.5 * model.r.iter().map(|v| v * v).sum::<f64>(),
             seed,
             joints,
@@ -1363,8 +1498,9 @@ fn finish(
     // a law that leaves the cone, or keeps it only faster than the axes
     // go, not proven by the rate: search every positioner path on a grid
     // (only where a speed is bounded: an unlimited positioner reaches any
-    // pose at every point)
-    let failed = c.binding.is_some();
+    // pose at every point); not again under the arm's rows, searched when
+    // the layer's law was first solved
+    let failed = c.binding.is_some() && pb.arm.is_empty();
     let unreachable =
         if failed && required <= available && pb.max_speed.iter().any(|v| v.is_finite()) {
             // coarse first (cheap, proves the clear cases), then finer:
