@@ -1702,17 +1702,22 @@ mod tests {
         assert_eq!(following_turning(&x, &vec![Vector3::z(); n]), x);
     }
 
-    fn cell(cone_deg: f64) -> TorchCarriedCell {
-        let mut c = match crate::io::cell_file::read_cell_file(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/parts/cells/kuka_kr16_2_torch_carried.toml"
-        ))
-        .expect("sample cell")
-        .cell
+    /// A torch-carried sample cell of `parts/cells`.
+    fn sample_cell(file: &str) -> TorchCarriedCell {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("parts/cells")
+            .join(file);
+        match crate::io::cell_file::read_cell_file(&path)
+            .expect("sample cell")
+            .cell
         {
             Some(crate::robot::CellLayout::TorchCarried(c)) => c,
             other => panic!("not a torch-carried sample cell: {other:?}"),
-        };
+        }
+    }
+
+    fn cell(cone_deg: f64) -> TorchCarriedCell {
+        let mut c = sample_cell("kuka_kr16_2_torch_carried.toml");
         c.max_vertical_error_rad = cone_deg.to_radians();
         c.table_from_part =
             Isometry3::from_parts(Translation3::new(0.0, 0.0, 0.0), UnitQuaternion::identity());
@@ -1770,16 +1775,7 @@ mod tests {
     /// within the stroke and stays within its 200° (the arm takes the rest).
     #[test]
     fn the_turn_stays_within_the_controllers_stroke() {
-        let mut c = match crate::io::cell_file::read_cell_file(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/parts/cells/robowam_torch_carried.toml"
-        ))
-        .expect("sample cell")
-        .cell
-        {
-            Some(crate::robot::CellLayout::TorchCarried(c)) => c,
-            other => panic!("not a torch-carried sample cell: {other:?}"),
-        };
+        let mut c = sample_cell("robowam_torch_carried.toml");
         let n = 120;
         let points: Vec<CellPoint> = (0..n)
             .map(|m| {

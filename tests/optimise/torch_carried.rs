@@ -486,6 +486,42 @@ fn max_hose_deg(plan: &waam_slicer::optimise::LayerPlan) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The KUKA helix's layer `n` (as [`kuka_helix_layer`]) with the
+/// positioner's law solved for it, the law checked to keep cone, travel and
+/// speeds.
+fn kuka_helix_law(
+    n: usize,
+) -> (
+    Cell,
+    waam_slicer::optimise::LayerPoints,
+    waam_slicer::optimise::OptimiseOptions,
+    waam_slicer::optimise::positioner::PositionerLaw,
+) {
+    use waam_slicer::robot::CellLayout;
+    let (cell, layer, opts) = kuka_helix_layer(n);
+    let CellLayout::TorchCarried(tc) = &cell.layout else {
+        panic!("a torch-carried cell")
+    };
+    let law = waam_slicer::optimise::positioner::positioner_law(
+        tc,
+        &layer.points,
+        opts.travel_speed_mm_s,
+        opts.joint_limit_margin_rad,
+        0.0,
+        &opts.positioner,
+    );
+    assert!(law.feasible, "{:?}", law.binding);
+    (cell, layer, opts, law)
+}
+
+/// The cell's cone of the vertical (rad).
+fn cone(cell: &Cell) -> f64 {
+    match &cell.layout {
+        waam_slicer::robot::CellLayout::TorchCarried(tc) => tc.max_vertical_error_rad,
+        _ => panic!("a torch-carried cell"),
+    }
+}
+
 /// The layer planned by the arm's `R_Z` stage on given positioner joints.
 fn on_law(
     cell: &Cell,
@@ -507,21 +543,8 @@ fn on_law(
 /// layer was refused, not proven). Hose torsion recomputed from the joints.
 #[test]
 fn where_the_arm_cannot_follow_the_best_law_another_in_the_cone_builds_the_layer() {
-    use waam_slicer::optimise::positioner::{positioner_law, PositionerSeed};
-    use waam_slicer::robot::CellLayout;
-    let (cell, layer, opts) = kuka_helix_layer(85);
-    let CellLayout::TorchCarried(tc) = &cell.layout else {
-        panic!("a torch-carried cell")
-    };
-    let law = positioner_law(
-        tc,
-        &layer.points,
-        opts.travel_speed_mm_s,
-        opts.joint_limit_margin_rad,
-        0.0,
-        &opts.positioner,
-    );
-    assert!(law.feasible, "{:?}", law.binding);
+    use waam_slicer::optimise::positioner::PositionerSeed;
+    let (cell, layer, opts, law) = kuka_helix_law(85);
     let best = on_law(&cell, &layer, &opts, &law.joints);
     assert!(!best.status.is_feasible(), "the best law builds the layer");
     assert!(best.status.to_string().contains("hose"), "{}", best.status);
@@ -530,7 +553,7 @@ fn where_the_arm_cannot_follow_the_best_law_another_in_the_cone_builds_the_layer
         .iter()
         .find(|a| a.seed == PositionerSeed::Hold)
         .expect("the hold start's law is an alternative");
-    assert!(alt.feasible && alt.max_tilt_rad <= tc.max_vertical_error_rad + 1e-9);
+    assert!(alt.feasible && alt.max_tilt_rad <= cone(&cell) + 1e-9);
     let built = on_law(&cell, &layer, &opts, &alt.joints);
     assert!(built.status.is_feasible(), "{}", built.status);
     assert!(
@@ -554,21 +577,8 @@ fn where_the_arm_cannot_follow_the_best_law_another_in_the_cone_builds_the_layer
 /// law's report against the cell's cone.
 #[test]
 fn the_arms_hose_put_into_the_positioners_law_builds_a_layer_no_start_could() {
-    use waam_slicer::optimise::positioner::{positioner_law, PositionerSeed};
-    use waam_slicer::robot::CellLayout;
-    let (cell, layer, opts) = kuka_helix_layer(32);
-    let CellLayout::TorchCarried(tc) = &cell.layout else {
-        panic!("a torch-carried cell")
-    };
-    let law = positioner_law(
-        tc,
-        &layer.points,
-        opts.travel_speed_mm_s,
-        opts.joint_limit_margin_rad,
-        0.0,
-        &opts.positioner,
-    );
-    assert!(law.feasible, "{:?}", law.binding);
+    use waam_slicer::optimise::positioner::PositionerSeed;
+    let (cell, layer, opts, law) = kuka_helix_law(32);
     for l in std::iter::once(&law).chain(&law.alternatives) {
         let p = on_law(&cell, &layer, &opts, &l.joints);
         assert!(
@@ -585,6 +595,6 @@ fn the_arms_hose_put_into_the_positioners_law_builds_a_layer_no_start_could() {
     assert!(l.status.is_feasible(), "{}", l.status);
     let kept = l.positioner.as_ref().unwrap();
     assert_eq!(kept.seed, PositionerSeed::Arm);
-    assert!(kept.feasible && kept.max_tilt_rad <= tc.max_vertical_error_rad + 1e-9);
+    assert!(kept.feasible && kept.max_tilt_rad <= cone(&cell) + 1e-9);
     assert!(max_hose_deg(l) <= 120.0 + 1e-6, "{}", max_hose_deg(l));
 }
