@@ -1022,9 +1022,10 @@ pub fn unreachable_point(
 
 /// The grids of positioner poses [`unreachable_point`] searches, coarse to
 /// fine (deg): each is tried where the coarser one proved nothing. The
-/// finest costs about 0.3 s a 400-point layer (16 times the coarsest) and is
-/// run only on a layer whose law failed.
-const GRID_CELLS_DEG: [f64; 3] = [2.0, 1.0, 0.5];
+/// 0.5° grid costs about 0.3 s a 400-point layer (16 times the coarsest),
+/// the 0.25° grid about 4 times that; they run only on a layer whose law
+/// failed and that no coarser grid proved.
+const GRID_CELLS_DEG: [f64; 4] = [2.0, 1.0, 0.5, 0.25];
 
 /// Share of the spline's abscissa given to the turning of `b` (unitless):
 /// the knots, uniform in the blended abscissa, crowd where `b` turns fast.
@@ -1648,10 +1649,12 @@ mod tests {
     /// of motion per anchor, so a finer grid proves layers a coarser one
     /// cannot. The layer of the test above (`b` tilting from −40° to +40° in
     /// 1 s, a 15° cone): with a 14°/s tilt the 2° grid proves nothing and
-    /// the 1° grid proves it; with 16°/s only the 0.5° grid does; from
-    /// 18°/s none does. The proof falls where `b` crosses the table normal
-    /// (point 25 of 51). The rate bound proves none of them (the turn's
-    /// 1000°/s).
+    /// the 1° grid proves it; with 16°/s only the 0.5° and 0.25° grids do;
+    /// on this layer the 0.5° grid is already tight (both prove 16.6°/s,
+    /// neither 16.7°/s; the S-bend's layer 92 is one the 0.25° grid proves
+    /// and the 0.5° grid does not, `tests/optimise/torch_carried.rs`). The
+    /// proof falls where `b` crosses the table normal (point 25 of 51). The
+    /// rate bound proves none of them (the turn's 1000°/s).
     #[test]
     fn a_finer_grid_proves_what_the_coarse_one_cannot() {
         let (mut pos, b, dt) = tilting_layer();
@@ -1664,9 +1667,11 @@ mod tests {
                 .collect()
         };
         for (v7, expected) in [
-            (14.0, [false, true, true]),
-            (16.0, [false, false, true]),
-            (18.0, [false, false, false]),
+            (14.0, [false, true, true, true]),
+            (16.0, [false, false, true, true]),
+            (16.6, [false, false, true, true]),
+            (16.7, [false, false, false, false]),
+            (18.0, [false, false, false, false]),
         ] {
             pos.max_speed_rad_s = [f64::to_radians(v7), 1000f64.to_radians()];
             let (rate, _) = required_rotation_rate(&b, &dt, cone);

@@ -598,3 +598,69 @@ fn the_arms_hose_put_into_the_positioners_law_builds_a_layer_no_start_could() {
     assert!(kept.feasible && kept.max_tilt_rad <= cone(&cell) + 1e-9);
     assert!(max_hose_deg(l) <= 120.0 + 1e-6, "{}", max_hose_deg(l));
 }
+
+/// The grid proof's finest cells: the S-bend's layer 92 at its own grid in
+/// the ROBOWAM torch-carried cell has no law that keeps `b` in the cone;
+/// the 0.5° grid of positioner poses does not prove it unbuildable (its
+/// relaxation's slack is a cell), the 0.25° grid does, and the plan lists it
+/// as proven. The 0.5° search is called here on the layer's build
+/// directions in the table frame, as the law's problem states them.
+#[test]
+fn the_quarter_degree_grid_proves_an_s_bend_layer_the_half_degree_grid_cannot() {
+    use waam_slicer::optimise::positioner::{positioner_law, unreachable_point};
+    use waam_slicer::optimise::{layer_points, OptimiseOptions};
+    use waam_slicer::robot::CellLayout;
+    let part = Part::read(part_path("s-bend.toml")).unwrap();
+    let sliced = waam_slicer::slice_part(&part).unwrap();
+    let layer = layer_points(&sliced.path, &sliced.axes.frames).swap_remove(92);
+    let cell = Cell::read(part_path("cells/robowam_torch_carried.toml")).unwrap();
+    let CellLayout::TorchCarried(tc) = &cell.layout else {
+        panic!("a torch-carried cell")
+    };
+    let opts = OptimiseOptions {
+        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
+        ..OptimiseOptions::default()
+    };
+    let law = positioner_law(
+        tc,
+        &layer.points,
+        opts.travel_speed_mm_s,
+        opts.joint_limit_margin_rad,
+        0.0,
+        &opts.positioner,
+    );
+    assert!(!law.feasible);
+    assert!(law.required_rate_rad_s <= law.available_rate_rad_s);
+    assert!(law.proven_infeasible && law.unreachable_point.is_some());
+    let r = tc.table_from_part.rotation;
+    let b: Vec<_> = layer
+        .points
+        .iter()
+        .map(|p| r * p.build_direction.unwrap_or(p.tool_axis).into_inner())
+        .collect();
+    let dt: Vec<f64> = std::iter::once(0.0)
+        .chain(
+            layer
+                .points
+                .windows(2)
+                .map(|w| (w[1].position_mm - w[0].position_mm).norm() / opts.travel_speed_mm_s),
+        )
+        .collect();
+    let r0 = *tc
+        .base_from_positioner
+        .rotation
+        .to_rotation_matrix()
+        .matrix();
+    let at = |cell_deg: f64| {
+        unreachable_point(
+            &tc.positioner,
+            &r0,
+            &b,
+            &dt,
+            tc.max_vertical_error_rad,
+            f64::to_radians(cell_deg),
+        )
+    };
+    assert_eq!(at(0.5), None, "the 0.5° grid proves it");
+    assert!(at(0.25).is_some());
+}
