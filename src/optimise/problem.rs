@@ -4,12 +4,14 @@
 //! as a sum of squared residuals and the constraints per point, and linearise
 //! both through the basis `R = B c` for the SQP.
 
+use std::sync::Arc;
+
 use nalgebra::{Matrix6, Vector6};
 
 use crate::optimise::options::Objective;
 use crate::optimise::outcome::{Binding, Constraint};
 use crate::optimise::parameterisation::Basis;
-use crate::robot::cell::{CellLayout, CellPoint};
+use crate::robot::cell::{CellLayout, CellPoint, CellPose, TorchPointFrame};
 use crate::robot::ik::Configuration;
 use crate::robot::indices::{
     dexterity, dexterity_warm, positioning_uncertainty, SvdWarmStart, UncertaintyFormula,
@@ -80,6 +82,28 @@ pub(crate) struct LayerProblem<'a> {
     /// Quadrature weights when `points` is a subsample of the layer
     /// (`None`: every point of the layer, each of weight 1).
     pub weights: Option<SampleWeights>,
+    /// Per point, what its pose keeps whatever `R_Z` (torch-carried cell,
+    /// positioner joints planned; [`point_frames`]); `None` where the cell
+    /// computes the whole pose. Empty: `None` everywhere.
+    pub frames: Arc<[Option<TorchPointFrame>]>,
+}
+
+/// The [`TorchPointFrame`] of every point of `points` whose positioner
+/// joints are planned, in a torch-carried cell (`None` elsewhere): those do
+/// not depend on `R_Z` or on the points before, so [`LayerProblem::pose`]
+/// computes each once instead of in every evaluation. Empty in the
+/// part-carried cell.
+pub(crate) fn point_frames(
+    cell: &CellLayout,
+    points: &[CellPoint],
+) -> Arc<[Option<TorchPointFrame>]> {
+    match cell {
+        CellLayout::TorchCarried(c) => points
+            .iter()
+            .map(|p| p.positioner.and_then(|_| c.point_frame(p, 0.0).ok()))
+            .collect(),
+        CellLayout::PartCarried(_) => Arc::from([]),
+    }
 }
 
 /// How a subsample of a layer stands for the whole layer in the objective:
@@ -174,6 +198,23 @@ impl<'a> LayerProblem<'a> {
             dex_scale: self.dex_scale,
             start_near: self.start_near,
             weights: Some(SampleWeights { step, point }),
+            frames: if self.frames.is_empty() {
+                Arc::from([])
+            } else {
+                idx.iter().map(|&m| self.frames[m]).collect()
+            },
+        }
+    }
+
+    /// The cell pose of point `m` at `r_z` (rad), as [`CellLayout::pose`]
+    /// gives it (from the point's frame when it has one).
+    ///
+    /// # Errors
+    /// As [`CellLayout::pose`].
+    pub fn pose(&self, m: usize, r_z: f64, q8_hint: f64) -> Result<CellPose, RobotError> {
+        match (self.cell, self.frames.get(m)) {
+            (CellLayout::TorchCarried(c), Some(Some(f))) => Ok(c.pose_in(f, r_z)),
+            _ => self.cell.pose(&self.points[m], r_z, q8_hint),
         }
     }
 
@@ -184,8 +225,8 @@ impl<'a> LayerProblem<'a> {
         r_z: f64,
         near: Option<&Joints>,
         q8_hint: f64,
-    ) -> Result<(Joints, crate::robot::cell::CellPose), RobotError> {
-        let pose = self.cell.pose(&self.points[m], r_z, q8_hint)?;
+    ) -> Result<(Joints, CellPose), RobotError> {
+        let pose = self.pose(m, r_z, q8_hint)?;
         let robot = self.cell.robot();
         let q = match near {
             Some(n) => robot.inverse_near(&pose.base_from_flange, self.configuration, n)?,
