@@ -4,6 +4,7 @@
 //! as a sum of squared residuals and the constraints per point, and linearise
 //! both through the basis `R = B c` for the SQP.
 
+use std::cell::Cell;
 use std::sync::Arc;
 
 use nalgebra::{Matrix6, Vector6};
@@ -134,6 +135,21 @@ pub(crate) struct Evaluation {
     pub dex_exact: Vec<bool>,
     /// `I_m` (scaled units) when the objective needs it.
     pub unc: Vec<f64>,
+    /// Per point, the dexterity's slope along `R_Z` (per rad) once
+    /// [`LayerProblem::constraints`] has needed it (NaN before): the SQP
+    /// linearises the constraints at one evaluation several times (a refused
+    /// step, the polish, the next degree's start), each time the same slope.
+    dex_slope: Vec<Cell<f64>>,
+}
+
+impl Evaluation {
+    /// Replaces the dexterity at point `m` by its exact value `dex` (a
+    /// lower bound of it before).
+    pub fn set_exact_dexterity(&mut self, m: usize, dex: f64) {
+        self.dex[m] = dex;
+        self.dex_exact[m] = true;
+        self.dex_slope[m].set(f64::NAN);
+    }
 }
 
 /// A point failed.
@@ -271,8 +287,8 @@ impl<'a> LayerProblem<'a> {
         let mut warm = SvdWarmStart::default();
         for m in 0..e.q.len() {
             if !e.dex_exact[m] {
-                e.dex[m] = dexterity_warm(&robot.jacobian(&e.q[m]), self.dex_scale, &mut warm);
-                e.dex_exact[m] = true;
+                let dex = dexterity_warm(&robot.jacobian(&e.q[m]), self.dex_scale, &mut warm);
+                e.set_exact_dexterity(m, dex);
             }
         }
     }
@@ -352,6 +368,7 @@ impl<'a> LayerProblem<'a> {
             dex,
             dex_exact,
             unc,
+            dex_slope: vec![Cell::new(f64::NAN); p],
         })
     }
 
@@ -369,6 +386,16 @@ impl<'a> LayerProblem<'a> {
         } else {
             0.0
         }
+    }
+
+    /// [`LayerProblem::slope`] of the dexterity at point `m` of `e`,
+    /// computed once per evaluation and point.
+    fn dex_slope(&self, e: &Evaluation, m: usize) -> f64 {
+        let cached = &e.dex_slope[m];
+        if cached.get().is_nan() {
+            cached.set(self.slope(e, m, e.dex[m], Self::dex_of));
+        }
+        cached.get()
     }
 
     /// The objective: sum of squared residuals (displacement or uncertainty)
@@ -581,7 +608,7 @@ impl<'a> LayerProblem<'a> {
             let psi = self.psi[m];
             if psi > 0.0 {
                 let d = if with_dex_slope && e.dex[m] < 1.5 * psi {
-                    self.slope(e, m, e.dex[m], Self::dex_of)
+                    self.dex_slope(e, m)
                 } else {
                     0.0
                 };
