@@ -5,10 +5,10 @@
 //! layer's [`LayerProblem`] in a branch and its dexterity floors [SPEC §7,
 //! eq. 4.6].
 
-use super::branch_types::Anchor;
-use super::parameterisation::{cylindrical_angles, turns_about_z};
 use std::sync::Arc;
 
+use super::branch_types::Anchor;
+use super::parameterisation::{cylindrical_angles, turns_about_z};
 use super::problem::{encoder_sigma_rad, point_frames, LayerProblem};
 use super::{Abscissa, DexterityFloor, OptimiseOptions, Parameterisation};
 use crate::robot::cell::{CellLayout, CellPoint, TorchPointFrame};
