@@ -4,12 +4,15 @@
 //! as a sum of squared residuals and the constraints per point, and linearise
 //! both through the basis `R = B c` for the SQP.
 
+use std::cell::Cell;
+use std::sync::Arc;
+
 use nalgebra::{Matrix6, Vector6};
 
 use crate::optimise::options::Objective;
 use crate::optimise::outcome::{Binding, Constraint};
 use crate::optimise::parameterisation::Basis;
-use crate::robot::cell::{CellLayout, CellPoint};
+use crate::robot::cell::{CellLayout, CellPoint, CellPose, TorchPointFrame};
 use crate::robot::ik::Configuration;
 use crate::robot::indices::{
     dexterity, dexterity_warm, positioning_uncertainty, SvdWarmStart, UncertaintyFormula,
@@ -80,6 +83,28 @@ pub(crate) struct LayerProblem<'a> {
     /// Quadrature weights when `points` is a subsample of the layer
     /// (`None`: every point of the layer, each of weight 1).
     pub weights: Option<SampleWeights>,
+    /// Per point, what its pose keeps whatever `R_Z` (torch-carried cell,
+    /// positioner joints planned; [`point_frames`]); `None` where the cell
+    /// computes the whole pose. Empty: `None` everywhere.
+    pub frames: Arc<[Option<TorchPointFrame>]>,
+}
+
+/// The [`TorchPointFrame`] of every point of `points` whose positioner
+/// joints are planned, in a torch-carried cell (`None` elsewhere): those do
+/// not depend on `R_Z` or on the points before, so [`LayerProblem::pose`]
+/// computes each once instead of in every evaluation. Empty in the
+/// part-carried cell.
+pub(crate) fn point_frames(
+    cell: &CellLayout,
+    points: &[CellPoint],
+) -> Arc<[Option<TorchPointFrame>]> {
+    match cell {
+        CellLayout::TorchCarried(c) => points
+            .iter()
+            .map(|p| p.positioner.and_then(|_| c.point_frame(p, 0.0).ok()))
+            .collect(),
+        CellLayout::PartCarried(_) => Arc::from([]),
+    }
 }
 
 /// How a subsample of a layer stands for the whole layer in the objective:
@@ -110,6 +135,21 @@ pub(crate) struct Evaluation {
     pub dex_exact: Vec<bool>,
     /// `I_m` (scaled units) when the objective needs it.
     pub unc: Vec<f64>,
+    /// Per point, the dexterity's slope along `R_Z` (per rad) once
+    /// [`LayerProblem::constraints`] has needed it (NaN before): the SQP
+    /// linearises the constraints at one evaluation several times (a refused
+    /// step, the polish, the next degree's start), each time the same slope.
+    dex_slope: Vec<Cell<f64>>,
+}
+
+impl Evaluation {
+    /// Replaces the dexterity at point `m` by its exact value `dex` (a
+    /// lower bound of it before).
+    pub fn set_exact_dexterity(&mut self, m: usize, dex: f64) {
+        self.dex[m] = dex;
+        self.dex_exact[m] = true;
+        self.dex_slope[m].set(f64::NAN);
+    }
 }
 
 /// A point failed.
@@ -174,6 +214,23 @@ impl<'a> LayerProblem<'a> {
             dex_scale: self.dex_scale,
             start_near: self.start_near,
             weights: Some(SampleWeights { step, point }),
+            frames: if self.frames.is_empty() {
+                Arc::from([])
+            } else {
+                idx.iter().map(|&m| self.frames[m]).collect()
+            },
+        }
+    }
+
+    /// The cell pose of point `m` at `r_z` (rad), as [`CellLayout::pose`]
+    /// gives it (from the point's frame when it has one).
+    ///
+    /// # Errors
+    /// As [`CellLayout::pose`].
+    pub fn pose(&self, m: usize, r_z: f64, q8_hint: f64) -> Result<CellPose, RobotError> {
+        match (self.cell, self.frames.get(m)) {
+            (CellLayout::TorchCarried(c), Some(Some(f))) => Ok(c.pose_in(f, r_z)),
+            _ => self.cell.pose(&self.points[m], r_z, q8_hint),
         }
     }
 
@@ -184,8 +241,8 @@ impl<'a> LayerProblem<'a> {
         r_z: f64,
         near: Option<&Joints>,
         q8_hint: f64,
-    ) -> Result<(Joints, crate::robot::cell::CellPose), RobotError> {
-        let pose = self.cell.pose(&self.points[m], r_z, q8_hint)?;
+    ) -> Result<(Joints, CellPose), RobotError> {
+        let pose = self.pose(m, r_z, q8_hint)?;
         let robot = self.cell.robot();
         let q = match near {
             Some(n) => robot.inverse_near(&pose.base_from_flange, self.configuration, n)?,
@@ -230,8 +287,8 @@ impl<'a> LayerProblem<'a> {
         let mut warm = SvdWarmStart::default();
         for m in 0..e.q.len() {
             if !e.dex_exact[m] {
-                e.dex[m] = dexterity_warm(&robot.jacobian(&e.q[m]), self.dex_scale, &mut warm);
-                e.dex_exact[m] = true;
+                let dex = dexterity_warm(&robot.jacobian(&e.q[m]), self.dex_scale, &mut warm);
+                e.set_exact_dexterity(m, dex);
             }
         }
     }
@@ -311,6 +368,7 @@ impl<'a> LayerProblem<'a> {
             dex,
             dex_exact,
             unc,
+            dex_slope: vec![Cell::new(f64::NAN); p],
         })
     }
 
@@ -328,6 +386,16 @@ impl<'a> LayerProblem<'a> {
         } else {
             0.0
         }
+    }
+
+    /// [`LayerProblem::slope`] of the dexterity at point `m` of `e`,
+    /// computed once per evaluation and point.
+    fn dex_slope(&self, e: &Evaluation, m: usize) -> f64 {
+        let cached = &e.dex_slope[m];
+        if cached.get().is_nan() {
+            cached.set(self.slope(e, m, e.dex[m], Self::dex_of));
+        }
+        cached.get()
     }
 
     /// The objective: sum of squared residuals (displacement or uncertainty)
@@ -540,7 +608,7 @@ impl<'a> LayerProblem<'a> {
             let psi = self.psi[m];
             if psi > 0.0 {
                 let d = if with_dex_slope && e.dex[m] < 1.5 * psi {
-                    self.slope(e, m, e.dex[m], Self::dex_of)
+                    self.dex_slope(e, m)
                 } else {
                     0.0
                 };

@@ -75,8 +75,7 @@ pub(super) fn finish(
             // unwrapping); the SVD is not repeated there
             for (m, jp) in t.points.iter().enumerate().take(p) {
                 if !e.dex_exact[m] && jp.joints == Some(e.q[m]) {
-                    e.dex[m] = jp.dexterity;
-                    e.dex_exact[m] = true;
+                    e.set_exact_dexterity(m, jp.dexterity);
                 }
             }
             t.report.violations

@@ -68,7 +68,7 @@ impl LayerSetup<'_> {
                 vec![(0.0, 0.0, 0.0, prob.start_near); cfgs.len()];
             let mut q8 = 0.0;
             for &m in &idx {
-                let pose = match self.cell.pose(&self.points[m], r[m], q8) {
+                let pose = match prob.pose(m, r[m], q8) {
                     Ok(pose) => pose,
                     Err(_) => {
                         for a in &mut acc {

@@ -1,13 +1,17 @@
 //! What is fixed about one layer before its branch is chosen: its points,
 //! the times between them at the travel speed (s), their cylindrical angles
-//! (rad), and the spiral anchor; builds the layer's [`LayerProblem`] in a
-//! branch and its dexterity floors [SPEC §7, eq. 4.6].
+//! (rad), the spiral anchor, and in the torch-carried cell what each
+//! point's pose keeps whatever `R_Z` (computed once per layer); builds the
+//! layer's [`LayerProblem`] in a branch and its dexterity floors [SPEC §7,
+//! eq. 4.6].
+
+use std::sync::Arc;
 
 use super::branch_types::Anchor;
 use super::parameterisation::{cylindrical_angles, turns_about_z};
-use super::problem::{encoder_sigma_rad, LayerProblem};
+use super::problem::{encoder_sigma_rad, point_frames, LayerProblem};
 use super::{Abscissa, DexterityFloor, OptimiseOptions, Parameterisation};
-use crate::robot::cell::{CellLayout, CellPoint};
+use crate::robot::cell::{CellLayout, CellPoint, TorchPointFrame};
 use crate::robot::ik::Configuration;
 use crate::robot::indices::{dexterity_warm, SvdWarmStart};
 
@@ -21,6 +25,8 @@ pub(super) struct LayerSetup<'a> {
     pub(super) turning: bool,
     pub(super) cylindrical: bool,
     pub(super) anchor: Option<Anchor>,
+    /// Per point, what its pose keeps whatever `R_Z` ([`point_frames`]).
+    pub(super) frames: Arc<[Option<TorchPointFrame>]>,
 }
 
 impl<'a> LayerSetup<'a> {
@@ -59,6 +65,7 @@ impl<'a> LayerSetup<'a> {
             turning,
             cylindrical,
             anchor,
+            frames: point_frames(cell, points),
         }
     }
 
@@ -96,6 +103,7 @@ impl<'a> LayerSetup<'a> {
             dex_scale: self.opts.trajectory.dexterity_length_scale_mm,
             start_near: self.anchor.map(|a| a.joints),
             weights: None,
+            frames: Arc::clone(&self.frames),
         }
     }
 

@@ -139,8 +139,22 @@ fn degree_loop(
     let mut history = Vec::new();
     let mut best: Option<Best> = None;
     let mut stalled = 0;
+    // the previous degree's evaluations (samples, every point): where a
+    // constraint holds the law, the raised degree's new coefficient stays 0
+    // and its `R_Z` is the previous one to the bit, so neither is repeated
+    let mut previous: Option<Evaluations> = None;
     for degree in degrees.start..=degrees.max.max(degrees.start) {
-        let Some(done) = certify(problem, samples, &full_basis, c, scale, setup, counts) else {
+        let done = certify(
+            problem,
+            samples,
+            &full_basis,
+            c,
+            scale,
+            setup,
+            counts,
+            previous.take(),
+        );
+        let Some(done) = done else {
             // not certified: the whole layer decides
             return None;
         };
@@ -150,6 +164,7 @@ fn degree_loop(
             sub_c,
         } = done;
         c = sub_c;
+        let whole = res.eval.clone();
         history.push((degree, res.objective));
         let gain = Best::offer(&mut best, degree, &c, &full_basis, res);
         stalled = if gain < degrees.stop_relative_gain {
@@ -178,8 +193,29 @@ fn degree_loop(
         }
         full_basis = raised;
         c.push(0.0);
+        previous = Some(Evaluations {
+            samples: sub_eval,
+            whole,
+        });
     }
     best.map(|b| (b, history))
+}
+
+/// A law's evaluations on the samples (as they were when it was certified)
+/// and on every point, kept for the next degree's start.
+struct Evaluations {
+    samples: super::problem::Evaluation,
+    whole: super::problem::Evaluation,
+}
+
+/// `e` when it was evaluated at exactly `r` (every value to the bit):
+/// [`LayerProblem::evaluate`] is a function of `r` on a given problem, so
+/// it stands for evaluating `r` again.
+fn at_same_r(
+    e: Option<super::problem::Evaluation>,
+    r: &[f64],
+) -> Option<super::problem::Evaluation> {
+    e.filter(|e| e.r.len() == r.len() && e.r.iter().zip(r).all(|(a, b)| a.to_bits() == b.to_bits()))
 }
 
 /// One degree solved on the samples and certified on every point.
@@ -200,7 +236,10 @@ struct Certified {
 /// tell: a point without joint solution, a joint representation on the
 /// samples that is not the whole layer's, or no certificate after
 /// [`MAX_ROUNDS`] refinements. A law the samples cannot make feasible is
-/// returned with its violation on every point.
+/// returned with its violation on every point. `previous`: the previous
+/// degree's evaluations, used in place of evaluating the same `R_Z` again
+/// (on the same samples, which it was certified on).
+#[allow(clippy::too_many_arguments)]
 fn certify(
     problem: &LayerProblem,
     samples: &mut Samples,
@@ -209,17 +248,28 @@ fn certify(
     scale: f64,
     setup: &LayerSetup,
     counts: &mut BranchOutcome,
+    previous: Option<Evaluations>,
 ) -> Option<Certified> {
     let mut c = c;
+    let (mut last_samples, mut last_whole) = match previous {
+        Some(l) => (Some(l.samples), Some(l.whole)),
+        None => (None, None),
+    };
     for round in 0..=MAX_ROUNDS {
         let sub = problem.restricted(&samples.idx, &samples.points);
         let sub_basis = full_basis.restricted(&samples.idx)?;
-        let res = sqp::solve(&sub, &sub_basis, c, None, 0.0, scale, &setup.opts.sqp).ok()?;
+        // only the first round runs on the samples the last degree's were
+        let start = at_same_r(last_samples.take(), &sub_basis.eval(&c));
+        let res = sqp::solve(&sub, &sub_basis, c, start, 0.0, scale, &setup.opts.sqp).ok()?;
         counts.iterations += res.iterations;
         counts.qp_solves += res.qp_solves;
         counts.qp_failures += res.qp_failures;
         c = res.c.clone();
-        let e = problem.evaluate(&full_basis.eval(&c)).ok()?;
+        let r = full_basis.eval(&c);
+        let e = match at_same_r(last_whole.take(), &r) {
+            Some(e) => e,
+            None => problem.evaluate(&r).ok()?,
+        };
         let same = samples.idx.iter().zip(&res.eval.q).all(|(&m, qs)| {
             e.q[m]
                 .iter()

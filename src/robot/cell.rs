@@ -478,27 +478,75 @@ impl TorchCarriedCell {
     /// # Errors
     /// [`RobotError::PositionerUnreachable`].
     pub fn pose(&self, p: &CellPoint, r_z: f64, q8_hint: f64) -> Result<CellPose, RobotError> {
-        let qp = match p.positioner {
+        Ok(self.pose_in(&self.point_frame(p, q8_hint)?, r_z))
+    }
+
+    /// What [`TorchCarriedCell::pose`] computes of one point before `R_Z`:
+    /// the positioner joints, the point and tool axis in the base frame and
+    /// the torch's tilt (`q8_hint` as in [`TorchCarriedCell::pose`]).
+    ///
+    /// # Errors
+    /// [`RobotError::PositionerUnreachable`].
+    pub(crate) fn point_frame(
+        &self,
+        p: &CellPoint,
+        q8_hint: f64,
+    ) -> Result<TorchPointFrame, RobotError> {
+        let positioner = match p.positioner {
             Some(q) => q,
             None => self.positioner_angles(p, q8_hint)?,
         };
-        let base_from_part = self.base_from_part(&qp);
-        let m = base_from_part * p.position_mm;
-        let t = base_from_part.rotation * p.tool_axis;
-        let b = bryant_matrix(&torch_carried_angles(&t, r_z));
-        let base_from_tcp = iso(b, m.coords);
-        let base_from_flange = base_from_tcp * self.flange_from_tcp.inverse();
-        let twist = twist_about_axis(
-            &t.into_inner(),
-            &m,
-            &Point3::from(base_from_flange.translation.vector),
-        );
-        Ok(CellPose {
-            base_from_flange,
-            positioner: Some(qp),
-            flange_twist_per_rz: twist,
+        let base_from_part = self.base_from_part(&positioner);
+        let point = base_from_part * p.position_mm;
+        let axis = base_from_part.rotation * p.tool_axis;
+        // R_X and R_Y of eq. 3.12–3.13 do not depend on R_Z
+        let b = torch_carried_angles(&axis, 0.0);
+        let (sx, cx) = b.rx.sin_cos();
+        let (sy, cy) = b.ry.sin_cos();
+        Ok(TorchPointFrame {
+            positioner,
+            point,
+            axis,
+            tilt: rot_x(sx, cx) * rot_y(sy, cy),
         })
     }
+
+    /// [`TorchCarriedCell::pose`] at `r_z` (rad) from the point's
+    /// [`TorchCarriedCell::point_frame`]: the same values to the bit (the
+    /// torch's rotation is `(Rx·Ry)·Rz`, the product `bryant_matrix` forms).
+    pub(crate) fn pose_in(&self, f: &TorchPointFrame, r_z: f64) -> CellPose {
+        let (sz, cz) = r_z.sin_cos();
+        let b = f.tilt * rot_z(sz, cz);
+        let base_from_tcp = iso(b, f.point.coords);
+        let base_from_flange = base_from_tcp * self.flange_from_tcp.inverse();
+        let twist = twist_about_axis(
+            &f.axis.into_inner(),
+            &f.point,
+            &Point3::from(base_from_flange.translation.vector),
+        );
+        CellPose {
+            base_from_flange,
+            positioner: Some(f.positioner),
+            flange_twist_per_rz: twist,
+        }
+    }
+}
+
+/// One point of the torch-carried cell as the arm sees it whatever `R_Z`
+/// ([`TorchCarriedCell::point_frame`]): the optimiser computes it once per
+/// point of a layer whose positioner joints are planned, instead of in
+/// every evaluation of the point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TorchPointFrame {
+    /// Positioner joints `[q7, q8]` (rad).
+    pub positioner: PositionerJoints,
+    /// Deposition point, robot base frame (mm).
+    pub point: Point3,
+    /// Tool axis `T`, robot base frame.
+    pub axis: UnitVector3,
+    /// `Rx(R_X)·Ry(R_Y)` of eq. 3.12–3.13: the torch's rotation at `R_Z = 0`
+    /// (base frame).
+    pub tilt: Matrix3,
 }
 
 /// The physical layout of a cell, either kind (closed set): the robot, the
