@@ -92,6 +92,10 @@ const ZERO_OBJECTIVE: f64 = 1e-14;
 /// the SQP is stuck: more samples cannot help.
 const STUCK_VIOLATION: f64 = 1e-9;
 
+/// [`required_rotation_rate`] skips a pair whose build directions' cosine
+/// is this much above the cone's width's (unitless): they need no rotation.
+const PAIR_SKIP_COS: f64 = 1e-12;
+
 /// Two laws within this of each other at every point (rad, each axis) are
 /// the same law (an alternative is kept once).
 const SAME_LAW_RAD: f64 = 1e-6;
@@ -398,12 +402,18 @@ pub fn required_rotation_rate(b: &[Vector3], dt: &[f64], cone_rad: f64) -> (f64,
     if reach <= 0.0 {
         return best;
     }
+    // pairs closer than the cone's width need no rotation: skipped before
+    // the angle (a hair inside, so that rounding cannot skip a pair in need)
+    let within = (2.0 * cone_rad).cos() + PAIR_SKIP_COS;
     for i in 0..n {
         for j in i + 1..n {
             let t = time[j] - time[i];
             // no later j can need more: θ ≤ π
             if t > 0.0 && reach / t <= best.0 {
                 break;
+            }
+            if b[i].dot(&b[j]) > within {
+                continue;
             }
             let theta = b[i].cross(&b[j]).norm().atan2(b[i].dot(&b[j]));
             let need = theta - 2.0 * cone_rad;
