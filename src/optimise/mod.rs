@@ -279,17 +279,8 @@ pub fn optimise_with(
         if let (CellLayout::TorchCarried(c), Some(laws)) = (cell, &laws) {
             plan.positioner = Some(laws[i].clone());
             // the positioner's laws see the arm only through a proxy: where
-            // the arm cannot follow them, the thesis's exact vertical (inside
-            // any cone) is tried, and kept when it builds the layer
-            if !plan.status.is_feasible() && laws[i].seed != positioner::PositionerSeed::Vertical {
-                if let Some((alt_plan, law)) =
-                    vertical_alternative(c, cell, &given[i], &laws[i], opts)
-                {
-                    plan = alt_plan;
-                    plan.positioner = Some(law);
-                }
-            }
-            // then the other starts' laws that keep the cone, best first
+            // the arm cannot follow the law, the other laws that keep the
+            // cone (the thesis's exact vertical first), best first
             if !plan.status.is_feasible() {
                 for alt in &laws[i].alternatives {
                     let p =
@@ -333,36 +324,6 @@ pub fn optimise_with(
         transitions,
         time_s: t0.elapsed().as_secs_f64(),
     })
-}
-
-/// The layer planned with the thesis's exact-vertical positioner (the turn
-/// starting near the law's), when that is feasible for the positioner and
-/// the arm; with its law.
-fn vertical_alternative(
-    c: &crate::robot::cell::TorchCarriedCell,
-    cell: &CellLayout,
-    layer: &LayerPoints,
-    law: &positioner::PositionerLaw,
-    opts: &OptimiseOptions,
-) -> Option<(LayerPlan, positioner::PositionerLaw)> {
-    let vertical = positioner::PositionerOptions {
-        mode: positioner::PositionerMode::Vertical,
-        ..opts.positioner
-    };
-    let hint = law.joints.first().map_or(0.0, |q| q[1]);
-    let alt = positioner::positioner_law(
-        c,
-        &layer.points,
-        opts.travel_speed_mm_s,
-        opts.joint_limit_margin_rad,
-        hint,
-        &vertical,
-    );
-    if !alt.feasible {
-        return None;
-    }
-    let plan = optimise_layer(cell, &layer.with_positioner(&alt.joints), opts, None).0;
-    plan.status.is_feasible().then_some((plan, alt))
 }
 
 /// Rounds of [`arm_coupled`]: each adds the arm's rows at the points where

@@ -1193,11 +1193,16 @@ fn solve_law(
     } else {
         (0..n).map(|m| m as f64).collect()
     };
+    // the exact vertical as a law only where its bead fits the stroke
+    let vertical = follow
+        .as_deref()
+        .filter(|f| stroke_window(cell, f, margin_rad).is_none());
     let mut iterations = 0;
     let (mut best, mut others) = solve_bases(
         &pb,
         &abscissa,
         follow.as_deref(),
+        vertical,
         start,
         q8_hint,
         &mut iterations,
@@ -1212,6 +1217,7 @@ fn solve_law(
             &pb,
             &abscissa,
             follow.as_deref(),
+            vertical,
             start,
             q8_hint,
             &mut iterations,
@@ -1272,13 +1278,16 @@ fn stroke_window(
 /// The law of a layer's starts ([`solve_seeds`]): on knots uniform in
 /// `abscissa` first; where that law fails, on knots crowding where `b`
 /// turns ([`following_turning`]), the better kept; where neither keeps the
-/// cone (a corner of `b`), the thesis's exact vertical `follow` when it
+/// cone (a corner of `b`), the thesis's exact vertical `vertical` when it
 /// breaks no constraint (an unlimited positioner), so that the arm is judged
-/// on it.
+/// on it. Returns the best law and the other feasible ones, best first
+/// (the exact vertical first when it is not the best).
+#[allow(clippy::too_many_arguments)]
 fn solve_bases(
     pb: &LawProblem,
     abscissa: &[f64],
     follow: Option<&[PositionerJoints]>,
+    vertical: Option<&[PositionerJoints]>,
     start: Option<&[PositionerJoints]>,
     q8_hint: f64,
     iterations: &mut usize,
@@ -1303,8 +1312,13 @@ fn solve_bases(
             iterations,
         ));
     }
-    if let (false, Some(f)) = (all.iter().any(|s| s.feasible), follow) {
-        if check(pb, f).binding.is_none() {
+    // the thesis's exact vertical, unfitted, where it breaks no constraint
+    // (an unlimited positioner): the law where no smooth one keeps the cone
+    // (a corner of b), else the first alternative (the arm may follow it
+    // where it cannot follow the smooth laws)
+    let mut vertical = vertical
+        .filter(|f| check(pb, f).binding.is_none())
+        .map(|f| {
             let per_point = Basis::PerPoint { points: n };
             let x: Vec<f64> = f
                 .iter()
@@ -1312,17 +1326,18 @@ fn solve_bases(
                 .chain(f.iter().map(|q| q[1]))
                 .collect();
             let model = build_model(pb, &per_point, &(0..n).collect::<Vec<_>>(), &x);
-            let objective = 0.5 * model.r.iter().map(|v| v * v).sum::<f64>();
-            all.push(Solved {
+            Solved {
                 feasible: true,
                 violation: 0.0,
                 arm: pb.arm_violation(f),
-                objective,
+                objective: 0.5 * model.r.iter().map(|v| v * v).sum::<f64>(),
                 seed: PositionerSeed::Vertical,
                 joints: f.to_vec(),
                 samples: n,
-            });
-        }
+            }
+        });
+    if !all.iter().any(|s| s.feasible) {
+        all.extend(vertical.take());
     }
     let mut best = 0;
     for (i, s) in all.iter().enumerate() {
@@ -1344,6 +1359,9 @@ fn solve_bases(
         if !same(&best) && !others.iter().any(same) {
             others.push(s);
         }
+    }
+    if let Some(v) = vertical {
+        others.insert(0, v);
     }
     (best, others)
 }
