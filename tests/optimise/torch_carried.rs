@@ -453,9 +453,11 @@ fn a_law_whose_degrees_gain_nothing_stops_raising() {
     }
 }
 
-/// Layer `n` of the helix at its own grid, the KUKA torch-carried cell and
-/// the options its plan uses.
-fn kuka_helix_layer(
+/// Layer `n` of a sample part at its own grid, a sample cell and the
+/// options its plan uses.
+fn sample_layer(
+    part_file: &str,
+    cell_file: &str,
     n: usize,
 ) -> (
     Cell,
@@ -463,10 +465,10 @@ fn kuka_helix_layer(
     waam_slicer::optimise::OptimiseOptions,
 ) {
     use waam_slicer::optimise::{layer_points, OptimiseOptions};
-    let part = Part::read(part_path("helix.toml")).unwrap();
+    let part = Part::read(part_path(part_file)).unwrap();
     let sliced = waam_slicer::slice_part(&part).unwrap();
     let layer = layer_points(&sliced.path, &sliced.axes.frames).swap_remove(n);
-    let cell = Cell::read(part_path("cells/kuka_kr16_2_torch_carried.toml")).unwrap();
+    let cell = Cell::read(part_path(&format!("cells/{cell_file}"))).unwrap();
     let opts = OptimiseOptions {
         travel_speed_mm_s: sliced.process.travel_speed_mm_s,
         ..OptimiseOptions::default()
@@ -486,7 +488,7 @@ fn max_hose_deg(plan: &waam_slicer::optimise::LayerPlan) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The KUKA helix's layer `n` (as [`kuka_helix_layer`]) with the
+/// The KUKA helix's layer `n` (as [`sample_layer`]) with the
 /// positioner's law solved for it, the law checked to keep cone, travel and
 /// speeds.
 fn kuka_helix_law(
@@ -498,7 +500,7 @@ fn kuka_helix_law(
     waam_slicer::optimise::positioner::PositionerLaw,
 ) {
     use waam_slicer::robot::CellLayout;
-    let (cell, layer, opts) = kuka_helix_layer(n);
+    let (cell, layer, opts) = sample_layer("helix.toml", "kuka_kr16_2_torch_carried.toml", n);
     let CellLayout::TorchCarried(tc) = &cell.layout else {
         panic!("a torch-carried cell")
     };
@@ -608,18 +610,10 @@ fn the_arms_hose_put_into_the_positioners_law_builds_a_layer_no_start_could() {
 #[test]
 fn the_quarter_degree_grid_proves_an_s_bend_layer_the_half_degree_grid_cannot() {
     use waam_slicer::optimise::positioner::{positioner_law, unreachable_point};
-    use waam_slicer::optimise::{layer_points, OptimiseOptions};
     use waam_slicer::robot::CellLayout;
-    let part = Part::read(part_path("s-bend.toml")).unwrap();
-    let sliced = waam_slicer::slice_part(&part).unwrap();
-    let layer = layer_points(&sliced.path, &sliced.axes.frames).swap_remove(92);
-    let cell = Cell::read(part_path("cells/robowam_torch_carried.toml")).unwrap();
+    let (cell, layer, opts) = sample_layer("s-bend.toml", "robowam_torch_carried.toml", 92);
     let CellLayout::TorchCarried(tc) = &cell.layout else {
         panic!("a torch-carried cell")
-    };
-    let opts = OptimiseOptions {
-        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
-        ..OptimiseOptions::default()
     };
     let law = positioner_law(
         tc,
