@@ -577,6 +577,7 @@ fn align_seams(layers: &mut [Layer], opts: &SliceOptions) {
                     da.total_cmp(&db)
                 })
                 .unwrap_or(0);
+            start = onto_corner(&layers[k], start);
         }
         let slice = layers[k].slice as f64;
         let shift = ((opts.stagger_rad * slice / TAU).rem_euclid(1.0) * n as f64).round() as usize;
@@ -584,9 +585,131 @@ fn align_seams(layers: &mut [Layer], opts: &SliceOptions) {
     }
 }
 
+/// How far the aligned start may move onto a corner (points).
+const SEAM_CORNER_REACH: usize = 2;
+
+/// The start moved from `start` by at most [`SEAM_CORNER_REACH`] points
+/// so that a corner of the layer next to it falls across the seam: the start
+/// `s` whose seam vertices `s − 1` and `s` turn most together, where one of
+/// them is a corner (the test of [`Layer::bead_wraps`]). Constant-distance
+/// layers grow corners (SPEC §3.4) and the aligned seam settles on them,
+/// but the closest point to the end below often lands one vertex off, so
+/// that the bead's first segment crosses the corner (turning 40–50° at each
+/// end of a 0.14 mm segment on the helix). Across the seam the bead does not
+/// turn it: the torch ends on one side and starts on the other.
+fn onto_corner(layer: &Layer, start: usize) -> usize {
+    let n = layer.points.len();
+    if n < 2 * SEAM_CORNER_REACH + 3 {
+        return start;
+    }
+    let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
+    let turns = super::smooth::turning_angles(&positions, true);
+    let corner = super::corner_turn_rad(&turns);
+    let at = |d: isize| (start as isize + d).rem_euclid(n as isize) as usize;
+    let reach = SEAM_CORNER_REACH as isize;
+    if !(-reach - 1..=reach).any(|d| turns[at(d)] > corner) {
+        return start;
+    }
+    // nearest first, so that a tie keeps the start closest to the end below
+    let mut best = (turns[at(-1)] + turns[at(0)], start);
+    for d in 1..=reach {
+        for s in [at(-d), at(d)] {
+            let c = turns[(s + n - 1) % n] + turns[s];
+            if c > best.0 {
+                best = (c, s);
+            }
+        }
+    }
+    best.1
+}
+
 #[cfg(test)]
 mod tests {
-    use super::runs;
+    use super::{onto_corner, runs, Layer, PathPoint};
+    use crate::math::Point3;
+
+    /// A closed layer through `pts` (mm), in order.
+    fn layer(pts: Vec<Point3>) -> Layer {
+        Layer {
+            slice: 1,
+            points: pts
+                .into_iter()
+                .map(|position| PathPoint {
+                    t: 0.0,
+                    v: 0.0,
+                    position,
+                    delta: None,
+                })
+                .collect(),
+            closed: true,
+        }
+    }
+
+    /// A lens (two arcs of radius 10 mm whose centres are 6 mm either side
+    /// of its axis), `n` points a side, starting at one of its two corners
+    /// (the arcs' tangents there 2·asin(0.6) ≈ 73.7° apart).
+    fn lens(n: usize) -> Vec<Point3> {
+        let (r, d) = (10.0_f64, 6.0_f64);
+        let half = (d / r).acos(); // half the arc's angle
+        let arc = |cy: f64, from: f64, to: f64| {
+            (0..n).map(move |i| {
+                let a = from + (to - from) * i as f64 / n as f64;
+                Point3::new(r * a.cos(), cy + r * a.sin(), 0.0)
+            })
+        };
+        let top = std::f64::consts::FRAC_PI_2;
+        // from the corner (+8, 0) over the upper arc, back over the lower one
+        arc(-d, top - half, top + half)
+            .chain(arc(d, -top - half, -top + half))
+            .collect()
+    }
+
+    #[test]
+    fn a_corner_at_the_seam_does_not_wrap_the_bead() {
+        let pts = lens(100);
+        // the corner's turning: the arcs' tangents' angle, plus half a
+        // step of each arc (2·acos(0.6) over 100 steps)
+        let turns = crate::path::smooth::turning_angles(&pts, true);
+        let step = 2.0 * 0.6_f64.acos() / 100.0;
+        assert!(
+            (turns[0] - 2.0 * 0.6_f64.asin() - step).abs() < 1e-9,
+            "{}",
+            turns[0]
+        );
+        assert!(!layer(pts.clone()).bead_wraps());
+        // the same lens started mid-arc: both corners inside the bead
+        let mut mid = pts.clone();
+        mid.rotate_left(50);
+        assert!(layer(mid).bead_wraps());
+        // a circle, wherever it starts, and an open layer
+        let circle: Vec<Point3> = (0..200)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / 200.0;
+                Point3::new(10.0 * a.cos(), 10.0 * a.sin(), 0.0)
+            })
+            .collect();
+        assert!(layer(circle).bead_wraps());
+        let mut open = layer(pts);
+        open.closed = false;
+        assert!(!open.bead_wraps());
+    }
+
+    #[test]
+    fn the_aligned_start_moves_onto_a_corner_next_to_it() {
+        let pts = lens(100);
+        for off in [-2_isize, -1, 1, 2] {
+            let start = off.rem_euclid(200) as usize;
+            let s = onto_corner(&layer(pts.clone()), start);
+            let mut rotated = pts.clone();
+            rotated.rotate_left(s);
+            // the corner (index 0) is a seam vertex: the last or the first
+            assert!(s == 0 || s == 1, "from {start}: {s}");
+            assert!(!layer(rotated).bead_wraps(), "from {start}: {s}");
+        }
+        // too far from the corner, or on a smooth layer: not moved
+        assert_eq!(onto_corner(&layer(pts.clone()), 50), 50);
+        assert_eq!(onto_corner(&layer(pts.clone()), 4), 4);
+    }
 
     #[test]
     fn runs_split_cyclically() {

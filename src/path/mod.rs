@@ -217,6 +217,50 @@ pub struct Layer {
     pub closed: bool,
 }
 
+/// A seam of a closed layer turning more than this is a corner (rad, 10°),
+/// where it also turns more than [`SEAM_CORNER_OVER_MEDIAN`] times the
+/// layer's median turning. The sample parts' smooth seams turn 0.1–1° at
+/// 400 points a layer; the corners constant-distance layers grow (SPEC
+/// §3.4), which the seam rule of §3.3 draws the seam onto, turn 10–113°.
+pub const SEAM_CORNER_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
+
+/// A corner seam turns more than this many times the layer's median turning
+/// (unitless): on a coarse layer every smooth step turns a lot.
+pub const SEAM_CORNER_OVER_MEDIAN: f64 = 4.0;
+
+impl Layer {
+    /// Whether per-point quantities along the bead (the tangent's central
+    /// difference, eq. 2.34; the tool axis's rate smoothing) wrap across the
+    /// seam: a closed layer whose seam is not a corner. The bead runs from
+    /// the first point to the last; it does not turn the seam's corner (the
+    /// layer's start and end are one step apart and the arc is lit at
+    /// neither across it), so a wrapped central difference there would give
+    /// the first and last points a tangent, and a build direction, half way
+    /// round the corner, belonging to neither end of the bead. A closed layer
+    /// whose seam turns more than [`SEAM_CORNER_RAD`] and
+    /// [`SEAM_CORNER_OVER_MEDIAN`] times its median turning takes one-sided
+    /// differences at its ends, as an open layer does.
+    pub fn bead_wraps(&self) -> bool {
+        if !self.closed || self.points.len() < 3 {
+            return self.closed;
+        }
+        let positions: Vec<Point3> = self.points.iter().map(|p| p.position).collect();
+        let turns = smooth::turning_angles(&positions, true);
+        let n = turns.len();
+        turns[0].max(turns[n - 1]) <= corner_turn_rad(&turns)
+    }
+}
+
+/// The turning angle above which a vertex of a closed layer is a corner
+/// (rad), from the layer's turning angles `turns`: [`SEAM_CORNER_RAD`], or
+/// [`SEAM_CORNER_OVER_MEDIAN`] times their median where more.
+pub(crate) fn corner_turn_rad(turns: &[f64]) -> f64 {
+    let mut sorted = turns.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    SEAM_CORNER_RAD.max(SEAM_CORNER_OVER_MEDIAN * median)
+}
+
 /// Why the generation stopped (`summary.json`: its snake_case name).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]

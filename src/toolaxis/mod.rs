@@ -438,9 +438,10 @@ fn layer_axes(
         angles.push((out.lead_rad, out.tilt_rad));
     }
     let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
+    let wraps = layer.bead_wraps();
     // 4. Smoothing of the lead/tilt angles along the layer.
     if let Some(rate) = opts.max_rate_rad_per_mm {
-        let moved = smooth_angles(&positions, &mut angles, layer.closed, rate);
+        let moved = smooth_angles(&positions, &mut angles, wraps, rate);
         report.smoothed_points += moved;
         if moved > 0 {
             for (f, &(lead, tilt)) in frames.iter_mut().zip(&angles) {
@@ -451,7 +452,7 @@ fn layer_axes(
     // 5. Bound on the rate of T itself.
     let mut axes: Vec<Vector3> = frames.iter().map(|f| f.tool).collect();
     if let Some(rate) = opts.max_axis_rate_rad_per_mm {
-        let moved = smooth_layer(&positions, &mut axes, layer.closed, rate);
+        let moved = smooth_layer(&positions, &mut axes, wraps, rate);
         report.smoothed_points += moved;
         if moved > 0 {
             for ((f, t), a) in frames.iter_mut().zip(&axes).zip(angles.iter_mut()) {
@@ -460,7 +461,7 @@ fn layer_axes(
             }
         }
     }
-    report.max_rate_rad_per_mm = rules::max_rate(&positions, &axes, layer.closed);
+    report.max_rate_rad_per_mm = rules::max_rate(&positions, &axes, wraps);
     for a in &axes {
         report.max_angle_from_z_rad = report.max_angle_from_z_rad.max(a.z.clamp(-1.0, 1.0).acos());
     }

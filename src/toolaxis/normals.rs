@@ -32,7 +32,8 @@ pub enum NormalMethod {
 }
 
 /// Indices of the neighbours of point `i` used by the central difference
-/// (eq. 2.34): wrapping on a closed layer, one-sided at the ends of an open one.
+/// (eq. 2.34): wrapping on a closed layer whose bead wraps
+/// ([`Layer::bead_wraps`]), one-sided at the ends of an open one.
 pub(crate) fn neighbours(n: usize, i: usize, closed: bool) -> (usize, usize) {
     if closed {
         ((i + n - 1) % n, (i + 1) % n)
@@ -66,10 +67,11 @@ pub(crate) fn analytic_frames_checked(
 /// legacy mode (fall back to `∂M/∂v` for a zero chord).
 fn analytic_layer(layer: &Layer, tube: &Tube, li: usize) -> Result<Vec<LocalFrame>, ToolAxisError> {
     let n = layer.points.len();
+    let wraps = layer.bead_wraps();
     (0..n)
         .map(|i| {
             let p = &layer.points[i];
-            let (prev, next) = neighbours(n, i, layer.closed);
+            let (prev, next) = neighbours(n, i, wraps);
             let sp = tube.surface(p.t, p.v);
             let normal = sp.normal.into_inner();
             let chord = layer.points[next].position - layer.points[prev].position;
@@ -164,10 +166,11 @@ fn numeric_layer(
     above: Option<&SegmentIndex>,
 ) -> Result<Vec<LocalFrame>, ToolAxisError> {
     let n = layer.points.len();
+    let wraps = layer.bead_wraps();
     let pos = |i: usize| layer.points[i].position;
     let mut frames = Vec::with_capacity(n);
     for i in 0..n {
-        let (prev, next) = neighbours(n, i, layer.closed);
+        let (prev, next) = neighbours(n, i, wraps);
         let m = pos(i);
         let c = pos(next) - pos(prev);
         let c_len = c.norm();

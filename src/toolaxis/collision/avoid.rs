@@ -341,7 +341,7 @@ pub fn avoid_collisions(
             if smooth_angles(
                 &positions,
                 &mut pairs,
-                layer.closed,
+                layer.bead_wraps(),
                 aopts.max_rate_rad_per_mm,
             ) > 0
             {
