@@ -577,7 +577,6 @@ fn align_seams(layers: &mut [Layer], opts: &SliceOptions) {
                     da.total_cmp(&db)
                 })
                 .unwrap_or(0);
-            start = onto_corner(&layers[k], start);
         }
         let slice = layers[k].slice as f64;
         let shift = ((opts.stagger_rad * slice / TAU).rem_euclid(1.0) * n as f64).round() as usize;
@@ -585,47 +584,9 @@ fn align_seams(layers: &mut [Layer], opts: &SliceOptions) {
     }
 }
 
-/// How far the aligned start may move onto a corner (points).
-const SEAM_CORNER_REACH: usize = 2;
-
-/// The start moved from `start` by at most [`SEAM_CORNER_REACH`] points
-/// so that a corner of the layer next to it falls across the seam: the start
-/// `s` whose seam vertices `s − 1` and `s` turn most together, where one of
-/// them is a corner (the test of [`Layer::bead_wraps`]). Constant-distance
-/// layers grow corners (SPEC §3.4) and the aligned seam settles on them,
-/// but the closest point to the end below often lands one vertex off, so
-/// that the bead's first segment crosses the corner (turning 40–50° at each
-/// end of a 0.14 mm segment on the helix). Across the seam the bead does not
-/// turn it: the torch ends on one side and starts on the other.
-fn onto_corner(layer: &Layer, start: usize) -> usize {
-    let n = layer.points.len();
-    if n < 2 * SEAM_CORNER_REACH + 3 {
-        return start;
-    }
-    let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
-    let turns = super::smooth::turning_angles(&positions, true);
-    let corner = super::corner_turn_rad(&turns);
-    let at = |d: isize| (start as isize + d).rem_euclid(n as isize) as usize;
-    let reach = SEAM_CORNER_REACH as isize;
-    if !(-reach - 1..=reach).any(|d| turns[at(d)] > corner) {
-        return start;
-    }
-    // nearest first, so that a tie keeps the start closest to the end below
-    let mut best = (turns[at(-1)] + turns[at(0)], start);
-    for d in 1..=reach {
-        for s in [at(-d), at(d)] {
-            let c = turns[(s + n - 1) % n] + turns[s];
-            if c > best.0 {
-                best = (c, s);
-            }
-        }
-    }
-    best.1
-}
-
 #[cfg(test)]
 mod tests {
-    use super::{onto_corner, runs, Layer, PathPoint};
+    use super::{runs, Layer, PathPoint};
     use crate::math::Point3;
 
     /// A closed layer through `pts` (mm), in order.
@@ -692,23 +653,6 @@ mod tests {
         let mut open = layer(pts);
         open.closed = false;
         assert!(!open.bead_wraps());
-    }
-
-    #[test]
-    fn the_aligned_start_moves_onto_a_corner_next_to_it() {
-        let pts = lens(100);
-        for off in [-2_isize, -1, 1, 2] {
-            let start = off.rem_euclid(200) as usize;
-            let s = onto_corner(&layer(pts.clone()), start);
-            let mut rotated = pts.clone();
-            rotated.rotate_left(s);
-            // the corner (index 0) is a seam vertex: the last or the first
-            assert!(s == 0 || s == 1, "from {start}: {s}");
-            assert!(!layer(rotated).bead_wraps(), "from {start}: {s}");
-        }
-        // too far from the corner, or on a smooth layer: not moved
-        assert_eq!(onto_corner(&layer(pts.clone()), 50), 50);
-        assert_eq!(onto_corner(&layer(pts.clone()), 4), 4);
     }
 
     #[test]

@@ -221,7 +221,7 @@ pub struct Layer {
 /// where it also turns more than [`SEAM_CORNER_OVER_MEDIAN`] times the
 /// layer's median turning. The sample parts' smooth seams turn 0.1–1° at
 /// 400 points a layer; the corners constant-distance layers grow (SPEC
-/// §3.4), which the seam rule of §3.3 draws the seam onto, turn 10–113°.
+/// §3.4), onto which the aligned seams of §3.3 settle, turn 10–113°.
 pub const SEAM_CORNER_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
 
 /// A corner seam turns more than this many times the layer's median turning
