@@ -300,6 +300,12 @@ pub enum PositionerSeed {
     /// The law the arm could not follow, solved again under the arm's
     /// linearised constraints ([`ArmRow`], [`positioner_law_for_arm`]).
     Arm,
+    /// A path of positioner poses found on a grid ([`grid_path`]) that keeps
+    /// `b` inside the cone at a sequence of the layer's points within the
+    /// axes' speeds, fitted by the law: where no other start's law keeps the
+    /// cone (a layer whose `b` passes the pole and swings far off it, where
+    /// the smooth starts fall into a local minimum).
+    Grid,
 }
 
 /// A linearised constraint of the arm on one point's positioner joints:
@@ -1030,6 +1036,183 @@ pub fn unreachable_point(
     None
 }
 
+/// Cell of [`grid_path`]'s grid of positioner poses (deg).
+const GRID_PATH_CELL_DEG: f64 = 2.0;
+
+/// Share of the cone [`grid_path`] keeps `b` within at its points
+/// (unitless): room for the points between them and for the law's fit.
+const GRID_PATH_CONE_SHARE: f64 = 0.8;
+
+/// A path of positioner joints (rad, one per point of the layer) that keeps
+/// `b` within [`GRID_PATH_CONE_SHARE`] of the cone at a sequence of the
+/// layer's points, moving each axis within its speed between them, with the
+/// least range-weighted motion: a shortest path over a grid of poses of
+/// [`GRID_PATH_CELL_DEG`] (the tilt within its travel, the turn modulo a
+/// whole turn), joined linearly between those points. The points follow
+/// each other where the slower axis could move two cells since the last,
+/// so that each hop between grid cells is within the speeds. `None` where
+/// the grid holds no such path. A start for the law ([`PositionerSeed::Grid`]),
+/// not a proof: the law's own check judges every point.
+fn grid_path(pb: &LawProblem) -> Option<Vec<PositionerJoints>> {
+    use std::f64::consts::{PI, TAU};
+    let n = pb.b.len();
+    let h = GRID_PATH_CELL_DEG.to_radians();
+    let (lo7, hi7) = if pb.lower[0].is_finite() && pb.upper[0].is_finite() {
+        (pb.lower[0], pb.upper[0])
+    } else {
+        (-PI, PI)
+    };
+    if n == 0 || !(hi7 > lo7) {
+        return None;
+    }
+    let n7 = (((hi7 - lo7) / h).floor() as usize).max(1);
+    let h7 = (hi7 - lo7) / n7 as f64;
+    let n8 = (TAU / h).ceil() as usize;
+    let h8 = TAU / n8 as f64;
+    let up = pb.r0.transpose() * Vector3::z();
+    let tilted: Vec<Vector3> = (0..n7)
+        .map(|i| {
+            let (s, c) = (lo7 + (i as f64 + 0.5) * h7).sin_cos();
+            Vector3::new(c * up.x - s * up.z, up.y, s * up.x + c * up.z)
+        })
+        .collect();
+    let turns: Vec<(f64, f64)> = (0..n8).map(|j| (j as f64 * h8).sin_cos()).collect();
+    let min_cos = (GRID_PATH_CONE_SHARE * pb.cone).cos();
+    let inside = |m: usize, i: usize, j: usize| {
+        let (s, c) = turns[j];
+        let b = pb.b[m];
+        let w = Vector3::new(c * b.x - s * b.y, s * b.x + c * b.y, b.z);
+        tilted[i].dot(&w) >= min_cos
+    };
+    // the points the path passes through cells at
+    let (v7, v8) = (pb.max_speed[0], pb.max_speed[1]);
+    let hop_s = 2.0 * (h7 / v7).max(h8 / v8);
+    let mut at = vec![0];
+    let mut since = 0.0;
+    for m in 1..n {
+        since += pb.dt[m];
+        if since >= hop_s || m + 1 == n {
+            at.push(m);
+            since = 0.0;
+        }
+    }
+    // range-weighted motion per cell (an endless turn weighted as one turn)
+    let weight = |g: f64| if g > 0.0 { g } else { 1.0 / TAU };
+    let (w7, w8) = (weight(pb.gamma[0]) * h7, weight(pb.gamma[1]) * h8);
+    let cells = n7 * n8;
+    let mut cost: Vec<f64> = (0..cells)
+        .map(|k| {
+            if inside(0, k / n8, k % n8) {
+                0.0
+            } else {
+                f64::INFINITY
+            }
+        })
+        .collect();
+    let mut along = vec![f64::INFINITY; cells];
+    // per hop, the move of each cell's predecessor: turn (of the row the
+    // tilt came from) and tilt
+    let mut hops: Vec<(Vec<i8>, Vec<i8>)> = Vec::with_capacity(at.len());
+    for w in at.windows(2) {
+        let span: f64 = pb.dt[w[0] + 1..=w[1]].iter().sum();
+        let reach = |v: f64, hc: f64, cap: usize| -> usize {
+            if v.is_finite() {
+                ((v * span / hc).floor() as usize).min(cap)
+            } else {
+                cap
+            }
+        };
+        let d7 = reach(v7, h7, 127.min(n7));
+        let d8 = reach(v8, h8, 127.min(n8 / 2));
+        let mut dj = vec![0i8; cells];
+        let mut di = vec![0i8; cells];
+        for i in 0..n7 {
+            for j in 0..n8 {
+                let mut best = (cost[i * n8 + j], 0i8);
+                for d in 1..=d8 {
+                    for sd in [d as isize, -(d as isize)] {
+                        let jj = (j as isize + sd).rem_euclid(n8 as isize) as usize;
+                        let c = cost[i * n8 + jj] + w8 * d as f64;
+                        if c < best.0 {
+                            best = (c, sd as i8);
+                        }
+                    }
+                }
+                along[i * n8 + j] = best.0;
+                dj[i * n8 + j] = best.1;
+            }
+        }
+        let m = w[1];
+        for i in 0..n7 {
+            for j in 0..n8 {
+                let k = i * n8 + j;
+                if !inside(m, i, j) {
+                    cost[k] = f64::INFINITY;
+                    continue;
+                }
+                let mut best = (along[k], 0i8);
+                for d in 1..=d7 {
+                    for sd in [d as isize, -(d as isize)] {
+                        let ii = i as isize + sd;
+                        if ii < 0 || ii >= n7 as isize {
+                            continue;
+                        }
+                        let c = along[ii as usize * n8 + j] + w7 * d as f64;
+                        if c < best.0 {
+                            best = (c, sd as i8);
+                        }
+                    }
+                }
+                cost[k] = best.0;
+                di[k] = best.1;
+            }
+        }
+        hops.push((dj, di));
+    }
+    let last = (0..cells)
+        .filter(|&k| cost[k].is_finite())
+        .min_by(|&a, &b| cost[a].total_cmp(&cost[b]))?;
+    // back along the hops: the cell at each of the points `at`
+    let mut cell = (last / n8, last % n8);
+    let mut path = vec![cell; at.len()];
+    for (h, (dj, di)) in hops.iter().enumerate().rev() {
+        let (i, j) = cell;
+        let ii = (i as isize + di[i * n8 + j] as isize) as usize;
+        let jj = (j as isize + dj[ii * n8 + j] as isize).rem_euclid(n8 as isize) as usize;
+        cell = (ii, jj);
+        path[h] = cell;
+    }
+    // the turn unwrapped, then each point between two of `at` joined linearly
+    let mut poses: Vec<PositionerJoints> = Vec::with_capacity(at.len());
+    for &(i, j) in &path {
+        let q7 = lo7 + (i as f64 + 0.5) * h7;
+        let mut q8 = j as f64 * h8;
+        if let Some(prev) = poses.last() {
+            q8 += ((prev[1] - q8) / TAU).round() * TAU;
+        }
+        poses.push([q7, q8]);
+    }
+    let mut joints = vec![[0.0; 2]; n];
+    for (w, q) in at.windows(2).zip(poses.windows(2)) {
+        let span: f64 = pb.dt[w[0] + 1..=w[1]].iter().sum();
+        let mut t = 0.0;
+        for m in w[0]..=w[1] {
+            if m > w[0] {
+                t += pb.dt[m];
+            }
+            let f = if span > 0.0 { t / span } else { 0.0 };
+            joints[m] = [
+                q[0][0] + f * (q[1][0] - q[0][0]),
+                q[0][1] + f * (q[1][1] - q[0][1]),
+            ];
+        }
+    }
+    if at.len() == 1 {
+        joints.fill(poses[0]);
+    }
+    Some(joints)
+}
+
 /// The grids of positioner poses [`unreachable_point`] searches, coarse to
 /// fine (deg): each is tried where the coarser one proved nothing. The
 /// 0.5° grid costs about 0.3 s a 400-point layer (16 times the coarsest),
@@ -1312,6 +1495,25 @@ fn solve_bases(
             iterations,
         ));
     }
+    // a layer whose b passes the pole and swings far off it: the smooth
+    // starts may all fall into a local minimum; a shortest path over a grid
+    // of poses, fitted, on either knot set
+    if !all.iter().any(|s| s.feasible) {
+        if let Some(path) = grid_path(pb) {
+            for basis in [
+                Basis::spline(abscissa, spans),
+                Basis::spline(&following_turning(abscissa, &pb.b), spans),
+            ] {
+                let x0 = fitted_on(&basis, &path);
+                let solved = solve_starts(pb, &basis, vec![(PositionerSeed::Grid, x0)], iterations);
+                let feasible = solved.iter().any(|s| s.feasible);
+                all.extend(solved);
+                if feasible {
+                    break;
+                }
+            }
+        }
+    }
     // the thesis's exact vertical, unfitted, where it breaks no constraint
     // (an unlimited positioner): the law where no smooth one keeps the cone
     // (a corner of b), else the first alternative (the arm may follow it
@@ -1407,7 +1609,6 @@ fn solve_seeds(
     q8_hint: f64,
     iterations: &mut usize,
 ) -> Vec<Solved> {
-    let n = pb.b.len();
     // the hold seed: the pose turning the mean b vertical
     let mean_b = pb.b.iter().fold(Vector3::zeros(), |a, b| a + b);
     let hold = UnitVector3::try_new(mean_b, MIN_BUILD_SUM)
@@ -1420,11 +1621,7 @@ fn solve_seeds(
         })
         .unwrap_or([0.0, q8_hint]);
     let k = basis.len();
-    let fitted = |q: &[PositionerJoints]| {
-        let c7 = basis.fit(&q.iter().map(|q| q[0]).collect::<Vec<_>>());
-        let c8 = basis.fit(&q.iter().map(|q| q[1]).collect::<Vec<_>>());
-        [c7, c8].concat()
-    };
+    let fitted = |q: &[PositionerJoints]| fitted_on(basis, q);
     let mut seeds: Vec<(PositionerSeed, Vec<f64>)> = Vec::new();
     let mut x_hold = vec![0.0; 2 * k];
     x_hold[0] = hold[0];
@@ -1437,14 +1634,35 @@ fn solve_seeds(
     if let Some(f) = follow {
         seeds.push((PositionerSeed::Follow, fitted(f)));
     }
-    let mut solved_all: Vec<Solved> = Vec::new();
-    let target = pb.opts.sample_points.min(n);
     // the thesis's follower first: on a part of revolution it is exact and
     // costs nothing, and no other seed can do better than nothing
     seeds.reverse();
     if let Some(s) = arm_start {
         seeds.insert(0, (PositionerSeed::Arm, fitted(s)));
     }
+    solve_starts(pb, basis, seeds, iterations)
+}
+
+/// Joints `q` (rad per point) fitted on `basis`: `[c7; c8]`.
+fn fitted_on(basis: &Basis, q: &[PositionerJoints]) -> Vec<f64> {
+    let c7 = basis.fit(&q.iter().map(|q| q[0]).collect::<Vec<_>>());
+    let c8 = basis.fit(&q.iter().map(|q| q[1]).collect::<Vec<_>>());
+    [c7, c8].concat()
+}
+
+/// Each start `seeds` (coefficients on `basis`) solved on samples grown
+/// with its worst points, in order, until one keeps every constraint at no
+/// cost.
+fn solve_starts(
+    pb: &LawProblem,
+    basis: &Basis,
+    seeds: Vec<(PositionerSeed, Vec<f64>)>,
+    iterations: &mut usize,
+) -> Vec<Solved> {
+    let n = pb.b.len();
+    let k = basis.len();
+    let mut solved_all: Vec<Solved> = Vec::new();
+    let target = pb.opts.sample_points.min(n);
     for (seed, x0) in seeds {
         if solved_all
             .iter()

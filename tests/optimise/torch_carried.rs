@@ -678,3 +678,57 @@ fn a_one_degree_grid_proves_an_s_bend_layer_the_two_degree_grid_cannot() {
     assert_eq!(at(2.0), None, "the 2° grid proves it");
     assert!(at(1.0).is_some());
 }
+
+/// The helix's layer 1 at its own grid in the KUKA torch-carried cell: its
+/// `b` passes within 10° of the table's normal (the turn's pole) and swings
+/// more than 60° off it, with half a turn of azimuth, twice along the
+/// layer. Every smooth start's law fell into a local minimum 38–64° out of
+/// the cone; the grid's least-motion path of poses, fitted by the law,
+/// keeps `b` within the cone at every point (recomputed here from the
+/// positioner's forward kinematics), and the stage plans the layer.
+#[test]
+fn a_layer_through_the_pole_twice_plans_on_the_grids_path() {
+    use waam_slicer::optimise::positioner::{positioner_law, PositionerSeed};
+    use waam_slicer::robot::CellLayout;
+    let (cell, layer, opts) = sample_layer("helix.toml", "kuka_kr16_2_torch_carried.toml", 1);
+    let CellLayout::TorchCarried(tc) = &cell.layout else {
+        panic!("a torch-carried cell")
+    };
+    let b_of = |p: &waam_slicer::robot::CellPoint| p.build_direction.unwrap_or(p.tool_axis);
+    let off_normal: Vec<f64> = layer
+        .points
+        .iter()
+        .map(|p| {
+            let b = tc.table_from_part.rotation * b_of(p).into_inner();
+            b.z.clamp(-1.0, 1.0).acos().to_degrees()
+        })
+        .collect();
+    let (lo, hi) = off_normal
+        .iter()
+        .fold((f64::INFINITY, 0.0_f64), |(l, h), &a| (l.min(a), h.max(a)));
+    assert!(lo < 10.0 && hi > 60.0, "{lo}° .. {hi}°");
+    let law = positioner_law(
+        tc,
+        &layer.points,
+        opts.travel_speed_mm_s,
+        opts.joint_limit_margin_rad,
+        0.0,
+        &opts.positioner,
+    );
+    assert!(law.feasible, "{:?}", law.binding);
+    assert_eq!(law.seed, PositionerSeed::Grid);
+    for (m, (p, q)) in layer.points.iter().zip(&law.joints).enumerate() {
+        let b = tc.base_from_part(q).rotation * b_of(p).into_inner();
+        let tilt = b.z.clamp(-1.0, 1.0).acos();
+        assert!(
+            tilt <= tc.max_vertical_error_rad + 1e-9,
+            "point {m}: {}°",
+            tilt.to_degrees()
+        );
+    }
+    let planned =
+        waam_slicer::optimise::optimise(&cell.layout, std::slice::from_ref(&layer), &opts).unwrap();
+    let l = &planned.layers[0];
+    assert!(l.status.is_feasible(), "{}", l.status);
+    assert_eq!(l.positioner.as_ref().unwrap().seed, PositionerSeed::Grid);
+}
