@@ -1196,12 +1196,12 @@ fn grid_path(pb: &LawProblem) -> Option<Vec<PositionerJoints>> {
     for (w, q) in at.windows(2).zip(poses.windows(2)) {
         let span: f64 = pb.dt[w[0] + 1..=w[1]].iter().sum();
         let mut t = 0.0;
-        for m in w[0]..=w[1] {
+        for (m, joint) in joints.iter_mut().enumerate().take(w[1] + 1).skip(w[0]) {
             if m > w[0] {
                 t += pb.dt[m];
             }
             let f = if span > 0.0 { t / span } else { 0.0 };
-            joints[m] = [
+            *joint = [
                 q[0][0] + f * (q[1][0] - q[0][0]),
                 q[0][1] + f * (q[1][1] - q[0][1]),
             ];
