@@ -300,11 +300,11 @@ pub enum PositionerSeed {
     /// The law the arm could not follow, solved again under the arm's
     /// linearised constraints ([`ArmRow`], [`positioner_law_for_arm`]).
     Arm,
-    /// A path of positioner poses found on a grid ([`grid_path`]) that keeps
-    /// `b` inside the cone at a sequence of the layer's points within the
-    /// axes' speeds, fitted by the law: where no other start's law keeps the
-    /// cone (a layer whose `b` passes the pole and swings far off it, where
-    /// the smooth starts fall into a local minimum).
+    /// A least-motion path of positioner poses over a grid of 2° cells that
+    /// keeps `b` inside the cone at a sequence of the layer's points within
+    /// the axes' speeds, fitted by the law: where no other start's law keeps
+    /// the cone (a layer whose `b` passes the pole and swings far off it,
+    /// where the smooth starts fall into a local minimum).
     Grid,
 }
 
