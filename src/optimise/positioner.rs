@@ -936,7 +936,7 @@ pub fn unreachable_point(
         .map(|i| {
             let q7 = lo7 + (i as f64 + 0.5) * h7;
             let (s, c) = q7.sin_cos();
-            Vector3::new(c * up.x - s * up.z, up.y, s * up.x + c * up.z)
+            tilted_back(&up, s, c)
         })
         .collect();
     let turns: Vec<(f64, f64)> = (0..n8).map(|j| ((j as f64 + 0.5) * h8).sin_cos()).collect();
@@ -1014,7 +1014,7 @@ pub fn unreachable_point(
             for (j, (s, c)) in turns.iter().enumerate() {
                 let k = i * n8 + j;
                 if reach[k] {
-                    let w = Vector3::new(c * bm.x - s * bm.y, s * bm.x + c * bm.y, bm.z);
+                    let w = turned(bm, *s, *c);
                     reach[k] = t.dot(&w) >= min_cos;
                     if reach[k] {
                         any = true;
@@ -1034,6 +1034,21 @@ pub fn unreachable_point(
         }
     }
     None
+}
+
+/// The world's up in the table frame's tilt-turned coordinates of the
+/// pose grids: `up` (the vertical in the positioner frame) turned back by a
+/// tilt whose sine and cosine are `s`, `c` (`Ry(−q7)·up`). With [`turned`],
+/// `b` is within the cone at `(q7, q8)` where their dot product is at least
+/// the cone's cosine.
+fn tilted_back(up: &Vector3, s: f64, c: f64) -> Vector3 {
+    Vector3::new(c * up.x - s * up.z, up.y, s * up.x + c * up.z)
+}
+
+/// `b` (table frame) turned by a turn whose sine and cosine are `s`, `c`
+/// (`Rz(q8)·b`).
+fn turned(b: &Vector3, s: f64, c: f64) -> Vector3 {
+    Vector3::new(c * b.x - s * b.y, s * b.x + c * b.y, b.z)
 }
 
 /// Cell of [`grid_path`]'s grid of positioner poses (deg).
@@ -1073,7 +1088,7 @@ fn grid_path(pb: &LawProblem) -> Option<Vec<PositionerJoints>> {
     let tilted: Vec<Vector3> = (0..n7)
         .map(|i| {
             let (s, c) = (lo7 + (i as f64 + 0.5) * h7).sin_cos();
-            Vector3::new(c * up.x - s * up.z, up.y, s * up.x + c * up.z)
+            tilted_back(&up, s, c)
         })
         .collect();
     let turns: Vec<(f64, f64)> = (0..n8).map(|j| (j as f64 * h8).sin_cos()).collect();
@@ -1081,7 +1096,7 @@ fn grid_path(pb: &LawProblem) -> Option<Vec<PositionerJoints>> {
     let inside = |m: usize, i: usize, j: usize| {
         let (s, c) = turns[j];
         let b = pb.b[m];
-        let w = Vector3::new(c * b.x - s * b.y, s * b.x + c * b.y, b.z);
+        let w = turned(&b, s, c);
         tilted[i].dot(&w) >= min_cos
     };
     // the points the path passes through cells at

@@ -488,6 +488,22 @@ fn max_hose_deg(plan: &waam_slicer::optimise::LayerPlan) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The positioner's law of `layer` in `tc`, as the stage solves it.
+fn law_of(
+    tc: &waam_slicer::robot::cell::TorchCarriedCell,
+    layer: &waam_slicer::optimise::LayerPoints,
+    opts: &waam_slicer::optimise::OptimiseOptions,
+) -> waam_slicer::optimise::positioner::PositionerLaw {
+    waam_slicer::optimise::positioner::positioner_law(
+        tc,
+        &layer.points,
+        opts.travel_speed_mm_s,
+        opts.joint_limit_margin_rad,
+        0.0,
+        &opts.positioner,
+    )
+}
+
 /// Layer `n` of the S-bend at its own grid (as [`sample_layer`]) in the
 /// KUKA torch-carried cell with its hose package allowing
 /// [`SHORT_HOSE_DEG`] of torsion, and the positioner's law solved for it,
@@ -506,14 +522,7 @@ fn short_hose_s_bend_law(
         panic!("a torch-carried cell")
     };
     tc.max_hose_torsion_rad = SHORT_HOSE_DEG.to_radians();
-    let law = waam_slicer::optimise::positioner::positioner_law(
-        tc,
-        &layer.points,
-        opts.travel_speed_mm_s,
-        opts.joint_limit_margin_rad,
-        0.0,
-        &opts.positioner,
-    );
+    let law = law_of(tc, &layer, &opts);
     assert!(law.feasible, "{:?}", law.binding);
     (cell, layer, opts, law)
 }
@@ -629,20 +638,13 @@ fn the_arms_hose_put_into_the_positioners_law_builds_a_layer_no_start_could() {
 /// directions in the table frame, as the law's problem states them.
 #[test]
 fn a_one_degree_grid_proves_an_s_bend_layer_the_two_degree_grid_cannot() {
-    use waam_slicer::optimise::positioner::{positioner_law, unreachable_point};
+    use waam_slicer::optimise::positioner::unreachable_point;
     use waam_slicer::robot::CellLayout;
     let (cell, layer, opts) = sample_layer("s-bend.toml", "robowam_torch_carried.toml", 171);
     let CellLayout::TorchCarried(tc) = &cell.layout else {
         panic!("a torch-carried cell")
     };
-    let law = positioner_law(
-        tc,
-        &layer.points,
-        opts.travel_speed_mm_s,
-        opts.joint_limit_margin_rad,
-        0.0,
-        &opts.positioner,
-    );
+    let law = law_of(tc, &layer, &opts);
     assert!(!law.feasible);
     assert!(law.required_rate_rad_s <= law.available_rate_rad_s);
     assert!(law.proven_infeasible && law.unreachable_point.is_some());
@@ -688,7 +690,7 @@ fn a_one_degree_grid_proves_an_s_bend_layer_the_two_degree_grid_cannot() {
 /// positioner's forward kinematics), and the stage plans the layer.
 #[test]
 fn a_layer_through_the_pole_twice_plans_on_the_grids_path() {
-    use waam_slicer::optimise::positioner::{positioner_law, PositionerSeed};
+    use waam_slicer::optimise::positioner::PositionerSeed;
     use waam_slicer::robot::CellLayout;
     let (cell, layer, opts) = sample_layer("helix.toml", "kuka_kr16_2_torch_carried.toml", 1);
     let CellLayout::TorchCarried(tc) = &cell.layout else {
@@ -707,14 +709,7 @@ fn a_layer_through_the_pole_twice_plans_on_the_grids_path() {
         .iter()
         .fold((f64::INFINITY, 0.0_f64), |(l, h), &a| (l.min(a), h.max(a)));
     assert!(lo < 10.0 && hi > 60.0, "{lo}° .. {hi}°");
-    let law = positioner_law(
-        tc,
-        &layer.points,
-        opts.travel_speed_mm_s,
-        opts.joint_limit_margin_rad,
-        0.0,
-        &opts.positioner,
-    );
+    let law = law_of(tc, &layer, &opts);
     assert!(law.feasible, "{:?}", law.binding);
     assert_eq!(law.seed, PositionerSeed::Grid);
     for (m, (p, q)) in layer.points.iter().zip(&law.joints).enumerate() {
