@@ -476,6 +476,76 @@ fn sample_layer(
     (cell, layer, opts)
 }
 
+/// The S-bend's layers 85 and 170, where `b` turns through a corner (40°
+/// of azimuth between two points 0.1 s apart on layer 85) off the pole:
+/// every smooth start's law ended 0.5–1.1° out of the 15° cone, and no
+/// grid proved them unbuildable (the outer grid at 0.0625° reaches every
+/// point). The grid's path, relaxed, fitted and solved, keeps `b` within
+/// the cone at every point, recomputed here from the positioner's forward
+/// kinematics (`TorchCarriedCell::base_from_part`), each positioner axis
+/// within its travel and its speed at the travel speed (recomputed from the
+/// points), and the stage plans the layer: layer 85 in each torch-carried
+/// cell, layer 170 in the thesis's.
+#[test]
+fn a_corner_off_the_pole_plans_on_the_grids_path_in_every_torch_carried_cell() {
+    use waam_slicer::optimise::positioner::PositionerSeed;
+    use waam_slicer::robot::CellLayout;
+    for (cell_file, n) in [
+        ("robowam_torch_carried.toml", 85),
+        ("kuka_kr16_2_torch_carried.toml", 85),
+        ("abb_irb2600_torch_carried.toml", 85),
+        ("robowam_torch_carried.toml", 170),
+    ] {
+        let (cell, layer, opts) = sample_layer("s-bend.toml", cell_file, n);
+        let CellLayout::TorchCarried(tc) = &cell.layout else {
+            panic!("a torch-carried cell")
+        };
+        let law = law_of(tc, &layer, &opts);
+        assert!(law.feasible, "{cell_file} layer {n}: {:?}", law.binding);
+        assert_eq!(law.seed, PositionerSeed::Grid, "{cell_file} layer {n}");
+        let lim = &tc.positioner.limits;
+        for (m, (p, q)) in layer.points.iter().zip(&law.joints).enumerate() {
+            let b = tc.base_from_part(q).rotation * p.build_direction.unwrap().into_inner();
+            let tilt = b.z.clamp(-1.0, 1.0).acos();
+            assert!(
+                tilt <= tc.max_vertical_error_rad + 1e-9,
+                "{cell_file} layer {n} point {m}: {}°",
+                tilt.to_degrees()
+            );
+            for (a, (q, lim)) in q.iter().zip(lim).enumerate() {
+                assert!(
+                    *q >= lim.lower_rad && *q <= lim.upper_rad,
+                    "{cell_file} layer {n} point {m}: J{} at {q} rad",
+                    7 + a,
+                );
+            }
+            if m > 0 {
+                let dt = (p.position_mm - layer.points[m - 1].position_mm).norm()
+                    / opts.travel_speed_mm_s;
+                let before = law.joints[m - 1];
+                for (a, max) in tc.positioner.max_speed_rad_s.iter().enumerate() {
+                    let speed = (q[a] - before[a]).abs() / dt;
+                    assert!(
+                        speed <= max * (1.0 + 1e-9),
+                        "{cell_file} layer {n} point {m}: J{} at {}°/s",
+                        7 + a,
+                        speed.to_degrees()
+                    );
+                }
+            }
+        }
+        let planned =
+            waam_slicer::optimise::optimise(&cell.layout, std::slice::from_ref(&layer), &opts)
+                .unwrap();
+        let l = &planned.layers[0];
+        assert!(
+            l.status.is_feasible(),
+            "{cell_file} layer {n}: {}",
+            l.status
+        );
+    }
+}
+
 /// The largest hose torsion `|J4 + J6|` of a planned layer (deg), from its
 /// joints.
 fn max_hose_deg(plan: &waam_slicer::optimise::LayerPlan) -> f64 {
