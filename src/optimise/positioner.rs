@@ -412,13 +412,26 @@ pub fn required_rotation_rate(b: &[Vector3], dt: &[f64], cone_rad: f64) -> (f64,
     // the angle (a hair inside, so that rounding cannot skip a pair in need)
     let within = (2.0 * cone_rad).cos() + PAIR_SKIP_COS;
     for i in 0..n {
+        // per block of j, the widest angle a pair of the block needs to beat
+        // the best so far at the block's first (shortest) time: pairs within
+        // it cannot, and are skipped before the angle
+        let mut skip_above = within;
         for j in i + 1..n {
             let t = time[j] - time[i];
             // no later j can need more: θ ≤ π
             if t > 0.0 && reach / t <= best.0 {
                 break;
             }
-            if b[i].dot(&b[j]) > within {
+            if (j - i - 1) % RATE_BLOCK == 0 {
+                let beat = 2.0 * cone_rad + best.0 * t;
+                // (beat ≥ 2·cone: never fewer skipped than `within`)
+                skip_above = if beat < std::f64::consts::PI {
+                    beat.cos() + PAIR_SKIP_COS
+                } else {
+                    -2.0
+                };
+            }
+            if b[i].dot(&b[j]) > skip_above {
                 continue;
             }
             let theta = b[i].cross(&b[j]).norm().atan2(b[i].dot(&b[j]));
@@ -433,6 +446,9 @@ pub fn required_rotation_rate(b: &[Vector3], dt: &[f64], cone_rad: f64) -> (f64,
     }
     best
 }
+
+/// Pairs of [`required_rotation_rate`] that share one skipping bound.
+const RATE_BLOCK: usize = 16;
 
 /// What a law is solved against: the layer in the table frame.
 struct LawProblem<'a> {
@@ -1403,6 +1419,26 @@ impl Packed {
     }
 }
 
+/// Whether the rate bound ([`required_rotation_rate`]) or the coarsest
+/// two grids of [`GRID_CELLS_DEG`] prove that no positioner path keeps the
+/// layer's `b` within the cone: then [`grid_path`], whose grid is finer
+/// and whose approximation is inner, finds none either, and is not run.
+fn cheaply_proven(pb: &LawProblem) -> bool {
+    let available = pb.max_speed[0] + pb.max_speed[1];
+    required_rotation_rate(&pb.b, &pb.dt, pb.cone).0 > available
+        || GRID_CELLS_DEG[..2].iter().any(|cell_deg| {
+            unreachable_point(
+                &pb.cell.positioner,
+                &pb.r0,
+                &pb.b,
+                &pb.dt,
+                pb.cone,
+                cell_deg.to_radians(),
+            )
+            .is_some()
+        })
+}
+
 /// Sweeps of [`relax`].
 const RELAX_SWEEPS: usize = 200;
 
@@ -1563,7 +1599,8 @@ fn solve_law(
         if let Some(w) = stroke_window(cell, &joints, margin_rad) {
             pb.within_stroke(w);
         }
-        return finish(&pb, joints, PositionerSeed::Vertical, 0, n, 0.0);
+        let rate = required_rotation_rate(&pb.b, &pb.dt, pb.cone);
+        return finish(&pb, rate, joints, PositionerSeed::Vertical, 0, n, 0.0);
     }
     let positions: Vec<Point3> = points.iter().map(|p| p.position_mm).collect();
     let theta = cylindrical_angles(&positions);
@@ -1602,8 +1639,11 @@ fn solve_law(
             &mut iterations,
         );
     }
+    // the layer's geometry, the same for every law
+    let rate = required_rotation_rate(&pb.b, &pb.dt, pb.cone);
     let mut law = finish(
         &pb,
+        rate,
         best.joints,
         best.seed,
         iterations,
@@ -1612,7 +1652,7 @@ fn solve_law(
     );
     law.alternatives = others
         .into_iter()
-        .map(|s| finish(&pb, s.joints, s.seed, 0, s.samples, s.objective))
+        .map(|s| finish(&pb, rate, s.joints, s.seed, 0, s.samples, s.objective))
         .collect();
     law
 }
@@ -1694,8 +1734,9 @@ fn solve_bases(
     // a layer whose b passes the pole and swings far off it, or turns a
     // corner: the smooth starts may all fall into a local minimum; a path
     // over a grid of poses, fitted, on either knot set, else the path
-    // itself where it keeps every constraint
-    if !all.iter().any(|s| s.feasible) {
+    // itself where it keeps every constraint; not where the cheap proofs
+    // already show no path exists
+    if !all.iter().any(|s| s.feasible) && !cheaply_proven(pb) {
         if let Some(path) = grid_path(pb) {
             for basis in [
                 Basis::spline(abscissa, spans),
@@ -1926,8 +1967,13 @@ fn solve_starts(
     solved_all
 }
 
+/// The law of `joints` checked against every constraint, with the layer's
+/// rate bound `(required, between)` ([`required_rotation_rate`], computed
+/// once a layer) and, where the law fails, the grids' proof
+/// ([`unreachable_point`]).
 fn finish(
     pb: &LawProblem,
+    (required, between): (f64, (usize, usize)),
     joints: Vec<PositionerJoints>,
     seed: PositionerSeed,
     iterations: usize,
@@ -1935,7 +1981,6 @@ fn finish(
     objective: f64,
 ) -> PositionerLaw {
     let c = check(pb, &joints);
-    let (required, between) = required_rotation_rate(&pb.b, &pb.dt, pb.cone);
     let available = pb.max_speed[0] + pb.max_speed[1];
     // a law that leaves the cone, or keeps it only faster than the axes
     // go, not proven by the rate: search every positioner path on a grid
@@ -2044,6 +2089,43 @@ mod tests {
         let mut dt2 = dt[..11].to_vec();
         dt2[10] = 0.0;
         assert!(required_rotation_rate(&corner, &dt2, cone).0.is_infinite());
+    }
+
+    /// The bound's skipping (the early break, the cone's width, the blocks'
+    /// bound) against every pair computed: the same rate and the same pair,
+    /// on `b` round a cone of 10–80° about the vertical (a dome's layers)
+    /// with a wobble, at uneven steps.
+    #[test]
+    fn the_rate_bound_skips_no_pair_that_binds() {
+        let cone = 15f64.to_radians();
+        for half_angle in [10.0, 25.0, 40.0, 55.0, 80.0] {
+            let n = 300;
+            let b: Vec<Vector3> = (0..n)
+                .map(|m| {
+                    let v = std::f64::consts::TAU * m as f64 / n as f64;
+                    let a = f64::to_radians(half_angle) * (1.0 + 0.2 * (5.0 * v).sin());
+                    Vector3::new(a.sin() * v.cos(), a.sin() * v.sin(), a.cos())
+                })
+                .collect();
+            let dt: Vec<f64> = (0..n).map(|m| 0.05 + 0.03 * (m % 7) as f64 / 7.0).collect();
+            let mut time = vec![0.0; n];
+            for m in 1..n {
+                time[m] = time[m - 1] + dt[m];
+            }
+            let mut brute = (0.0f64, (0, 0));
+            for i in 0..n {
+                for j in i + 1..n {
+                    let theta = b[i].angle(&b[j]);
+                    let rate = (theta - 2.0 * cone) / (time[j] - time[i]);
+                    if rate > brute.0 {
+                        brute = (rate, (i, j));
+                    }
+                }
+            }
+            let (rate, pair) = required_rotation_rate(&b, &dt, cone);
+            approx::assert_relative_eq!(rate, brute.0, max_relative = 1e-12);
+            assert_eq!(pair, brute.1, "half angle {half_angle}°");
+        }
     }
 
     /// A ROBOWAM positioner with a ±135° tilt, and a layer of 51 points
