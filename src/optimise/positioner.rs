@@ -538,6 +538,21 @@ impl<'a> LawProblem<'a> {
             opts: *opts,
         }
     }
+
+    /// The first point [`unreachable_point`] proves out of reach on the
+    /// first of the grids `cells_deg` (deg) that proves one.
+    fn unreachable_on(&self, cells_deg: &[f64]) -> Option<usize> {
+        cells_deg.iter().find_map(|cell_deg| {
+            unreachable_point(
+                &self.cell.positioner,
+                &self.r0,
+                &self.b,
+                &self.dt,
+                self.cone,
+                cell_deg.to_radians(),
+            )
+        })
+    }
 }
 
 /// `1/range` of a travel, 0 when unlimited.
@@ -1426,17 +1441,7 @@ impl Packed {
 fn cheaply_proven(pb: &LawProblem) -> bool {
     let available = pb.max_speed[0] + pb.max_speed[1];
     required_rotation_rate(&pb.b, &pb.dt, pb.cone).0 > available
-        || GRID_CELLS_DEG[..2].iter().any(|cell_deg| {
-            unreachable_point(
-                &pb.cell.positioner,
-                &pb.r0,
-                &pb.b,
-                &pb.dt,
-                pb.cone,
-                cell_deg.to_radians(),
-            )
-            .is_some()
-        })
+        || pb.unreachable_on(&GRID_CELLS_DEG[..2]).is_some()
 }
 
 /// Sweeps of [`relax`].
@@ -1993,16 +1998,7 @@ fn finish(
             // coarse first (cheap, proves the clear cases), then finer:
             // the relaxation's slack is a cell, so a finer grid proves a
             // layer that misses the cone by less
-            GRID_CELLS_DEG.iter().find_map(|cell_deg| {
-                unreachable_point(
-                    &pb.cell.positioner,
-                    &pb.r0,
-                    &pb.b,
-                    &pb.dt,
-                    pb.cone,
-                    cell_deg.to_radians(),
-                )
-            })
+            pb.unreachable_on(&GRID_CELLS_DEG)
         } else {
             None
         };
