@@ -1170,21 +1170,27 @@ impl PoseGrid {
 
 /// Scratch of [`Dilation::dilate`].
 struct Dilation {
+    /// The source dilated along the turn.
     next: Vec<bool>,
+    /// Prefix counts along a row.
     count: Vec<usize>,
+    /// Set cells per column within the tilt's window.
+    columns: Vec<u32>,
 }
 
 impl Dilation {
     fn new(grid: &PoseGrid) -> Self {
         Dilation {
             next: vec![false; grid.n7 * grid.n8],
-            count: Vec::with_capacity(3 * grid.n8.max(grid.n7) + 1),
+            count: Vec::with_capacity(3 * grid.n8 + 1),
+            columns: Vec::with_capacity(grid.n8),
         }
     }
 
     /// `out` ← the cells within `d7` rows and `d8` columns (the turn
     /// periodic) of a set cell of `src`, whose set cells lie in the rows
-    /// `band` (first, last): sliding windows by prefix counts.
+    /// `band` (first, last): the turn's window by prefix counts along each
+    /// row, then the tilt's by running counts per column, row after row.
     fn dilate(
         &mut self,
         grid: &PoseGrid,
@@ -1195,16 +1201,17 @@ impl Dilation {
         out: &mut [bool],
     ) {
         let (n7, n8) = (grid.n7, grid.n8);
-        let (next, count) = (&mut self.next, &mut self.count);
+        let (next, count, columns) = (&mut self.next, &mut self.count, &mut self.columns);
         let (lo, hi) = band;
         let (out_lo, out_hi) = (lo.saturating_sub(d7), hi.saturating_add(d7).min(n7 - 1));
         out[..out_lo * n8].fill(false);
         out[(out_hi + 1) * n8..].fill(false);
         for i in lo..=hi {
             let row = &src[i * n8..(i + 1) * n8];
-            if d8 >= n8 / 2 {
+            let dilated = &mut next[i * n8..(i + 1) * n8];
+            if !row.contains(&true) || d8 >= n8 / 2 {
                 let any = row.contains(&true);
-                next[i * n8..(i + 1) * n8].fill(any);
+                dilated.fill(any);
                 continue;
             }
             count.clear();
@@ -1213,24 +1220,36 @@ impl Dilation {
                 let c = count[k] + usize::from(row[k % n8]);
                 count.push(c);
             }
-            for j in 0..n8 {
+            for (j, cell) in dilated.iter_mut().enumerate() {
                 // cells j − d8 ..= j + d8, shifted by one turn
                 let (a, z) = (j + n8 - d8, j + n8 + d8 + 1);
-                next[i * n8 + j] = count[z] > count[a];
+                *cell = count[z] > count[a];
             }
         }
-        for j in 0..n8 {
-            // count[i − lo]: reached rows lo..i of column j
-            count.clear();
-            count.push(0);
-            for i in lo..=hi {
-                let c = count[i - lo] + usize::from(next[i * n8 + j]);
-                count.push(c);
+        // rows max(i − d7, lo) ..= min(i + d7, hi) counted per column: never
+        // empty, as out_lo ..= out_hi is the band widened by d7
+        columns.clear();
+        columns.resize(n8, 0);
+        let (mut entered, mut left) = (lo, lo);
+        for i in out_lo..=out_hi {
+            let last = i.saturating_add(d7).min(hi);
+            while entered <= last {
+                let row = &next[entered * n8..(entered + 1) * n8];
+                for (c, x) in columns.iter_mut().zip(row) {
+                    *c += u32::from(*x);
+                }
+                entered += 1;
             }
-            for i in out_lo..=out_hi {
-                let a = i.saturating_sub(d7).max(lo) - lo;
-                let z = i.saturating_add(d7).min(hi) + 1 - lo;
-                out[i * n8 + j] = z > a && count[z] > count[a];
+            let first = i.saturating_sub(d7).max(lo);
+            while left < first {
+                let row = &next[left * n8..(left + 1) * n8];
+                for (c, x) in columns.iter_mut().zip(row) {
+                    *c -= u32::from(*x);
+                }
+                left += 1;
+            }
+            for (o, c) in out[i * n8..(i + 1) * n8].iter_mut().zip(columns.iter()) {
+                *o = *c > 0;
             }
         }
     }
