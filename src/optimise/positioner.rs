@@ -300,11 +300,14 @@ pub enum PositionerSeed {
     /// The law the arm could not follow, solved again under the arm's
     /// linearised constraints ([`ArmRow`], [`positioner_law_for_arm`]).
     Arm,
-    /// A least-motion path of positioner poses over a grid of 2° cells that
-    /// keeps `b` inside the cone at a sequence of the layer's points within
-    /// the axes' speeds, fitted by the law: where no other start's law keeps
-    /// the cone (a layer whose `b` passes the pole and swings far off it,
-    /// where the smooth starts fall into a local minimum).
+    /// A path of positioner poses over a grid of 0.25–2° cells that keeps
+    /// `b` inside the cone at every point of the layer within the axes'
+    /// speeds (the reachable poses propagated point to point, followed back
+    /// with the least motion and relaxed), fitted by the law, or kept as it
+    /// is where no fit keeps the constraints: where no other start's law
+    /// keeps the cone (a layer whose `b` passes the pole and swings far off
+    /// it, or turns a corner off the pole, where the smooth starts fall into
+    /// a local minimum).
     Grid,
 }
 
