@@ -3,7 +3,8 @@
 //! a smooth refit of the guide, until the guide stops moving; a final pass
 //! fits the radius law (and wall thickness) and measures the residuals.
 
-use super::report::{self, FitReport};
+use super::outcome::{EndRing, FitReport, Station, TubeFit};
+use super::report;
 use super::section::{fit_circle, fit_plane, plane_basis, CircleFit, SectionPoint};
 use super::topology::{self, median_edge, Surfaces};
 use super::{smooth, FitError, FitOptions, StartEnd, TubeMesh};
@@ -14,81 +15,6 @@ use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::Polyline;
 use rayon::prelude::*;
 
-/// A fitted tube (part frame = mesh frame, mm): the guide as the points of a
-/// natural cubic spline (`t` = chord length from the start end, mm), the
-/// radius law and the wall thickness as natural cubic splines over the same
-/// knots, the substrate plane at the start end, and the fit report.
-#[derive(Debug, Clone)]
-pub struct TubeFit {
-    /// The mesh file.
-    pub file: String,
-    /// Points of the spline guide, from the start end (mm).
-    pub guide_points: Vec<Point3>,
-    /// Guide parameter of each point: cumulative chord length (mm).
-    pub knots: Vec<f64>,
-    /// Guide parameter of the start end (mm): the first and last guide
-    /// points lie one knot interval past the ends, so that the spline's
-    /// natural end condition (no curvature) falls outside the tube.
-    pub t_min: f64,
-    /// Guide parameter of the other end (mm).
-    pub t_max: f64,
-    /// Radius of the (mid-surface) profile at each knot (mm).
-    pub radius_mm: Vec<f64>,
-    /// Wall thickness at each knot (mm), when two skins were given.
-    pub thickness_mm: Option<Vec<f64>>,
-    /// A point of the substrate plane: the guide's point at `t_min` (mm).
-    pub substrate_point: Point3,
-    /// The substrate's normal, toward the part: the start end's plane.
-    pub substrate_normal: UnitVector3,
-    /// Parameter range needed below `t = 0` for the substrate to cut the
-    /// tube when the start end is not normal to the guide (mm).
-    pub extend_before_mm: f64,
-    /// Distance (mm) of each vertex of the mesh (same order as
-    /// [`TubeMesh::vertices`]) to the fitted surface, as in the report's
-    /// RMS and largest distance; `None` for a vertex left out of the fit
-    /// (a flat cap, a stray piece).
-    pub vertex_distance_mm: Vec<Option<f64>>,
-    /// What the fit found and how well it fits.
-    pub report: FitReport,
-}
-
-impl TubeFit {
-    /// Length of the tube's parameter range `t_max - t_min` (mm).
-    pub fn length(&self) -> f64 {
-        self.t_max - self.t_min
-    }
-
-    /// The guide curve.
-    pub fn guide(&self) -> CubicSpline {
-        CubicSpline::new(&self.guide_points).expect("validated when fitted")
-    }
-
-    /// The radius law `A(t)` (mm).
-    pub fn radius(&self, t: f64) -> f64 {
-        let m = smooth::natural_second_derivatives(&self.knots, &self.radius_mm);
-        smooth::eval(&self.knots, &self.radius_mm, &m, t)
-    }
-
-    /// The wall thickness law (mm), when two skins were fitted.
-    pub fn wall_thickness(&self, t: f64) -> Option<f64> {
-        self.thickness_mm.as_ref().map(|e| {
-            let m = smooth::natural_second_derivatives(&self.knots, e);
-            smooth::eval(&self.knots, e, &m, t)
-        })
-    }
-}
-
-/// An open end of the tube (mesh frame, mm).
-#[derive(Debug, Clone)]
-pub(super) struct EndRing {
-    pub centre: Point3,
-    pub normal: UnitVector3,
-    pub radius: f64,
-    pub capped: bool,
-    /// The loop index of this end in each skin.
-    pub loops: Vec<usize>,
-}
-
 /// The points the fit uses: every skin vertex, with its skin.
 struct Samples {
     pos: Vec<Point3>,
@@ -96,16 +22,51 @@ struct Samples {
     skins: usize,
 }
 
-/// One station's sections (one per skin) and the combined centre and radius.
-#[derive(Debug, Clone)]
-pub(super) struct Station {
-    pub t: f64,
-    pub fits: Vec<Option<CircleFit>>,
-    pub centre: Option<Point3>,
-    pub radius: Option<f64>,
-    pub thickness: Option<f64>,
-    pub points: usize,
-}
+/// Default station spacing, in median mesh edges: two edges between
+/// stations gives each section a full ring of vertices.
+const STATION_SPACING_EDGES: f64 = 2.0;
+/// Smallest default station spacing (mm): finer stations on a fine mesh
+/// only cost time.
+const MIN_STATION_SPACING_MM: f64 = 0.5;
+/// Largest default station spacing, as a fraction of the smaller end
+/// radius (dimensionless): a coarse mesh still gets four stations per radius.
+const MAX_STATION_SPACING_RADII: f64 = 0.25;
+/// Default knot spacing of the refit, as a fraction of the smaller end
+/// radius (dimensionless): the guide bends over lengths of a radius or more.
+const KNOT_SPACING_RADII: f64 = 0.5;
+/// Default knot spacing's bounds (mm): short enough to follow a bend,
+/// long enough for the sections between two knots to hold the spline.
+const KNOT_SPACING_RANGE_MM: (f64, f64) = (4.0, 12.0);
+/// Smallest knot spacing, in station spacings (dimensionless): every knot
+/// interval holds more than one station.
+const MIN_KNOT_STATIONS: f64 = 1.5;
+/// How far past its ends the guide is searched for a vertex's nearest
+/// point, in smaller end radii (dimensionless): an end cut obliquely has
+/// vertices past the guide's end.
+const PROJECT_PAST_END_RADII: f64 = 2.0;
+/// A guide more than this many times its first length has diverged
+/// (dimensionless).
+const DIVERGED_LENGTH_RATIO: f64 = 3.0;
+/// The guide has stalled when its largest move is under this many fit
+/// tolerances (dimensionless)...
+const STALL_TOLERANCES: f64 = 10.0;
+/// ... or under this fraction of the sections' median RMS (dimensionless):
+/// vertices changing station make the last moves go back and forth.
+const STALL_NOISE_FRACTION: f64 = 0.25;
+/// ... and no longer shrinking: the last move is over this fraction of the
+/// one before (dimensionless).
+const STALL_SHRINK_RATIO: f64 = 0.8;
+/// A radius law whose spread is under this many
+/// [`FitOptions::constant_radius_tol_mm`] is made constant (dimensionless):
+/// the tolerance bounds each side of the mean.
+const CONSTANT_RADIUS_SPREAD_TOLS: f64 = 2.0;
+/// Largest tangent of the start end's tilt used for the range below `t = 0`
+/// (dimensionless; about 84 degrees): a nearly tangent end plane would ask
+/// for an endless extension.
+const MAX_START_TILT_TAN: f64 = 10.0;
+/// Margin added to the range below `t = 0` (mm), so that the substrate
+/// cuts the tube inside the range.
+const EXTEND_BEFORE_MARGIN_MM: f64 = 1.0;
 
 /// Fits a tube to `mesh`.
 ///
@@ -121,13 +82,18 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
     let samples = samples(mesh, &surf);
     let edge = median_edge(mesh, &surf.skins[0].triangles);
     let r0 = start.radius.min(finish.radius);
-    let spacing = opts
-        .station_spacing_mm
-        .unwrap_or_else(|| (2.0 * edge).clamp(0.5, (0.25 * r0).max(0.5)));
+    let spacing = opts.station_spacing_mm.unwrap_or_else(|| {
+        (STATION_SPACING_EDGES * edge).clamp(
+            MIN_STATION_SPACING_MM,
+            (MAX_STATION_SPACING_RADII * r0).max(MIN_STATION_SPACING_MM),
+        )
+    });
     let knot_h = opts
         .knot_spacing_mm
-        .unwrap_or_else(|| (0.5 * r0).clamp(4.0, 12.0))
-        .max(1.5 * spacing);
+        .unwrap_or_else(|| {
+            (KNOT_SPACING_RADII * r0).clamp(KNOT_SPACING_RANGE_MM.0, KNOT_SPACING_RANGE_MM.1)
+        })
+        .max(MIN_KNOT_STATIONS * spacing);
     let mut guide = initial_guide(mesh, &surf, &start, &finish, edge, knot_h)?;
     let mut hints: Option<Vec<f64>> = None;
     // The radius law's slope from the previous pass (none at first).
@@ -141,8 +107,14 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
         iterations += 1;
         let spline = spline_of(mesh, &guide)?;
         let range = tube_range(&guide);
-        let t = project_all(&spline, range, &samples, hints.as_deref(), 2.0 * r0);
-        if range.1 - range.0 > 3.0 * first_length {
+        let t = project_all(
+            &spline,
+            range,
+            &samples,
+            hints.as_deref(),
+            PROJECT_PAST_END_RADII * r0,
+        );
+        if range.1 - range.0 > DIVERGED_LENGTH_RATIO * first_length {
             return Err(FitError::Degenerate {
                 file: mesh.file.clone(),
                 station: 0,
@@ -186,8 +158,8 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
             let k = scatter.len() / 2;
             *scatter.select_nth_unstable_by(k, f64::total_cmp).1
         };
-        let stall_level = (10.0 * opts.tolerance_mm).max(0.25 * noise);
-        let stalled = last_move < stall_level && last_move > 0.8 * previous;
+        let stall_level = (STALL_TOLERANCES * opts.tolerance_mm).max(STALL_NOISE_FRACTION * noise);
+        let stalled = last_move < stall_level && last_move > STALL_SHRINK_RATIO * previous;
         if last_move < opts.tolerance_mm || stalled {
             converged = true;
             break;
@@ -196,7 +168,13 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
     let spline = spline_of(mesh, &guide)?;
     let knots = chord_knots(&guide);
     let range = tube_range(&guide);
-    let t = project_all(&spline, range, &samples, hints.as_deref(), 2.0 * r0);
+    let t = project_all(
+        &spline,
+        range,
+        &samples,
+        hints.as_deref(),
+        PROJECT_PAST_END_RADII * r0,
+    );
     let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref());
     check_sections(mesh, &stations, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick);
@@ -204,7 +182,7 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
     let spread = radius_mm
         .iter()
         .fold((f64::MAX, f64::MIN), |a, &r| (a.0.min(r), a.1.max(r)));
-    if spread.1 - spread.0 < 2.0 * opts.constant_radius_tol_mm {
+    if spread.1 - spread.0 < CONSTANT_RADIUS_SPREAD_TOLS * opts.constant_radius_tol_mm {
         let mean = radius_mm.iter().sum::<f64>() / radius_mm.len() as f64;
         radius_mm.iter_mut().for_each(|r| *r = mean);
     }
@@ -218,7 +196,8 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
         normal = -normal;
     }
     let tilt = normal.angle(&spline.d1(range.0));
-    let extend_before_mm = start.radius * tilt.tan().min(10.0) + 1.0;
+    let extend_before_mm =
+        start.radius * tilt.tan().min(MAX_START_TILT_TAN) + EXTEND_BEFORE_MARGIN_MM;
     let mut fit = TubeFit {
         file: mesh.file.clone(),
         substrate_point: guide[1],

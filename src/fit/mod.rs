@@ -25,16 +25,17 @@
 mod driver;
 mod mesh;
 mod options;
+mod outcome;
 mod output;
 mod report;
 pub mod section;
 pub mod smooth;
 pub mod topology;
 
-pub use driver::{fit_tube, TubeFit};
+pub use driver::fit_tube;
 pub use mesh::{TubeMesh, MAX_MESH_BYTES};
 pub use options::{FitOptions, StartEnd};
-pub use report::{FitReport, StationReport, WallReport};
+pub use outcome::{FitReport, StationReport, TubeFit, WallReport};
 
 /// Errors of the fit stage; each names the mesh file, and the station
 /// (index along the guide from the start end, and its `t` in mm) when there

@@ -3,7 +3,7 @@
 //! same knots, a flat substrate at the start end, and the slicing, tool-axis
 //! and process tables of a template part (or the sample parts' defaults).
 
-use super::driver::TubeFit;
+use super::outcome::TubeFit;
 use super::smooth;
 use crate::io::part_file::{
     FrameSpec, GuideSpec, PartSpec, ProcessSpec, ProfilePieceSpec, ProfileSpec, RangeSpec, Scalar,

@@ -1,8 +1,9 @@
-//! The fit report: how far the mesh is from the fitted tube, per station and
-//! overall (mm), the radius errors, the wall thickness. Serialises to the
-//! `fit.json` that `waam fit` writes; every number is finite.
+//! The fit report's builder: how far the mesh is from the fitted tube, per
+//! station and overall (mm), the radius errors, the wall thickness, as a
+//! [`FitReport`] (the `fit.json` that `waam fit` writes; every number is
+//! finite).
 
-use super::driver::{EndRing, Station, TubeFit};
+use super::outcome::{EndReport, EndRing, FitReport, Station, StationReport, TubeFit, WallReport};
 use super::section::plane_basis;
 use super::smooth;
 use super::topology::Surfaces;
@@ -12,110 +13,6 @@ use crate::math::{Point3, UnitVector3};
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::TriMesh;
 use rayon::prelude::*;
-use serde::Serialize;
-
-/// One open end of the tube as found in the mesh (mesh frame, mm).
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct EndReport {
-    /// Centre of its circle (mm).
-    pub centre_mm: [f64; 3],
-    /// Normal of its plane (unit; either sense).
-    pub normal: [f64; 3],
-    /// Radius of its circle (mm; the mid-surface's for two skins).
-    pub radius_mm: f64,
-    /// Whether a flat cap closes it.
-    pub capped: bool,
-}
-
-/// One station along the fitted guide.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct StationReport {
-    /// Index from the start end.
-    pub index: usize,
-    /// Guide parameter (mm from the start end along the chords).
-    pub t_mm: f64,
-    /// Mesh vertices in its section.
-    pub points: usize,
-    /// Centre of its least-squares circle (mesh frame, mm), when fitted.
-    pub centre_mm: Option<[f64; 3]>,
-    /// Radius of its least-squares circle (mm; mid-surface for two skins).
-    pub section_radius_mm: Option<f64>,
-    /// The fitted radius law there (mm).
-    pub law_radius_mm: f64,
-    /// Law minus section radius (mm).
-    pub radius_error_mm: Option<f64>,
-    /// RMS of the section's points to its own circle (mm; the worse skin).
-    pub section_rms_mm: Option<f64>,
-    /// RMS distance of its vertices to the fitted tube surface (mm).
-    pub vertex_rms_mm: f64,
-    /// Wall thickness of its two circles (mm), for two skins.
-    pub wall_thickness_mm: Option<f64>,
-    /// The fitted thickness law there (mm), for two skins.
-    pub law_thickness_mm: Option<f64>,
-}
-
-/// Wall thickness along the tube (two skins given), from the fitted law (mm).
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct WallReport {
-    /// Mean over the stations (mm).
-    pub mean_mm: f64,
-    /// Smallest (mm).
-    pub min_mm: f64,
-    /// Largest (mm).
-    pub max_mm: f64,
-}
-
-/// What the fit found and how well the fitted tube matches the mesh.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct FitReport {
-    /// The mesh file.
-    pub file: String,
-    /// Triangles in the mesh.
-    pub triangles: usize,
-    /// Vertices of the skins (the points fitted).
-    pub vertices: usize,
-    /// 1: the mid-surface; 2: the inner and outer skins of the wall.
-    pub skins: usize,
-    /// Flat faces (end caps) left out of the fit.
-    pub caps: usize,
-    /// Triangles of small stray pieces left out of the fit.
-    pub ignored_triangles: usize,
-    /// The start end (on the substrate).
-    pub start: EndReport,
-    /// The other end.
-    pub end: EndReport,
-    /// Refits of the guide.
-    pub iterations: usize,
-    /// Whether the guide stopped moving within the tolerance.
-    pub converged: bool,
-    /// Largest move of a guide point in the last refit (mm).
-    pub last_move_mm: f64,
-    /// Length of the guide's parameter range (mm).
-    pub length_mm: f64,
-    /// Points of the spline guide.
-    pub guide_points: usize,
-    /// Smallest radius of the law (mm).
-    pub radius_min_mm: f64,
-    /// Largest radius of the law (mm).
-    pub radius_max_mm: f64,
-    /// RMS distance of the skins' vertices to the fitted surface (mm).
-    pub rms_mm: f64,
-    /// Largest distance of a vertex to the fitted surface (mm).
-    pub max_mm: f64,
-    /// Where that vertex is (mesh frame, mm).
-    pub max_at_mm: [f64; 3],
-    /// Largest distance of a sample of the fitted surface to the mesh (mm;
-    /// parry3d), when measured.
-    pub surface_to_mesh_max_mm: Option<f64>,
-    /// Largest distance (mm) of the start end's rim (its fitted circle) to
-    /// the substrate mesh, when one was given
-    /// ([`FitOptions::substrate`](super::FitOptions::substrate)).
-    pub substrate_distance_mm: Option<f64>,
-    /// Wall thickness, for two skins.
-    pub wall: Option<WallReport>,
-    /// The stations.
-    pub stations: Vec<StationReport>,
-}
 
 /// What the report is built from.
 pub(super) struct Context<'a> {

@@ -1,0 +1,199 @@
+//! **The fit stage's output types**: the fitted tube ([`TubeFit`]) and its
+//! report ([`FitReport`]: per station, per end, the wall), plus the two
+//! values the driver hands to the report builder (an open end's ring, a
+//! station's sections). Mesh frame = part frame, mm.
+
+use super::section::CircleFit;
+use super::smooth;
+use crate::geometry::guide::CubicSpline;
+use crate::math::{Point3, UnitVector3};
+use serde::Serialize;
+
+/// A fitted tube (part frame = mesh frame, mm): the guide as the points of a
+/// natural cubic spline (`t` = chord length from the start end, mm), the
+/// radius law and the wall thickness as natural cubic splines over the same
+/// knots, the substrate plane at the start end, and the fit report.
+#[derive(Debug, Clone)]
+pub struct TubeFit {
+    /// The mesh file.
+    pub file: String,
+    /// Points of the spline guide, from the start end (mm).
+    pub guide_points: Vec<Point3>,
+    /// Guide parameter of each point: cumulative chord length (mm).
+    pub knots: Vec<f64>,
+    /// Guide parameter of the start end (mm): the first and last guide
+    /// points lie one knot interval past the ends, so that the spline's
+    /// natural end condition (no curvature) falls outside the tube.
+    pub t_min: f64,
+    /// Guide parameter of the other end (mm).
+    pub t_max: f64,
+    /// Radius of the (mid-surface) profile at each knot (mm).
+    pub radius_mm: Vec<f64>,
+    /// Wall thickness at each knot (mm), when two skins were given.
+    pub thickness_mm: Option<Vec<f64>>,
+    /// A point of the substrate plane: the guide's point at `t_min` (mm).
+    pub substrate_point: Point3,
+    /// The substrate's normal, toward the part: the start end's plane.
+    pub substrate_normal: UnitVector3,
+    /// Parameter range needed below `t = 0` for the substrate to cut the
+    /// tube when the start end is not normal to the guide (mm).
+    pub extend_before_mm: f64,
+    /// Distance (mm) of each vertex of the mesh (same order as
+    /// [`TubeMesh::vertices`](super::TubeMesh::vertices)) to the fitted surface, as in the report's
+    /// RMS and largest distance; `None` for a vertex left out of the fit
+    /// (a flat cap, a stray piece).
+    pub vertex_distance_mm: Vec<Option<f64>>,
+    /// What the fit found and how well it fits.
+    pub report: FitReport,
+}
+
+impl TubeFit {
+    /// Length of the tube's parameter range `t_max - t_min` (mm).
+    pub fn length(&self) -> f64 {
+        self.t_max - self.t_min
+    }
+
+    /// The guide curve.
+    pub fn guide(&self) -> CubicSpline {
+        CubicSpline::new(&self.guide_points).expect("validated when fitted")
+    }
+
+    /// The radius law `A(t)` (mm).
+    pub fn radius(&self, t: f64) -> f64 {
+        let m = smooth::natural_second_derivatives(&self.knots, &self.radius_mm);
+        smooth::eval(&self.knots, &self.radius_mm, &m, t)
+    }
+
+    /// The wall thickness law (mm), when two skins were fitted.
+    pub fn wall_thickness(&self, t: f64) -> Option<f64> {
+        self.thickness_mm.as_ref().map(|e| {
+            let m = smooth::natural_second_derivatives(&self.knots, e);
+            smooth::eval(&self.knots, e, &m, t)
+        })
+    }
+}
+
+/// An open end of the tube (mesh frame, mm).
+#[derive(Debug, Clone)]
+pub(super) struct EndRing {
+    pub centre: Point3,
+    pub normal: UnitVector3,
+    pub radius: f64,
+    pub capped: bool,
+    /// The loop index of this end in each skin.
+    pub loops: Vec<usize>,
+}
+
+/// One station's sections (one per skin) and the combined centre and radius.
+#[derive(Debug, Clone)]
+pub(super) struct Station {
+    pub t: f64,
+    pub fits: Vec<Option<CircleFit>>,
+    pub centre: Option<Point3>,
+    pub radius: Option<f64>,
+    pub thickness: Option<f64>,
+    pub points: usize,
+}
+
+/// One open end of the tube as found in the mesh (mesh frame, mm).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct EndReport {
+    /// Centre of its circle (mm).
+    pub centre_mm: [f64; 3],
+    /// Normal of its plane (unit; either sense).
+    pub normal: [f64; 3],
+    /// Radius of its circle (mm; the mid-surface's for two skins).
+    pub radius_mm: f64,
+    /// Whether a flat cap closes it.
+    pub capped: bool,
+}
+
+/// One station along the fitted guide.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct StationReport {
+    /// Index from the start end.
+    pub index: usize,
+    /// Guide parameter (mm from the start end along the chords).
+    pub t_mm: f64,
+    /// Mesh vertices in its section.
+    pub points: usize,
+    /// Centre of its least-squares circle (mesh frame, mm), when fitted.
+    pub centre_mm: Option<[f64; 3]>,
+    /// Radius of its least-squares circle (mm; mid-surface for two skins).
+    pub section_radius_mm: Option<f64>,
+    /// The fitted radius law there (mm).
+    pub law_radius_mm: f64,
+    /// Law minus section radius (mm).
+    pub radius_error_mm: Option<f64>,
+    /// RMS of the section's points to its own circle (mm; the worse skin).
+    pub section_rms_mm: Option<f64>,
+    /// RMS distance of its vertices to the fitted tube surface (mm).
+    pub vertex_rms_mm: f64,
+    /// Wall thickness of its two circles (mm), for two skins.
+    pub wall_thickness_mm: Option<f64>,
+    /// The fitted thickness law there (mm), for two skins.
+    pub law_thickness_mm: Option<f64>,
+}
+
+/// Wall thickness along the tube (two skins given), from the fitted law (mm).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct WallReport {
+    /// Mean over the stations (mm).
+    pub mean_mm: f64,
+    /// Smallest (mm).
+    pub min_mm: f64,
+    /// Largest (mm).
+    pub max_mm: f64,
+}
+
+/// What the fit found and how well the fitted tube matches the mesh.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct FitReport {
+    /// The mesh file.
+    pub file: String,
+    /// Triangles in the mesh.
+    pub triangles: usize,
+    /// Vertices of the skins (the points fitted).
+    pub vertices: usize,
+    /// 1: the mid-surface; 2: the inner and outer skins of the wall.
+    pub skins: usize,
+    /// Flat faces (end caps) left out of the fit.
+    pub caps: usize,
+    /// Triangles of small stray pieces left out of the fit.
+    pub ignored_triangles: usize,
+    /// The start end (on the substrate).
+    pub start: EndReport,
+    /// The other end.
+    pub end: EndReport,
+    /// Refits of the guide.
+    pub iterations: usize,
+    /// Whether the guide stopped moving within the tolerance.
+    pub converged: bool,
+    /// Largest move of a guide point in the last refit (mm).
+    pub last_move_mm: f64,
+    /// Length of the guide's parameter range (mm).
+    pub length_mm: f64,
+    /// Points of the spline guide.
+    pub guide_points: usize,
+    /// Smallest radius of the law (mm).
+    pub radius_min_mm: f64,
+    /// Largest radius of the law (mm).
+    pub radius_max_mm: f64,
+    /// RMS distance of the skins' vertices to the fitted surface (mm).
+    pub rms_mm: f64,
+    /// Largest distance of a vertex to the fitted surface (mm).
+    pub max_mm: f64,
+    /// Where that vertex is (mesh frame, mm).
+    pub max_at_mm: [f64; 3],
+    /// Largest distance of a sample of the fitted surface to the mesh (mm;
+    /// parry3d), when measured.
+    pub surface_to_mesh_max_mm: Option<f64>,
+    /// Largest distance (mm) of the start end's rim (its fitted circle) to
+    /// the substrate mesh, when one was given
+    /// ([`FitOptions::substrate`](super::FitOptions::substrate)).
+    pub substrate_distance_mm: Option<f64>,
+    /// Wall thickness, for two skins.
+    pub wall: Option<WallReport>,
+    /// The stations.
+    pub stations: Vec<StationReport>,
+}
