@@ -283,8 +283,12 @@ pub struct PlaceArgs {
 /// Arguments of `waam fit`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct FitArgs {
-    /// The mesh (STL, binary or ASCII; mm).
+    /// The mesh (STL, binary or ASCII; in --units).
     pub mesh: PathBuf,
+    /// The unit of the mesh's coordinates: mm, cm, m or in. Every length printed, written or
+    /// taken (--start, --max-rms, --substrate-tolerance) is in mm.
+    #[arg(long, default_value = "mm", value_parser = parse_units)]
+    pub units: waam_slicer::fit::Units,
     /// Output folder.
     #[arg(long, default_value = "out/fit")]
     pub out: PathBuf,
@@ -307,6 +311,10 @@ pub struct FitArgs {
     /// Refuse a start end further than this from the --substrate mesh (mm).
     #[arg(long, value_name = "MM", default_value_t = 1.0)]
     pub substrate_tolerance: f64,
+}
+
+fn parse_units(s: &str) -> Result<waam_slicer::fit::Units, String> {
+    s.parse()
 }
 
 fn parse_start(s: &str) -> Result<waam_slicer::StartEnd, String> {

@@ -5,6 +5,7 @@ use waam_slicer::{FitOptions, Part};
 
 pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
     let opts = FitOptions {
+        units: a.units,
         start: a.start,
         max_rms_mm: a.max_rms,
         template: a.template.clone(),
@@ -16,8 +17,11 @@ pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
     let fitted = Part::from_mesh(&a.mesh, &opts).map_err(|e| e.to_string())?;
     let mut files = fitted.write(&a.out).map_err(|e| e.to_string())?;
     files.push(fitted.write_report(&a.out).map_err(|e| e.to_string())?);
+    let r = fitted.report();
+    for w in &r.warnings {
+        eprintln!("warning     {w}");
+    }
     if !quiet {
-        let r = fitted.report();
         println!(
             "fitted      {} ({} triangles, {} skin{}): guide {:.2} mm through {} points, {} iterations{}",
             r.file,

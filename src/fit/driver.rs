@@ -3,11 +3,12 @@
 //! a smooth refit of the guide, until the guide stops moving; a final pass
 //! fits the radius law (and wall thickness) and measures the residuals.
 
+use super::options::units_warning;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
 use super::report;
 use super::section::{fit_circle, fit_plane, plane_basis, CircleFit, SectionPoint};
 use super::topology::{self, median_edge, Surfaces};
-use super::{smooth, FitError, FitOptions, StartEnd, TubeMesh};
+use super::{smooth, FitError, FitOptions, StartEnd, TubeMesh, Units};
 use crate::geometry::guide::{CubicSpline, GuideCurve};
 use crate::math::{Point3, UnitVector3, Vector3};
 use nalgebra::DMatrix;
@@ -76,6 +77,32 @@ const EXTEND_BEFORE_MARGIN_MM: f64 = 1.0;
 /// residual over [`FitOptions::max_rms_mm`], a degenerate fit.
 pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
     opts.validate(&mesh.file)?;
+    let warning = units_warning(mesh.bounding_box_size(), opts.units);
+    let in_mm;
+    let mesh = if opts.units == Units::Mm {
+        mesh
+    } else {
+        in_mm = mesh.scaled(opts.units.mm_per_unit());
+        &in_mm
+    };
+    match fit_in_mm(mesh, opts) {
+        Ok(mut fit) => {
+            fit.report.units = opts.units;
+            fit.report.warnings.extend(warning);
+            Ok(fit)
+        }
+        Err(e) => Err(match warning {
+            Some(hint) => FitError::Units {
+                hint,
+                source: Box::new(e),
+            },
+            None => e,
+        }),
+    }
+}
+
+/// [`fit_tube`] on a mesh already in mm.
+fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
     let surf = topology::surfaces(mesh, opts)?;
     let ends = end_rings(mesh, &surf)?;
     let [start, finish] = choose_start(mesh, ends, opts)?;

@@ -133,6 +133,26 @@ impl TubeMesh {
         })
     }
 
+    /// The mesh with every coordinate multiplied by `mm_per_unit` (its
+    /// file's unit to mm; [`Units::mm_per_unit`](super::Units::mm_per_unit)).
+    /// Same vertex and triangle order.
+    pub fn scaled(&self, mm_per_unit: f64) -> TubeMesh {
+        TubeMesh {
+            file: self.file.clone(),
+            vertices: self.vertices.iter().map(|p| p * mm_per_unit).collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+
+    /// Largest side of the vertices' bounding box (the file's unit).
+    pub fn bounding_box_size(&self) -> f64 {
+        let (lo, hi) = self.vertices.iter().fold(
+            (Point3::from([f64::MAX; 3]), Point3::from([f64::MIN; 3])),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
+        (hi - lo).max().max(0.0)
+    }
+
     /// Number of triangles.
     pub fn num_triangles(&self) -> usize {
         self.triangles.len()

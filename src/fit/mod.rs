@@ -34,7 +34,7 @@ pub mod topology;
 
 pub use driver::fit_tube;
 pub use mesh::{TubeMesh, MAX_MESH_BYTES};
-pub use options::{FitOptions, StartEnd};
+pub use options::{FitOptions, StartEnd, Units};
 pub use outcome::{FitReport, StationReport, TubeFit, WallReport};
 
 /// Errors of the fit stage; each names the mesh file, and the station
@@ -140,6 +140,15 @@ pub enum FitError {
         distance_mm: f64,
         /// The bound (mm).
         tolerance_mm: f64,
+    },
+    /// The fit failed on a mesh whose size suggests another unit than
+    /// [`FitOptions::units`]: the failure, with the likely unit.
+    #[error("{source}\n  note: {hint}")]
+    Units {
+        /// The warning naming the likely unit.
+        hint: String,
+        /// Why the fit failed.
+        source: Box<FitError>,
     },
     /// The fit could not be computed (too few points at a station, a
     /// singular system, no convergence to a usable guide).

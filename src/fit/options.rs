@@ -50,11 +50,111 @@ impl std::str::FromStr for StartEnd {
     }
 }
 
+/// The length unit of a mesh file's coordinates. The fit converts the mesh
+/// to mm first; everything it prints, writes or takes is then in mm.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Units {
+    /// Millimetres (the default).
+    #[default]
+    Mm,
+    /// Centimetres.
+    Cm,
+    /// Metres (how many CAD tools export).
+    M,
+    /// Inches.
+    In,
+}
+
+impl Units {
+    /// Every unit, smallest first.
+    pub const ALL: [Units; 4] = [Units::Mm, Units::Cm, Units::In, Units::M];
+
+    /// Millimetres in one of this unit.
+    pub fn mm_per_unit(self) -> f64 {
+        match self {
+            Units::Mm => 1.0,
+            Units::Cm => 10.0,
+            Units::M => 1000.0,
+            Units::In => 25.4,
+        }
+    }
+
+    /// The unit's name as typed: `mm`, `cm`, `m`, `in`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Units::Mm => "mm",
+            Units::Cm => "cm",
+            Units::M => "m",
+            Units::In => "in",
+        }
+    }
+}
+
+/// A mesh's largest bounding-box side under this many of its unit looks
+/// like a mesh in a larger unit (dimensionless).
+pub const UNITS_SMALL_SIZE: f64 = 1.0;
+/// A mesh's largest bounding-box side over this many of its unit looks like
+/// a mesh in a smaller unit (dimensionless).
+pub const UNITS_LARGE_SIZE: f64 = 10_000.0;
+/// The size (mm) a tube printed by WAAM most likely has: the likely unit of
+/// a mesh is the one that brings its size nearest this, on a log scale.
+const TYPICAL_SIZE_MM: f64 = 200.0;
+
+/// A warning naming the likely unit when `size` (the largest side of the
+/// mesh's bounding box, in `units`) is under [`UNITS_SMALL_SIZE`] or over
+/// [`UNITS_LARGE_SIZE`] and another unit gives a more usual size (nearer
+/// 200 mm); `None` otherwise.
+pub fn units_warning(size: f64, units: Units) -> Option<String> {
+    if (UNITS_SMALL_SIZE..=UNITS_LARGE_SIZE).contains(&size) || !(size > 0.0) {
+        return None;
+    }
+    let off = |u: Units| (size * u.mm_per_unit() / TYPICAL_SIZE_MM).ln().abs();
+    let likely = Units::ALL
+        .into_iter()
+        .min_by(|a, b| off(*a).total_cmp(&off(*b)))
+        .unwrap_or(units);
+    let across = format!("the mesh is {size:.4} {units} across (its bounding box's largest side)");
+    if likely != units {
+        Some(format!(
+            "{across}: it looks like a mesh in {likely} ({size:.4} {likely} = {:.1} mm; units = \"{likely}\", `--units {likely}`)",
+            size * likely.mm_per_unit()
+        ))
+    } else {
+        // Larger than any usual part even in the smallest unit offered.
+        (size > UNITS_LARGE_SIZE).then(|| {
+            format!("{across}: it looks like a mesh in a unit smaller than {units} (micrometres?); scale it to mm")
+        })
+    }
+}
+
+impl std::fmt::Display for Units {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Units {
+    type Err = String;
+
+    /// `mm`, `cm`, `m` or `in`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        Units::ALL
+            .into_iter()
+            .find(|u| u.name() == s.trim())
+            .ok_or_else(|| format!("`{s}`: expected a length unit `mm`, `cm`, `m` or `in`"))
+    }
+}
+
 /// How a tubular mesh is fitted ([`fit_tube`](super::fit_tube)). Lengths in
 /// mm, angles in degrees (as typed by a user; converted inside).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FitOptions {
+    /// The unit of the mesh file's coordinates (default mm). The mesh is
+    /// converted to mm first: every other length of these options, of the
+    /// fit and of its report is in mm.
+    pub units: Units,
     /// Which end stands on the substrate (default: the lowest).
     pub start: StartEnd,
     /// Largest RMS distance (mm) of the mesh's vertices to the fitted tube
@@ -113,6 +213,7 @@ pub struct FitOptions {
 impl Default for FitOptions {
     fn default() -> Self {
         Self {
+            units: Units::Mm,
             start: StartEnd::Lowest,
             max_rms_mm: 0.5,
             max_section_rms_ratio: 0.03,
@@ -179,6 +280,15 @@ impl FitOptions {
             if !p.iter().all(|x| x.is_finite()) {
                 return Err(bad("start", format!("point {p:?} is not finite")));
             }
+        }
+        if self.substrate.is_some() && self.units != Units::Mm {
+            return Err(bad(
+                "units",
+                format!(
+                    "{}: a substrate mesh is named by the written part and read in mm by the later stages; give both meshes in mm",
+                    self.units
+                ),
+            ));
         }
         if let Some(name) = &self.name {
             if name.trim().is_empty() {

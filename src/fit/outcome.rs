@@ -4,7 +4,7 @@
 //! station's sections). Mesh frame = part frame, mm.
 
 use super::section::CircleFit;
-use super::smooth;
+use super::{smooth, Units};
 use crate::geometry::guide::CubicSpline;
 use crate::math::{Point3, UnitVector3};
 use serde::Serialize;
@@ -196,4 +196,10 @@ pub struct FitReport {
     pub wall: Option<WallReport>,
     /// The stations.
     pub stations: Vec<StationReport>,
+    /// The unit of the mesh file's coordinates; every length of this report
+    /// is in mm.
+    pub units: Units,
+    /// What the fit noticed but did not refuse (a size suggesting another
+    /// unit).
+    pub warnings: Vec<String>,
 }

@@ -162,6 +162,8 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> (FitReport, Vec<Option<f
         substrate_distance_mm: None,
         wall,
         stations,
+        units: Default::default(),
+        warnings: Vec::new(),
     };
     (report, per_vertex)
 }

@@ -22,7 +22,8 @@ pub struct FittedPart {
     pub fit: TubeFit,
     /// The part file (TOML) that [`FittedPart::write`] writes as `part.toml`.
     pub toml: String,
-    /// The mesh the tube was fitted to (mesh frame = part frame, mm), for
+    /// The mesh the tube was fitted to, converted to mm from
+    /// [`FitOptions::units`] (mesh frame = part frame), for
     /// [`FittedPart::write_report`].
     pub mesh: TubeMesh,
 }
@@ -198,7 +199,7 @@ impl Part {
             part,
             fit,
             toml,
-            mesh: mesh.clone(),
+            mesh: mesh.scaled(opts.units.mm_per_unit()),
         })
     }
 }

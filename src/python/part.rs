@@ -44,18 +44,21 @@ impl PyPart {
         })
     }
 
-    /// Fits a part to a tubular mesh (binary or ASCII STL, mm): a spline
+    /// Fits a part to a tubular mesh (binary or ASCII STL, in `units`): a spline
     /// guide and a radius law from end to end (and the wall thickness when
     /// the mesh holds both skins), a flat substrate at the start end
     /// (`start`: `"lowest"`, `"highest"`, `"capped"` or a point `(x, y, z)`);
-    /// the other keywords are `FitOptions`' fields. Releases the GIL.
+    /// `units`: the mesh's length unit, `"mm"` (default), `"cm"`, `"m"` or
+    /// `"in"`; every other length, and the fit, is in mm. The other keywords
+    /// are `FitOptions`' fields. Releases the GIL.
     #[staticmethod]
-    #[pyo3(signature = (path, *, start = None, max_rms_mm = None, template = None, name = None,
+    #[pyo3(signature = (path, *, units = None, start = None, max_rms_mm = None, template = None, name = None,
         station_spacing_mm = None, knot_spacing_mm = None, check_surface = None))]
     #[allow(clippy::too_many_arguments)]
     fn from_mesh(
         py: Python<'_>,
         path: PathBuf,
+        units: Option<String>,
         start: Option<Bound<'_, PyAny>>,
         max_rms_mm: Option<f64>,
         template: Option<PathBuf>,
@@ -65,6 +68,11 @@ impl PyPart {
         check_surface: Option<bool>,
     ) -> PyResult<Self> {
         let mut opts = crate::FitOptions::default();
+        if let Some(u) = units {
+            opts.units = u
+                .parse()
+                .map_err(|e: String| waam_error(format!("units: {e}")))?;
+        }
         if let Some(s) = start {
             opts.start = match s.extract::<String>() {
                 Ok(text) => text

@@ -374,3 +374,8 @@ pub fn y_branch(r: f64, h: f64, n: usize) -> (Vec<Point3>, Vec<[u32; 3]>) {
     }
     (v, f)
 }
+
+/// The mesh in metres: every coordinate divided by 1000, as many CAD tools export.
+pub fn in_metres(v: &[Point3]) -> Vec<Point3> {
+    v.iter().map(|p| p / 1000.0).collect()
+}

@@ -9,6 +9,7 @@ mod common;
 mod gen;
 mod page;
 mod substrate;
+mod units;
 
 use gen::Truth;
 use waam_slicer::fit::{FitError, TubeMesh};
