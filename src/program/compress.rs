@@ -32,10 +32,12 @@
 //! by distance bounds; 100 000 points take a few tenths of a second in a
 //! release build.
 
-use std::f64::consts::TAU;
 use std::fmt;
 
-use nalgebra::{Point3, UnitQuaternion, Vector3};
+use nalgebra::{Point3, Vector3};
+
+pub use crate::program::pose::{arc_length, interpolate, tool_z_map, ControllerPose};
+pub(crate) use crate::program::pose::{Arc3, MovePath};
 
 /// Default [`CompressOptions::path_tolerance_mm`] (mm).
 pub const DEFAULT_PATH_TOLERANCE_MM: f64 = 0.05;
@@ -54,8 +56,6 @@ pub const MIN_ARC_RADIUS_MM: f64 = 0.5;
 /// Upper bound on curve samples of one move (memory and time guard).
 pub const MAX_SAMPLES_PER_MOVE: usize = 1 << 20;
 
-/// Three points whose chord angle has a sine below this are collinear.
-const COLLINEAR_SIN: f64 = 1e-9;
 /// Torch-axis change (degrees) allowed between two consecutive curve samples.
 const ORIENTATION_SAMPLE_STEP_DEG: f64 = 0.5;
 /// Resample a move when its sample gaps exceed the wanted step by this factor.
@@ -76,32 +76,6 @@ const MIN_AXIS_NORM: f64 = 1e-9;
 const UNIT_QUATERNION_TOLERANCE: f64 = 1e-6;
 /// Slack (rad) on the arc sweep limit, for arcs of exactly the limit.
 const ARC_SWEEP_SLACK_RAD: f64 = 1e-9;
-
-/// One programmed (or interpolated) controller pose.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ControllerPose {
-    /// Torch (TCP) position in the robot base frame, mm.
-    pub p: Point3<f64>,
-    /// Torch orientation in the robot base frame.
-    pub q: UnitQuaternion<f64>,
-    /// Extra axis values (e.g. positioner joints, rad); may be empty, but all
-    /// poses of one bead have the same length.
-    pub ext: Vec<f64>,
-}
-
-impl ControllerPose {
-    /// Builds a pose from a position (mm), an orientation and extra axes.
-    pub fn new(p: Point3<f64>, q: UnitQuaternion<f64>, ext: Vec<f64>) -> Self {
-        Self { p, q, ext }
-    }
-}
-
-/// Identity-like map for cells where the part does not move: the deposition
-/// point is the TCP position `pose.p` (mm) and the torch axis is the tool Z
-/// axis `pose.q * Z`, both in the base frame, which is then the part frame.
-pub fn tool_z_map(pose: &ControllerPose) -> (Point3<f64>, Vector3<f64>) {
-    (pose.p, pose.q * Vector3::z())
-}
 
 /// Tolerances and limits of [`compress`].
 #[derive(Clone, Debug, PartialEq)]
@@ -418,25 +392,6 @@ impl Compressed {
     }
 }
 
-/// Controller model: the pose at fraction `s` (clamped to [0, 1]) of the move
-/// from `a` to `b`, circular through `via.p` when `via` is given and the
-/// three positions are not collinear, else linear. Position: straight line,
-/// or circle arc from `a.p` through `via.p` to `b.p` with `s` the arc-length
-/// fraction (mm, base frame). Orientation: `slerp(a.q, b.q, s)` along the
-/// shortest rotation (the via's orientation is not used). Extra axes: linear
-/// in `s` (pairs beyond the shorter `ext` are dropped).
-pub fn interpolate(
-    a: &ControllerPose,
-    via: Option<&ControllerPose>,
-    b: &ControllerPose,
-    s: f64,
-) -> ControllerPose {
-    let path = MovePath::new(a, via.map(|v| &v.p), b);
-    let mut out = a.clone();
-    path.pose_into(s.clamp(0.0, 1.0), &mut out);
-    out
-}
-
 /// Whether the compressor may program a circular move through these three
 /// positions (mm, base frame): not collinear, radius within
 /// [`MIN_ARC_RADIUS_MM`]..=`max_radius_mm`, sweep at most `max_arc_angle_deg`.
@@ -451,17 +406,6 @@ pub fn circular_move_allowed(
             && arc.radius <= opts.max_radius_mm
             && arc.sweep <= opts.max_arc_angle_deg.to_radians() + ARC_SWEEP_SLACK_RAD
     })
-}
-
-/// Length (mm) of the controller's path from `a` through `via` to `b`: the
-/// circle arc through the three points, or the two chords `a → via → b`
-/// where they are (nearly) collinear or `via` is not between them on the
-/// circle. The same circle as [`interpolate`].
-pub fn arc_length(a: &Point3<f64>, via: &Point3<f64>, b: &Point3<f64>) -> f64 {
-    match Arc3::through(a, via, b) {
-        Some(arc) => arc.radius * arc.sweep,
-        None => (via - a).norm() + (b - via).norm(),
-    }
 }
 
 /// Measures one move from pose `from` to `mv.to()` as [`compress`] does, in
@@ -614,87 +558,6 @@ fn cumulative(steps: impl Iterator<Item = f64>) -> Vec<f64> {
         out.push(acc);
     }
     out
-}
-
-/// Circle arc from `a` through a via to `b` (controller frame, mm).
-#[derive(Clone, Copy, Debug)]
-struct Arc3 {
-    center: Point3<f64>,
-    /// Unit vector from the centre to the start point.
-    u: Vector3<f64>,
-    /// Unit vector in the arc plane, 90° ahead of `u` in the travel direction.
-    w: Vector3<f64>,
-    radius: f64,
-    /// Swept angle from start to end, rad, in (0, 2π).
-    sweep: f64,
-}
-
-impl Arc3 {
-    /// The arc through three points, or `None` if they are (nearly) collinear.
-    fn through(a: &Point3<f64>, via: &Point3<f64>, b: &Point3<f64>) -> Option<Self> {
-        let (av, ab) = (via - a, b - a);
-        let normal = av.cross(&ab);
-        let normal_sq = normal.norm_squared();
-        let scale = av.norm_squared() * ab.norm_squared();
-        if !(scale > 0.0 && normal_sq > COLLINEAR_SIN * COLLINEAR_SIN * scale) {
-            return None;
-        }
-        let offset = (av.norm_squared() * ab - ab.norm_squared() * av).cross(&normal);
-        let center = a + offset / (2.0 * normal_sq);
-        let radius = (a - center).norm();
-        let u = (a - center) / radius;
-        let w = (normal / normal_sq.sqrt()).cross(&u);
-        let angle_of = |p: &Point3<f64>| {
-            let d = p - center;
-            d.dot(&w).atan2(d.dot(&u)).rem_euclid(TAU)
-        };
-        let (via_angle, sweep) = (angle_of(via), angle_of(b));
-        let ordered = via_angle > 0.0 && via_angle < sweep;
-        (radius.is_finite() && ordered).then_some(Self {
-            center,
-            u,
-            w,
-            radius,
-            sweep,
-        })
-    }
-
-    fn point_at(&self, s: f64) -> Point3<f64> {
-        let (sin, cos) = (s * self.sweep).sin_cos();
-        self.center + (self.u * cos + self.w * sin) * self.radius
-    }
-}
-
-/// The controller's interpolated path of one move.
-struct MovePath<'a> {
-    a: &'a ControllerPose,
-    b: &'a ControllerPose,
-    arc: Option<Arc3>,
-    /// Scaled axis of the shortest rotation from `a.q` to `b.q` (body frame).
-    rotation: Vector3<f64>,
-}
-
-impl<'a> MovePath<'a> {
-    fn new(a: &'a ControllerPose, via: Option<&Point3<f64>>, b: &'a ControllerPose) -> Self {
-        Self {
-            a,
-            b,
-            arc: via.and_then(|v| Arc3::through(&a.p, v, &b.p)),
-            rotation: (a.q.inverse() * b.q).scaled_axis(),
-        }
-    }
-
-    /// Writes the pose at fraction `s` into `out`, reusing its buffers.
-    fn pose_into(&self, s: f64, out: &mut ControllerPose) {
-        out.p = match &self.arc {
-            Some(arc) => arc.point_at(s),
-            None => self.a.p + (self.b.p - self.a.p) * s,
-        };
-        out.q = self.a.q * UnitQuaternion::from_scaled_axis(self.rotation * s);
-        out.ext.clear();
-        let pairs = self.a.ext.iter().zip(&self.b.ext);
-        out.ext.extend(pairs.map(|(x, y)| x + s * (y - x)));
-    }
 }
 
 /// Planned part-frame points and axes with cumulative measures.
@@ -1436,7 +1299,9 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::UnitQuaternion;
     use std::f64::consts::PI;
+    use std::f64::consts::TAU;
     use std::time::Instant;
 
     const TOL_MM: f64 = DEFAULT_PATH_TOLERANCE_MM;

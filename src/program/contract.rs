@@ -36,12 +36,6 @@ pub trait Controller {
     const EMITTER: &'static str;
     /// Extensions of the format's files, lower case without the dot.
     const EXTENSIONS: &'static [&'static str];
-    /// `true` when the controller always moves the part-carried cell's
-    /// linear moves about the fixed torch (KUKA's external TCP, ABB's
-    /// stationary tool): the path is linear over the part. `false`: only
-    /// with [`ProgramOptions::remote_tcp`] (FANUC `RTCP`), else the held
-    /// tool's pose is interpolated in the robot base frame.
-    const FIXED_TOOL_MOVES: bool = false;
     /// The emitter's options.
     type Options: Clone + std::fmt::Debug;
     /// The files read back: the controller's program model.
@@ -326,26 +320,6 @@ pub fn turn_modulo(cell: &CellLayout) -> bool {
     }
 }
 
-/// `true` when `cell`'s linear moves are interpolated in the part frame
-/// (the part is the moving frame: a fixed tool about which the part-carried
-/// robot moves, or coordinated motion with the positioner); `false` when
-/// in the robot base frame.
-pub fn moves_in_part_frame(cell: &CellLayout, opts: &ProgramOptions) -> bool {
-    struct FixedTool;
-    impl ControllerTask for FixedTool {
-        type Output = bool;
-        fn run<C: Controller>(self) -> bool {
-            C::FIXED_TOOL_MOVES
-        }
-    }
-    match cell {
-        CellLayout::TorchCarried(_) => opts.coordinated,
-        CellLayout::PartCarried(_) => {
-            opts.remote_tcp || with_controller(cell.robot().vendor, FixedTool)
-        }
-    }
-}
-
 /// Every vendor with a program format, in the order of messages.
 pub const VENDORS: [Vendor; 3] = [Vendor::Fanuc, Vendor::Kuka, Vendor::Abb];
 
@@ -491,4 +465,36 @@ pub fn read_file(path: &Path) -> Result<EmittedFile, ProgramError> {
         name: path.display().to_string(),
         text,
     })
+}
+/// The vendor's name as written in messages (`FANUC`, `KUKA`, `ABB`).
+pub fn vendor_name(vendor: Vendor) -> &'static str {
+    match vendor {
+        Vendor::Fanuc => "FANUC",
+        Vendor::Kuka => "KUKA",
+        Vendor::Abb => "ABB",
+    }
+}
+
+/// Checks that `cell`'s robot is a `vendor` arm, the only one whose joints
+/// (controller convention, rad) and flange poses the `emitter` (e.g. `KUKA
+/// KRL`) may write or read.
+///
+/// # Errors
+/// [`ProgramError::VendorMismatch`] naming both vendors and the robot.
+pub fn check_vendor(
+    cell: &CellLayout,
+    vendor: Vendor,
+    emitter: &'static str,
+) -> Result<(), ProgramError> {
+    let robot = cell.robot();
+    if robot.vendor == vendor {
+        Ok(())
+    } else {
+        Err(ProgramError::VendorMismatch {
+            emitter,
+            emitter_vendor: vendor_name(vendor),
+            robot: robot.name.clone(),
+            robot_vendor: vendor_name(robot.vendor),
+        })
+    }
 }

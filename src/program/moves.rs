@@ -23,9 +23,9 @@
 //! changes and every point outside beads are kept.
 
 use crate::math::Isometry3;
-use crate::program::compress::{arc_length, compress, CompressOptions, ControllerPose, Move};
-use crate::program::contract::moves_in_part_frame;
+use crate::program::compress::{compress, CompressOptions, Move};
 use crate::program::frames::fixed_torch_at;
+use crate::program::pose::{arc_length, controller_pose_at, moves_in_part_frame, ControllerPose};
 use crate::program::validate::between::{check_between, InterpolatedMove};
 use crate::program::{ArcFlag, Program, ProgramError, ProgramOptions, ProgramPoint};
 use crate::robot::CellLayout;
@@ -93,61 +93,6 @@ fn must_keep(bead: &[ProgramPoint]) -> Vec<bool> {
 /// else robot base frame.
 fn controller_pose(cell: &CellLayout, p: &ProgramPoint, in_part: bool) -> ControllerPose {
     controller_pose_at(cell, &p.joints, p.positioner, in_part)
-}
-
-/// [`controller_pose`] of the arm at joints `q` (rad) and the positioner
-/// at `qp` (rad).
-pub(crate) fn controller_pose_at(
-    cell: &CellLayout,
-    q: &crate::robot::Joints,
-    qp: Option<[f64; 2]>,
-    in_part: bool,
-) -> ControllerPose {
-    let flange = cell.robot().flange_pose(q);
-    let (tcp, ext): (Isometry3, Vec<f64>) = match cell {
-        CellLayout::PartCarried(c) if in_part => {
-            let base_from_part = flange * c.flange_from_part;
-            let torch = fixed_torch_at(&c.deposition_point_mm);
-            (base_from_part.inverse() * torch, Vec::new())
-        }
-        // the held tool (the flange) in the base frame
-        CellLayout::PartCarried(_) => (flange, Vec::new()),
-        CellLayout::TorchCarried(c) => {
-            let tcp = flange * c.flange_from_tcp;
-            let qp = qp.unwrap_or([0.0; 2]);
-            let tcp = if in_part {
-                c.base_from_part(&qp).inverse() * tcp
-            } else {
-                tcp
-            };
-            (tcp, qp.to_vec())
-        }
-    };
-    ControllerPose::new(tcp.translation.vector.into(), tcp.rotation, ext)
-}
-
-/// The flange pose (robot base frame) that puts the controller's tool at
-/// `pose` ([`controller_pose_at`]'s inverse), with the positioner at
-/// `pose.ext`.
-pub(crate) fn flange_of(cell: &CellLayout, pose: &ControllerPose, in_part: bool) -> Isometry3 {
-    let controller = Isometry3::from_parts(pose.p.coords.into(), pose.q);
-    match cell {
-        CellLayout::PartCarried(c) if in_part => {
-            // controller = (flange · F_fp)⁻¹ · torch
-            fixed_torch_at(&c.deposition_point_mm)
-                * controller.inverse()
-                * c.flange_from_part.inverse()
-        }
-        CellLayout::PartCarried(_) => controller,
-        CellLayout::TorchCarried(c) => {
-            let tcp = if in_part {
-                c.base_from_part(&[pose.ext[0], pose.ext[1]]) * controller
-            } else {
-                controller
-            };
-            tcp * c.flange_from_tcp.inverse()
-        }
-    }
 }
 
 /// `true` when the circular move from `a` through `via` to `b` runs as the

@@ -35,6 +35,7 @@
 
 pub mod calibration;
 pub mod cell;
+pub mod controller;
 mod error;
 pub mod ik;
 pub mod indices;

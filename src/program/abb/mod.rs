@@ -651,7 +651,7 @@ pub fn confdata(robot: &RobotModel, q: &Joints) -> [i32; 4] {
     let quarter = |v: f64| (printed(v) / std::f64::consts::FRAC_PI_2).floor() as i32;
     let c = robot.configuration_of(q);
     let side = matches!(c.side, crate::robot::ArmSide::Back) as i32;
-    let elbow = !crate::program::kuka::elbow_positive_cos(&c) as i32;
+    let elbow = !crate::robot::controller::elbow_positive_cos(&c) as i32;
     let wrist = (printed(q[4]) < 0.0) as i32;
     [
         quarter(q[0]),
@@ -1198,7 +1198,6 @@ impl Controller for Abb {
     const VENDOR: Vendor = Vendor::Abb;
     const EMITTER: &'static str = EMITTER;
     const EXTENSIONS: &'static [&'static str] = &["mod"];
-    const FIXED_TOOL_MOVES: bool = true;
     type Options = AbbOptions;
     type Read = read::RapidModule;
 

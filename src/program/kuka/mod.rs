@@ -153,7 +153,7 @@ use crate::program::{
     segment_length_mm, ArcFlag, BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::KukaAbc;
-use crate::robot::{ArmSide, CellLayout, Elbow, Joints, RobotModel, Vendor};
+use crate::robot::{ArmSide, CellLayout, Joints, RobotModel, Vendor};
 
 /// The emitter's name in [`ProgramError::VendorMismatch`].
 pub const EMITTER: &str = "KUKA KRL";
@@ -578,17 +578,9 @@ pub fn status(robot: &RobotModel, q: &Joints) -> u8 {
     let c = robot.configuration_of(q);
     let back = c.side == ArmSide::Back;
     let a5_negative = crate::program::fmt::as_printed_rad(q[4]) < 0.0;
-    (back as u8) | ((elbow_positive_cos(&c) as u8) << 1) | ((a5_negative as u8) << 2)
-}
-
-/// The elbow joint test of a configuration: `true` on the side of the
-/// stretched elbow where the arm is in the usual elbow-up posture with the
-/// wrist centre in front of J1 (KUKA `A3 >= phi`, ABB wrist centre in front
-/// of the lower arm). [`Configuration`](crate::robot::Configuration)'s elbow
-/// is geometric (above or below the shoulder-wrist line), which swaps when
-/// the wrist centre goes behind J1; this test does not.
-pub fn elbow_positive_cos(c: &crate::robot::Configuration) -> bool {
-    (c.side == ArmSide::Front) == (c.elbow == Elbow::Up)
+    (back as u8)
+        | ((crate::robot::controller::elbow_positive_cos(&c) as u8) << 1)
+        | ((a5_negative as u8) << 2)
 }
 
 /// KUKA Turn bits of joints `q`: bit `i` set when `A(i+1) < 0`.
@@ -1278,7 +1270,6 @@ impl Controller for Kuka {
     const VENDOR: Vendor = Vendor::Kuka;
     const EMITTER: &'static str = EMITTER;
     const EXTENSIONS: &'static [&'static str] = &["src", "dat"];
-    const FIXED_TOOL_MOVES: bool = true;
     type Options = KukaOptions;
     type Read = read::KrlProgram;
 

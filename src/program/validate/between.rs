@@ -1,10 +1,10 @@
 //! Between the moves: a linear or circular move sampled as the controller
-//! interpolates it ([`interpolate`](crate::program::compress::interpolate),
+//! interpolates it ([`interpolate`](crate::program::pose::interpolate),
 //! the model the compressor thinned the beads with: the tool on a straight
 //! line or on the circle through the via, its orientation by slerp from
 //! start to end, the positioner linearly, in the frame the move is
 //! programmed in,
-//! [`moves_in_part_frame`](crate::program::contract::moves_in_part_frame)),
+//! [`moves_in_part_frame`](crate::program::pose::moves_in_part_frame)),
 //! each sample's joints solved in the cell's branch nearest the previous
 //! sample's, and checked: joint travel, joint speeds over each sampled
 //! stretch at the move's timing, no jump, and, when the plan is known, the
@@ -16,9 +16,7 @@
 use std::f64::consts::PI;
 
 use crate::math::Point3;
-use crate::program::compress::interpolate;
-use crate::program::contract::moves_in_part_frame;
-use crate::program::moves::{controller_pose_at, flange_of};
+use crate::program::pose::{controller_pose_at, flange_of, interpolate, moves_in_part_frame};
 use crate::program::ProgramOptions;
 use crate::robot::{CellLayout, Joints};
 

@@ -5,7 +5,7 @@
 use std::f64::consts::PI;
 
 use crate::math::Point3;
-use crate::program::compress::{arc_length, interpolate, ControllerPose};
+use crate::program::pose::{arc_length, interpolate, ControllerPose};
 use crate::program::transit::{joint_move_clearance, WallBeads};
 use crate::program::MoveKind;
 use crate::program::ProgramOptions;

@@ -1,0 +1,636 @@
+//! Stage 7, the builder: [`build_program`] and [`build_program_with`] check
+//! that a planned [`JointTrajectory`] is buildable and assemble the
+//! [`Program`]: one bead per layer between its approach and retract points,
+//! the set-up before each bead, the home moves and the transits between
+//! beads.
+
+use crate::math::Point3;
+use crate::program::{
+    check_name, contract, joints_move, moves, split, transit, ArcFlag, BeadSetup, HomePosition,
+    Program, ProgramError, ProgramOptions, ProgramPoint, TravelSpeed,
+};
+use crate::robot::cell::CellPoint;
+use crate::robot::positioner::PositionerJoints;
+use crate::robot::trajectory::{JointTrajectory, PathPointInput};
+use crate::robot::{CellLayout, Joints};
+
+/// Checks that the plan is buildable and assembles the program.
+///
+/// `points` and `trajectory` must be the same path in the same order (the
+/// trajectory computed for these points by
+/// [`joint_trajectory`](crate::robot::trajectory::joint_trajectory) or an
+/// optimiser); each layer becomes one bead of at least two points. Joint
+/// speeds are re-checked at the given travel speeds.
+///
+/// # Errors
+/// [`ProgramError::InvalidOptions`] for a bad name or speed,
+/// [`ProgramError::Mismatch`] when the inputs differ in length, layer or
+/// point indices, or a layer has one point, and [`ProgramError::Infeasible`]
+/// when the trajectory reports violations or a point has no joints, naming
+/// the first.
+pub fn build_program(
+    name: &str,
+    cell: &CellLayout,
+    points: &[PathPointInput],
+    trajectory: &JointTrajectory,
+    speed: &TravelSpeed,
+) -> Result<Program, ProgramError> {
+    build_program_with(
+        name,
+        cell,
+        points,
+        trajectory,
+        speed,
+        &ProgramOptions::default(),
+    )
+}
+
+/// [`build_program`] with approach and retract points as `opts` say: before
+/// each bead an [`ArcFlag::Approach`] point `clearance_mm` away from the part
+/// along the tool axis (same orientation, same positioner joints), after it
+/// an [`ArcFlag::Retract`] point, both checked like the bead points (joint
+/// limits, and joint speeds of the linear moves into and out of the bead at
+/// `approach_speed_mm_s`).
+///
+/// # Errors
+/// As [`build_program`]; [`ProgramError::InvalidOptions`] for bad options;
+/// [`ProgramError::Infeasible`] when an approach or retract point cannot be
+/// reached, naming the layer.
+pub fn build_program_with(
+    name: &str,
+    cell: &CellLayout,
+    points: &[PathPointInput],
+    trajectory: &JointTrajectory,
+    speed: &TravelSpeed,
+    opts: &ProgramOptions,
+) -> Result<Program, ProgramError> {
+    opts.validate()?;
+    check_name(name)?;
+    if points.len() != trajectory.points.len() {
+        return Err(ProgramError::Mismatch {
+            index: points.len().min(trajectory.points.len()),
+            reason: format!(
+                "{} path points but {} trajectory points",
+                points.len(),
+                trajectory.points.len()
+            ),
+        });
+    }
+    if points.is_empty() {
+        return Err(ProgramError::Mismatch {
+            index: 0,
+            reason: "empty path".into(),
+        });
+    }
+    let speeds: Vec<f64> = match speed {
+        TravelSpeed::Constant(v) => vec![*v; points.len()],
+        TravelSpeed::PerPoint(v) => {
+            if v.len() != points.len() {
+                return Err(ProgramError::Mismatch {
+                    index: v.len().min(points.len()),
+                    reason: format!("{} speeds for {} points", v.len(), points.len()),
+                });
+            }
+            v.clone()
+        }
+    };
+    for (i, v) in speeds.iter().enumerate() {
+        if !(v.is_finite() && *v > 0.0) {
+            return Err(ProgramError::InvalidOptions {
+                field: "travel_speed_mm_s",
+                value: format!("{v} (index {i})"),
+                reason: "must be finite and > 0",
+            });
+        }
+    }
+    if let Some(v) = trajectory.report.violations.first() {
+        return Err(ProgramError::Infeasible {
+            count: trajectory.report.violations.len(),
+            first: v.to_string(),
+            layers: vec![v.layer],
+        });
+    }
+    let robot = cell.robot();
+    let mut out: Vec<ProgramPoint> = Vec::with_capacity(points.len());
+    for (i, (p, jp)) in points.iter().zip(&trajectory.points).enumerate() {
+        if p.layer != jp.layer || p.point != jp.point {
+            return Err(ProgramError::Mismatch {
+                index: i,
+                reason: format!(
+                    "path point is layer {}, point {} but trajectory point is layer {}, point {}",
+                    p.layer, p.point, jp.layer, jp.point
+                ),
+            });
+        }
+        let Some(q) = jp.joints else {
+            return Err(ProgramError::Infeasible {
+                count: 1,
+                first: format!("layer {}, point {}: no joint solution", p.layer, p.point),
+                layers: vec![p.layer],
+            });
+        };
+        let first = i == 0 || points[i - 1].layer != p.layer;
+        let last = i + 1 == points.len() || points[i + 1].layer != p.layer;
+        if first && last {
+            return Err(ProgramError::Mismatch {
+                index: i,
+                reason: format!("layer {} has a single point: no bead", p.layer),
+            });
+        }
+        // speed re-check at the programmed speed (the trajectory used one TS)
+        if !first {
+            let prev = &out[i - 1];
+            let d = (p.position_mm - prev.position_mm).norm();
+            let turns = || {
+                joints_move(&q, &prev.joints)
+                    || match (jp.positioner, prev.positioner) {
+                        (Some(a), Some(b)) => joints_move(&a, &b),
+                        _ => false,
+                    }
+            };
+            if d == 0.0 && turns() {
+                return Err(ProgramError::Infeasible {
+                    count: 1,
+                    first: format!(
+                        "layer {}, point {}: same position as point {} while the joints turn: \
+                         a zero-length segment has no travel time at any speed",
+                        p.layer,
+                        p.point,
+                        points[i - 1].point
+                    ),
+                    layers: vec![p.layer],
+                });
+            }
+            if d > 0.0 {
+                let dt = d / speeds[i];
+                for (j, (qj, pj)) in q.iter().zip(prev.joints).enumerate() {
+                    let s = (qj - pj).abs() / dt;
+                    if s > robot.max_speed_rad_s[j] {
+                        return Err(ProgramError::Infeasible {
+                            count: 1,
+                            first: format!(
+                                "layer {}, point {}: J{} needs {:.2}°/s at {} mm/s, maximum {:.1}°/s",
+                                p.layer,
+                                p.point,
+                                j + 1,
+                                s.to_degrees(),
+                                speeds[i],
+                                robot.max_speed_rad_s[j].to_degrees()
+                            ),
+                            layers: vec![p.layer],
+                        });
+                    }
+                }
+            }
+        }
+        out.push(ProgramPoint {
+            layer: p.layer,
+            point: p.point,
+            position_mm: p.position_mm,
+            tool_axis: p.tool_axis,
+            r_z: p.r_z,
+            joints: q,
+            positioner: jp.positioner,
+            speed_mm_s: if first && !last {
+                speeds[i + 1]
+            } else {
+                speeds[i]
+            },
+            arc: if first {
+                ArcFlag::Start
+            } else if last {
+                ArcFlag::End
+            } else {
+                ArcFlag::On
+            },
+            via: false,
+        });
+    }
+    if opts.clearance_mm > 0.0 {
+        let mut all = Vec::with_capacity(out.len() + 2 * trajectory.points.len().min(out.len()));
+        for (p, input) in out.iter().zip(points) {
+            if p.arc == ArcFlag::Start {
+                all.push(clearance_point_within_travel(
+                    cell,
+                    p,
+                    input,
+                    ArcFlag::Approach,
+                    opts,
+                )?);
+            }
+            all.push(*p);
+            if p.arc == ArcFlag::End {
+                all.push(clearance_point_within_travel(
+                    cell,
+                    p,
+                    input,
+                    ArcFlag::Retract,
+                    opts,
+                )?);
+            }
+        }
+        out = all;
+    }
+    let home = opts.home(cell);
+    if let Some(h) = &home {
+        check_home(cell, h)?;
+    }
+    unwind_turns(cell, &mut out, home.as_ref())?;
+    let bead_setup = out
+        .iter()
+        .filter(|p| p.arc == ArcFlag::Start)
+        .enumerate()
+        .map(|(k, p)| BeadSetup {
+            layer: p.layer,
+            payload: None,
+            dwell_s: if k > 0 { opts.dwell_s } else { 0.0 },
+            wait_input: if k > 0 { opts.interpass_input } else { None },
+        })
+        .collect();
+    let mut program = Program {
+        name: name.to_string(),
+        cell: cell.clone(),
+        configuration: trajectory.configuration,
+        points: out,
+        home,
+        bead_setup,
+        planned: Vec::new(),
+    };
+    if opts.transit_check {
+        safe_transits(&mut program, points, opts)?;
+    }
+    program.planned = program.bead_points().map(|p| p.position_mm).collect();
+    moves::thin_beads(&mut program, opts)?;
+    Ok(program)
+}
+
+/// Shifts the positioner's turn of each bead's block of points (approach,
+/// bead, retract) by whole turns into the turn's stroke
+/// ([`Positioner::turn_stroke`](crate::robot::positioner::Positioner::turn_stroke)),
+/// choosing, of the shifts that fit, the one that starts the block nearest
+/// where the table is (the previous block's last point, or home): the
+/// table unwinds during the arc-off joint move between beads, never during
+/// a bead. The turn is periodic, so the arm's joints and the deposition
+/// point are unchanged. Nothing to do without a positioner.
+///
+/// # Errors
+/// [`ProgramError::Infeasible`] naming the layer whose bead turns the
+/// table through more than the stroke holds.
+fn unwind_turns(
+    cell: &CellLayout,
+    points: &mut [ProgramPoint],
+    home: Option<&HomePosition>,
+) -> Result<(), ProgramError> {
+    use std::f64::consts::TAU;
+    let CellLayout::TorchCarried(c) = cell else {
+        return Ok(());
+    };
+    let stroke = contract::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
+    let mut at = home.and_then(|h| h.positioner).map_or(0.0, |q| q[1]);
+    for b in blocks(points) {
+        let turns: Vec<f64> = points[b.first..=b.last]
+            .iter()
+            .filter_map(|p| p.positioner.map(|q| q[1]))
+            .collect();
+        let Some(&start) = turns.first() else {
+            continue;
+        };
+        let lo = turns.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = turns.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let Some((k_min, k_max)) = stroke.whole_turn_shifts(lo, hi) else {
+            return Err(ProgramError::Infeasible {
+                count: 1,
+                first: format!(
+                    "layer {}: the bead turns the positioner's table from {:.1}° to {:.1}° ({:.1}°), more than its stroke [{:.1}°, {:.1}°] holds",
+                    points[b.start].layer,
+                    lo.to_degrees(),
+                    hi.to_degrees(),
+                    (hi - lo).to_degrees(),
+                    stroke.lower_rad.to_degrees(),
+                    stroke.upper_rad.to_degrees()
+                ),
+                layers: vec![points[b.start].layer],
+            });
+        };
+        let k = ((at - start) / TAU).round().clamp(k_min, k_max);
+        for p in &mut points[b.first..=b.last] {
+            if let Some(q) = &mut p.positioner {
+                q[1] += k * TAU;
+            }
+        }
+        at = points[b.last].positioner.map_or(at, |q| q[1]);
+    }
+    Ok(())
+}
+
+/// Refuses a home position outside the arm's (or positioner's) travel.
+fn check_home(cell: &CellLayout, h: &HomePosition) -> Result<(), ProgramError> {
+    let bad = |what: String| ProgramError::InvalidOptions {
+        field: "home_deg",
+        value: what,
+        reason: "the home position must be inside the joints' travel",
+    };
+    if let Some((j, v)) = cell.robot().limit_violations(&h.joints).next() {
+        return Err(bad(format!("J{} = {:.3}°", j + 1, v.to_degrees())));
+    }
+    if let (CellLayout::TorchCarried(c), Some(qp)) = (cell, h.positioner) {
+        let turn = contract::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
+        let stroke = [c.positioner.limits[0], turn];
+        for (i, (l, v)) in stroke.iter().zip(qp).enumerate() {
+            if !l.contains(v) {
+                return Err(ProgramError::InvalidOptions {
+                    field: "home_positioner_deg",
+                    value: format!("J{} = {:.3}°", i + 7, v.to_degrees()),
+                    reason: "the home position must be inside the positioner's travel",
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The points of one bead's block in a program: indices of its first point
+/// (approach, or the bead's first point), its bead's first and last points,
+/// its last point (retract, or the bead's last point), and of the bead's
+/// first point among the path points.
+#[derive(Debug, Clone, Copy)]
+struct Block {
+    first: usize,
+    start: usize,
+    end: usize,
+    last: usize,
+    start_input: usize,
+}
+
+fn blocks(points: &[ProgramPoint]) -> Vec<Block> {
+    let arcs: Vec<ArcFlag> = points.iter().map(|p| p.arc).collect();
+    let mut bead_points = 0;
+    split::beads(&arcs)
+        .into_iter()
+        .map(|r| {
+            let find = |flag| r.clone().find(|&i| arcs[i] == flag).unwrap_or(r.start);
+            let block = Block {
+                first: r.start,
+                start: find(ArcFlag::Start),
+                end: find(ArcFlag::End),
+                last: r.end - 1,
+                start_input: bead_points,
+            };
+            bead_points += arcs[r].iter().filter(|a| a.is_bead()).count();
+            block
+        })
+        .collect()
+}
+
+/// Checks every arc-off joint move between two beads (and the last one, to
+/// home) against the wall deposited so far ([`transit`](crate::program::transit)); where one
+/// collides, moves that transition's retract and approach points further
+/// along the tool axis (2, 4, 8… times `clearance_mm`, up to
+/// `transit_max_clearance_mm`) until it clears.
+fn safe_transits(
+    program: &mut Program,
+    inputs: &[PathPointInput],
+    opts: &ProgramOptions,
+) -> Result<(), ProgramError> {
+    use rayon::prelude::*;
+    let torch = crate::toolaxis::collision::Torch::new(&Default::default()).map_err(|e| {
+        ProgramError::InvalidOptions {
+            field: "transit_check",
+            value: e.to_string(),
+            reason: "the torch model for the transit check is invalid",
+        }
+    })?;
+    let blocks = blocks(&program.points);
+    // Each bead decimated once; the wall after bead k is the union of at
+    // most log2(k + 1) + 1 blocks of them, each block's tree built once.
+    let mut decimated = transit::WallBeads::default();
+    for b in &blocks {
+        let bead: Vec<Point3> = program.points[b.start..=b.end]
+            .iter()
+            .map(|p| p.position_mm)
+            .collect();
+        decimated.push(&bead);
+    }
+    let n = blocks.len();
+    let target = |program: &Program, k: usize| -> Option<(Joints, Option<PositionerJoints>)> {
+        if k + 1 < n {
+            let p = &program.points[blocks[k + 1].first];
+            Some((p.joints, p.positioner))
+        } else {
+            program.home.map(|h| (h.joints, h.positioner))
+        }
+    };
+    let check = |program: &Program, k: usize| -> Result<transit::TransitClearance, ProgramError> {
+        let inf = transit::TransitClearance {
+            min_clearance_mm: f64::INFINITY,
+            at_fraction: 0.0,
+            tip_mm: Point3::origin(),
+        };
+        let Some((qb, pb)) = target(program, k) else {
+            return Ok(inf);
+        };
+        let wall = decimated.wall(k + 1, opts.bead_radius_mm);
+        let from = &program.points[blocks[k].last];
+        transit::joint_move_clearance(
+            &program.cell,
+            &wall,
+            &torch,
+            (&from.joints, from.positioner),
+            (&qb, pb),
+        )
+        .map_err(|e| ProgramError::Infeasible {
+            count: 1,
+            first: format!("layer {}: transit check: {e}", from.layer),
+            layers: vec![from.layer],
+        })
+    };
+    let first: Vec<Result<transit::TransitClearance, ProgramError>> =
+        (0..n).into_par_iter().map(|k| check(program, k)).collect();
+    for (k, r) in first.into_iter().enumerate() {
+        let r = r?;
+        if r.min_clearance_mm > 0.0 {
+            continue;
+        }
+        let layer = program.points[blocks[k].end].layer;
+        let next_layer = (k + 1 < n).then(|| program.points[blocks[k + 1].start].layer);
+        let to_what = match next_layer {
+            Some(l) => format!("layer {l}'s approach"),
+            None => "home".to_string(),
+        };
+        let layers: Vec<usize> = std::iter::once(layer)
+            .chain(next_layer.filter(|&l| l != layer))
+            .collect();
+        let refuse = |why: String| ProgramError::Infeasible {
+            count: 1,
+            first: format!(
+                "layer {layer}: the arc-off joint move to {to_what} passes {:.1} mm into the \
+                 deposited wall at {:.0}% of the move (torch tip at [{:.1}, {:.1}, {:.1}] mm, \
+                 part frame){why}",
+                -r.min_clearance_mm,
+                100.0 * r.at_fraction,
+                r.tip_mm.x,
+                r.tip_mm.y,
+                r.tip_mm.z
+            ),
+            layers: layers.clone(),
+        };
+        let has_retract = program.points[blocks[k].last].arc == ArcFlag::Retract;
+        let next_approach = (k + 1 < n)
+            .then(|| blocks[k + 1])
+            .filter(|b| program.points[b.first].arc == ArcFlag::Approach);
+        if opts.clearance_mm <= 0.0 || !has_retract {
+            return Err(refuse(
+                " and the program has no retract points to raise (clearance_mm = 0)".into(),
+            ));
+        }
+        let mut c = opts.clearance_mm;
+        let mut fixed = false;
+        while c < opts.transit_max_clearance_mm && !fixed {
+            c = (2.0 * c).min(opts.transit_max_clearance_mm);
+            let end = program.points[blocks[k].end];
+            let end_input = &inputs[blocks[k].start_input + (blocks[k].end - blocks[k].start)];
+            let Ok(retract) =
+                clearance_point(&program.cell, &end, end_input, ArcFlag::Retract, opts, c)
+            else {
+                continue;
+            };
+            let approach = match next_approach {
+                Some(b) => {
+                    let start = program.points[b.start];
+                    match clearance_point(
+                        &program.cell,
+                        &start,
+                        &inputs[b.start_input],
+                        ArcFlag::Approach,
+                        opts,
+                        c,
+                    ) {
+                        Ok(a) => Some((b.first, a)),
+                        Err(_) => continue,
+                    }
+                }
+                None => None,
+            };
+            let old_retract = program.points[blocks[k].last];
+            let old_approach = approach.map(|(i, _)| program.points[i]);
+            program.points[blocks[k].last] = retract;
+            if let Some((i, a)) = approach {
+                program.points[i] = a;
+            }
+            if check(program, k)?.min_clearance_mm > 0.0 {
+                fixed = true;
+            } else {
+                program.points[blocks[k].last] = old_retract;
+                if let (Some((i, _)), Some(a)) = (approach, old_approach) {
+                    program.points[i] = a;
+                }
+            }
+        }
+        if !fixed {
+            return Err(refuse(format!(
+                ", even with the retract and approach points raised up to {} mm along the tool \
+                 axis (transit_max_clearance_mm)",
+                opts.transit_max_clearance_mm
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The approach or retract point of bead point `p` at `clearance_mm`, or,
+/// where that one leaves a joint's travel (a bead that ends with J5 a
+/// fraction of a degree inside its stop), at a half, a quarter or an eighth
+/// of it; refused with the full clearance's reason if none works.
+fn clearance_point_within_travel(
+    cell: &CellLayout,
+    p: &ProgramPoint,
+    input: &PathPointInput,
+    flag: ArcFlag,
+    opts: &ProgramOptions,
+) -> Result<ProgramPoint, ProgramError> {
+    let mut first_error = None;
+    for divisor in [1.0, 2.0, 4.0, 8.0] {
+        match clearance_point(cell, p, input, flag, opts, opts.clearance_mm / divisor) {
+            Ok(point) => return Ok(point),
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    Err(first_error.expect("at least one clearance tried"))
+}
+
+/// The approach or retract point of bead point `p`: `clearance_mm` along the
+/// tool axis, same orientation and positioner joints, joints unwrapped
+/// towards `p`'s; refused if a joint leaves its travel or the linear move
+/// between it and `p` outruns a joint at the approach speed.
+fn clearance_point(
+    cell: &CellLayout,
+    p: &ProgramPoint,
+    input: &PathPointInput,
+    flag: ArcFlag,
+    opts: &ProgramOptions,
+    clearance_mm: f64,
+) -> Result<ProgramPoint, ProgramError> {
+    let what = if flag == ArcFlag::Approach {
+        "approach"
+    } else {
+        "retract"
+    };
+    let infeasible = |msg: String| ProgramError::Infeasible {
+        count: 1,
+        first: format!(
+            "layer {}, {what} point ({} mm from point {} along the tool axis): {msg}",
+            p.layer, clearance_mm, p.point
+        ),
+        layers: vec![p.layer],
+    };
+    let position_mm = p.position_mm + p.tool_axis.into_inner() * clearance_mm;
+    let cp = CellPoint {
+        position_mm,
+        tool_axis: p.tool_axis,
+        build_direction: input.build_direction,
+        // the planned positioner as the program writes it (its turn
+        // unwound by whole turns, `unwind_turns`)
+        positioner: input.positioner.and(p.positioner),
+    };
+    let q8 = p.positioner.map_or(0.0, |q| q[1]);
+    let (q, pose) = cell
+        .joints(&cp, p.r_z, Some(&p.joints), q8)
+        .map_err(|e| infeasible(e.to_string()))?;
+    if let (Some(a), Some(b)) = (pose.positioner, p.positioner) {
+        if (a[0] - b[0]).abs() > 1e-9 || (a[1] - b[1]).abs() > 1e-9 {
+            return Err(infeasible("the positioner would have to move".into()));
+        }
+    }
+    let robot = cell.robot();
+    if let Some((j, v)) = robot.limit_violations(&q).next() {
+        return Err(infeasible(format!(
+            "J{} = {:.3}° outside its travel",
+            j + 1,
+            v.to_degrees()
+        )));
+    }
+    let dt = clearance_mm / opts.approach_speed_mm_s;
+    for (j, (qj, pj)) in q.iter().zip(p.joints).enumerate() {
+        let s = (qj - pj).abs() / dt;
+        if s > robot.max_speed_rad_s[j] {
+            return Err(infeasible(format!(
+                "J{} needs {:.2}°/s at {} mm/s, maximum {:.1}°/s",
+                j + 1,
+                s.to_degrees(),
+                opts.approach_speed_mm_s,
+                robot.max_speed_rad_s[j].to_degrees()
+            )));
+        }
+    }
+    Ok(ProgramPoint {
+        position_mm,
+        joints: q,
+        positioner: pose.positioner,
+        speed_mm_s: opts.approach_speed_mm_s,
+        arc: flag,
+        via: false,
+        ..*p
+    })
+}
