@@ -17,7 +17,8 @@
 //! | torch-carried cell: the positioner's laws within the cone, solved before `R_Z` (stage 5a) | [`positioner`] | [`positioner::positioner_law`], [`positioner::required_rotation_rate`] |
 //! | `R_Z = B c`: polynomials (eq. 4.1–4.2), per point | [`parameterisation`] | [`parameterisation::Basis`] |
 //! | the per-layer problem (objective, constraints, `dq/dR_Z`) | `problem` | — |
-//! | sequential QP with clarabel, trust region, elastic mode | `sqp` | — |
+//! | sequential QP, trust region, elastic mode | `sqp` | — |
+//! | the elastic QP both SQPs solve (closed form, else clarabel on a working set; a leaf) | `qp` | — |
 //! | outcomes as data | [`outcome`] | [`Plan`], [`LayerPlan`], [`LayerStatus`] |
 //! | a layer's setup: times, angles, problem per branch, dexterity floors | `setup` | — |
 //! | seeds scored in every branch | `seed` | — |
@@ -115,6 +116,7 @@ pub mod parameterisation;
 mod point_by_point;
 pub mod positioner;
 mod problem;
+mod qp;
 mod report;
 mod seed;
 mod setup;

@@ -12,6 +12,7 @@ use nalgebra::{Matrix6, Vector6};
 use crate::optimise::options::Objective;
 use crate::optimise::outcome::{Binding, Constraint};
 use crate::optimise::parameterisation::Basis;
+use crate::optimise::qp::Row;
 use crate::robot::cell::{CellLayout, CellPoint, CellPose, TorchPointFrame};
 use crate::robot::ik::Configuration;
 use crate::robot::indices::{
@@ -161,13 +162,6 @@ pub(crate) struct PointFailure {
 
 /// Receives one residual and its row over the coefficients.
 pub(crate) type ResidualSink<'s> = dyn FnMut(f64, &[(usize, f64)]) + 's;
-
-/// One linearised inequality `a · δc ≤ b`.
-#[derive(Debug, Clone)]
-pub(crate) struct Row {
-    pub a: Vec<(usize, f64)>,
-    pub b: f64,
-}
 
 impl<'a> LayerProblem<'a> {
     /// This whole-layer problem on the samples `idx` (increasing point

@@ -7,7 +7,7 @@
 
 use crate::math::{Matrix3, Vector3};
 use crate::optimise::parameterisation::Basis;
-use crate::optimise::problem::Row;
+use crate::optimise::qp::Row;
 use crate::robot::cell::{CellPoint, TorchCarriedCell};
 use crate::robot::positioner::{Positioner, PositionerJoints};
 

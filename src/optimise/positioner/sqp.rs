@@ -5,7 +5,7 @@
 //! driver's SQP: no secant correction, no ratio test, no polish.
 
 use crate::optimise::parameterisation::Basis;
-use crate::optimise::sqp::solve_qp;
+use crate::optimise::qp::solve_qp;
 
 use super::problem::{build_model, LawProblem, Model};
 
