@@ -9,6 +9,7 @@ use serde::Serialize;
 use crate::optimise::positioner::{PositionerLaw, PositionerSeed};
 use crate::optimise::RzLaw;
 use crate::path::distance_map::DistanceStats;
+pub use crate::program::cell_check::CollisionSummary;
 use crate::toolaxis::NormalMethod;
 
 /// What `slice` and `plan` report of the path (the shared part of
@@ -165,57 +166,6 @@ pub struct PlanSummary {
     /// The path, process, tool axes and distances.
     #[serde(flatten)]
     pub path: PathSummary,
-}
-
-/// A collision found by the whole-cell check
-/// ([`crate::program::cell_check`]).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct CollisionSummary {
-    /// The layer the motion belongs to.
-    pub layer: usize,
-    /// The point (bead point, or the point a move goes to); `None` for a
-    /// home move.
-    pub point: Option<usize>,
-    /// The motion: `bead`, `approach`, `retract`, `arc-off transit`, `home
-    /// move`.
-    pub motion: &'static str,
-    /// The two bodies (arm links, `part`, the positioner's table or tilt
-    /// body, a keep-out box by its name).
-    pub bodies: [String; 2],
-    /// Their distance (mm; negative: penetration).
-    pub distance_mm: f64,
-    /// The penetration depth (mm, ≥ 0).
-    pub depth_mm: f64,
-    /// The clearance asked for (mm).
-    pub clearance_mm: f64,
-}
-
-impl CollisionSummary {
-    /// The collision `e` names, if it is one
-    /// ([`ProgramError::Collision`](crate::program::ProgramError::Collision)).
-    pub fn of(e: &crate::program::ProgramError) -> Option<Self> {
-        let crate::program::ProgramError::Collision {
-            layer,
-            point,
-            motion,
-            body_a,
-            body_b,
-            distance_mm,
-            clearance_mm,
-        } = e
-        else {
-            return None;
-        };
-        Some(Self {
-            layer: *layer,
-            point: *point,
-            motion,
-            bodies: [body_a.clone(), body_b.clone()],
-            distance_mm: *distance_mm,
-            depth_mm: (-distance_mm).max(0.0),
-            clearance_mm: *clearance_mm,
-        })
-    }
 }
 
 /// The whole-cell check's counts.

@@ -77,7 +77,7 @@ use serde::{Deserialize, Serialize};
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use crate::optimise::LayerPoints;
 use crate::program::{ArcFlag, Program, ProgramError};
-use crate::report::cell_view::arm_chain;
+use crate::robot::chain::arm_chain;
 use crate::robot::trajectory::JointTrajectory;
 use crate::robot::{CellLayout, Joints, RobotModel, Vendor};
 
@@ -222,6 +222,57 @@ pub struct CellClearance {
     pub exact_queries: usize,
     /// Pairs culled by their bounding spheres.
     pub culled: usize,
+}
+
+/// A collision found by the whole-cell check, as the plan's summary
+/// (`summary.json`'s `collision`) and the report write it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CollisionSummary {
+    /// The layer the motion belongs to.
+    pub layer: usize,
+    /// The point (bead point, or the point a move goes to); `None` for a
+    /// home move.
+    pub point: Option<usize>,
+    /// The motion: `bead`, `approach`, `retract`, `arc-off transit`, `home
+    /// move`.
+    pub motion: &'static str,
+    /// The two bodies (arm links, `part`, the positioner's table or tilt
+    /// body, a keep-out box by its name).
+    pub bodies: [String; 2],
+    /// Their distance (mm; negative: penetration).
+    pub distance_mm: f64,
+    /// The penetration depth (mm, ≥ 0).
+    pub depth_mm: f64,
+    /// The clearance asked for (mm).
+    pub clearance_mm: f64,
+}
+
+impl CollisionSummary {
+    /// The collision `e` names, if it is one
+    /// ([`ProgramError::Collision`]).
+    pub fn of(e: &ProgramError) -> Option<Self> {
+        let ProgramError::Collision {
+            layer,
+            point,
+            motion,
+            body_a,
+            body_b,
+            distance_mm,
+            clearance_mm,
+        } = e
+        else {
+            return None;
+        };
+        Some(Self {
+            layer: *layer,
+            point: *point,
+            motion,
+            bodies: [body_a.clone(), body_b.clone()],
+            distance_mm: *distance_mm,
+            depth_mm: (-distance_mm).max(0.0),
+            clearance_mm: *clearance_mm,
+        })
+    }
 }
 
 /// A body of the scene at one sample: its name, shape, pose (base frame)

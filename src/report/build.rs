@@ -3,31 +3,20 @@
 //! one JSON object whose arrays are base64 typed arrays.
 
 use super::cell_view::{snapshot, CHAIN_POINTS};
-use serde::Serialize;
 
 use super::encode::{f32s, i8s, u32s, unit_i8};
+use super::page::{
+    kept, script_safe_json, stride, BodyData, ClosestData, CollisionData, FieldData, MarkData,
+    PageData, PlanData,
+};
+use super::substrate::substrate_triangles;
 use super::{PlanView, ReportError, ReportInput};
-use crate::geometry::Substrate;
 use crate::math::{Point3, Vector3};
 use crate::program::cell_check::{
-    arm_outlines, keep_out_outlines, positioner_outlines, BodyOutline, OutlineKind, PART_NAME,
+    arm_outlines, keep_out_outlines, positioner_outlines, BodyOutline, CollisionSummary, PART_NAME,
 };
 use crate::program::ProgramError;
 use crate::robot::CellLayout;
-
-/// Indices kept of a run of `n` points with stride `k`: `0, k, 2k, ...` and `n − 1`.
-pub(crate) fn kept(n: usize, k: usize) -> impl Iterator<Item = usize> {
-    let k = k.max(1);
-    let last = n.saturating_sub(1);
-    (0..n)
-        .step_by(k)
-        .chain((n > 0 && last % k != 0).then_some(last))
-}
-
-/// The stride that keeps at most about `bound` of `total` points.
-pub(crate) fn stride(total: usize, bound: usize) -> usize {
-    total.div_ceil(bound.max(1)).max(1)
-}
 
 fn check(input: &ReportInput) -> Result<(), ReportError> {
     let path = input.path;
@@ -388,178 +377,6 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
     script_safe_json(&data)
 }
 
-/// The page's data object (`report.html`'s embedded JSON): the path drawn
-/// (part frame, mm; base64 typed arrays), its colour fields, marks, notes
-/// and the plan's animation data.
-/// A fit page (`fit_page`) fills the same object: its path is the fitted
-/// guide (one layer) and `fit` holds the mesh.
-#[derive(Serialize)]
-pub(super) struct PageData<'a> {
-    pub version: u32,
-    pub title: &'a str,
-    pub strategy: &'static str,
-    pub delta_mm: f64,
-    pub bead_width_mm: f64,
-    pub points_total: usize,
-    pub points_shown: usize,
-    pub stride: usize,
-    pub length_mm: f64,
-    pub layer_slice: Vec<usize>,
-    pub layer_closed: Vec<u8>,
-    pub layer_points: Vec<usize>,
-    /// Base64 `Uint32Array`: each layer's first drawn point, then the total.
-    pub layer_start: String,
-    /// Base64 `Float32Array`: drawn points, xyz (mm).
-    pub pos: String,
-    /// Base64 `Int8Array`s: unit vectors × 127.
-    pub tool: String,
-    pub normal: String,
-    pub build: String,
-    pub fields: Vec<FieldData>,
-    /// Base64 `Float32Array` of the substrate's triangles, `null` if none.
-    pub substrate: Option<String>,
-    pub marks: Vec<MarkData<'a>>,
-    pub marks_total: usize,
-    pub plan: Option<PlanData<'a>>,
-    pub notes: Vec<String>,
-    /// The mesh of a fit page (absent from a path's page).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub fit: Option<super::fit_page::FitData<'a>>,
-}
-
-/// A colour field: one value per drawn point (base64 `Float32Array`), or
-/// with `mesh` one per vertex of a fit page's mesh.
-#[derive(Serialize)]
-pub(super) struct FieldData {
-    pub key: &'static str,
-    pub name: &'static str,
-    pub unit: &'static str,
-    pub diverging: bool,
-    pub min_half_range: f64,
-    pub data: String,
-    /// The values colour the fit page's mesh vertices, not the path.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub mesh: bool,
-}
-
-/// A marked point (a violation).
-#[derive(Serialize)]
-pub(super) struct MarkData<'a> {
-    layer: usize,
-    point: usize,
-    text: &'a str,
-    /// Part frame (mm).
-    at: [f64; 3],
-}
-
-/// The plan's part of the page data: the cell, limits (deg) and the cell at
-/// every animation frame (base64 typed arrays).
-#[derive(Serialize)]
-pub(super) struct PlanData<'a> {
-    cell_kind: &'static str,
-    cell: &'a str,
-    robot: &'a str,
-    reach_mm: f64,
-    /// `[lower, upper]` per axis (J1–J6, then J7–J8 with a positioner), deg.
-    limits_deg: Vec<[f64; 2]>,
-    /// `null` in a part-carried cell.
-    max_hose_deg: Option<f64>,
-    feasible: bool,
-    infeasible_layers: Vec<usize>,
-    frames: usize,
-    points_total: usize,
-    frame_stride: usize,
-    duration_s: f64,
-    /// The program's cycle time (s; `null` without a program).
-    cycle_time_s: Option<f64>,
-    /// Each bead's layer number and its share of the cycle time (s).
-    cycle_layers: Vec<usize>,
-    cycle_layer_s: Vec<f64>,
-    f_layer: String,
-    f_point: String,
-    f_time: String,
-    f_rz: String,
-    f_joints: String,
-    f_chain: String,
-    f_torch: String,
-    f_table: String,
-    f_part: String,
-    /// The whole-cell check's bodies (robot base frame, mm), as
-    /// [`crate::program::cell_check`] models them: the moving ones first
-    /// (their ends per frame in `f_bodies`), then the fixed ones.
-    bodies: Vec<BodyData>,
-    /// Base64 `Float32Array`: per frame, the ends `a`, `b` of every moving
-    /// body of `bodies` (6 floats a body; NaN without joints), base frame (mm).
-    f_bodies: String,
-    /// Per plan layer (the index of `f_layer`): the whole-cell check's
-    /// closest approach and pair; empty when the check did not run.
-    closest: Vec<ClosestData>,
-    /// The program's collision refusal, `null` without one.
-    collision: Option<CollisionData>,
-    /// The name the check gives the part (its wall so far).
-    part_body: &'static str,
-}
-
-/// One body of the whole-cell check (robot base frame, mm).
-#[derive(Serialize)]
-struct BodyData {
-    name: String,
-    kind: OutlineKind,
-    radius_mm: f64,
-    /// `true`: its ends are per frame in `f_bodies`; else in `a`, `b`.
-    moving: bool,
-    /// Segment end or lower corner of a fixed body (mm).
-    a: Option<[f64; 3]>,
-    /// Segment end or upper corner of a fixed body (mm).
-    b: Option<[f64; 3]>,
-}
-
-/// A layer's closest approach (`CellClearance`'s `LayerClearance`).
-#[derive(Serialize, Debug, Clone, PartialEq)]
-pub(crate) struct ClosestData {
-    /// The layer's number (`LayerPoints::layer`).
-    pub layer: usize,
-    /// Closest approach (mm; `null` when no pair was measured).
-    pub distance_mm: Option<f64>,
-    /// The two bodies, as the check names them.
-    pub pair: Option<[String; 2]>,
-}
-
-/// A collision refusal (`ProgramError::Collision`).
-#[derive(Serialize)]
-struct CollisionData {
-    /// Index of the layer in the plan (`f_layer`'s numbering), `null` if
-    /// the refused layer is not one of the plan's.
-    layer_index: Option<usize>,
-    layer: usize,
-    point: Option<usize>,
-    motion: &'static str,
-    body_a: String,
-    body_b: String,
-    distance_mm: f64,
-    clearance_mm: f64,
-    /// The refusal's message.
-    text: String,
-}
-
-/// `value` as JSON text that can sit inside a `<script>` element: `<`, `>`,
-/// `&` and the line separators U+2028/U+2029 (only ever inside strings) are
-/// written as `\u00XX` escapes. Non-finite numbers are `null`.
-pub(crate) fn script_safe_json(value: &impl Serialize) -> Result<String, ReportError> {
-    let text =
-        serde_json::to_string(value).map_err(|e| ReportError::Encode(std::sync::Arc::new(e)))?;
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '<' | '>' | '&' | '\u{2028}' | '\u{2029}' => {
-                out.push_str(&format!("\\u{:04x}", c as u32));
-            }
-            c => out.push(c),
-        }
-    }
-    Ok(out)
-}
-
 /// Smallest distance of `q` to its joint limits (rad; negative outside),
 /// unlimited joints left out; `+inf` if every joint is unlimited.
 pub(crate) fn limit_margin_rad(robot: &crate::robot::model::RobotModel, q: &[f64; 6]) -> f64 {
@@ -570,87 +387,6 @@ pub(crate) fn limit_margin_rad(robot: &crate::robot::model::RobotModel, q: &[f64
         .filter(|(l, _)| !l.is_unlimited())
         .map(|(l, v)| (v - l.lower_rad).min(l.upper_rad - v))
         .fold(f64::INFINITY, f64::min)
-}
-
-/// Triangles (part frame, mm, 9 floats each) of the substrate around the
-/// drawn points `pos` (xyz triples), and a note when it is not drawn.
-pub(super) fn substrate_triangles(
-    substrate: Option<&Substrate>,
-    pos: &[f32],
-) -> (Option<Vec<f32>>, Option<&'static str>) {
-    let Some(substrate) = substrate else {
-        return (None, None);
-    };
-    let pts: Vec<Point3> = pos
-        .chunks_exact(3)
-        .map(|c| Point3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])))
-        .collect();
-    let mut lo = Vector3::repeat(f64::INFINITY);
-    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for p in &pts {
-        lo = lo.inf(&p.coords);
-        hi = hi.sup(&p.coords);
-    }
-    let centre = Point3::from((lo + hi) * 0.5);
-    let size = (hi - lo).max().max(1.0);
-    let mut tris: Vec<f32> = vec![];
-    let mut push = |a: Point3, b: Point3, c: Point3| {
-        for p in [a, b, c] {
-            tris.extend([p.x as f32, p.y as f32, p.z as f32]);
-        }
-    };
-    match substrate {
-        Substrate::Plane { point, normal } => {
-            let n = normal.into_inner();
-            let c = centre - n * (centre - point).dot(&n);
-            let u = n.cross(&if n.x.abs() < 0.9 {
-                Vector3::x()
-            } else {
-                Vector3::y()
-            });
-            let u = u.normalize() * (0.75 * size);
-            let v = n.cross(&u);
-            let q = [c - u - v, c + u - v, c + u + v, c - u + v];
-            push(q[0], q[1], q[2]);
-            push(q[0], q[2], q[3]);
-        }
-        Substrate::Cylinder {
-            axis_point,
-            axis,
-            radius,
-        } => {
-            let a = axis.into_inner();
-            let (mut s0, mut s1) = (f64::INFINITY, f64::NEG_INFINITY);
-            for p in &pts {
-                let s = (p - axis_point).dot(&a);
-                s0 = s0.min(s);
-                s1 = s1.max(s);
-            }
-            let margin = 0.25 * size;
-            let (s0, s1) = (s0 - margin, s1 + margin);
-            let u = a
-                .cross(&if a.x.abs() < 0.9 {
-                    Vector3::x()
-                } else {
-                    Vector3::y()
-                })
-                .normalize();
-            let v = a.cross(&u);
-            let n = 48;
-            let ring = |k: usize, s: f64| {
-                let th = std::f64::consts::TAU * k as f64 / n as f64;
-                axis_point + a * s + (u * th.cos() + v * th.sin()) * *radius
-            };
-            for k in 0..n {
-                let (p0, p1) = (ring(k, s0), ring(k + 1, s0));
-                let (p2, p3) = (ring(k + 1, s1), ring(k, s1));
-                push(p0, p1, p2);
-                push(p0, p2, p3);
-            }
-        }
-        Substrate::Mesh(_) => return (None, Some("The mesh substrate is not drawn.")),
-    }
-    (Some(tris), None)
 }
 
 /// The plan part of the data: cell, limits and the cell at every frame.
@@ -862,7 +598,7 @@ pub(crate) fn closest_per_layer(pv: &PlanView) -> Vec<ClosestData> {
 
 fn collision_data(pv: &PlanView) -> Option<CollisionData> {
     let e = pv.refusal?;
-    let c = crate::pipeline::summary::CollisionSummary::of(e)?;
+    let c = CollisionSummary::of(e)?;
     let [body_a, body_b] = c.bodies;
     Some(CollisionData {
         layer_index: pv.layers.iter().position(|l| l.layer == c.layer),

@@ -2,8 +2,9 @@
 //! joint frame origins from the library's forward kinematics, the torch, the
 //! positioner and the pose of the part (robot base frame, mm).
 
-use crate::math::{Isometry3, Point3, Rotation3, Vector3};
-use crate::robot::model::{Joints, RobotModel};
+use crate::math::{Isometry3, Point3, Vector3};
+use crate::robot::chain::arm_chain;
+use crate::robot::model::Joints;
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::CellLayout;
 
@@ -30,27 +31,6 @@ pub struct CellSnapshot {
 
 /// Length of the drawn torch body (mm).
 pub const TORCH_LENGTH_MM: f64 = 180.0;
-
-/// Joint frame origins of `robot` at controller joints `q` (rad), base frame (mm).
-pub fn arm_chain(robot: &RobotModel, q: &Joints) -> [Point3; 7] {
-    let g = &robot.geometry;
-    let s = robot.chain_state(q);
-    let t = s.angles.0;
-    let rz = Rotation3::from_axis_angle(&Vector3::z_axis(), t[0]);
-    let (s3, c3) = t[2].sin_cos();
-    let shoulder = s.axis_points[1];
-    let elbow = s.axis_points[2];
-    let offset_end = elbow + rz * Vector3::new(g.elbow_offset_mm * s3, 0.0, g.elbow_offset_mm * c3);
-    [
-        Point3::origin(),
-        Point3::new(0.0, 0.0, g.shoulder_height_mm),
-        shoulder,
-        elbow,
-        offset_end,
-        s.wrist_centre,
-        Point3::from(s.base_from_flange.translation.vector),
-    ]
-}
 
 /// The cell at one point: joints `q` (rad, `None` when the plan has none),
 /// positioner joints `e` (rad), the point `m` and tool axis of the point for

@@ -6,13 +6,12 @@
 //! encodings as the path's page: the page data's path is the fitted guide
 //! (one layer) and its `fit` object holds the mesh.
 
-use serde::Serialize;
-
-use super::build::{script_safe_json, substrate_triangles, FieldData, PageData};
 use super::encode::{f32s, i8s, u32s, unit_i8};
+use super::page::{script_safe_json, stride, FieldData, FitData, PageData};
+use super::substrate::substrate_triangles;
 use super::ReportError;
 use crate::fit::section::plane_basis;
-use crate::fit::{FitReport, TubeFit, TubeMesh};
+use crate::fit::{TubeFit, TubeMesh};
 use crate::geometry::guide::GuideCurve;
 use crate::geometry::Substrate;
 use crate::math::{Point3, UnitVector3, Vector3};
@@ -54,24 +53,6 @@ impl<'a> FitReportInput<'a> {
             max_triangles: 400_000,
         }
     }
-}
-
-/// The `fit` object of the page data: the mesh (base64 typed arrays, mesh
-/// frame, mm), the fitted surface's triangles and the fit report.
-#[derive(Serialize)]
-pub(super) struct FitData<'a> {
-    file: &'a str,
-    vertices_total: usize,
-    triangles_total: usize,
-    triangles_shown: usize,
-    triangle_stride: usize,
-    /// Base64 `Float32Array`: every vertex, xyz (mm).
-    vertices: String,
-    /// Base64 `Uint32Array`: the drawn triangles' vertex indices.
-    triangles: String,
-    /// Base64 `Float32Array`: triangles of the fitted surface (9 floats each).
-    tube: String,
-    report: &'a FitReport,
 }
 
 /// Triangles (9 floats each, mm) of the fitted surface: rings along the
@@ -133,7 +114,7 @@ fn tube_triangles(fit: &TubeFit) -> Vec<f32> {
 fn mesh_substrate_triangles(sub: &Substrate, max: usize) -> Option<Vec<f32>> {
     let Substrate::Mesh(m) = sub else { return None };
     let tris = m.triangles();
-    let k = super::build::stride(tris.len(), max);
+    let k = stride(tris.len(), max);
     Some(
         tris.iter()
             .step_by(k)
@@ -223,7 +204,7 @@ pub(super) fn fit_data(input: &FitReportInput) -> Result<String, ReportError> {
         });
     }
     let total = mesh.triangles.len();
-    let k = super::build::stride(total, input.max_triangles);
+    let k = stride(total, input.max_triangles);
     let drawn: Vec<u32> = mesh
         .triangles
         .iter()

@@ -60,6 +60,8 @@ mod build;
 pub mod cell_view;
 mod encode;
 mod fit_page;
+mod page;
+mod substrate;
 
 use crate::geometry::Substrate;
 use crate::optimise::{LayerPoints, Plan};

@@ -1,11 +1,11 @@
-use super::build::script_safe_json;
-use super::build::{kept, stride};
-use super::cell_view::{arm_chain, snapshot};
+use super::cell_view::snapshot;
 use super::encode::base64;
+use super::page::{kept, script_safe_json, stride};
 use super::*;
 use crate::io::cell_file::read_cell_file;
 use crate::math::{Point3, UnitVector3, Vector3};
 use crate::path::{Layer, PathPoint, SliceReport, Strategy};
+use crate::robot::chain::arm_chain;
 use crate::robot::CellPoint;
 
 fn cell(name: &str) -> CellLayout {

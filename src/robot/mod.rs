@@ -8,6 +8,7 @@
 //! |---|---|---|
 //! | arm as data, presets | [`model`] | [`RobotModel`], [`RobotModel::arcmate_120ic_nominal`], [`RobotModel::validate`] |
 //! | forward kinematics | [`kinematics`] | [`RobotModel::flange_pose`] |
+//! | the arm's joint frame origins (the chain the cell check and the report draw) | [`chain`] | [`chain::arm_chain`] |
 //! | inverse kinematics, FANUC configurations | [`ik`] | [`RobotModel::inverse`], [`RobotModel::inverse_all`], [`Configuration`] |
 //! | Jacobian | [`jacobian`] | [`RobotModel::jacobian`] |
 //! | indices (eq. 1.4–1.8, 4.10–4.12) | [`indices`] | [`indices::dexterity`], [`indices::positioning_uncertainty`] |
@@ -35,6 +36,7 @@
 
 pub mod calibration;
 pub mod cell;
+pub mod chain;
 pub mod controller;
 mod error;
 pub mod ik;

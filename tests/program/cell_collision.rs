@@ -8,7 +8,7 @@ use crate::shared::part_path;
 use waam_slicer::math::{Isometry3, Point3, Translation3, Vector3};
 use waam_slicer::program::cell_check::{check_cell, CellScene, KeepOut};
 use waam_slicer::program::ProgramError;
-use waam_slicer::report::cell_view::arm_chain;
+use waam_slicer::robot::chain::arm_chain;
 use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions};
 use waam_slicer::robot::CellLayout;
 use waam_slicer::{plan_part, Cell, Part, PlanOptions, PlannedPart, SliceOverrides};

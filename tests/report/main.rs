@@ -541,7 +541,7 @@ fn report_data_holds_the_closest_pair_of_every_layer() {
 /// draws the box.
 fn refused_part() -> waam_slicer::PlannedPart {
     use waam_slicer::program::cell_check::{check_cell, CellScene, KeepOut};
-    use waam_slicer::report::cell_view::arm_chain;
+    use waam_slicer::robot::chain::arm_chain;
     use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions};
     let mut p = planned_part("robowam_part_carried");
     let inputs = waam_slicer::optimise::trajectory_inputs(&p.layers, &p.plan);
