@@ -12,18 +12,23 @@
 //! (`ActUnit` before the first, `DeactUnit` after the last), and the
 //! `seamdata` gas times against the options.
 
+use std::collections::HashMap;
 use std::f64::consts::TAU;
 
 use crate::math::{Isometry3, Point3};
-use crate::program::abb::read::{RapidFrame, RapidModule, ToolArg};
-use crate::program::abb::{AbbOptions, PREDEFINED_ZONES_MM};
+use crate::program::abb::read::{RapidModule, RapidOp, RapidTarget, RapidTargetValue};
+use crate::program::abb::AbbOptions;
 use crate::program::MoveKind;
 use crate::program::ProcessControl;
-use crate::robot::{CellLayout, Configuration};
+use crate::robot::{CellLayout, Configuration, Joints};
 
 use crate::program::validate::ProblemKind;
 use crate::program::validate::{arm_of, wrist_of_j5};
 use crate::program::validate::{decode_pose, push, Motion, MotionSpeed, Step, ValidationReport};
+
+mod declarations;
+
+use declarations::{check_declared, check_gas_times, check_motion_args, check_scope, Decls};
 
 /// The value of `q` (its solution in `(-π, π]`) shifted by whole turns to
 /// lie in ABB quadrant `cf` (`floor(q / 90°)`), `None` if more than 1e-6 rad
@@ -240,248 +245,6 @@ fn file_frames(
     Some(frames)
 }
 
-/// The module's names (pushed as [`ProblemKind::Declaration`] problems at
-/// their line): `MODULE MOD_<program>`; one routine, the entry routine,
-/// global and named `<program>` (never `main`, the task's own); every data
-/// declaration `LOCAL`, so that nothing in the module clashes with a global
-/// of the task it is loaded into (RAPID reference, "Basic Characteristics",
-/// §3.1 and §5.1: a `LOCAL` name hides a global one). Names are compared
-/// without case, as RAPID does.
-fn check_scope(module: &RapidModule, report: &mut ValidationReport) {
-    use crate::program::abb::MODULE_PREFIX;
-    let file = &module.file;
-    let program = module
-        .name
-        .strip_prefix(MODULE_PREFIX)
-        .filter(|p| !p.is_empty());
-    if program.is_none() {
-        push(
-            report,
-            ProblemKind::Declaration,
-            file,
-            module.line,
-            format!(
-                "MODULE {}: expected MODULE {MODULE_PREFIX}<program> (the entry routine takes the program's name, which its module cannot share)",
-                module.name
-            ),
-        );
-    }
-    let entry = module.routines.iter().position(|r| !r.local);
-    match entry.map(|k| &module.routines[k]) {
-        None => push(
-            report,
-            ProblemKind::Declaration,
-            file,
-            module.line,
-            format!(
-                "no global routine: the entry routine {} must be global (the task's main calls it)",
-                program.unwrap_or("<program>")
-            ),
-        ),
-        Some(r) if r.name.eq_ignore_ascii_case("main") => push(
-            report,
-            ProblemKind::Declaration,
-            file,
-            r.line,
-            format!(
-                "PROC {}: clashes with the task's own main; the entry routine is named after the program ({})",
-                r.name,
-                program.unwrap_or("<program>")
-            ),
-        ),
-        Some(r) => {
-            if let Some(p) = program.filter(|p| !r.name.eq_ignore_ascii_case(p)) {
-                push(
-                    report,
-                    ProblemKind::Declaration,
-                    file,
-                    r.line,
-                    format!(
-                        "entry routine {} is not named after the module's program {p} (MODULE {})",
-                        r.name, module.name
-                    ),
-                );
-            }
-        }
-    }
-    // without a global routine the first one stands for the entry routine
-    let first = entry.or((!module.routines.is_empty()).then_some(0));
-    for (k, r) in module.routines.iter().enumerate() {
-        if Some(k) == first {
-            continue;
-        }
-        let scope = if r.local { "LOCAL PROC" } else { "global PROC" };
-        push(
-            report,
-            ProblemKind::Declaration,
-            file,
-            r.line,
-            format!(
-                "{scope} {}: the module holds one routine, its entry routine{}",
-                r.name,
-                first.map_or(String::new(), |e| format!(
-                    " {} (line {})",
-                    module.routines[e].name, module.routines[e].line
-                ))
-            ),
-        );
-    }
-    for d in &module.declarations {
-        if d.scope.as_deref() != Some("LOCAL") {
-            let scope = d
-                .scope
-                .as_deref()
-                .map_or(String::new(), |s| format!("{s} "));
-            push(
-                report,
-                ProblemKind::Declaration,
-                file,
-                d.line,
-                format!(
-                    "{scope}{} {} {} is not LOCAL: a global would clash with the task's own {} (only the entry routine is global)",
-                    d.storage, d.ty, d.name, d.name
-                ),
-            );
-        }
-    }
-}
-
-/// The `seamdata` gas times against [`AbbOptions::purge_time_s`],
-/// [`AbbOptions::preflow_time_s`] and [`AbbOptions::postflow_time_s`]
-/// (written to the ms): an [`ProblemKind::Options`] problem at the
-/// declaration for each that differs.
-fn check_gas_times(module: &RapidModule, opts: &AbbOptions, report: &mut ValidationReport) {
-    for s in &module.seams {
-        for (component, read, field, want) in [
-            (
-                "purge_time",
-                s.purge_time_s,
-                "purge_time_s",
-                opts.purge_time_s,
-            ),
-            (
-                "preflow_time",
-                s.preflow_time_s,
-                "preflow_time_s",
-                opts.preflow_time_s,
-            ),
-            (
-                "postflow_time",
-                s.postflow_time_s,
-                "postflow_time_s",
-                opts.postflow_time_s,
-            ),
-        ] {
-            // written with 3 decimals
-            if !((read - want).abs() <= 5e-4 + 1e-9) {
-                push(
-                    report,
-                    ProblemKind::Options,
-                    &module.file,
-                    s.line,
-                    format!(
-                        "{}: {component} {read} s, the options give {field} = {want} s",
-                        s.name
-                    ),
-                );
-            }
-        }
-    }
-}
-
-/// The module's declarations by name.
-type Decls<'a> = std::collections::HashMap<&'a str, &'a crate::program::abb::read::RapidDecl>;
-
-/// Pushes a Declaration problem unless `name` is declared with type `ty`
-/// (or `predefined`); `true` when it is.
-fn check_declared(
-    module: &RapidModule,
-    decls: &Decls,
-    name: &str,
-    ty: &str,
-    predefined: bool,
-    line: usize,
-    report: &mut ValidationReport,
-) -> bool {
-    if predefined {
-        return true;
-    }
-    match decls.get(name) {
-        Some(d) if d.ty == ty => true,
-        Some(d) => {
-            push(
-                report,
-                ProblemKind::Declaration,
-                &module.file,
-                line,
-                format!("{name} is a {} (line {}), not a {ty}", d.ty, d.line),
-            );
-            false
-        }
-        None => {
-            push(
-                report,
-                ProblemKind::Declaration,
-                &module.file,
-                line,
-                format!("{ty} {name} is not declared in the module"),
-            );
-            false
-        }
-    }
-}
-
-/// Checks a motion's zone, tool and work object identifiers.
-fn check_motion_args(
-    module: &RapidModule,
-    decls: &Decls,
-    zone: &str,
-    tool: &ToolArg,
-    line: usize,
-    report: &mut ValidationReport,
-) {
-    let predefined_zone = zone == "fine"
-        || zone
-            .strip_prefix('z')
-            .and_then(|n| n.parse::<u32>().ok())
-            .is_some_and(|n| PREDEFINED_ZONES_MM.contains(&n));
-    check_declared(
-        module,
-        decls,
-        zone,
-        "zonedata",
-        predefined_zone,
-        line,
-        report,
-    );
-    check_declared(module, decls, &tool.tool, "tooldata", false, line, report);
-    let frame_of = |f: &Option<RapidFrame>| f.as_ref().map(|f| f.name.clone());
-    if frame_of(&module.tool).as_deref() != Some(tool.tool.as_str())
-        && decls.contains_key(tool.tool.as_str())
-    {
-        push(
-            report,
-            ProblemKind::Frame,
-            &module.file,
-            line,
-            format!("tool {} is not the module's tool", tool.tool),
-        );
-    }
-    match &tool.wobj {
-        Some(w) => {
-            check_declared(module, decls, w, "wobjdata", false, line, report);
-        }
-        None => push(
-            report,
-            ProblemKind::Frame,
-            &module.file,
-            line,
-            "motion without \\WObj: the controller would use wobj0, not the module's work object"
-                .into(),
-        ),
-    }
-}
-
 /// Validates an ABB module read by
 /// [`parse_mod`](crate::program::abb::read::parse_mod) against `cell`
 /// with the options `opts`; the frames are the file's own `tooldata` and
@@ -517,7 +280,6 @@ pub(crate) fn abb_steps(
     opts: &AbbOptions,
     report: &mut ValidationReport,
 ) -> Option<Vec<Step>> {
-    use crate::program::abb::read::{RapidOp, RapidTargetValue};
     let file = &module.file;
     let slots = match opts.positioner_slots() {
         Ok(s) => s,
@@ -526,278 +288,408 @@ pub(crate) fn abb_steps(
             return None;
         }
     };
-    let robot = cell.robot();
     check_scope(module, report);
     check_gas_times(module, opts, report);
-    let frames = file_frames(module, cell, opts, report);
-    let decls: Decls = module
-        .declarations
-        .iter()
-        .map(|d| (d.name.as_str(), d))
-        .collect();
-    let targets: std::collections::HashMap<&str, _> = module
-        .targets
-        .iter()
-        .map(|t| (t.name.as_str(), t))
-        .collect();
-    let (start, schedule) = match &opts.process {
-        ProcessControl::Arc { schedule } => (None, Some(*schedule)),
-        ProcessControl::Custom { start, end } => (Some((start.clone(), end.clone())), None),
-    };
-    let mut steps = Vec::new();
-    let mut conf_l = false;
-    let mut prev_positioner: Option<[f64; 2]> = None;
-    let mut unit = UnitState::new(matches!(cell, CellLayout::TorchCarried(_)));
+    let mut d = Decoder::new(module, cell, opts, slots, report);
     for ins in &module.instructions {
         let line = ins.line;
         if matches!(ins.op, RapidOp::MoveAbsJ { .. } | RapidOp::Linear { .. }) {
-            unit.motion(file, line, &opts.ufmec, report);
+            d.unit.motion(file, line, &opts.ufmec, report);
         }
-        let wait = |seconds, input| Step::Wait {
-            file: file.clone(),
-            line,
-            seconds,
-            input,
+        match &ins.op {
+            RapidOp::ConfL(on) => d.conf_l = *on,
+            RapidOp::WaitTime(t) => d.steps.push(Step::Wait {
+                file: file.clone(),
+                line,
+                seconds: Some(*t),
+                input: None,
+            }),
+            RapidOp::WaitDi { signal, value } => d.wait_di(signal, *value, line, report),
+            RapidOp::ActUnit(u) | RapidOp::DeactUnit(u) => {
+                let act = matches!(ins.op, RapidOp::ActUnit(_));
+                d.unit.switch(act, u, file, line, &opts.ufmec, report);
+            }
+            RapidOp::GripLoad(name) => d.grip_load(name, line, report),
+            RapidOp::Other(s) => d.custom_switch(s, line, report),
+            RapidOp::MoveAbsJ { target, zone, tool } => {
+                check_motion_args(module, &d.decls, zone, tool, line, report);
+                d.move_to(
+                    target,
+                    MoveKind::Joint,
+                    line,
+                    MotionSpeed::Joint,
+                    None,
+                    report,
+                );
+            }
+            RapidOp::Linear { .. } => d.linear(&ins.op, line, report),
+        }
+    }
+    d.unit.end(file, &opts.ufmec, report);
+    Some(d.steps)
+}
+
+/// What [`abb_steps`] carries from instruction to instruction.
+struct Decoder<'a> {
+    module: &'a RapidModule,
+    cell: &'a CellLayout,
+    opts: &'a AbbOptions,
+    /// The positioner's two axes among `eax_a` .. `eax_f`.
+    slots: [usize; 2],
+    /// The file's tool and work object (`None` when unusable, reported).
+    frames: Option<FileFrames>,
+    decls: Decls<'a>,
+    targets: HashMap<&'a str, &'a RapidTarget>,
+    /// The custom process's start and end instructions.
+    start: Option<(String, String)>,
+    /// The arc process's weld schedule.
+    schedule: Option<u32>,
+    steps: Vec<Step>,
+    /// `ConfL \On` in force.
+    conf_l: bool,
+    /// The positioner joints (rad) of the last motion's end.
+    prev_positioner: Option<[f64; 2]>,
+    unit: UnitState,
+}
+
+impl<'a> Decoder<'a> {
+    fn new(
+        module: &'a RapidModule,
+        cell: &'a CellLayout,
+        opts: &'a AbbOptions,
+        slots: [usize; 2],
+        report: &mut ValidationReport,
+    ) -> Self {
+        let frames = file_frames(module, cell, opts, report);
+        let decls: Decls = module
+            .declarations
+            .iter()
+            .map(|d| (d.name.as_str(), d))
+            .collect();
+        let targets: HashMap<&str, _> = module
+            .targets
+            .iter()
+            .map(|t| (t.name.as_str(), t))
+            .collect();
+        let (start, schedule) = match &opts.process {
+            ProcessControl::Arc { schedule } => (None, Some(*schedule)),
+            ProcessControl::Custom { start, end } => (Some((start.clone(), end.clone())), None),
         };
-        let motion = match &ins.op {
-            RapidOp::ConfL(on) => {
-                conf_l = *on;
-                continue;
+        Self {
+            module,
+            cell,
+            opts,
+            slots,
+            frames,
+            decls,
+            targets,
+            start,
+            schedule,
+            steps: Vec::new(),
+            conf_l: false,
+            prev_positioner: None,
+            unit: UnitState::new(matches!(cell, CellLayout::TorchCarried(_))),
+        }
+    }
+
+    /// The module's file name.
+    fn file(&self) -> &'a String {
+        &self.module.file
+    }
+
+    /// `WaitDI signal, value`: the interpass wait (a [`Step::Wait`] for
+    /// `[program] interpass_input`).
+    fn wait_di(&mut self, signal: &str, value: u8, line: usize, report: &mut ValidationReport) {
+        let (file, opts) = (self.file(), self.opts);
+        if signal != opts.interpass_signal {
+            push(
+                report,
+                ProblemKind::Declaration,
+                file,
+                line,
+                format!(
+                    "signal {signal} is neither declared in the module nor the options' controller signal (interpass_signal = {})",
+                    opts.interpass_signal
+                ),
+            );
+        } else if value != 1 {
+            push(
+                report,
+                ProblemKind::Instruction,
+                file,
+                line,
+                format!("WaitDI {signal}, {value}: the interpass wait waits for 1"),
+            );
+        } else {
+            match opts.common.interpass_input {
+                Some(n) => self.steps.push(Step::Wait {
+                    file: file.clone(),
+                    line,
+                    seconds: None,
+                    input: Some(n),
+                }),
+                None => push(
+                    report,
+                    ProblemKind::Options,
+                    file,
+                    line,
+                    format!("WaitDI {signal}: the options have no interpass_input"),
+                ),
             }
-            RapidOp::WaitTime(t) => {
-                steps.push(wait(Some(*t), None));
-                continue;
-            }
-            RapidOp::WaitDi { signal, value } => {
-                if *signal != opts.interpass_signal {
+        }
+    }
+
+    /// `GripLoad name`: a [`Step::Payload`], its centre of gravity back in
+    /// the flange frame.
+    fn grip_load(&mut self, name: &str, line: usize, report: &mut ValidationReport) {
+        let module = self.module;
+        let load = if name == "load0" {
+            Some(crate::program::abb::LOAD0).map(|l| (l.mass_kg, Point3::from(l.cog_mm)))
+        } else if check_declared(module, &self.decls, name, "loaddata", false, line, report) {
+            module
+                .loads
+                .iter()
+                .find(|(n, _, _)| n == name)
+                .map(|(_, _, l)| (l.mass_kg, l.cog_mm))
+        } else {
+            None
+        };
+        if let (Some((mass_kg, cog)), Some(f)) = (load, &self.frames) {
+            self.steps.push(Step::Payload {
+                file: module.file.clone(),
+                line,
+                mass_kg,
+                cog_mm: f.flange_from_payload_frame() * cog,
+            });
+        }
+    }
+
+    /// Any other instruction: the custom process's start or end.
+    fn custom_switch(&mut self, s: &str, line: usize, report: &mut ValidationReport) {
+        let file = self.file();
+        match &self.start {
+            Some((a, _)) if s == a => self.steps.push(Step::ProcessOn {
+                file: file.clone(),
+                line,
+            }),
+            Some((_, b)) if s == b => self.steps.push(Step::ProcessOff {
+                file: file.clone(),
+                line,
+            }),
+            _ => push(
+                report,
+                ProblemKind::Instruction,
+                file,
+                line,
+                format!("unexpected instruction `{s}`"),
+            ),
+        }
+    }
+
+    /// A linear or circular move (`MoveL`, `MoveC`, ArcWare's `ArcL…`,
+    /// `ArcC…`): its targets as motion steps at the speed the controller
+    /// runs them, then the arc switched on or off by it.
+    fn linear(&mut self, op: &RapidOp, line: usize, report: &mut ValidationReport) {
+        let RapidOp::Linear {
+            instruction,
+            via,
+            target,
+            speed_mm_s,
+            v_reax_deg_s,
+            seam,
+            weld,
+            time_s,
+            zone,
+            tool,
+        } = op
+        else {
+            return;
+        };
+        check_motion_args(self.module, &self.decls, zone, tool, line, report);
+        let arc = !instruction.starts_with("Move");
+        let mut v = *speed_mm_s;
+        if arc {
+            v = self.weld_speed(
+                instruction,
+                seam.as_deref(),
+                weld.as_deref(),
+                v,
+                line,
+                report,
+            );
+        }
+        let event = match instruction.as_str() {
+            "ArcLStart" => Some(true),
+            "ArcLEnd" | "ArcCEnd" => Some(false),
+            _ => None,
+        };
+        let speed = self.linear_speed(*time_s, v, *v_reax_deg_s);
+        // a circular move's circle point first, as its own step
+        let moves_to = match via {
+            Some(c) => vec![(c, MoveKind::Via), (target, MoveKind::Circular)],
+            None => vec![(target, MoveKind::Linear)],
+        };
+        let v_reax_time = time_s.map(|t| (t, *v_reax_deg_s));
+        for (target, kind) in moves_to {
+            self.move_to(target, kind, line, speed, v_reax_time, report);
+        }
+        let file = self.file();
+        match event {
+            Some(true) => self.steps.push(Step::ProcessOn {
+                file: file.clone(),
+                line,
+            }),
+            Some(false) => self.steps.push(Step::ProcessOff {
+                file: file.clone(),
+                line,
+            }),
+            None => {}
+        }
+    }
+
+    /// An ArcWare move's `seamdata` and `welddata` checked; the speed
+    /// (mm/s) it runs at: the `welddata`'s weld speed, else `v` (the
+    /// speeddata's `v_tcp`).
+    fn weld_speed(
+        &self,
+        instruction: &str,
+        seam: Option<&str>,
+        weld: Option<&str>,
+        mut v: f64,
+        line: usize,
+        report: &mut ValidationReport,
+    ) -> f64 {
+        let (module, file, decls) = (self.module, self.file(), &self.decls);
+        if self.start.is_some() {
+            push(
+                report,
+                ProblemKind::Options,
+                file,
+                line,
+                format!("{instruction}: the options give a custom process"),
+            );
+        }
+        if let Some(s) = seam {
+            check_declared(module, decls, s, "seamdata", false, line, report);
+        }
+        let wd = weld.unwrap_or("");
+        if check_declared(module, decls, wd, "welddata", false, line, report) {
+            let d = module.welds.iter().find(|d| d.name == wd);
+            if let (Some(d), Some(sched)) = (d, self.schedule) {
+                if d.sched != sched as f64 {
                     push(
                         report,
-                        ProblemKind::Declaration,
+                        ProblemKind::Options,
                         file,
                         line,
                         format!(
-                            "signal {signal} is neither declared in the module nor the options' controller signal (interpass_signal = {})",
-                            opts.interpass_signal
+                            "{instruction} with {wd}: schedule {} (main_arc.sched, line {}), the options give {sched}",
+                            d.sched, d.line
                         ),
                     );
-                } else if *value != 1 {
+                }
+            }
+            // ArcWare runs arc-on moves at weld_speed
+            if let (Some(d), true) = (d, instruction != "ArcLStart") {
+                if (d.weld_speed_mm_s - v).abs() > 1e-9 {
                     push(
                         report,
-                        ProblemKind::Instruction,
+                        ProblemKind::Timing,
                         file,
                         line,
-                        format!("WaitDI {signal}, {value}: the interpass wait waits for 1"),
-                    );
-                } else {
-                    match opts.common.interpass_input {
-                        Some(n) => steps.push(wait(None, Some(n))),
-                        None => push(
-                            report,
-                            ProblemKind::Options,
-                            file,
-                            line,
-                            format!("WaitDI {signal}: the options have no interpass_input"),
+                        format!(
+                            "{instruction}: {wd}.weld_speed {} mm/s (line {}) differs from the speeddata's v_tcp {v} mm/s",
+                            d.weld_speed_mm_s, d.line
                         ),
-                    }
+                    );
                 }
-                continue;
+                v = d.weld_speed_mm_s;
             }
-            RapidOp::ActUnit(u) | RapidOp::DeactUnit(u) => {
-                let act = matches!(ins.op, RapidOp::ActUnit(_));
-                unit.switch(act, u, file, line, &opts.ufmec, report);
-                continue;
-            }
-            RapidOp::GripLoad(name) => {
-                let load = if name == "load0" {
-                    Some(crate::program::abb::LOAD0).map(|l| (l.mass_kg, Point3::from(l.cog_mm)))
-                } else if check_declared(module, &decls, name, "loaddata", false, line, report) {
-                    module
-                        .loads
-                        .iter()
-                        .find(|(n, _, _)| n == name)
-                        .map(|(_, _, l)| (l.mass_kg, l.cog_mm))
-                } else {
-                    None
-                };
-                if let (Some((mass_kg, cog)), Some(f)) = (load, &frames) {
-                    steps.push(Step::Payload {
-                        file: file.clone(),
-                        line,
-                        mass_kg,
-                        cog_mm: f.flange_from_payload_frame() * cog,
-                    });
-                }
-                continue;
-            }
-            RapidOp::Other(s) => {
-                match &start {
-                    Some((a, _)) if s == a => steps.push(Step::ProcessOn {
-                        file: file.clone(),
-                        line,
-                    }),
-                    Some((_, b)) if s == b => steps.push(Step::ProcessOff {
-                        file: file.clone(),
-                        line,
-                    }),
-                    _ => push(
-                        report,
-                        ProblemKind::Instruction,
-                        file,
-                        line,
-                        format!("unexpected instruction `{s}`"),
-                    ),
-                }
-                continue;
-            }
-            RapidOp::MoveAbsJ { target, zone, tool } => {
-                check_motion_args(module, &decls, zone, tool, line, report);
-                (vec![(target, MoveKind::Joint)], None, None, None)
-            }
-            RapidOp::Linear {
-                instruction,
-                via,
-                target,
-                speed_mm_s,
-                v_reax_deg_s,
-                seam,
-                weld,
-                time_s,
-                zone,
-                tool,
-            } => {
-                check_motion_args(module, &decls, zone, tool, line, report);
-                let arc = !instruction.starts_with("Move");
-                let mut v = *speed_mm_s;
-                if arc {
-                    if start.is_some() {
-                        push(
-                            report,
-                            ProblemKind::Options,
-                            file,
-                            line,
-                            format!("{instruction}: the options give a custom process"),
-                        );
-                    }
-                    if let Some(s) = seam {
-                        check_declared(module, &decls, s, "seamdata", false, line, report);
-                    }
-                    let wd = weld.as_deref().unwrap_or("");
-                    if check_declared(module, &decls, wd, "welddata", false, line, report) {
-                        let d = module.welds.iter().find(|d| d.name == wd);
-                        if let (Some(d), Some(sched)) = (d, schedule) {
-                            if d.sched != sched as f64 {
-                                push(
-                                    report,
-                                    ProblemKind::Options,
-                                    file,
-                                    line,
-                                    format!(
-                                        "{instruction} with {wd}: schedule {} (main_arc.sched, line {}), the options give {sched}",
-                                        d.sched, d.line
-                                    ),
-                                );
-                            }
+        }
+        v
+    }
+
+    /// The speed of a linear move at `v` mm/s (or in `time_s` s), its
+    /// external axes at most `v_reax_deg_s`, in the frame it holds in.
+    fn linear_speed(&self, time_s: Option<f64>, v: f64, v_reax_deg_s: f64) -> MotionSpeed {
+        match (time_s, &self.frames) {
+            (Some(t), _) => MotionSpeed::Time(t),
+            // v_tcp is the speed of the robot-held tool in the world
+            (
+                None,
+                Some(FileFrames::Held {
+                    flange_from_tool, ..
+                }),
+            ) => MotionSpeed::Tcp {
+                mm_s: v,
+                flange_from_tcp: *flange_from_tool,
+                extax_fraction: match self.cell {
+                    CellLayout::TorchCarried(c) => [0, 1].map(|n| {
+                        let max = c.positioner.max_speed_rad_s[n];
+                        if max.is_finite() && max > 0.0 {
+                            (v_reax_deg_s.to_radians() / max).min(1.0)
+                        } else {
+                            1.0
                         }
-                        // ArcWare runs arc-on moves at weld_speed
-                        if let (Some(d), true) = (d, instruction != "ArcLStart") {
-                            if (d.weld_speed_mm_s - v).abs() > 1e-9 {
-                                push(
-                                    report,
-                                    ProblemKind::Timing,
-                                    file,
-                                    line,
-                                    format!(
-                                        "{instruction}: {wd}.weld_speed {} mm/s (line {}) differs from the speeddata's v_tcp {v} mm/s",
-                                        d.weld_speed_mm_s, d.line
-                                    ),
-                                );
-                            }
-                            v = d.weld_speed_mm_s;
-                        }
-                    }
-                }
-                let event = match instruction.as_str() {
-                    "ArcLStart" => Some(true),
-                    "ArcLEnd" | "ArcCEnd" => Some(false),
-                    _ => None,
-                };
-                let speed = match (time_s, &frames) {
-                    (Some(t), _) => MotionSpeed::Time(*t),
-                    // v_tcp is the speed of the robot-held tool in the world
-                    (
-                        None,
-                        Some(FileFrames::Held {
-                            flange_from_tool, ..
-                        }),
-                    ) => MotionSpeed::Tcp {
-                        mm_s: v,
-                        flange_from_tcp: *flange_from_tool,
-                        extax_fraction: match cell {
-                            CellLayout::TorchCarried(c) => [0, 1].map(|n| {
-                                let max = c.positioner.max_speed_rad_s[n];
-                                if max.is_finite() && max > 0.0 {
-                                    (v_reax_deg_s.to_radians() / max).min(1.0)
-                                } else {
-                                    1.0
-                                }
-                            }),
-                            CellLayout::PartCarried(_) => [1.0; 2],
-                        },
-                    },
-                    // a stationary tool or a coordinated work object: v_tcp
-                    // is the torch's speed over the part
-                    (None, _) => MotionSpeed::Linear(v),
-                };
-                // a circular move's circle point first, as its own step
-                let moves_to = match via {
-                    Some(c) => vec![(c, MoveKind::Via), (target, MoveKind::Circular)],
-                    None => vec![(target, MoveKind::Linear)],
-                };
-                (
-                    moves_to,
-                    Some(speed),
-                    event,
-                    time_s.map(|t| (t, *v_reax_deg_s)),
-                )
-            }
+                    }),
+                    CellLayout::PartCarried(_) => [1.0; 2],
+                },
+            },
+            // a stationary tool or a coordinated work object: v_tcp
+            // is the torch's speed over the part
+            (None, _) => MotionSpeed::Linear(v),
+        }
+    }
+
+    /// A move of the instruction at `line` to `target` (`kind`) at
+    /// `speed`: a motion step, its joints decoded; a `\T` time with its
+    /// `v_reax` (s, deg/s) checked against the positioner's turn.
+    fn move_to(
+        &mut self,
+        target: &str,
+        kind: MoveKind,
+        line: usize,
+        speed: MotionSpeed,
+        v_reax_time: Option<(f64, f64)>,
+        report: &mut ValidationReport,
+    ) {
+        let file = self.file();
+        if kind == MoveKind::Linear && !self.conf_l {
+            push(
+                report,
+                ProblemKind::Configuration,
+                file,
+                line,
+                "linear move without `ConfL \\On`: the controller may change the configuration"
+                    .into(),
+            );
+        }
+        let Some(t) = self.targets.get(target).copied() else {
+            push(
+                report,
+                ProblemKind::Declaration,
+                file,
+                line,
+                format!("{target} is not declared"),
+            );
+            self.prev_positioner = None;
+            return;
         };
-        let (moves_to, speed, event, v_reax_time) = motion;
-        for (target, kind) in moves_to {
-            if kind == MoveKind::Linear && !conf_l {
+        let slots = self.slots;
+        let positioner = match (t.external[slots[0]], t.external[slots[1]]) {
+            (Some(a), Some(b)) => Some([a.to_radians(), b.to_radians()]),
+            _ => None,
+        };
+        // checked over the whole move, at its end (not at a circle point)
+        let v_reax_time = v_reax_time.filter(|_| kind != MoveKind::Via);
+        if let (Some((time, v_reax)), Some(a), Some(b)) =
+            (v_reax_time, positioner, self.prev_positioner)
+        {
+            // a controller running the move at weld_speed instead of \T
+            // is held back by v_reax only
+            let turn = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).to_degrees();
+            if turn / v_reax < time - 1e-3 {
                 push(
-                    report,
-                    ProblemKind::Configuration,
-                    file,
-                    line,
-                    "linear move without `ConfL \\On`: the controller may change the configuration"
-                        .into(),
-                );
-            }
-            let Some(t) = targets.get(target.as_str()).copied() else {
-                push(
-                    report,
-                    ProblemKind::Declaration,
-                    file,
-                    line,
-                    format!("{target} is not declared"),
-                );
-                prev_positioner = None;
-                continue;
-            };
-            let positioner = match (t.external[slots[0]], t.external[slots[1]]) {
-                (Some(a), Some(b)) => Some([a.to_radians(), b.to_radians()]),
-                _ => None,
-            };
-            // checked over the whole move, at its end (not at a circle point)
-            let v_reax_time = v_reax_time.filter(|_| kind != MoveKind::Via);
-            if let (Some((time, v_reax)), Some(a), Some(b)) =
-                (v_reax_time, positioner, prev_positioner)
-            {
-                // a controller running the move at weld_speed instead of \T
-                // is held back by v_reax only
-                let turn = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).to_degrees();
-                if turn / v_reax < time - 1e-3 {
-                    push(
                     report,
                     ProblemKind::Timing,
                     file,
@@ -807,116 +699,118 @@ pub(crate) fn abb_steps(
                         turn / v_reax
                     ),
                 );
-                }
             }
-            if kind != MoveKind::Via {
-                prev_positioner = positioner;
+        }
+        if kind != MoveKind::Via {
+            self.prev_positioner = positioner;
+        }
+        let (joints, from_cartesian) = match (&t.value, kind) {
+            (RapidTargetValue::Joint(a), MoveKind::Joint) => (Some(a.map(f64::to_radians)), false),
+            (
+                RapidTargetValue::Rob { pose, conf },
+                MoveKind::Linear | MoveKind::Via | MoveKind::Circular,
+            ) => (
+                self.decode_robtarget(t, pose, conf, positioner, report),
+                true,
+            ),
+            _ => {
+                push(
+                    report,
+                    ProblemKind::Declaration,
+                    file,
+                    line,
+                    format!("{target}: wrong target type for this instruction"),
+                );
+                return;
             }
-            let (joints, from_cartesian) = match (&t.value, kind) {
-                (RapidTargetValue::Joint(a), MoveKind::Joint) => {
-                    (Some(a.map(f64::to_radians)), false)
-                }
-                (
-                    RapidTargetValue::Rob { pose, conf },
-                    MoveKind::Linear | MoveKind::Via | MoveKind::Circular,
-                ) => {
-                    // cfx bit 2: wrist centre behind axis 1; bit 1: behind the
-                    // lower arm, the elbow joint test (abb::confdata)
-                    let (side, elbow) = arm_of(conf[3] & 4 != 0, conf[3] & 2 == 0);
-                    let cfg = Configuration {
-                        wrist: wrist_of_j5(robot, conf[3] & 1 == 0),
-                        elbow,
-                        side,
-                    };
-                    if !(0..8).contains(&conf[3]) || cfg != cell.configuration() {
-                        push(
-                        report, ProblemKind::Configuration,
-                        file,
-                        t.line,
-                        format!(
-                            "{}: cfx {} is configuration '{cfg}', not the cell's '{}' (configuration flip)",
-                            t.name,
-                            conf[3],
-                            cell.configuration()
-                        ),
-                    );
-                    }
-                    let f = frames.and_then(|f| {
-                        let at = f.at(cell, positioner);
-                        if at.is_none() {
-                            push(
-                                report,
-                                ProblemKind::Format,
-                                file,
-                                t.line,
-                                format!(
-                                    "{}: no positioner values for the coordinated work object",
-                                    t.name
-                                ),
-                            );
-                        }
-                        at
-                    });
-                    let q = f.and_then(|f| {
-                        decode_pose(
-                            robot,
-                            &f.flange(pose),
-                            cfg,
-                            |j, q| {
-                                let cf = match j {
-                                    0 => conf[0],
-                                    3 => conf[1],
-                                    _ => conf[2],
-                                };
-                                abb_quadrant(q, cf)
-                            },
-                            &t.name,
-                            file,
-                            t.line,
-                            report,
-                        )
-                    });
-                    (q, true)
-                }
-                _ => {
-                    push(
-                        report,
-                        ProblemKind::Declaration,
-                        file,
-                        line,
-                        format!("{target}: wrong target type for this instruction"),
-                    );
-                    continue;
-                }
-            };
-            steps.push(Step::Motion(Box::new(Motion {
-                file: file.clone(),
-                line,
-                label: t.name.clone(),
-                record_file: file.clone(),
-                record_line: t.line,
-                value_lines: [t.line; 6],
-                joints,
-                from_cartesian,
-                positioner,
-                kind,
-                speed: speed.unwrap_or(MotionSpeed::Joint),
-            })));
-        }
-        match event {
-            Some(true) => steps.push(Step::ProcessOn {
-                file: file.clone(),
-                line,
-            }),
-            Some(false) => steps.push(Step::ProcessOff {
-                file: file.clone(),
-                line,
-            }),
-            None => {}
-        }
+        };
+        self.steps.push(Step::Motion(Box::new(Motion {
+            file: file.clone(),
+            line,
+            label: t.name.clone(),
+            record_file: file.clone(),
+            record_line: t.line,
+            value_lines: [t.line; 6],
+            joints,
+            from_cartesian,
+            positioner,
+            kind,
+            speed,
+        })));
     }
-    unit.end(file, &opts.ufmec, report);
-    Some(steps)
+
+    /// The arm joints (rad) of the `robtarget` `t` (`pose` in the file's
+    /// work object at the positioner joints `positioner`), its `confdata`
+    /// checked against the cell's configuration and giving each of A1,
+    /// A4, A6 its quadrant.
+    fn decode_robtarget(
+        &self,
+        t: &RapidTarget,
+        pose: &Isometry3,
+        conf: &[i32; 4],
+        positioner: Option<[f64; 2]>,
+        report: &mut ValidationReport,
+    ) -> Option<Joints> {
+        let (cell, file) = (self.cell, self.file());
+        let robot = cell.robot();
+        // cfx bit 2: wrist centre behind axis 1; bit 1: behind the
+        // lower arm, the elbow joint test (abb::confdata)
+        let (side, elbow) = arm_of(conf[3] & 4 != 0, conf[3] & 2 == 0);
+        let cfg = Configuration {
+            wrist: wrist_of_j5(robot, conf[3] & 1 == 0),
+            elbow,
+            side,
+        };
+        if !(0..8).contains(&conf[3]) || cfg != cell.configuration() {
+            push(
+                report,
+                ProblemKind::Configuration,
+                file,
+                t.line,
+                format!(
+                    "{}: cfx {} is configuration '{cfg}', not the cell's '{}' (configuration flip)",
+                    t.name,
+                    conf[3],
+                    cell.configuration()
+                ),
+            );
+        }
+        let f = self.frames.and_then(|f| {
+            let at = f.at(cell, positioner);
+            if at.is_none() {
+                push(
+                    report,
+                    ProblemKind::Format,
+                    file,
+                    t.line,
+                    format!(
+                        "{}: no positioner values for the coordinated work object",
+                        t.name
+                    ),
+                );
+            }
+            at
+        });
+        f.and_then(|f| {
+            decode_pose(
+                robot,
+                &f.flange(pose),
+                cfg,
+                |j, q| {
+                    let cf = match j {
+                        0 => conf[0],
+                        3 => conf[1],
+                        _ => conf[2],
+                    };
+                    abb_quadrant(q, cf)
+                },
+                &t.name,
+                file,
+                t.line,
+                report,
+            )
+        })
+    }
 }
 
 /// The positioner's mechanical unit along the entry routine: in the
