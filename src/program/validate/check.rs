@@ -19,6 +19,10 @@ use super::{
     deposition_point, push, Motion, MotionSpeed, Step, ValidationReport, NAMES, REACH_TOLERANCE_MM,
 };
 
+/// A motion as the checker keeps it for the next move: its joints (rad),
+/// its positioner joints (rad) and its deposition point (part frame, mm).
+type Reached = (Joints, Option<[f64; 2]>, Option<Point3>);
+
 /// Checks decoded `steps` against `cell` (module doc), adding problems and
 /// counts to `report`. `planned`: the planned deposition points (part
 /// frame, mm), one per bead motion in execution order.
@@ -29,8 +33,34 @@ pub fn check_steps(
     common: &crate::program::ProgramOptions,
     report: &mut ValidationReport,
 ) {
-    // which motions are bead points: made with the process on, or the last
-    // motion before the process starts
+    let bead = bead_points(steps);
+    let mut checker = Checker {
+        cell,
+        planned,
+        common,
+        bead: &bead,
+        arc_on: None,
+        prev: None,
+        plan_cursor: 0,
+        via: None,
+        prev_matched: None,
+        bead_motions: 0,
+        first_file: None,
+    };
+    for (i, s) in steps.iter().enumerate() {
+        match s {
+            Step::ProcessOn { file, line } => checker.process_on(file, *line, report),
+            Step::ProcessOff { file, line } => checker.process_off(file, *line, report),
+            Step::Wait { .. } | Step::Payload { .. } => {}
+            Step::Motion(m) => checker.motion(i, m, report),
+        }
+    }
+    checker.finish(steps, report);
+}
+
+/// Which motions of `steps` are bead points: made with the process on, or
+/// the last motion before the process starts.
+fn bead_points(steps: &[Step]) -> Vec<bool> {
     let mut bead = vec![false; steps.len()];
     let mut on = false;
     let mut last_motion: Option<usize> = None;
@@ -50,54 +80,68 @@ pub fn check_steps(
             Step::Wait { .. } | Step::Payload { .. } => {}
         }
     }
-    let robot = cell.robot();
-    let mut arc_on: Option<(String, usize)> = None;
-    let mut prev: Option<(Joints, Option<[f64; 2]>, Option<Point3>)> = None;
-    // the planned point each bead motion lands on, in order: thinned
-    // programs skip planned points, none goes back
-    let mut plan_cursor = 0;
-    // the via of the circular move the next motion ends (joints,
-    // positioner, deposition point)
-    let mut via: Option<(Joints, Option<[f64; 2]>, Option<Point3>)> = None;
-    let mut prev_matched: Option<usize> = None;
-    let mut bead_motions = 0;
-    let mut first_file: Option<String> = None;
-    for (i, s) in steps.iter().enumerate() {
-        let m = match s {
-            Step::ProcessOn { file, line } => {
-                if let Some((f, l)) = &arc_on {
-                    let msg = format!(
-                        "bead starts while the bead started at {f}:{l} is still on (missing Arc End / end instruction)"
-                    );
-                    push(report, ProblemKind::Bead, file, *line, msg);
-                }
-                arc_on = Some((file.clone(), *line));
-                continue;
-            }
-            Step::ProcessOff { file, line } => {
-                if arc_on.take().is_none() {
-                    push(
-                        report,
-                        ProblemKind::Bead,
-                        file,
-                        *line,
-                        "bead stops but none was started".into(),
-                    );
-                } else {
-                    report.beads += 1;
-                }
-                continue;
-            }
-            Step::Wait { .. } | Step::Payload { .. } => continue,
-            Step::Motion(m) => m,
-        };
-        first_file.get_or_insert_with(|| m.file.clone());
-        report.motions += 1;
-        let k = bead_motions;
-        if bead[i] {
-            bead_motions += 1;
+    bead
+}
+
+/// What [`check_steps`] carries from step to step.
+struct Checker<'a> {
+    cell: &'a CellLayout,
+    planned: Option<&'a [Point3]>,
+    common: &'a ProgramOptions,
+    /// `bead[i]`: step `i` is a bead motion.
+    bead: &'a [bool],
+    /// The bead on: file and line of its start.
+    arc_on: Option<(String, usize)>,
+    /// The last motion's end.
+    prev: Option<Reached>,
+    /// The planned point each bead motion lands on, in order: thinned
+    /// programs skip planned points, none goes back.
+    plan_cursor: usize,
+    /// The via of the circular move the next motion ends.
+    via: Option<Reached>,
+    /// The planned point the last motion landed on.
+    prev_matched: Option<usize>,
+    bead_motions: usize,
+    first_file: Option<String>,
+}
+
+impl Checker<'_> {
+    /// A bead starts at `file:line`.
+    fn process_on(&mut self, file: &str, line: usize, report: &mut ValidationReport) {
+        if let Some((f, l)) = &self.arc_on {
+            let msg = format!(
+                "bead starts while the bead started at {f}:{l} is still on (missing Arc End / end instruction)"
+            );
+            push(report, ProblemKind::Bead, file, line, msg);
         }
-        if m.kind == MoveKind::Joint && arc_on.is_some() {
+        self.arc_on = Some((file.to_string(), line));
+    }
+
+    /// A bead stops at `file:line`.
+    fn process_off(&mut self, file: &str, line: usize, report: &mut ValidationReport) {
+        if self.arc_on.take().is_none() {
+            push(
+                report,
+                ProblemKind::Bead,
+                file,
+                line,
+                "bead stops but none was started".into(),
+            );
+        } else {
+            report.beads += 1;
+        }
+    }
+
+    /// Motion `m`, step `i`: its position (limits, configuration, the plan)
+    /// and the move to it from the last one.
+    fn motion(&mut self, i: usize, m: &Motion, report: &mut ValidationReport) {
+        self.first_file.get_or_insert_with(|| m.file.clone());
+        report.motions += 1;
+        let k = self.bead_motions;
+        if self.bead[i] {
+            self.bead_motions += 1;
+        }
+        if m.kind == MoveKind::Joint && self.arc_on.is_some() {
             push(
                 report,
                 ProblemKind::Bead,
@@ -108,7 +152,7 @@ pub fn check_steps(
         }
         // a circular move's via comes first as its own motion; the move is
         // checked at its end, the next motion
-        let circle_via = via.take();
+        let circle_via = self.via.take();
         match (m.kind, &circle_via) {
             (MoveKind::Circular, None) => push(
                 report,
@@ -131,10 +175,32 @@ pub fn check_steps(
             _ => {}
         }
         let Some(q) = m.joints else {
-            prev = None;
-            prev_matched = None;
-            continue;
+            self.prev = None;
+            self.prev_matched = None;
+            return;
         };
+        self.check_position(m, &q, report);
+        let qp = m.positioner;
+        let dep = deposition_point(self.cell, &q, qp);
+        let matched = self.match_plan(i, m, dep, k, report);
+        if m.kind == MoveKind::Via {
+            self.via = Some((q, qp, dep));
+            return;
+        }
+        if let Some(prev) = &self.prev {
+            let msgs = self.check_move(i, m, prev, &(q, qp, dep), circle_via.as_ref(), matched);
+            for (kind, msg) in msgs {
+                push(report, kind, &m.file, m.line, msg);
+            }
+        }
+        self.prev = Some((q, qp, dep));
+        self.prev_matched = matched;
+    }
+
+    /// Motion `m`'s joints `q`: inside the arm's limits, in the cell's
+    /// configuration (joint positions), the positioner inside its travel.
+    fn check_position(&self, m: &Motion, q: &Joints, report: &mut ValidationReport) {
+        let (cell, robot) = (self.cell, self.cell.robot());
         for (j, name) in NAMES.iter().enumerate() {
             let l = robot.limits[j];
             if !l.contains(q[j]) {
@@ -153,7 +219,7 @@ pub fn check_steps(
                 );
             }
         }
-        let cfg = robot.configuration_of(&q);
+        let cfg = robot.configuration_of(q);
         if !m.from_cartesian && cfg != cell.configuration() {
             push(
                 report,
@@ -200,15 +266,28 @@ pub fn check_steps(
                 }
             }
         }
-        let dep = deposition_point(cell, &q, qp);
+    }
+
+    /// The planned point bead motion `m` (step `i`, the `k`-th bead motion)
+    /// lands on with its deposition point `dep`: the plan is followed in
+    /// order, from where it stands on.
+    fn match_plan(
+        &mut self,
+        i: usize,
+        m: &Motion,
+        dep: Option<Point3>,
+        k: usize,
+        report: &mut ValidationReport,
+    ) -> Option<usize> {
         let mut matched = None;
-        if let (true, Some(plan), Some(d)) = (bead[i], planned, dep) {
+        let plan_cursor = self.plan_cursor;
+        if let (true, Some(plan), Some(d)) = (self.bead[i], self.planned, dep) {
             matched =
                 (plan_cursor..plan.len()).find(|&j| (d - plan[j]).norm() <= REACH_TOLERANCE_MM);
             match matched {
                 // a bead's first motion lands on the next planned point:
                 // no bead is skipped
-                Some(j) if prev_matched.is_none() && j != plan_cursor => {
+                Some(j) if self.prev_matched.is_none() && j != plan_cursor => {
                     push(
                         report,
                         ProblemKind::Deviation,
@@ -219,9 +298,9 @@ pub fn check_steps(
                             m.label
                         ),
                     );
-                    plan_cursor = j + 1;
+                    self.plan_cursor = j + 1;
                 }
-                Some(j) => plan_cursor = j + 1,
+                Some(j) => self.plan_cursor = j + 1,
                 None => {
                     let e = plan
                         .get(plan_cursor.min(plan.len().saturating_sub(1)))
@@ -239,177 +318,243 @@ pub fn check_steps(
                 }
             }
         }
-        if m.kind == MoveKind::Via {
-            via = Some((q, qp, dep));
-            continue;
-        }
-        if let Some((pq, pqp, pm)) = &prev {
-            let mut msgs = Vec::new();
-            let linear = m.speed != MotionSpeed::Joint;
-            // joint moves (between beads) may rewind J4/J6; linear and
-            // circular moves (each leg of these) may not jump
-            let legs: Vec<(&Joints, &Joints)> = match &circle_via {
-                Some((qv, _, _)) => vec![(pq, qv), (qv, &q)],
-                None => vec![(pq, &q)],
-            };
-            for (j, (a, b)) in (0..6)
-                .filter(|_| linear)
-                .flat_map(|j| legs.iter().map(move |leg| (j, *leg)))
-            {
-                if (b[j] - a[j]).abs() >= PI {
-                    msgs.push((ProblemKind::Configuration, format!(
-                        "{} jumps by {:.2}° from the previous position (turn or configuration change)",
-                        NAMES[j],
-                        (b[j] - a[j]).to_degrees()
-                    )));
-                }
-            }
-            // the length of the path: the chord, or the arc through the via
-            let path_length = |a: &Point3, b: &Point3, via: Option<Point3>| match via {
-                Some(v) => arc_length(a, &v, b),
-                None => (b - a).norm(),
-            };
-            let via_dep = circle_via.as_ref().and_then(|(_, _, d)| *d);
-            let dt = match (m.speed, dep, pm) {
-                (MotionSpeed::Linear(v), Some(a), Some(b))
-                    if circle_via.is_none() || via_dep.is_some() =>
-                {
-                    let d = path_length(b, &a, via_dep);
-                    (d > 0.0).then(|| (d / v, format!("at {v:.3} mm/s")))
-                }
-                (
-                    MotionSpeed::Tcp {
-                        mm_s,
-                        flange_from_tcp,
-                        extax_fraction,
-                    },
-                    _,
-                    _,
-                ) => {
-                    let tcp =
-                        |q: &Joints| (robot.flange_pose(q) * flange_from_tcp).translation.vector;
-                    let via_tcp = circle_via.as_ref().map(|(qv, _, _)| Point3::from(tcp(qv)));
-                    let mut t =
-                        path_length(&Point3::from(tcp(pq)), &Point3::from(tcp(&q)), via_tcp) / mm_s;
-                    if let (CellLayout::TorchCarried(c), Some(a), Some(b)) = (cell, qp, pqp) {
-                        for n in 0..2 {
-                            let max = c.positioner.max_speed_rad_s[n] * extax_fraction[n];
-                            let turn = (a[n] - b[n]).abs();
-                            if max.is_finite() && max > 0.0 && turn > 0.0 {
-                                t = t.max(turn / max);
-                            }
-                        }
-                    }
-                    if t == 0.0 && crate::program::joints_move(&q, pq) {
-                        // the controller then runs the move at its
-                        // orientation speed, not at any planned speed
-                        msgs.push((ProblemKind::Timing, format!(
-                            "linear move at {mm_s:.3} mm/s TCP speed with the TCP still while the joints turn: \
-                             the controller would turn at its orientation speed limit (write it time-based)"
-                        )));
-                    }
-                    (t > 0.0).then(|| (t, format!("at {mm_s:.3} mm/s TCP speed")))
-                }
-                (MotionSpeed::Time(t), _, _) => {
-                    if t > 0.0 {
-                        Some((t, format!("in {:.0} ms", t * 1000.0)))
-                    } else {
-                        msgs.push((ProblemKind::Timing, "zero duration".into()));
-                        None
-                    }
+        matched
+    }
+
+    /// The problems of the move of motion `m` (step `i`) from `prev` to
+    /// `to` (through `circle_via`, landing on planned point `matched`):
+    /// joint jumps, what its duration asks of the joints, and the path
+    /// between its ends.
+    fn check_move(
+        &self,
+        i: usize,
+        m: &Motion,
+        prev: &Reached,
+        to: &Reached,
+        circle_via: Option<&Reached>,
+        matched: Option<usize>,
+    ) -> Vec<(ProblemKind, String)> {
+        let (cell, planned) = (self.cell, self.planned);
+        let ((pq, pqp, _), (q, qp, _)) = (prev, *to);
+        let mut msgs = jumps(m, pq, &q, circle_via);
+        let dt = self.duration(m, prev, to, circle_via, &mut msgs);
+        // with the plan known, a move between neighbouring planned
+        // points is the plan's own discretisation (the planner checked
+        // it); the moves that skip planned points are sampled
+        let skips = match (planned, self.prev_matched, matched) {
+            (Some(_), Some(j0), Some(j1)) => j1 > j0 + 1,
+            (Some(_), _, _) => false,
+            (None, _, _) => true,
+        } || m.kind == MoveKind::Circular;
+        let interpolated = matches!(m.kind, MoveKind::Linear | MoveKind::Circular);
+        if let (Some((duration_s, _)), true, true) = (&dt, interpolated, skips) {
+            let planned_between = match (planned, self.prev_matched, matched) {
+                // a move between neighbouring planned points is the
+                // plan's own discretisation: only moves that skip planned
+                // points are held to the planned polyline
+                (Some(plan), Some(j0), Some(j1)) if self.bead[i] && j1 > j0 + 1 => {
+                    Some(&plan[j0..=j1])
                 }
                 _ => None,
             };
-            // with the plan known, a move between neighbouring planned
-            // points is the plan's own discretisation (the planner checked
-            // it); the moves that skip planned points are sampled
-            let skips = match (planned, prev_matched, matched) {
-                (Some(_), Some(j0), Some(j1)) => j1 > j0 + 1,
-                (Some(_), _, _) => false,
-                (None, _, _) => true,
-            } || m.kind == MoveKind::Circular;
-            let interpolated = matches!(m.kind, MoveKind::Linear | MoveKind::Circular);
-            if let (Some((duration_s, _)), true, true) = (&dt, interpolated, skips) {
-                let planned_between = match (planned, prev_matched, matched) {
-                    // a move between neighbouring planned points is the
-                    // plan's own discretisation: only moves that skip planned
-                    // points are held to the planned polyline
-                    (Some(plan), Some(j0), Some(j1)) if bead[i] && j1 > j0 + 1 => {
-                        Some(&plan[j0..=j1])
-                    }
-                    _ => None,
-                };
-                msgs.extend(check_between(
-                    cell,
-                    common,
-                    &InterpolatedMove {
-                        from: (pq, *pqp),
-                        via: circle_via.as_ref().map(|(qv, qvp, _)| (qv, *qvp)),
-                        to: (&q, qp),
-                        duration_s: *duration_s,
-                        planned: planned_between,
-                    },
-                ));
+            msgs.extend(check_between(
+                cell,
+                self.common,
+                &InterpolatedMove {
+                    from: (pq, *pqp),
+                    via: circle_via.map(|(qv, qvp, _)| (qv, *qvp)),
+                    to: (&q, qp),
+                    duration_s: *duration_s,
+                    planned: planned_between,
+                },
+            ));
+        }
+        if let Some((dt, how)) = dt {
+            msgs.extend(joint_speeds(cell, pq, *pqp, &q, qp, dt, &how));
+        }
+        msgs
+    }
+
+    /// The duration (s) of the move of motion `m` from `prev` to `to`
+    /// (through `circle_via`) as the controller runs it at `m`'s speed, and
+    /// how, in messages; `None` for a joint move (the controller's own
+    /// speed). A move the controller would not run at its speed adds to
+    /// `msgs`.
+    fn duration(
+        &self,
+        m: &Motion,
+        prev: &Reached,
+        to: &Reached,
+        circle_via: Option<&Reached>,
+        msgs: &mut Vec<(ProblemKind, String)>,
+    ) -> Option<(f64, String)> {
+        let (cell, robot) = (self.cell, self.cell.robot());
+        let ((pq, pqp, pm), (q, qp, dep)) = (prev, *to);
+        // the length of the path: the chord, or the arc through the via
+        let path_length = |a: &Point3, b: &Point3, via: Option<Point3>| match via {
+            Some(v) => arc_length(a, &v, b),
+            None => (b - a).norm(),
+        };
+        let via_dep = circle_via.and_then(|(_, _, d)| *d);
+        match (m.speed, dep, pm) {
+            (MotionSpeed::Linear(v), Some(a), Some(b))
+                if circle_via.is_none() || via_dep.is_some() =>
+            {
+                let d = path_length(b, &a, via_dep);
+                (d > 0.0).then(|| (d / v, format!("at {v:.3} mm/s")))
             }
-            if let Some((dt, how)) = dt {
-                for j in 0..6 {
-                    let sp = (q[j] - pq[j]).abs() / dt;
-                    if sp > robot.max_speed_rad_s[j] {
-                        msgs.push((
-                            ProblemKind::JointSpeed,
-                            format!(
-                                "{} needs {:.2}°/s {how}, maximum {:.1}°/s",
-                                NAMES[j],
-                                sp.to_degrees(),
-                                robot.max_speed_rad_s[j].to_degrees()
-                            ),
-                        ));
-                    }
-                }
+            (
+                MotionSpeed::Tcp {
+                    mm_s,
+                    flange_from_tcp,
+                    extax_fraction,
+                },
+                _,
+                _,
+            ) => {
+                let tcp = |q: &Joints| (robot.flange_pose(q) * flange_from_tcp).translation.vector;
+                let via_tcp = circle_via.map(|(qv, _, _)| Point3::from(tcp(qv)));
+                let mut t =
+                    path_length(&Point3::from(tcp(pq)), &Point3::from(tcp(&q)), via_tcp) / mm_s;
                 if let (CellLayout::TorchCarried(c), Some(a), Some(b)) = (cell, qp, pqp) {
                     for n in 0..2 {
-                        let sp = (a[n] - b[n]).abs() / dt;
-                        if sp > c.positioner.max_speed_rad_s[n] {
-                            msgs.push((
-                                ProblemKind::JointSpeed,
-                                format!("positioner J{} needs {:.2}°/s", n + 1, sp.to_degrees()),
-                            ));
+                        let max = c.positioner.max_speed_rad_s[n] * extax_fraction[n];
+                        let turn = (a[n] - b[n]).abs();
+                        if max.is_finite() && max > 0.0 && turn > 0.0 {
+                            t = t.max(turn / max);
                         }
                     }
                 }
+                if t == 0.0 && crate::program::joints_move(&q, pq) {
+                    // the controller then runs the move at its
+                    // orientation speed, not at any planned speed
+                    msgs.push((ProblemKind::Timing, format!(
+                        "linear move at {mm_s:.3} mm/s TCP speed with the TCP still while the joints turn: \
+                         the controller would turn at its orientation speed limit (write it time-based)"
+                    )));
+                }
+                (t > 0.0).then(|| (t, format!("at {mm_s:.3} mm/s TCP speed")))
             }
-            for (kind, msg) in msgs {
-                push(report, kind, &m.file, m.line, msg);
+            (MotionSpeed::Time(t), _, _) => {
+                if t > 0.0 {
+                    Some((t, format!("in {:.0} ms", t * 1000.0)))
+                } else {
+                    msgs.push((ProblemKind::Timing, "zero duration".into()));
+                    None
+                }
             }
+            _ => None,
         }
-        prev = Some((q, qp, dep));
-        prev_matched = matched;
     }
-    if let Some((file, line)) = arc_on {
-        push(
-            report,
-            ProblemKind::Bead,
-            &file,
-            line,
-            "bead started here never stops (no Arc End / end instruction before the program ends)"
-                .into(),
-        );
-    }
-    check_setup(steps, cell, common, &bead, report);
-    if let Some(p) = planned {
-        if plan_cursor != p.len() {
+
+    /// After the last step: a bead never stopped, the set-up, and the plan
+    /// built to its end.
+    fn finish(self, steps: &[Step], report: &mut ValidationReport) {
+        if let Some((file, line)) = self.arc_on {
             push(
                 report,
-                ProblemKind::Deviation,
-                first_file.as_deref().unwrap_or(""),
-                0,
-                format!(
-                    "{bead_motions} bead motions in the programs end at planned point {plan_cursor} of {}: the rest of the plan is not built",
-                    p.len()
-                ),
+                ProblemKind::Bead,
+                &file,
+                line,
+                "bead started here never stops (no Arc End / end instruction before the program ends)"
+                    .into(),
             );
         }
+        check_setup(steps, self.cell, self.common, self.bead, report);
+        let (plan_cursor, bead_motions) = (self.plan_cursor, self.bead_motions);
+        if let Some(p) = self.planned {
+            if plan_cursor != p.len() {
+                push(
+                    report,
+                    ProblemKind::Deviation,
+                    self.first_file.as_deref().unwrap_or(""),
+                    0,
+                    format!(
+                        "{bead_motions} bead motions in the programs end at planned point {plan_cursor} of {}: the rest of the plan is not built",
+                        p.len()
+                    ),
+                );
+            }
+        }
     }
+}
+
+/// The joint jumps of a linear or circular move of motion `m` from `pq`
+/// to `q` (each leg through `circle_via`): joint moves (between beads) may
+/// rewind J4/J6; linear and circular moves (each leg of these) may not
+/// jump.
+fn jumps(
+    m: &Motion,
+    pq: &Joints,
+    q: &Joints,
+    circle_via: Option<&Reached>,
+) -> Vec<(ProblemKind, String)> {
+    let mut msgs = Vec::new();
+    let linear = m.speed != MotionSpeed::Joint;
+    // joint moves (between beads) may rewind J4/J6; linear and
+    // circular moves (each leg of these) may not jump
+    let legs: Vec<(&Joints, &Joints)> = match circle_via {
+        Some((qv, _, _)) => vec![(pq, qv), (qv, q)],
+        None => vec![(pq, q)],
+    };
+    for (j, (a, b)) in (0..6)
+        .filter(|_| linear)
+        .flat_map(|j| legs.iter().map(move |leg| (j, *leg)))
+    {
+        if (b[j] - a[j]).abs() >= PI {
+            msgs.push((
+                ProblemKind::Configuration,
+                format!(
+                    "{} jumps by {:.2}° from the previous position (turn or configuration change)",
+                    NAMES[j],
+                    (b[j] - a[j]).to_degrees()
+                ),
+            ));
+        }
+    }
+    msgs
+}
+
+/// The joint speeds of a move from `pq` (positioner `pqp`) to `q` (`qp`)
+/// in `dt` s (`how`, in messages) above the arm's and the positioner's
+/// maxima.
+fn joint_speeds(
+    cell: &CellLayout,
+    pq: &Joints,
+    pqp: Option<[f64; 2]>,
+    q: &Joints,
+    qp: Option<[f64; 2]>,
+    dt: f64,
+    how: &str,
+) -> Vec<(ProblemKind, String)> {
+    let robot = cell.robot();
+    let mut msgs = Vec::new();
+    for j in 0..6 {
+        let sp = (q[j] - pq[j]).abs() / dt;
+        if sp > robot.max_speed_rad_s[j] {
+            msgs.push((
+                ProblemKind::JointSpeed,
+                format!(
+                    "{} needs {:.2}°/s {how}, maximum {:.1}°/s",
+                    NAMES[j],
+                    sp.to_degrees(),
+                    robot.max_speed_rad_s[j].to_degrees()
+                ),
+            ));
+        }
+    }
+    if let (CellLayout::TorchCarried(c), Some(a), Some(b)) = (cell, qp, pqp) {
+        for n in 0..2 {
+            let sp = (a[n] - b[n]).abs() / dt;
+            if sp > c.positioner.max_speed_rad_s[n] {
+                msgs.push((
+                    ProblemKind::JointSpeed,
+                    format!("positioner J{} needs {:.2}°/s", n + 1, sp.to_degrees()),
+                ));
+            }
+        }
+    }
+    msgs
 }
 
 /// Largest difference between a home joint in the file and the cell's
