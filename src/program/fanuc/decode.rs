@@ -24,15 +24,15 @@ use std::f64::consts::TAU;
 use crate::math::{Isometry3, Point3};
 use crate::program::contract::{validate_decoded, Fanuc};
 use crate::program::fanuc::{
-    parse_frame_remark, ArmPosition, FanucFrames, FanucOptions, FrameKind, MoveKind, Op,
-    PayloadField, TpProgram,
+    parse_frame_remark, ArmPosition, FanucFrames, FanucOptions, FrameKind, MotionOptions, MoveKind,
+    Op, PayloadField, Position, Speed, TpProgram,
 };
 use crate::program::validate::{
     decode_pose, push, Motion, MotionSpeed, ProblemKind, Step, ValidationReport,
 };
 use crate::program::ProcessControl;
 use crate::robot::orientation::FanucPose;
-use crate::robot::{CellLayout, Configuration};
+use crate::robot::{CellLayout, Configuration, Joints};
 
 /// Largest difference between a stated frame and the options' frame:
 /// position (mm) and rotation (deg); the remarks print 3 decimals.
@@ -171,6 +171,8 @@ impl Decoder<'_> {
         }
     }
 
+    /// The steps of `tp` (called at `depth`) appended to `steps`: each
+    /// instruction to the decoder of its kind.
     fn steps(
         &mut self,
         tp: &TpProgram,
@@ -180,40 +182,14 @@ impl Decoder<'_> {
     ) {
         self.check_header(tp, report);
         let opts = self.opts;
-        let cell = self.cell;
         let (start, end) = opts.process_ops();
         let arc = matches!(opts.process, ProcessControl::Arc { .. });
-        let robot = cell.robot();
         let frames = self.frames;
-        let tool = frames.flange_from_tool;
-        let want_rtcp = opts.remote_tcp(cell);
-        let want_coord = opts.coordinated(cell);
         for ins in &tp.instructions {
             let line = ins.line;
             let file = &tp.name;
             match &ins.op {
-                Op::Call(name) => {
-                    if depth > 4 {
-                        push(
-                            report,
-                            ProblemKind::Call,
-                            file,
-                            line,
-                            format!("CALL {name}: calls nested too deep"),
-                        );
-                        continue;
-                    }
-                    match self.programs.iter().find(|p| &p.name == name) {
-                        Some(sub) => self.steps(sub, depth + 1, steps, report),
-                        None => push(
-                            report,
-                            ProblemKind::Call,
-                            file,
-                            line,
-                            format!("CALL {name}: no such program"),
-                        ),
-                    }
-                }
+                Op::Call(name) => self.call(name, depth, file, line, steps, report),
                 op if *op == start => steps.push(Step::ProcessOn {
                     file: file.clone(),
                     line,
@@ -273,38 +249,7 @@ impl Decoder<'_> {
                         .expect("every field is in ALL");
                     self.payloads.entry(*schedule).or_insert([None; 4])[k] = Some(*value);
                 }
-                Op::Payload(n) => {
-                    if *n != opts.payload_schedule {
-                        push(
-                            report,
-                            ProblemKind::Options,
-                            file,
-                            line,
-                            format!(
-                                "PAYLOAD[{n}]: the options give payload schedule {}",
-                                opts.payload_schedule
-                            ),
-                        );
-                    }
-                    match self.payloads.get(n) {
-                        Some([Some(m), Some(x), Some(y), Some(z)]) => steps.push(Step::Payload {
-                            file: file.clone(),
-                            line,
-                            mass_kg: *m,
-                            // FANUC payload CoG is in cm
-                            cog_mm: Point3::new(10.0 * x, 10.0 * y, 10.0 * z),
-                        }),
-                        _ => push(
-                            report,
-                            ProblemKind::Options,
-                            file,
-                            line,
-                            format!(
-                                "PAYLOAD[{n}] selects a schedule whose mass and CoG the programs do not set before it ($PLST_GRP1[{n}].$PAYLOAD, _X, _Y, _Z)"
-                            ),
-                        ),
-                    }
-                }
+                Op::Payload(n) => self.payload(*n, file, line, steps, report),
                 Op::ArcStart(_)
                 | Op::ArcEnd(_)
                 | Op::WeldStart(..)
@@ -352,146 +297,252 @@ impl Decoder<'_> {
                             );
                             continue;
                         };
-                        let label = format!("P[{}]", pos.index);
-                        let linear = kind != MoveKind::Joint;
-                        for (name, present, want) in [
-                            ("COORD", options.coord, want_coord && linear),
-                            ("RTCP", options.rtcp, want_rtcp && linear),
-                        ] {
-                            let why = match (present, want) {
-                            (false, true) if name == "COORD" => Some(
-                                "linear move without COORD: its speed would be the TCP's in the world frame, not the travel speed over the part on the positioner",
-                            ),
-                            (false, true) => Some(
-                                "linear move without RTCP: the controller would move the flange's tool frame, not the part about the fixed torch (remote TCP)",
-                            ),
-                            (true, false) if !linear => Some("on a joint move"),
-                            (true, false) => Some("not expected: the options and cell do not use it"),
-                            _ => None,
-                        };
-                            if let Some(why) = why {
-                                push(
-                                    report,
-                                    ProblemKind::Frame,
-                                    file,
-                                    line,
-                                    format!("{label}: {name}: {why}"),
-                                );
-                            }
-                        }
-                        if options.coord && tp.groups < 2 {
-                            push(
-                                report,
-                                ProblemKind::Frame,
-                                file,
-                                line,
-                                format!(
-                                    "{label}: COORD in a program of one motion group (no leader)"
-                                ),
-                            );
-                        }
-                        let (joints, from_cartesian) = match &pos.arm {
-                            ArmPosition::Joint(d) => (Some(d.map(f64::to_radians)), false),
-                            ArmPosition::Cartesian { .. } if tp.remote_tcp => {
-                                push(
-                                report,
-                                ProblemKind::Format,
-                                file,
-                                pos.line,
-                                format!("{label}: Cartesian position in a remote TCP program: its representation (RX..RR) is not documented, write joint positions"),
-                            );
-                                (None, true)
-                            }
-                            ArmPosition::Cartesian { xyzwpr, config } => {
-                                let cfg_line = pos.line + 2;
-                                let q = if pos.uf_ut != (frames.user_frame, frames.tool_frame) {
-                                    push(
-                                        report,
-                                        ProblemKind::Frame,
-                                        file,
-                                        pos.line,
-                                        format!(
-                                        "{label}: UF {}, UT {} are not the frames of the options",
-                                        pos.uf_ut.0, pos.uf_ut.1
-                                    ),
-                                    );
-                                    None
-                                } else if let Some((cfg, turns)) = parse_config(config) {
-                                    if cfg != cell.configuration() {
-                                        push(
-                                        report, ProblemKind::Configuration,
-                                        file,
-                                        cfg_line,
-                                        format!(
-                                            "{label}: CONFIG '{cfg}' is not the cell's '{}' (configuration flip)",
-                                            cell.configuration()
-                                        ),
-                                    );
-                                    }
-                                    let user_from_tool =
-                                        FanucPose::from_xyzwpr_deg(*xyzwpr).to_isometry();
-                                    let base_from_flange =
-                                        frames.base_from_user * user_from_tool * tool.inverse();
-                                    decode_pose(
-                                        robot,
-                                        &base_from_flange,
-                                        cfg,
-                                        |j, q| {
-                                            let t = match j {
-                                                0 => turns[0],
-                                                3 => turns[1],
-                                                _ => turns[2],
-                                            };
-                                            Some(q + TAU * t as f64)
-                                        },
-                                        &label,
-                                        file,
-                                        pos.value_lines[0],
-                                        report,
-                                    )
-                                } else {
-                                    push(
-                                        report,
-                                        ProblemKind::Configuration,
-                                        file,
-                                        cfg_line,
-                                        format!("{label}: bad CONFIG '{config}'"),
-                                    );
-                                    None
-                                };
-                                (q, true)
-                            }
-                        };
-                        steps.push(Step::Motion(Box::new(Motion {
-                            file: file.clone(),
-                            line,
-                            label,
-                            record_file: file.clone(),
-                            record_line: pos.line,
-                            value_lines: pos.value_lines,
-                            joints,
-                            from_cartesian,
-                            positioner: pos.group2.map(|g| g.map(f64::to_radians)),
-                            kind,
-                            speed: match (speed.mm_s(), speed.time_s()) {
-                                // COORD: relative to the leader (the positioner
-                                // carrying the part); RTCP: relative speed of
-                                // the workpiece and the fixed torch. Both are
-                                // the deposition point's speed over the part.
-                                (Some(v), _) if options.coord || options.rtcp => {
-                                    MotionSpeed::Linear(v)
-                                }
-                                (Some(v), _) => MotionSpeed::Tcp {
-                                    mm_s: v,
-                                    flange_from_tcp: tool,
-                                    extax_fraction: [1.0; 2],
-                                },
-                                (None, Some(t)) => MotionSpeed::Time(t),
-                                _ => MotionSpeed::Joint,
-                            },
-                        })));
+                        steps.push(self.motion(tp, line, pos, kind, speed, options, report));
                     }
                 }
+            }
+        }
+    }
+
+    /// `CALL name` at `file:line` (in a program called at `depth`): the
+    /// called program's steps.
+    fn call(
+        &mut self,
+        name: &str,
+        depth: usize,
+        file: &str,
+        line: usize,
+        steps: &mut Vec<Step>,
+        report: &mut ValidationReport,
+    ) {
+        if depth > 4 {
+            push(
+                report,
+                ProblemKind::Call,
+                file,
+                line,
+                format!("CALL {name}: calls nested too deep"),
+            );
+            return;
+        }
+        match self.programs.iter().find(|p| p.name == name) {
+            Some(sub) => self.steps(sub, depth + 1, steps, report),
+            None => push(
+                report,
+                ProblemKind::Call,
+                file,
+                line,
+                format!("CALL {name}: no such program"),
+            ),
+        }
+    }
+
+    /// `PAYLOAD[n]` at `file:line`: a [`Step::Payload`] of the mass and
+    /// CoG the programs set for schedule `n` before it.
+    fn payload(
+        &self,
+        n: u8,
+        file: &str,
+        line: usize,
+        steps: &mut Vec<Step>,
+        report: &mut ValidationReport,
+    ) {
+        let opts = self.opts;
+        if n != opts.payload_schedule {
+            push(
+                report,
+                ProblemKind::Options,
+                file,
+                line,
+                format!(
+                    "PAYLOAD[{n}]: the options give payload schedule {}",
+                    opts.payload_schedule
+                ),
+            );
+        }
+        match self.payloads.get(&n) {
+            Some([Some(m), Some(x), Some(y), Some(z)]) => steps.push(Step::Payload {
+                file: file.to_string(),
+                line,
+                mass_kg: *m,
+                // FANUC payload CoG is in cm
+                cog_mm: Point3::new(10.0 * x, 10.0 * y, 10.0 * z),
+            }),
+            _ => push(
+                report,
+                ProblemKind::Options,
+                file,
+                line,
+                format!(
+                    "PAYLOAD[{n}] selects a schedule whose mass and CoG the programs do not set before it ($PLST_GRP1[{n}].$PAYLOAD, _X, _Y, _Z)"
+                ),
+            ),
+        }
+    }
+
+    /// The motion step of a move at `line` of `tp` to `pos` (`kind`, at
+    /// `speed` with `options`): its options against the cell's, its
+    /// position decoded.
+    #[allow(clippy::too_many_arguments)]
+    fn motion(
+        &self,
+        tp: &TpProgram,
+        line: usize,
+        pos: &Position,
+        kind: MoveKind,
+        speed: &Speed,
+        options: &MotionOptions,
+        report: &mut ValidationReport,
+    ) -> Step {
+        let (opts, cell, file) = (self.opts, self.cell, &tp.name);
+        let want_rtcp = opts.remote_tcp(cell);
+        let want_coord = opts.coordinated(cell);
+        let label = format!("P[{}]", pos.index);
+        let linear = kind != MoveKind::Joint;
+        for (name, present, want) in [
+            ("COORD", options.coord, want_coord && linear),
+            ("RTCP", options.rtcp, want_rtcp && linear),
+        ] {
+            let why = match (present, want) {
+                (false, true) if name == "COORD" => Some(
+                    "linear move without COORD: its speed would be the TCP's in the world frame, not the travel speed over the part on the positioner",
+                ),
+                (false, true) => Some(
+                    "linear move without RTCP: the controller would move the flange's tool frame, not the part about the fixed torch (remote TCP)",
+                ),
+                (true, false) if !linear => Some("on a joint move"),
+                (true, false) => Some("not expected: the options and cell do not use it"),
+                _ => None,
+            };
+            if let Some(why) = why {
+                push(
+                    report,
+                    ProblemKind::Frame,
+                    file,
+                    line,
+                    format!("{label}: {name}: {why}"),
+                );
+            }
+        }
+        if options.coord && tp.groups < 2 {
+            push(
+                report,
+                ProblemKind::Frame,
+                file,
+                line,
+                format!("{label}: COORD in a program of one motion group (no leader)"),
+            );
+        }
+        let (joints, from_cartesian) = self.arm_joints(tp, pos, &label, report);
+        Step::Motion(Box::new(Motion {
+            file: file.clone(),
+            line,
+            label,
+            record_file: file.clone(),
+            record_line: pos.line,
+            value_lines: pos.value_lines,
+            joints,
+            from_cartesian,
+            positioner: pos.group2.map(|g| g.map(f64::to_radians)),
+            kind,
+            speed: match (speed.mm_s(), speed.time_s()) {
+                // COORD: relative to the leader (the positioner
+                // carrying the part); RTCP: relative speed of
+                // the workpiece and the fixed torch. Both are
+                // the deposition point's speed over the part.
+                (Some(v), _) if options.coord || options.rtcp => MotionSpeed::Linear(v),
+                (Some(v), _) => MotionSpeed::Tcp {
+                    mm_s: v,
+                    flange_from_tcp: self.frames.flange_from_tool,
+                    extax_fraction: [1.0; 2],
+                },
+                (None, Some(t)) => MotionSpeed::Time(t),
+                _ => MotionSpeed::Joint,
+            },
+        }))
+    }
+
+    /// The arm joints (rad) of `pos` (`label`) of `tp`, and whether they
+    /// were decoded from a Cartesian pose (with its `CONFIG` and turn
+    /// numbers, in the options' frames).
+    fn arm_joints(
+        &self,
+        tp: &TpProgram,
+        pos: &Position,
+        label: &str,
+        report: &mut ValidationReport,
+    ) -> (Option<Joints>, bool) {
+        let (cell, frames, file) = (self.cell, self.frames, &tp.name);
+        let tool = frames.flange_from_tool;
+        match &pos.arm {
+            ArmPosition::Joint(d) => (Some(d.map(f64::to_radians)), false),
+            ArmPosition::Cartesian { .. } if tp.remote_tcp => {
+                push(
+                    report,
+                    ProblemKind::Format,
+                    file,
+                    pos.line,
+                    format!("{label}: Cartesian position in a remote TCP program: its representation (RX..RR) is not documented, write joint positions"),
+                );
+                (None, true)
+            }
+            ArmPosition::Cartesian { xyzwpr, config } => {
+                let cfg_line = pos.line + 2;
+                let q = if pos.uf_ut != (frames.user_frame, frames.tool_frame) {
+                    push(
+                        report,
+                        ProblemKind::Frame,
+                        file,
+                        pos.line,
+                        format!(
+                            "{label}: UF {}, UT {} are not the frames of the options",
+                            pos.uf_ut.0, pos.uf_ut.1
+                        ),
+                    );
+                    None
+                } else if let Some((cfg, turns)) = parse_config(config) {
+                    if cfg != cell.configuration() {
+                        push(
+                            report,
+                            ProblemKind::Configuration,
+                            file,
+                            cfg_line,
+                            format!(
+                                "{label}: CONFIG '{cfg}' is not the cell's '{}' (configuration flip)",
+                                cell.configuration()
+                            ),
+                        );
+                    }
+                    let user_from_tool = FanucPose::from_xyzwpr_deg(*xyzwpr).to_isometry();
+                    let base_from_flange = frames.base_from_user * user_from_tool * tool.inverse();
+                    decode_pose(
+                        cell.robot(),
+                        &base_from_flange,
+                        cfg,
+                        |j, q| {
+                            let t = match j {
+                                0 => turns[0],
+                                3 => turns[1],
+                                _ => turns[2],
+                            };
+                            Some(q + TAU * t as f64)
+                        },
+                        label,
+                        file,
+                        pos.value_lines[0],
+                        report,
+                    )
+                } else {
+                    push(
+                        report,
+                        ProblemKind::Configuration,
+                        file,
+                        cfg_line,
+                        format!("{label}: bad CONFIG '{config}'"),
+                    );
+                    None
+                };
+                (q, true)
             }
         }
     }
