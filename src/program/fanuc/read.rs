@@ -43,314 +43,374 @@ struct Partial {
 /// instruction or value, a move to a position without record, `LINE_COUNT`
 /// different from the `/MN` lines, and a file ending before `/END`.
 pub fn parse_ls(text: &str, file: &str) -> Result<TpProgram, ProgramError> {
-    let err = |line: usize, reason: String| ProgramError::Read {
-        file: file.to_string(),
-        line,
-        reason,
+    let mut r = LsReader {
+        file,
+        tp: TpProgram {
+            name: String::new(),
+            comment: String::new(),
+            groups: 1,
+            arc_welding: false,
+            arc_enabled: false,
+            remote_tcp: false,
+            instructions: Vec::new(),
+            positions: Vec::new(),
+        },
+        section: Section::Start,
+        line_count: None,
+        mn_line: 0,
+        current: None,
+        pending_circular: None,
     };
-    let mut tp = TpProgram {
-        name: String::new(),
-        comment: String::new(),
-        groups: 1,
-        arc_welding: false,
-        arc_enabled: false,
-        remote_tcp: false,
-        instructions: Vec::new(),
-        positions: Vec::new(),
-    };
-    let mut section = Section::Start;
-    let mut line_count: Option<(usize, usize)> = None;
-    let mut mn_line = 0;
-    let mut current: Option<Partial> = None;
     let mut last_line = 0;
-    // a `C P[v]` line waiting for its `:  P[n] ...` continuation
-    let mut pending_circular: Option<(usize, String)> = None;
     for (i, raw) in text.lines().enumerate() {
         let n = i + 1;
         last_line = n;
         let l = raw.trim();
-        if l.is_empty() {
+        if l.is_empty() || r.header_or_marker(n, l)? {
             continue;
         }
-        if section == Section::End {
-            return Err(err(n, "text after /END".into()));
+        match r.section {
+            Section::Attr => r.attr(n, l)?,
+            Section::Appl => r.appl(l),
+            Section::Mn => r.instruction(n, l)?,
+            Section::Pos => r.position(n, l)?,
+            Section::Start | Section::End => unreachable!("handled above"),
+        }
+    }
+    r.end(last_line)
+}
+
+/// What [`parse_ls`] carries from line to line.
+struct LsReader<'a> {
+    /// The file's name, in errors.
+    file: &'a str,
+    tp: TpProgram,
+    section: Section,
+    /// `LINE_COUNT` and its line.
+    line_count: Option<(usize, usize)>,
+    /// Line of `/MN`.
+    mn_line: usize,
+    /// The position record open.
+    current: Option<Partial>,
+    /// A `C P[v]` line waiting for its `:  P[n] ...` continuation.
+    pending_circular: Option<(usize, String)>,
+}
+
+impl LsReader<'_> {
+    fn err(&self, line: usize, reason: String) -> ProgramError {
+        ProgramError::Read {
+            file: self.file.to_string(),
+            line,
+            reason,
+        }
+    }
+
+    /// `/PROG` and the section markers (`/ATTR`, `/APPL`, `/MN`, `/POS`,
+    /// `/END`) at line `n`: `true` when `l` is one (read).
+    fn header_or_marker(&mut self, n: usize, l: &str) -> Result<bool, ProgramError> {
+        if self.section == Section::End {
+            return Err(self.err(n, "text after /END".into()));
         }
         if let Some(name) = l.strip_prefix("/PROG") {
-            if section != Section::Start {
-                return Err(err(n, "/PROG not on the first line".into()));
+            if self.section != Section::Start {
+                return Err(self.err(n, "/PROG not on the first line".into()));
             }
-            tp.name = name.trim().to_string();
-            if tp.name.is_empty() {
-                return Err(err(n, "/PROG without a name".into()));
+            self.tp.name = name.trim().to_string();
+            if self.tp.name.is_empty() {
+                return Err(self.err(n, "/PROG without a name".into()));
             }
-            section = Section::Attr;
-            continue;
+            self.section = Section::Attr;
+            return Ok(true);
         }
-        if section == Section::Start {
-            return Err(err(n, "expected /PROG".into()));
+        if self.section == Section::Start {
+            return Err(self.err(n, "expected /PROG".into()));
         }
         match l {
-            "/ATTR" => continue,
-            "/APPL" => {
-                section = Section::Appl;
-                continue;
-            }
+            "/ATTR" => {}
+            "/APPL" => self.section = Section::Appl,
             "/MN" => {
-                section = Section::Mn;
-                mn_line = n;
-                continue;
+                self.section = Section::Mn;
+                self.mn_line = n;
             }
             "/POS" => {
-                if let Some((start, _)) = &pending_circular {
-                    return Err(err(
+                if let Some((start, _)) = &self.pending_circular {
+                    return Err(self.err(
                         *start,
                         "circular move without its end line `:  P[n] ...`".into(),
                     ));
                 }
-                if section != Section::Mn {
-                    return Err(err(n, "/POS before /MN".into()));
+                if self.section != Section::Mn {
+                    return Err(self.err(n, "/POS before /MN".into()));
                 }
-                section = Section::Pos;
-                continue;
+                self.section = Section::Pos;
             }
             "/END" => {
-                if let Some(p) = &current {
-                    return Err(err(
+                if let Some(p) = &self.current {
+                    return Err(self.err(
                         n,
                         format!("/END inside P[{}] (opened at line {})", p.index, p.line),
                     ));
                 }
-                if section != Section::Pos {
-                    return Err(err(n, "/END before /POS".into()));
+                if self.section != Section::Pos {
+                    return Err(self.err(n, "/END before /POS".into()));
                 }
-                section = Section::End;
-                continue;
+                self.section = Section::End;
             }
-            _ => {}
+            _ => return Ok(false),
         }
-        match section {
-            Section::Attr => {
-                if let Some(v) = attr_value(l, "COMMENT") {
-                    tp.comment = v.trim_matches('"').to_string();
-                } else if let Some(v) = attr_value(l, "DEFAULT_GROUP") {
-                    tp.groups = v.split(',').filter(|g| g.trim() == "1").count();
-                } else if let Some(v) = attr_value(l, "CONTROL_CODE") {
-                    tp.remote_tcp = v
-                        .split_whitespace()
-                        .next()
-                        .is_some_and(|c| c.ends_with('1'));
-                } else if let Some(v) = attr_value(l, "LINE_COUNT") {
-                    let c = v
-                        .parse()
-                        .map_err(|_| err(n, format!("bad LINE_COUNT `{v}`")))?;
-                    line_count = Some((c, n));
-                }
-            }
-            Section::Appl => {
-                let compact: String = l.chars().filter(|c| !c.is_whitespace()).collect();
-                if compact.eq_ignore_ascii_case("ARC:TRUE;") {
-                    tp.arc_enabled = true;
-                } else if l.starts_with("ARC Welding Equipment") {
-                    tp.arc_welding = true;
-                }
-            }
-            Section::Mn => {
-                // the continuation line of a circular move: `:  P[n] ... ;`
-                if let Some((start, head)) = pending_circular.take() {
-                    let rest = l.strip_prefix(':').ok_or_else(|| {
-                        err(
-                            n,
-                            format!("expected the end line `:  P[n] <speed> <FINE|CNTn> ;` of the circular move of line {start}"),
-                        )
-                    })?;
-                    let body = rest
-                        .trim_end()
-                        .strip_suffix(';')
-                        .ok_or_else(|| err(n, "instruction without `;`".into()))?
-                        .trim();
-                    let op = parse_op(&format!("{head} {body}")).map_err(|r| err(start, r))?;
-                    tp.instructions.push(Instruction { line: start, op });
-                    continue;
-                }
-                let (num, body) = l
-                    .split_once(':')
-                    .ok_or_else(|| err(n, format!("expected `<n>:<instruction> ;`, got `{l}`")))?;
-                let num: usize = num
-                    .trim()
-                    .parse()
-                    .map_err(|_| err(n, format!("bad line number `{num}`")))?;
-                if num != tp.instructions.len() + 1 {
-                    return Err(err(
-                        n,
-                        format!(
-                            "instruction number {num}, expected {}",
-                            tp.instructions.len() + 1
-                        ),
-                    ));
-                }
-                let body = body.trim();
-                if body.starts_with("C ") && !body.ends_with(';') {
-                    pending_circular = Some((n, body.to_string()));
-                    continue;
-                }
-                let body = body
-                    .strip_suffix(';')
-                    .ok_or_else(|| err(n, "instruction without `;`".into()))?
-                    .trim();
-                let op = parse_op(body).map_err(|r| err(n, r))?;
-                tp.instructions.push(Instruction { line: n, op });
-            }
-            Section::Pos => {
-                if let Some(rest) = l.strip_prefix("P[") {
-                    if let Some(p) = &current {
-                        return Err(err(
-                            n,
-                            format!("P[{}] opened at line {} not closed", p.index, p.line),
-                        ));
-                    }
-                    let idx = rest
-                        .strip_suffix("]{")
-                        .and_then(|s| s.parse::<usize>().ok())
-                        .ok_or_else(|| err(n, format!("bad position header `{l}`")))?;
-                    current = Some(Partial {
-                        index: idx,
-                        line: n,
-                        ..Default::default()
-                    });
-                    continue;
-                }
-                let Some(p) = current.as_mut() else {
-                    return Err(err(n, format!("`{l}` outside a position record")));
-                };
-                if l == "};" {
-                    let p = current.take().expect("checked");
-                    tp.positions
-                        .push(finish(p).map_err(|(line, r)| err(line, r))?);
-                } else if l == "GP1:" {
-                    p.group = 1;
-                } else if l == "GP2:" {
-                    p.group = 2;
-                } else if l.starts_with("UF") {
-                    let mut rest = l.to_string();
-                    if let Some(start) = l.find("CONFIG") {
-                        let q: Vec<&str> = l[start..].split('\'').collect();
-                        if q.len() < 3 {
-                            return Err(err(n, "CONFIG without a quoted string".into()));
-                        }
-                        p.config = Some(q[1].to_string());
-                        rest = l[..start].to_string();
-                    }
-                    let mut uf = None;
-                    let mut ut = None;
-                    for part in rest.split(',') {
-                        if let Some((k, v)) = part.split_once(':') {
-                            let v: u8 = v
-                                .trim()
-                                .parse()
-                                .map_err(|_| err(n, format!("bad frame number in `{part}`")))?;
-                            match k.trim() {
-                                "UF" => uf = Some(v),
-                                "UT" => ut = Some(v),
-                                k => return Err(err(n, format!("unknown key `{k}`"))),
-                            }
-                        }
-                    }
-                    match (uf, ut) {
-                        (Some(a), Some(b)) if p.group == 1 => p.uf_ut = Some((a, b)),
-                        (Some(_), Some(_)) => {}
-                        _ => return Err(err(n, "expected `UF : n, UT : n`".into())),
-                    }
-                } else {
-                    for part in l.split(',') {
-                        let part = part.trim();
-                        if part.is_empty() {
-                            continue;
-                        }
-                        let (k, v) = part.split_once('=').ok_or_else(|| {
-                            err(n, format!("expected `KEY = value`, got `{part}`"))
-                        })?;
-                        let v = v.trim();
-                        let v = v
-                            .strip_suffix("deg")
-                            .or_else(|| v.strip_suffix("mm"))
-                            .ok_or_else(|| err(n, format!("value without unit: `{part}`")))?
-                            .trim();
-                        let x: f64 = v
-                            .parse()
-                            .ok()
-                            .filter(|x: &f64| x.is_finite())
-                            .ok_or_else(|| err(n, format!("bad number `{v}`")))?;
-                        let k = k.trim();
-                        let slot = match (p.group, k) {
-                            (2, "J1") => {
-                                p.group2[0] = Some(x);
-                                p.group2_line = n;
-                                continue;
-                            }
-                            (2, "J2") => {
-                                p.group2[1] = Some(x);
-                                p.group2_line = n;
-                                continue;
-                            }
-                            (1, "J1") => &mut p.values[0],
-                            (1, "J2") => &mut p.values[1],
-                            (1, "J3") => &mut p.values[2],
-                            (1, "J4") => &mut p.values[3],
-                            (1, "J5") => &mut p.values[4],
-                            (1, "J6") => &mut p.values[5],
-                            (1, "X") => &mut p.cart[0],
-                            (1, "Y") => &mut p.cart[1],
-                            (1, "Z") => &mut p.cart[2],
-                            (1, "W") => &mut p.cart[3],
-                            (1, "P") => &mut p.cart[4],
-                            (1, "R") => &mut p.cart[5],
-                            _ => {
-                                return Err(err(
-                                    n,
-                                    format!("unexpected key `{k}` in group {}", p.group),
-                                ))
-                            }
-                        };
-                        *slot = Some((x, n));
-                    }
-                }
-            }
-            Section::Start | Section::End => unreachable!("handled above"),
+        Ok(true)
+    }
+
+    /// A line `l` (line `n`) of `/ATTR`.
+    fn attr(&mut self, n: usize, l: &str) -> Result<(), ProgramError> {
+        let tp = &mut self.tp;
+        if let Some(v) = attr_value(l, "COMMENT") {
+            tp.comment = v.trim_matches('"').to_string();
+        } else if let Some(v) = attr_value(l, "DEFAULT_GROUP") {
+            tp.groups = v.split(',').filter(|g| g.trim() == "1").count();
+        } else if let Some(v) = attr_value(l, "CONTROL_CODE") {
+            tp.remote_tcp = v
+                .split_whitespace()
+                .next()
+                .is_some_and(|c| c.ends_with('1'));
+        } else if let Some(v) = attr_value(l, "LINE_COUNT") {
+            let c = v
+                .parse()
+                .map_err(|_| self.err(n, format!("bad LINE_COUNT `{v}`")))?;
+            self.line_count = Some((c, n));
+        }
+        Ok(())
+    }
+
+    /// A line `l` of `/APPL`.
+    fn appl(&mut self, l: &str) {
+        let compact: String = l.chars().filter(|c| !c.is_whitespace()).collect();
+        if compact.eq_ignore_ascii_case("ARC:TRUE;") {
+            self.tp.arc_enabled = true;
+        } else if l.starts_with("ARC Welding Equipment") {
+            self.tp.arc_welding = true;
         }
     }
-    if section != Section::End {
-        let where_ = match (&current, section) {
-            (Some(p), _) => format!(" inside P[{}] (opened at line {})", p.index, p.line),
-            (None, Section::Mn) => " inside /MN".into(),
-            (None, Section::Pos) => " inside /POS".into(),
-            _ => String::new(),
-        };
-        return Err(err(
-            last_line,
-            format!("file ends{where_} without /END (truncated?)"),
-        ));
-    }
-    if let Some((c, line)) = line_count {
-        if c != tp.instructions.len() {
-            return Err(err(
-                line,
+
+    /// A line `l` (line `n`) of `/MN`: an instruction, or the continuation
+    /// line of a circular move.
+    fn instruction(&mut self, n: usize, l: &str) -> Result<(), ProgramError> {
+        // the continuation line of a circular move: `:  P[n] ... ;`
+        if let Some((start, head)) = self.pending_circular.take() {
+            let rest = l.strip_prefix(':').ok_or_else(|| {
+                self.err(
+                    n,
+                    format!("expected the end line `:  P[n] <speed> <FINE|CNTn> ;` of the circular move of line {start}"),
+                )
+            })?;
+            let body = rest
+                .trim_end()
+                .strip_suffix(';')
+                .ok_or_else(|| self.err(n, "instruction without `;`".into()))?
+                .trim();
+            let op = parse_op(&format!("{head} {body}")).map_err(|r| self.err(start, r))?;
+            self.tp.instructions.push(Instruction { line: start, op });
+            return Ok(());
+        }
+        let (num, body) = l
+            .split_once(':')
+            .ok_or_else(|| self.err(n, format!("expected `<n>:<instruction> ;`, got `{l}`")))?;
+        let num: usize = num
+            .trim()
+            .parse()
+            .map_err(|_| self.err(n, format!("bad line number `{num}`")))?;
+        if num != self.tp.instructions.len() + 1 {
+            return Err(self.err(
+                n,
                 format!(
-                    "LINE_COUNT = {c} but /MN (line {mn_line}) has {} instructions",
-                    tp.instructions.len()
+                    "instruction number {num}, expected {}",
+                    self.tp.instructions.len() + 1
                 ),
             ));
         }
+        let body = body.trim();
+        if body.starts_with("C ") && !body.ends_with(';') {
+            self.pending_circular = Some((n, body.to_string()));
+            return Ok(());
+        }
+        let body = body
+            .strip_suffix(';')
+            .ok_or_else(|| self.err(n, "instruction without `;`".into()))?
+            .trim();
+        let op = parse_op(body).map_err(|r| self.err(n, r))?;
+        self.tp.instructions.push(Instruction { line: n, op });
+        Ok(())
     }
-    for ins in &tp.instructions {
-        if let Op::Move { position, via, .. } = ins.op {
-            for position in via.into_iter().chain([position]) {
-                if !tp.positions.iter().any(|p| p.index == position) {
-                    return Err(err(ins.line, format!("P[{position}] has no /POS record")));
+
+    /// A line `l` (line `n`) of `/POS`: a record's header, group, frames,
+    /// values or end.
+    fn position(&mut self, n: usize, l: &str) -> Result<(), ProgramError> {
+        if let Some(rest) = l.strip_prefix("P[") {
+            if let Some(p) = &self.current {
+                return Err(self.err(
+                    n,
+                    format!("P[{}] opened at line {} not closed", p.index, p.line),
+                ));
+            }
+            let idx = rest
+                .strip_suffix("]{")
+                .and_then(|s| s.parse::<usize>().ok())
+                .ok_or_else(|| self.err(n, format!("bad position header `{l}`")))?;
+            self.current = Some(Partial {
+                index: idx,
+                line: n,
+                ..Default::default()
+            });
+            return Ok(());
+        }
+        let Some(mut p) = self.current.take() else {
+            return Err(self.err(n, format!("`{l}` outside a position record")));
+        };
+        if l == "};" {
+            let position = finish(p).map_err(|(line, r)| self.err(line, r))?;
+            self.tp.positions.push(position);
+            return Ok(());
+        }
+        let read = if l == "GP1:" {
+            p.group = 1;
+            Ok(())
+        } else if l == "GP2:" {
+            p.group = 2;
+            Ok(())
+        } else if l.starts_with("UF") {
+            self.frames(&mut p, n, l)
+        } else {
+            self.values(&mut p, n, l)
+        };
+        self.current = Some(p);
+        read
+    }
+
+    /// `UF : n, UT : n[, CONFIG : '...']` (line `n`) of record `p`.
+    fn frames(&self, p: &mut Partial, n: usize, l: &str) -> Result<(), ProgramError> {
+        let mut rest = l.to_string();
+        if let Some(start) = l.find("CONFIG") {
+            let q: Vec<&str> = l[start..].split('\'').collect();
+            if q.len() < 3 {
+                return Err(self.err(n, "CONFIG without a quoted string".into()));
+            }
+            p.config = Some(q[1].to_string());
+            rest = l[..start].to_string();
+        }
+        let mut uf = None;
+        let mut ut = None;
+        for part in rest.split(',') {
+            if let Some((k, v)) = part.split_once(':') {
+                let v: u8 = v
+                    .trim()
+                    .parse()
+                    .map_err(|_| self.err(n, format!("bad frame number in `{part}`")))?;
+                match k.trim() {
+                    "UF" => uf = Some(v),
+                    "UT" => ut = Some(v),
+                    k => return Err(self.err(n, format!("unknown key `{k}`"))),
                 }
             }
         }
+        match (uf, ut) {
+            (Some(a), Some(b)) if p.group == 1 => p.uf_ut = Some((a, b)),
+            (Some(_), Some(_)) => {}
+            _ => return Err(self.err(n, "expected `UF : n, UT : n`".into())),
+        }
+        Ok(())
     }
-    Ok(tp)
+
+    /// `KEY = value unit, ...` (line `n`) of record `p`'s current group.
+    fn values(&self, p: &mut Partial, n: usize, l: &str) -> Result<(), ProgramError> {
+        for part in l.split(',') {
+            let part = part.trim();
+            if part.is_empty() {
+                continue;
+            }
+            let (k, v) = part
+                .split_once('=')
+                .ok_or_else(|| self.err(n, format!("expected `KEY = value`, got `{part}`")))?;
+            let v = v.trim();
+            let v = v
+                .strip_suffix("deg")
+                .or_else(|| v.strip_suffix("mm"))
+                .ok_or_else(|| self.err(n, format!("value without unit: `{part}`")))?
+                .trim();
+            let x: f64 = v
+                .parse()
+                .ok()
+                .filter(|x: &f64| x.is_finite())
+                .ok_or_else(|| self.err(n, format!("bad number `{v}`")))?;
+            let k = k.trim();
+            let slot = match (p.group, k) {
+                (2, "J1") => {
+                    p.group2[0] = Some(x);
+                    p.group2_line = n;
+                    continue;
+                }
+                (2, "J2") => {
+                    p.group2[1] = Some(x);
+                    p.group2_line = n;
+                    continue;
+                }
+                (1, "J1") => &mut p.values[0],
+                (1, "J2") => &mut p.values[1],
+                (1, "J3") => &mut p.values[2],
+                (1, "J4") => &mut p.values[3],
+                (1, "J5") => &mut p.values[4],
+                (1, "J6") => &mut p.values[5],
+                (1, "X") => &mut p.cart[0],
+                (1, "Y") => &mut p.cart[1],
+                (1, "Z") => &mut p.cart[2],
+                (1, "W") => &mut p.cart[3],
+                (1, "P") => &mut p.cart[4],
+                (1, "R") => &mut p.cart[5],
+                _ => return Err(self.err(n, format!("unexpected key `{k}` in group {}", p.group))),
+            };
+            *slot = Some((x, n));
+        }
+        Ok(())
+    }
+
+    /// After the last line (`last_line`): the file ended with `/END`, its
+    /// `LINE_COUNT` and every move's record checked.
+    fn end(self, last_line: usize) -> Result<TpProgram, ProgramError> {
+        if self.section != Section::End {
+            let where_ = match (&self.current, self.section) {
+                (Some(p), _) => format!(" inside P[{}] (opened at line {})", p.index, p.line),
+                (None, Section::Mn) => " inside /MN".into(),
+                (None, Section::Pos) => " inside /POS".into(),
+                _ => String::new(),
+            };
+            return Err(self.err(
+                last_line,
+                format!("file ends{where_} without /END (truncated?)"),
+            ));
+        }
+        let tp = &self.tp;
+        if let Some((c, line)) = self.line_count {
+            if c != tp.instructions.len() {
+                return Err(self.err(
+                    line,
+                    format!(
+                        "LINE_COUNT = {c} but /MN (line {}) has {} instructions",
+                        self.mn_line,
+                        tp.instructions.len()
+                    ),
+                ));
+            }
+        }
+        for ins in &tp.instructions {
+            if let Op::Move { position, via, .. } = ins.op {
+                for position in via.into_iter().chain([position]) {
+                    if !tp.positions.iter().any(|p| p.index == position) {
+                        return Err(self.err(ins.line, format!("P[{position}] has no /POS record")));
+                    }
+                }
+            }
+        }
+        Ok(self.tp)
+    }
 }
 
 fn attr_value<'a>(l: &'a str, key: &str) -> Option<&'a str> {
