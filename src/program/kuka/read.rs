@@ -415,84 +415,14 @@ fn parse_blocks<T>(
     Ok(blocks)
 }
 
+/// One statement of a routine (`l`, comment stripped): a statement this
+/// reader knows by its keyword or the variable it assigns, else
+/// [`KrlOp::Other`].
 fn parse_statement(l: &str) -> Result<KrlOp, String> {
     let tokens: Vec<&str> = l.split_whitespace().collect();
     match tokens.first().copied() {
-        Some("PTP") => {
-            if tokens.len() != 2 {
-                return Err(format!("expected `PTP name`, got `{l}`"));
-            }
-            return Ok(KrlOp::Ptp(tokens[1].to_string()));
-        }
-        Some("LIN") => {
-            return match tokens.as_slice() {
-                [_, t] => Ok(KrlOp::Lin {
-                    target: t.to_string(),
-                    blended: false,
-                }),
-                [_, t, "C_DIS"] => Ok(KrlOp::Lin {
-                    target: t.to_string(),
-                    blended: true,
-                }),
-                _ => Err(format!("expected `LIN name [C_DIS]`, got `{l}`")),
-            };
-        }
-        Some("CIRC") => {
-            let circ = |aux: &str, t: &str, blended| {
-                Ok(KrlOp::Circ {
-                    aux: aux.to_string(),
-                    target: t.to_string(),
-                    blended,
-                })
-            };
-            let args: Vec<&str> = l["CIRC".len()..].split(',').map(str::trim).collect();
-            return match args.as_slice() {
-                [aux, rest] if !aux.is_empty() => {
-                    match rest.split_whitespace().collect::<Vec<_>>().as_slice() {
-                        [t] => circ(aux, t, false),
-                        [t, "C_DIS"] => circ(aux, t, true),
-                        _ => Err(format!("expected `CIRC aux, name [C_DIS]`, got `{l}`")),
-                    }
-                }
-                _ => Err(format!("expected `CIRC aux, name [C_DIS]`, got `{l}`")),
-            };
-        }
-        Some("TRIGGER") => {
-            let rest = l
-                .strip_prefix("TRIGGER WHEN DISTANCE=")
-                .ok_or_else(|| format!("bad TRIGGER `{l}`"))?;
-            let (d, rest) = rest
-                .split_once(' ')
-                .ok_or_else(|| format!("bad TRIGGER `{l}`"))?;
-            let distance = match d {
-                "0" => 0,
-                "1" => 1,
-                _ => return Err(format!("TRIGGER DISTANCE={d}: expected 0 or 1")),
-            };
-            let action = rest
-                .trim()
-                .strip_prefix("DELAY=0 DO ")
-                .ok_or_else(|| format!("bad TRIGGER `{l}`"))?
-                .trim();
-            // a trailing `PRIO = p` (spaces optional)
-            let (action, prio) = match action.rfind("PRIO") {
-                Some(k) if action[..k].ends_with(' ') => {
-                    let v = action[k + 4..].trim_start();
-                    let v = v
-                        .strip_prefix('=')
-                        .map(str::trim)
-                        .ok_or_else(|| format!("bad PRIO in `{l}`"))?;
-                    let p: i32 = v.parse().map_err(|_| format!("bad PRIO `{v}` in `{l}`"))?;
-                    (action[..k].trim_end(), Some(p))
-                }
-                _ => (action, None),
-            };
-            return Ok(KrlOp::Trigger {
-                distance,
-                action: action.to_string(),
-                prio,
-            });
-        }
+        Some("PTP" | "LIN" | "CIRC") => return parse_motion(l, &tokens),
+        Some("TRIGGER") => return parse_trigger(l),
         Some("WAIT") => return parse_wait(l),
         Some("HALT") if tokens.len() == 1 => return Ok(KrlOp::Halt),
         Some("ENDIF") if tokens.len() == 1 => return Ok(KrlOp::EndIf),
@@ -509,152 +439,270 @@ fn parse_statement(l: &str) -> Result<KrlOp, String> {
         }
         Some("INTERRUPT" | "GLOBAL") => return parse_interrupt(l),
         Some("IF") => {
-            let input = |r: &str| {
-                index_of(r.trim(), "$IN[")
-                    .map(|n| u32::try_from(n).map_err(|_| format!("bad input in `{l}`")))
-            };
-            let cond = l.strip_prefix("IF ").and_then(|r| r.strip_suffix("THEN"));
-            if let Some(n) = cond
-                .and_then(|r| r.trim().strip_prefix("NOT "))
-                .and_then(input)
-            {
-                return Ok(KrlOp::IfNotIn(n?));
-            }
-            if let Some(n) = cond.and_then(input) {
-                return Ok(KrlOp::IfIn(n?));
+            if let Some(op) = parse_if_input(l)? {
+                return Ok(op);
             }
         }
         Some(b) if b.starts_with("BAS") => {
-            if let Some(args) = l
-                .strip_prefix("BAS")
-                .map(str::trim)
-                .and_then(|r| r.strip_prefix('('))
-                .and_then(|r| r.strip_suffix(')'))
-            {
-                if let Some((what, n)) = args.split_once(',') {
-                    let n = n.trim();
-                    let int = || {
-                        n.parse::<u8>()
-                            .map_err(|_| format!("bad number `{n}` in `{l}`"))
-                    };
-                    match what.trim() {
-                        "#TOOL" => return Ok(KrlOp::Tool(int()?)),
-                        "#BASE" => return Ok(KrlOp::Base(int()?)),
-                        "#VEL_PTP" => {
-                            let v: f64 = n
-                                .parse()
-                                .ok()
-                                .filter(|v: &f64| *v > 0.0 && *v <= 100.0)
-                                .ok_or_else(|| format!("bad #VEL_PTP `{n}`"))?;
-                            return Ok(KrlOp::VelPtp(v));
-                        }
-                        _ => {}
-                    }
-                }
+            if let Some(op) = parse_bas(l)? {
+                return Ok(op);
             }
         }
         _ => {}
     }
     if let Some((k, v)) = l.split_once('=') {
         let (k, v) = (k.trim(), v.trim());
-        match k {
-            "$VEL.CP" => {
-                let x: f64 = v
-                    .parse()
-                    .ok()
-                    .filter(|x: &f64| x.is_finite() && *x > 0.0)
-                    .ok_or_else(|| format!("bad $VEL.CP `{v}`"))?;
-                return Ok(KrlOp::VelCp(x));
-            }
-            _ if k.starts_with("$VEL_EXTAX[") => {
-                let axis = k
-                    .strip_prefix("$VEL_EXTAX[")
-                    .and_then(|r| r.strip_suffix(']'))
-                    .and_then(|n| n.parse::<u8>().ok())
-                    .filter(|n| (1..=6).contains(n))
-                    .ok_or_else(|| format!("bad `{k}`"))?;
-                let percent: f64 = v
-                    .parse()
-                    .ok()
-                    .filter(|x: &f64| x.is_finite() && *x > 0.0 && *x <= 100.0)
-                    .ok_or_else(|| format!("bad {k} `{v}` (0 < % <= 100)"))?;
-                return Ok(KrlOp::VelExtax { axis, percent });
-            }
-            "$LOAD.M" => {
-                let m: f64 = v
-                    .parse()
-                    .ok()
-                    .filter(|x: &f64| x.is_finite() && *x >= 0.0)
-                    .ok_or_else(|| format!("bad $LOAD.M `{v}` (kg >= 0)"))?;
-                return Ok(KrlOp::LoadMass(m));
-            }
-            "$LOAD.CM" => return Ok(KrlOp::LoadCm(frame_of(v)?)),
-            "$LOAD.J" => {
-                let f = aggregate(v)?;
-                let get = |k: &str| field(&f, k, v);
-                return Ok(KrlOp::LoadJ([get("X")?, get("Y")?, get("Z")?]));
-            }
-            _ if k.starts_with("$TIMER[") => {
-                let timer = index_of(k, "$TIMER[")
-                    .and_then(|n| u8::try_from(n).ok())
-                    .ok_or_else(|| format!("bad `{k}`"))?;
-                let ms: f64 = v
-                    .parse()
-                    .ok()
-                    .filter(|x: &f64| x.is_finite())
-                    .ok_or_else(|| format!("bad {k} `{v}`"))?;
-                return Ok(KrlOp::Timer { timer, ms });
-            }
-            _ if k.starts_with("$TIMER_STOP[") => {
-                let timer = index_of(k, "$TIMER_STOP[")
-                    .and_then(|n| u8::try_from(n).ok())
-                    .ok_or_else(|| format!("bad `{k}`"))?;
-                let stop = match v {
-                    "TRUE" => true,
-                    "FALSE" => false,
-                    _ => return Err(format!("bad {k} `{v}`")),
-                };
-                return Ok(KrlOp::TimerStop { timer, stop });
-            }
-            "$ORI_TYPE" => return Ok(KrlOp::OriType(v.to_string())),
-            "$CIRC_TYPE" => return Ok(KrlOp::CircType(v.to_string())),
-            "$IPO_MODE" => {
-                return match v {
-                    "#TCP" => Ok(KrlOp::IpoTcp(true)),
-                    "#BASE" => Ok(KrlOp::IpoTcp(false)),
-                    _ => Err(format!("bad $IPO_MODE `{v}`")),
-                };
-            }
-            "$TOOL" | "$BASE" if v.starts_with('{') => {
-                let f = frame_of(v)?;
-                return Ok(if k == "$TOOL" {
-                    KrlOp::ToolFrame(f)
-                } else {
-                    KrlOp::BaseFrame(f)
-                });
-            }
-            "$BASE" if v.starts_with("EK") => return parse_ek(v),
-            "$TOOL" | "$BASE" => {
-                let prefix = if k == "$TOOL" {
-                    "TOOL_DATA["
-                } else {
-                    "BASE_DATA["
-                };
-                let n = v
-                    .strip_prefix(prefix)
-                    .and_then(|s| s.strip_suffix(']'))
-                    .and_then(|s| s.parse::<u8>().ok())
-                    .ok_or_else(|| format!("bad `{l}`"))?;
-                return Ok(if k == "$TOOL" {
-                    KrlOp::Tool(n)
-                } else {
-                    KrlOp::Base(n)
-                });
-            }
-            _ => {}
+        if let Some(op) = parse_setting(k, v)? {
+            return Ok(op);
+        }
+        if let Some(op) = parse_frame_setting(l, k, v)? {
+            return Ok(op);
         }
     }
     Ok(KrlOp::Other(l.to_string()))
+}
+
+/// `PTP name`, `LIN name [C_DIS]`, `CIRC aux, name [C_DIS]` (`tokens`: `l`
+/// split at whitespace).
+fn parse_motion(l: &str, tokens: &[&str]) -> Result<KrlOp, String> {
+    match tokens.first().copied() {
+        Some("PTP") => {
+            if tokens.len() != 2 {
+                return Err(format!("expected `PTP name`, got `{l}`"));
+            }
+            Ok(KrlOp::Ptp(tokens[1].to_string()))
+        }
+        Some("LIN") => match tokens {
+            [_, t] => Ok(KrlOp::Lin {
+                target: t.to_string(),
+                blended: false,
+            }),
+            [_, t, "C_DIS"] => Ok(KrlOp::Lin {
+                target: t.to_string(),
+                blended: true,
+            }),
+            _ => Err(format!("expected `LIN name [C_DIS]`, got `{l}`")),
+        },
+        _ => {
+            let circ = |aux: &str, t: &str, blended| {
+                Ok(KrlOp::Circ {
+                    aux: aux.to_string(),
+                    target: t.to_string(),
+                    blended,
+                })
+            };
+            let args: Vec<&str> = l["CIRC".len()..].split(',').map(str::trim).collect();
+            match args.as_slice() {
+                [aux, rest] if !aux.is_empty() => {
+                    match rest.split_whitespace().collect::<Vec<_>>().as_slice() {
+                        [t] => circ(aux, t, false),
+                        [t, "C_DIS"] => circ(aux, t, true),
+                        _ => Err(format!("expected `CIRC aux, name [C_DIS]`, got `{l}`")),
+                    }
+                }
+                _ => Err(format!("expected `CIRC aux, name [C_DIS]`, got `{l}`")),
+            }
+        }
+    }
+}
+
+/// `TRIGGER WHEN DISTANCE=d DELAY=0 DO action [PRIO=p]`.
+fn parse_trigger(l: &str) -> Result<KrlOp, String> {
+    let rest = l
+        .strip_prefix("TRIGGER WHEN DISTANCE=")
+        .ok_or_else(|| format!("bad TRIGGER `{l}`"))?;
+    let (d, rest) = rest
+        .split_once(' ')
+        .ok_or_else(|| format!("bad TRIGGER `{l}`"))?;
+    let distance = match d {
+        "0" => 0,
+        "1" => 1,
+        _ => return Err(format!("TRIGGER DISTANCE={d}: expected 0 or 1")),
+    };
+    let action = rest
+        .trim()
+        .strip_prefix("DELAY=0 DO ")
+        .ok_or_else(|| format!("bad TRIGGER `{l}`"))?
+        .trim();
+    // a trailing `PRIO = p` (spaces optional)
+    let (action, prio) = match action.rfind("PRIO") {
+        Some(k) if action[..k].ends_with(' ') => {
+            let v = action[k + 4..].trim_start();
+            let v = v
+                .strip_prefix('=')
+                .map(str::trim)
+                .ok_or_else(|| format!("bad PRIO in `{l}`"))?;
+            let p: i32 = v.parse().map_err(|_| format!("bad PRIO `{v}` in `{l}`"))?;
+            (action[..k].trim_end(), Some(p))
+        }
+        _ => (action, None),
+    };
+    Ok(KrlOp::Trigger {
+        distance,
+        action: action.to_string(),
+        prio,
+    })
+}
+
+/// `IF NOT $IN[n] THEN`, `IF $IN[n] THEN`; `None` for another `IF`.
+fn parse_if_input(l: &str) -> Result<Option<KrlOp>, String> {
+    let input = |r: &str| {
+        index_of(r.trim(), "$IN[")
+            .map(|n| u32::try_from(n).map_err(|_| format!("bad input in `{l}`")))
+    };
+    let cond = l.strip_prefix("IF ").and_then(|r| r.strip_suffix("THEN"));
+    if let Some(n) = cond
+        .and_then(|r| r.trim().strip_prefix("NOT "))
+        .and_then(input)
+    {
+        return Ok(Some(KrlOp::IfNotIn(n?)));
+    }
+    if let Some(n) = cond.and_then(input) {
+        return Ok(Some(KrlOp::IfIn(n?)));
+    }
+    Ok(None)
+}
+
+/// `BAS (#TOOL, n)`, `BAS (#BASE, n)`, `BAS (#VEL_PTP, v)`; `None` for
+/// another `BAS` call.
+fn parse_bas(l: &str) -> Result<Option<KrlOp>, String> {
+    if let Some(args) = l
+        .strip_prefix("BAS")
+        .map(str::trim)
+        .and_then(|r| r.strip_prefix('('))
+        .and_then(|r| r.strip_suffix(')'))
+    {
+        if let Some((what, n)) = args.split_once(',') {
+            let n = n.trim();
+            let int = || {
+                n.parse::<u8>()
+                    .map_err(|_| format!("bad number `{n}` in `{l}`"))
+            };
+            match what.trim() {
+                "#TOOL" => return Ok(Some(KrlOp::Tool(int()?))),
+                "#BASE" => return Ok(Some(KrlOp::Base(int()?))),
+                "#VEL_PTP" => {
+                    let v: f64 = n
+                        .parse()
+                        .ok()
+                        .filter(|v: &f64| *v > 0.0 && *v <= 100.0)
+                        .ok_or_else(|| format!("bad #VEL_PTP `{n}`"))?;
+                    return Ok(Some(KrlOp::VelPtp(v)));
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(None)
+}
+
+/// `k = v` for a speed, load or timer variable (`$VEL.CP`,
+/// `$VEL_EXTAX[n]`, `$LOAD.M`, `$LOAD.CM`, `$LOAD.J`, `$TIMER[t]`,
+/// `$TIMER_STOP[t]`); `None` for another variable.
+fn parse_setting(k: &str, v: &str) -> Result<Option<KrlOp>, String> {
+    Ok(Some(match k {
+        "$VEL.CP" => {
+            let x: f64 = v
+                .parse()
+                .ok()
+                .filter(|x: &f64| x.is_finite() && *x > 0.0)
+                .ok_or_else(|| format!("bad $VEL.CP `{v}`"))?;
+            KrlOp::VelCp(x)
+        }
+        _ if k.starts_with("$VEL_EXTAX[") => {
+            let axis = k
+                .strip_prefix("$VEL_EXTAX[")
+                .and_then(|r| r.strip_suffix(']'))
+                .and_then(|n| n.parse::<u8>().ok())
+                .filter(|n| (1..=6).contains(n))
+                .ok_or_else(|| format!("bad `{k}`"))?;
+            let percent: f64 = v
+                .parse()
+                .ok()
+                .filter(|x: &f64| x.is_finite() && *x > 0.0 && *x <= 100.0)
+                .ok_or_else(|| format!("bad {k} `{v}` (0 < % <= 100)"))?;
+            KrlOp::VelExtax { axis, percent }
+        }
+        "$LOAD.M" => {
+            let m: f64 = v
+                .parse()
+                .ok()
+                .filter(|x: &f64| x.is_finite() && *x >= 0.0)
+                .ok_or_else(|| format!("bad $LOAD.M `{v}` (kg >= 0)"))?;
+            KrlOp::LoadMass(m)
+        }
+        "$LOAD.CM" => KrlOp::LoadCm(frame_of(v)?),
+        "$LOAD.J" => {
+            let f = aggregate(v)?;
+            let get = |k: &str| field(&f, k, v);
+            KrlOp::LoadJ([get("X")?, get("Y")?, get("Z")?])
+        }
+        _ if k.starts_with("$TIMER[") => {
+            let timer = index_of(k, "$TIMER[")
+                .and_then(|n| u8::try_from(n).ok())
+                .ok_or_else(|| format!("bad `{k}`"))?;
+            let ms: f64 = v
+                .parse()
+                .ok()
+                .filter(|x: &f64| x.is_finite())
+                .ok_or_else(|| format!("bad {k} `{v}`"))?;
+            KrlOp::Timer { timer, ms }
+        }
+        _ if k.starts_with("$TIMER_STOP[") => {
+            let timer = index_of(k, "$TIMER_STOP[")
+                .and_then(|n| u8::try_from(n).ok())
+                .ok_or_else(|| format!("bad `{k}`"))?;
+            let stop = match v {
+                "TRUE" => true,
+                "FALSE" => false,
+                _ => return Err(format!("bad {k} `{v}`")),
+            };
+            KrlOp::TimerStop { timer, stop }
+        }
+        _ => return Ok(None),
+    }))
+}
+
+/// `k = v` (the statement `l`) for a frame variable (`$ORI_TYPE`,
+/// `$CIRC_TYPE`, `$IPO_MODE`, `$TOOL`, `$BASE`); `None` for another
+/// variable.
+fn parse_frame_setting(l: &str, k: &str, v: &str) -> Result<Option<KrlOp>, String> {
+    Ok(Some(match k {
+        "$ORI_TYPE" => KrlOp::OriType(v.to_string()),
+        "$CIRC_TYPE" => KrlOp::CircType(v.to_string()),
+        "$IPO_MODE" => match v {
+            "#TCP" => KrlOp::IpoTcp(true),
+            "#BASE" => KrlOp::IpoTcp(false),
+            _ => return Err(format!("bad $IPO_MODE `{v}`")),
+        },
+        "$TOOL" | "$BASE" if v.starts_with('{') => {
+            let f = frame_of(v)?;
+            if k == "$TOOL" {
+                KrlOp::ToolFrame(f)
+            } else {
+                KrlOp::BaseFrame(f)
+            }
+        }
+        "$BASE" if v.starts_with("EK") => parse_ek(v)?,
+        "$TOOL" | "$BASE" => {
+            let prefix = if k == "$TOOL" {
+                "TOOL_DATA["
+            } else {
+                "BASE_DATA["
+            };
+            let n = v
+                .strip_prefix(prefix)
+                .and_then(|s| s.strip_suffix(']'))
+                .and_then(|s| s.parse::<u8>().ok())
+                .ok_or_else(|| format!("bad `{l}`"))?;
+            if k == "$TOOL" {
+                KrlOp::Tool(n)
+            } else {
+                KrlOp::Base(n)
+            }
+        }
+        _ => return Ok(None),
+    }))
 }
 
 /// `[GLOBAL] INTERRUPT DECL p WHEN cond DO name(args)` and `INTERRUPT
