@@ -1,7 +1,7 @@
 //! The one contract every robot controller's program format implements:
 //! its options (from the cell file's `[program]` table), its emitter (a
 //! [`Program`] to files), its reader (files back to the controller's own
-//! program model) and its decoder (that model to the checker's [`Step`]s,
+//! program model) and its decoder (that model to the checker's [`DecodedStep`]s,
 //! checked by the one [`check_steps`]).
 //! FANUC, KUKA and ABB each implement [`Controller`] in their own folder;
 //! [`with_controller`] is the one place that turns a [`Vendor`] into its
@@ -20,7 +20,7 @@ pub use crate::program::fanuc::Fanuc;
 pub use crate::program::kuka::Kuka;
 use crate::program::split::{parse_group_name, Budget};
 use crate::program::validate::{
-    check_home_ends, check_steps, push, vendor_matches, ProblemKind, Step, ValidationReport,
+    check_home_ends, check_steps, push, vendor_matches, DecodedStep, ProblemKind, ValidationReport,
 };
 use crate::program::{EmittedFile, Program, ProgramError, ProgramOptions, ProgramSettings};
 use crate::robot::{CellLayout, Vendor};
@@ -121,7 +121,7 @@ pub trait Controller {
         cell: &CellLayout,
         opts: &Self::Options,
         report: &mut ValidationReport,
-    ) -> Option<Vec<Step>>;
+    ) -> Option<Vec<DecodedStep>>;
 
     /// Validates a program read back against `cell`: the vendor, the
     /// files, then every step ([`check_steps`]). `planned`: the planned
@@ -148,7 +148,7 @@ pub(crate) fn validate_decoded<C: Controller>(
     main_file: &str,
     opts: &C::Options,
     planned: Option<&[Point3]>,
-    decode: impl FnOnce(&mut ValidationReport) -> Option<Vec<Step>>,
+    decode: impl FnOnce(&mut ValidationReport) -> Option<Vec<DecodedStep>>,
 ) -> ValidationReport {
     let mut report = ValidationReport::default();
     if !vendor_matches(cell, C::VENDOR, C::EMITTER, main_file, &mut report) {
@@ -233,7 +233,7 @@ pub fn validate_build<C: Controller>(
     let mut report = ValidationReport::default();
     let groups = C::groups(files, &mut report)?;
     let budget = C::budget(opts);
-    let mut steps: Vec<Step> = Vec::new();
+    let mut steps: Vec<DecodedStep> = Vec::new();
     let mut ranges = Vec::with_capacity(groups.len());
     for g in &groups {
         let read = C::read(g)?;

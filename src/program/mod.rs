@@ -20,7 +20,7 @@
 //! | CSV of every point | [`csv`] | [`csv::write_csv`] |
 //! | the whole cell against collisions along every motion | [`cell_check`] | [`cell_check::check_cell`] |
 //! | the build's cycle time (per move, layer, build) | [`cycle`] | [`cycle::cycle_time`] |
-//! | the one checker of decoded steps (file + cell) | [`validate`] | [`validate::check_steps`], [`validate::Step`] |
+//! | the one checker of decoded steps (file + cell) | [`validate`] | [`validate::check_steps`], [`validate::DecodedStep`] |
 //! | approach and retract points | this module | [`build_program_with`], [`ProgramOptions`] |
 //! | arc-off transits against the wall | [`transit`] | [`transit::joint_move_clearance`] |
 //! | tool and work frames of every emitter | [`frames`] | [`frames::ToolFrames`], [`frames::held_tool`] |

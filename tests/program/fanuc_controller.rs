@@ -2,7 +2,7 @@
 //! stated and checked, `COORD` on the positioner's moves, `RTCP` for the
 //! part-carried cell, `ARC : TRUE`, `Arc Start[s]` or `Weld Start[p,s]`,
 //! home, payload, dwell and interpass wait — written, read back into
-//! [`Step`]s and checked, and corrupted files caught by the validator.
+//! [`DecodedStep`]s and checked, and corrupted files caught by the validator.
 //!
 //! Review of the golden `fanuc_setup_HEMI.ls` (and the regenerated FANUC
 //! goldens) against public third-party sources, found with the search tool:
@@ -61,7 +61,7 @@ use waam_slicer::program::fanuc::validate_fanuc;
 use waam_slicer::program::fanuc::{
     fanuc_files, joint_speed_ratio, FanucOptions, Op, TpProgram, JOINT_SPEED_MARGIN,
 };
-use waam_slicer::program::validate::{MotionSpeed, ProblemKind, Step, ValidationReport};
+use waam_slicer::program::validate::{DecodedStep, MotionSpeed, ProblemKind, ValidationReport};
 use waam_slicer::program::PositionMode;
 use waam_slicer::program::{
     BeadSetup, HomePosition, Payload, Program, ProgramError, ProgramOptions,
@@ -140,35 +140,35 @@ fn read_all(files: &[waam_slicer::program::EmittedFile]) -> Vec<TpProgram> {
         .collect()
 }
 
-fn steps_of(tps: &[TpProgram], cell: &CellLayout, opts: &FanucOptions) -> Vec<Step> {
+fn steps_of(tps: &[TpProgram], cell: &CellLayout, opts: &FanucOptions) -> Vec<DecodedStep> {
     let mut report = ValidationReport::default();
     let steps = fanuc_steps(tps, cell, opts, &mut report);
     assert!(report.is_ok(), "{report}");
     steps
 }
 
-fn motion_joints_deg(s: &Step) -> Option<[f64; 6]> {
+fn motion_joints_deg(s: &DecodedStep) -> Option<[f64; 6]> {
     match s {
-        Step::Motion(m) => m.joints.map(|q| q.map(f64::to_degrees)),
+        DecodedStep::Motion(m) => m.joints.map(|q| q.map(f64::to_degrees)),
         _ => None,
     }
 }
 
 /// The set-up steps (payload, waits) in order, as (kind, value) text.
-fn setup_steps(steps: &[Step]) -> Vec<String> {
+fn setup_steps(steps: &[DecodedStep]) -> Vec<String> {
     steps
         .iter()
         .filter_map(|s| match s {
-            Step::Payload {
+            DecodedStep::Payload {
                 mass_kg, cog_mm, ..
             } => Some(format!(
                 "payload {mass_kg:.3} kg at ({:.2}, {:.2}, {:.2}) mm",
                 cog_mm.x, cog_mm.y, cog_mm.z
             )),
-            Step::Wait {
+            DecodedStep::Wait {
                 seconds: Some(t), ..
             } => Some(format!("dwell {t:.2} s")),
-            Step::Wait { input: Some(n), .. } => Some(format!("wait DI[{n}]")),
+            DecodedStep::Wait { input: Some(n), .. } => Some(format!("wait DI[{n}]")),
             _ => None,
         })
         .collect()
@@ -205,9 +205,9 @@ fn setup_golden_reads_back_into_the_right_steps() {
 
     let tps = read_all(&files);
     let steps = steps_of(&tps, &cell, &opts);
-    let motions: Vec<&Step> = steps
+    let motions: Vec<&DecodedStep> = steps
         .iter()
-        .filter(|s| matches!(s, Step::Motion(_)))
+        .filter(|s| matches!(s, DecodedStep::Motion(_)))
         .collect();
     // home, 2 x (approach, 8 bead points, retract), home
     assert_eq!(motions.len(), 1 + 2 * 10 + 1);
@@ -217,7 +217,7 @@ fn setup_golden_reads_back_into_the_right_steps() {
             assert!((a - b).abs() < 1e-4, "{q:?}");
         }
     }
-    assert!(matches!(steps[0], Step::Motion(_)), "home first");
+    assert!(matches!(steps[0], DecodedStep::Motion(_)), "home first");
     assert_eq!(
         setup_steps(&steps),
         [
@@ -231,14 +231,14 @@ fn setup_golden_reads_back_into_the_right_steps() {
     // after the first bead's retract)
     let k = steps
         .iter()
-        .position(|s| matches!(s, Step::Wait { input: Some(3), .. }))
+        .position(|s| matches!(s, DecodedStep::Wait { input: Some(3), .. }))
         .unwrap();
-    assert!(matches!(&steps[k + 1], Step::Motion(m) if m.label == "P[11]"));
-    assert!(matches!(&steps[k - 3], Step::Motion(m) if m.label == "P[10]"));
+    assert!(matches!(&steps[k + 1], DecodedStep::Motion(m) if m.label == "P[11]"));
+    assert!(matches!(&steps[k - 3], DecodedStep::Motion(m) if m.label == "P[10]"));
     // RTCP speeds are the travel speed over the part
     assert!(steps.iter().any(|s| matches!(
         s,
-        Step::Motion(m) if m.speed == MotionSpeed::Linear(6.0)
+        DecodedStep::Motion(m) if m.speed == MotionSpeed::Linear(6.0)
     )));
     let r = validate_fanuc(&tps, &cell, &opts, Some(&planned));
     assert!(r.is_ok(), "{r}");
@@ -336,7 +336,7 @@ fn torch_carried_programs_are_coordinated_with_a_positioner_home() {
         let steps = steps_of(&tps, &cell, &opts);
         let want = prog.points.last().unwrap().positioner.unwrap();
         match &steps[0] {
-            Step::Motion(m) => {
+            DecodedStep::Motion(m) => {
                 let g = m.positioner.unwrap();
                 assert!(
                     (g[0] - want[0]).abs() < 1e-5 && (g[1] - want[1]).abs() < 1e-5,

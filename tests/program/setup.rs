@@ -14,7 +14,7 @@
 use waam_slicer::math::{Point3, Vector3};
 use waam_slicer::program::transit::{joint_move_clearance, torch_in_part, wall_of};
 use waam_slicer::program::validate::{
-    check_steps, Motion, MotionSpeed, ProblemKind, Step, ValidationReport,
+    check_steps, DecodedStep, Motion, MotionSpeed, ProblemKind, ValidationReport,
 };
 use waam_slicer::program::MoveKind;
 use waam_slicer::program::{
@@ -265,8 +265,8 @@ fn the_transits_of_the_sample_programs_clear_the_wall() {
     }
 }
 
-fn motion(line: usize, q: [f64; 6], kind: MoveKind) -> Step {
-    Step::Motion(Box::new(Motion {
+fn motion(line: usize, q: [f64; 6], kind: MoveKind) -> DecodedStep {
+    DecodedStep::Motion(Box::new(Motion {
         file: "T".into(),
         line,
         label: format!("P[{line}]"),
@@ -287,7 +287,10 @@ fn motion(line: usize, q: [f64; 6], kind: MoveKind) -> Step {
 
 /// The steps of a two-bead program in the part-carried cell as a reader
 /// would decode them, with `before_second` between the beads.
-fn two_beads(home: Option<[f64; 6]>, before_second: Vec<Step>) -> (Vec<Step>, CellLayout) {
+fn two_beads(
+    home: Option<[f64; 6]>,
+    before_second: Vec<DecodedStep>,
+) -> (Vec<DecodedStep>, CellLayout) {
     let cell = part_carried();
     let (prog, _) = program(&cell, 0..2, 12);
     let mut steps = Vec::new();
@@ -311,11 +314,11 @@ fn two_beads(home: Option<[f64; 6]>, before_second: Vec<Step>) -> (Vec<Step>, Ce
         };
         steps.push(motion(next(), p.joints, kind));
         match p.arc {
-            ArcFlag::Start => steps.push(Step::ProcessOn {
+            ArcFlag::Start => steps.push(DecodedStep::ProcessOn {
                 file: "T".into(),
                 line: next(),
             }),
-            ArcFlag::End => steps.push(Step::ProcessOff {
+            ArcFlag::End => steps.push(DecodedStep::ProcessOff {
                 file: "T".into(),
                 line: next(),
             }),
@@ -345,7 +348,7 @@ fn the_checker_wants_home_first_and_last_and_the_dwell_and_wait_between_beads() 
         interpass_input: Some(3),
         ..options()
     };
-    let wait = |s: Option<f64>, i: Option<u32>| Step::Wait {
+    let wait = |s: Option<f64>, i: Option<u32>| DecodedStep::Wait {
         file: "T".into(),
         line: 1000,
         seconds: s,
@@ -382,7 +385,7 @@ fn the_checker_refuses_a_wait_or_payload_with_the_arc_on_and_a_shrinking_payload
         payload_base_kg: 2.0,
         ..options()
     };
-    let payload = |m: f64| Step::Payload {
+    let payload = |m: f64| DecodedStep::Payload {
         file: "T".into(),
         line: 500,
         mass_kg: m,
@@ -393,11 +396,11 @@ fn the_checker_refuses_a_wait_or_payload_with_the_arc_on_and_a_shrinking_payload
     steps.insert(0, payload(2.0));
     let on = steps
         .iter()
-        .position(|s| matches!(s, Step::ProcessOn { .. }))
+        .position(|s| matches!(s, DecodedStep::ProcessOn { .. }))
         .unwrap();
     steps.insert(
         on + 2,
-        Step::Wait {
+        DecodedStep::Wait {
             file: "T".into(),
             line: 600,
             seconds: Some(1.0),
@@ -417,7 +420,7 @@ fn the_checker_finds_a_joint_move_through_the_wall() {
     let cell = part_carried();
     let (prog, _) = program(&cell, 0..7, 12);
     let q0 = prog.bead_points().next().unwrap().joints;
-    let mut steps: Vec<Step> = Vec::new();
+    let mut steps: Vec<DecodedStep> = Vec::new();
     let mut line = 0;
     for (i, p) in prog.points.iter().enumerate() {
         line += 1;
@@ -428,11 +431,11 @@ fn the_checker_finds_a_joint_move_through_the_wall() {
         };
         steps.push(motion(line, p.joints, kind));
         match p.arc {
-            ArcFlag::Start => steps.push(Step::ProcessOn {
+            ArcFlag::Start => steps.push(DecodedStep::ProcessOn {
                 file: "T".into(),
                 line,
             }),
-            ArcFlag::End => steps.push(Step::ProcessOff {
+            ArcFlag::End => steps.push(DecodedStep::ProcessOff {
                 file: "T".into(),
                 line,
             }),

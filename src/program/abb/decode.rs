@@ -1,4 +1,4 @@
-//! ABB modules as [`Step`]s: the module read by
+//! ABB modules as [`DecodedStep`]s: the module read by
 //! [`parse_mod`](crate::program::abb::read::parse_mod), each
 //! `robtarget` decoded with its `confdata` in the file's own frames (a
 //! fixed, robot-held or positioner-coordinated work object), every
@@ -24,7 +24,9 @@ use crate::robot::{CellLayout, Configuration, Joints};
 
 use crate::program::validate::ProblemKind;
 use crate::program::validate::{arm_of, wrist_of_j5};
-use crate::program::validate::{decode_pose, push, Motion, MotionSpeed, Step, ValidationReport};
+use crate::program::validate::{
+    decode_pose, push, DecodedStep, Motion, MotionSpeed, ValidationReport,
+};
 
 mod declarations;
 
@@ -255,8 +257,8 @@ fn file_frames(
 /// Arc-on moves run at their `welddata`'s `weld_speed` (checked equal to
 /// the `speeddata`'s `v_tcp`); timed moves (`\T`) must not let the
 /// positioner outrun the time at their `v_reax`. `WaitTime` becomes a
-/// [`Step::Wait`] with seconds, `WaitDI <interpass_signal>, 1` one with
-/// `[program] interpass_input`, `GripLoad` a [`Step::Payload`] (centre of
+/// [`DecodedStep::Wait`] with seconds, `WaitDI <interpass_signal>, 1` one with
+/// `[program] interpass_input`, `GripLoad` a [`DecodedStep::Payload`] (centre of
 /// gravity back in the flange frame). A cell whose robot is not an ABB arm
 /// is refused: the report holds that one problem (line 1 of the module).
 pub fn validate_abb(
@@ -269,7 +271,7 @@ pub fn validate_abb(
     Abb::validate(module, cell, opts, planned)
 }
 
-/// The [`Step`]s of an ABB module (motions decoded, process on and off,
+/// The [`DecodedStep`]s of an ABB module (motions decoded, process on and off,
 /// waits, payloads) in execution order, with the problems of the file
 /// itself (declarations, frames, motion arguments) added to `report`;
 /// `None` when the options themselves are unusable (the problem is in
@@ -279,7 +281,7 @@ pub(crate) fn abb_steps(
     cell: &CellLayout,
     opts: &AbbOptions,
     report: &mut ValidationReport,
-) -> Option<Vec<Step>> {
+) -> Option<Vec<DecodedStep>> {
     let file = &module.file;
     let slots = match opts.positioner_slots() {
         Ok(s) => s,
@@ -298,7 +300,7 @@ pub(crate) fn abb_steps(
         }
         match &ins.op {
             RapidOp::ConfL(on) => d.conf_l = *on,
-            RapidOp::WaitTime(t) => d.steps.push(Step::Wait {
+            RapidOp::WaitTime(t) => d.steps.push(DecodedStep::Wait {
                 file: file.clone(),
                 line,
                 seconds: Some(*t),
@@ -344,7 +346,7 @@ struct Decoder<'a> {
     start: Option<(String, String)>,
     /// The arc process's weld schedule.
     schedule: Option<u32>,
-    steps: Vec<Step>,
+    steps: Vec<DecodedStep>,
     /// `ConfL \On` in force.
     conf_l: bool,
     /// The positioner joints (rad) of the last motion's end.
@@ -397,7 +399,7 @@ impl<'a> Decoder<'a> {
         &self.module.file
     }
 
-    /// `WaitDI signal, value`: the interpass wait (a [`Step::Wait`] for
+    /// `WaitDI signal, value`: the interpass wait (a [`DecodedStep::Wait`] for
     /// `[program] interpass_input`).
     fn wait_di(&mut self, signal: &str, value: u8, line: usize, report: &mut ValidationReport) {
         let (file, opts) = (self.file(), self.opts);
@@ -422,7 +424,7 @@ impl<'a> Decoder<'a> {
             );
         } else {
             match opts.common.interpass_input {
-                Some(n) => self.steps.push(Step::Wait {
+                Some(n) => self.steps.push(DecodedStep::Wait {
                     file: file.clone(),
                     line,
                     seconds: None,
@@ -439,7 +441,7 @@ impl<'a> Decoder<'a> {
         }
     }
 
-    /// `GripLoad name`: a [`Step::Payload`], its centre of gravity back in
+    /// `GripLoad name`: a [`DecodedStep::Payload`], its centre of gravity back in
     /// the flange frame.
     fn grip_load(&mut self, name: &str, line: usize, report: &mut ValidationReport) {
         let module = self.module;
@@ -455,7 +457,7 @@ impl<'a> Decoder<'a> {
             None
         };
         if let (Some((mass_kg, cog)), Some(f)) = (load, &self.frames) {
-            self.steps.push(Step::Payload {
+            self.steps.push(DecodedStep::Payload {
                 file: module.file.clone(),
                 line,
                 mass_kg,
@@ -468,11 +470,11 @@ impl<'a> Decoder<'a> {
     fn custom_switch(&mut self, s: &str, line: usize, report: &mut ValidationReport) {
         let file = self.file();
         match &self.start {
-            Some((a, _)) if s == a => self.steps.push(Step::ProcessOn {
+            Some((a, _)) if s == a => self.steps.push(DecodedStep::ProcessOn {
                 file: file.clone(),
                 line,
             }),
-            Some((_, b)) if s == b => self.steps.push(Step::ProcessOff {
+            Some((_, b)) if s == b => self.steps.push(DecodedStep::ProcessOff {
                 file: file.clone(),
                 line,
             }),
@@ -535,11 +537,11 @@ impl<'a> Decoder<'a> {
         }
         let file = self.file();
         match event {
-            Some(true) => self.steps.push(Step::ProcessOn {
+            Some(true) => self.steps.push(DecodedStep::ProcessOn {
                 file: file.clone(),
                 line,
             }),
-            Some(false) => self.steps.push(Step::ProcessOff {
+            Some(false) => self.steps.push(DecodedStep::ProcessOff {
                 file: file.clone(),
                 line,
             }),
@@ -724,7 +726,7 @@ impl<'a> Decoder<'a> {
                 return;
             }
         };
-        self.steps.push(Step::Motion(Box::new(Motion {
+        self.steps.push(DecodedStep::Motion(Box::new(Motion {
             file: file.clone(),
             line,
             label: t.name.clone(),

@@ -142,7 +142,7 @@ pub use read::parse_mod;
 
 use crate::program::contract::{groups_by_name, read_file, Controller};
 use crate::program::split::{split_to_budget, Budget};
-use crate::program::validate::{Step, ValidationReport};
+use crate::program::validate::{DecodedStep, ValidationReport};
 use crate::program::{ProgramOptions, ProgramSettings};
 use std::path::Path;
 
@@ -1313,7 +1313,7 @@ impl Controller for Abb {
         cell: &CellLayout,
         opts: &AbbOptions,
         report: &mut ValidationReport,
-    ) -> Option<Vec<Step>> {
+    ) -> Option<Vec<DecodedStep>> {
         decode::abb_steps(read, cell, opts, report)
     }
 }

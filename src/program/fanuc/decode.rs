@@ -1,4 +1,4 @@
-//! FANUC TP programs as [`Step`]s: the programs read by
+//! FANUC TP programs as [`DecodedStep`]s: the programs read by
 //! [`parse_ls`](super::parse_ls), `CALL`s followed, each position decoded
 //! (joints, or a Cartesian pose with its `CONFIG` string and turn numbers)
 //! in the frames of [`FanucOptions::frames`].
@@ -15,8 +15,8 @@
 //! the arc instructions of the options (`Arc Start[s]` or `Weld
 //! Start[p,s]`; another schedule or form is a [`ProblemKind::Options`]);
 //! dwells (`WAIT x(sec)`) and interpass waits (`WAIT DI[n]=ON`) as
-//! [`Step::Wait`]; payload updates (`$PLST_GRP1[n]` mass and CoG, kg and
-//! cm, then `PAYLOAD[n]`) as [`Step::Payload`] (CoG in mm).
+//! [`DecodedStep::Wait`]; payload updates (`$PLST_GRP1[n]` mass and CoG, kg and
+//! cm, then `PAYLOAD[n]`) as [`DecodedStep::Payload`] (CoG in mm).
 
 use std::collections::HashMap;
 use std::f64::consts::TAU;
@@ -28,7 +28,7 @@ use crate::program::fanuc::{
     Op, PayloadField, Position, Speed, TpProgram,
 };
 use crate::program::validate::{
-    decode_pose, push, Motion, MotionSpeed, ProblemKind, Step, ValidationReport,
+    decode_pose, push, DecodedStep, Motion, MotionSpeed, ProblemKind, ValidationReport,
 };
 use crate::program::ProcessControl;
 use crate::robot::orientation::FanucPose;
@@ -38,7 +38,7 @@ use crate::robot::{CellLayout, Configuration, Joints};
 /// position (mm) and rotation (deg); the remarks print 3 decimals.
 pub const FRAME_TOLERANCE: f64 = 0.005;
 
-/// The [`Step`]s of `programs` (the first is executed; `CALL`s are followed
+/// The [`DecodedStep`]s of `programs` (the first is executed; `CALL`s are followed
 /// into the others by name) in `cell` with `opts`, in execution order; what
 /// cannot be decoded or disagrees with the options is added to `report`
 /// (module doc). The cell's robot is assumed to be a FANUC arm (checked by
@@ -48,7 +48,7 @@ pub fn fanuc_steps(
     cell: &CellLayout,
     opts: &FanucOptions,
     report: &mut ValidationReport,
-) -> Vec<Step> {
+) -> Vec<DecodedStep> {
     let mut steps = Vec::new();
     if let Some(main) = programs.first() {
         let mut state = Decoder {
@@ -177,7 +177,7 @@ impl Decoder<'_> {
         &mut self,
         tp: &TpProgram,
         depth: usize,
-        steps: &mut Vec<Step>,
+        steps: &mut Vec<DecodedStep>,
         report: &mut ValidationReport,
     ) {
         self.check_header(tp, report);
@@ -190,11 +190,11 @@ impl Decoder<'_> {
             let file = &tp.name;
             match &ins.op {
                 Op::Call(name) => self.call(name, depth, file, line, steps, report),
-                op if *op == start => steps.push(Step::ProcessOn {
+                op if *op == start => steps.push(DecodedStep::ProcessOn {
                     file: file.clone(),
                     line,
                 }),
-                op if *op == end => steps.push(Step::ProcessOff {
+                op if *op == end => steps.push(DecodedStep::ProcessOff {
                     file: file.clone(),
                     line,
                 }),
@@ -214,25 +214,25 @@ impl Decoder<'_> {
                         format!("`{}`: the options give `{}`", op_text(op), op_text(want)),
                     );
                     steps.push(if is_start {
-                        Step::ProcessOn {
+                        DecodedStep::ProcessOn {
                             file: file.clone(),
                             line,
                         }
                     } else {
-                        Step::ProcessOff {
+                        DecodedStep::ProcessOff {
                             file: file.clone(),
                             line,
                         }
                     });
                 }
                 Op::Remark(_) => {}
-                Op::WaitTime(t) => steps.push(Step::Wait {
+                Op::WaitTime(t) => steps.push(DecodedStep::Wait {
                     file: file.clone(),
                     line,
                     seconds: Some(*t),
                     input: None,
                 }),
-                Op::WaitInput(n) => steps.push(Step::Wait {
+                Op::WaitInput(n) => steps.push(DecodedStep::Wait {
                     file: file.clone(),
                     line,
                     seconds: None,
@@ -312,7 +312,7 @@ impl Decoder<'_> {
         depth: usize,
         file: &str,
         line: usize,
-        steps: &mut Vec<Step>,
+        steps: &mut Vec<DecodedStep>,
         report: &mut ValidationReport,
     ) {
         if depth > 4 {
@@ -337,14 +337,14 @@ impl Decoder<'_> {
         }
     }
 
-    /// `PAYLOAD[n]` at `file:line`: a [`Step::Payload`] of the mass and
+    /// `PAYLOAD[n]` at `file:line`: a [`DecodedStep::Payload`] of the mass and
     /// CoG the programs set for schedule `n` before it.
     fn payload(
         &self,
         n: u8,
         file: &str,
         line: usize,
-        steps: &mut Vec<Step>,
+        steps: &mut Vec<DecodedStep>,
         report: &mut ValidationReport,
     ) {
         let opts = self.opts;
@@ -361,7 +361,7 @@ impl Decoder<'_> {
             );
         }
         match self.payloads.get(&n) {
-            Some([Some(m), Some(x), Some(y), Some(z)]) => steps.push(Step::Payload {
+            Some([Some(m), Some(x), Some(y), Some(z)]) => steps.push(DecodedStep::Payload {
                 file: file.to_string(),
                 line,
                 mass_kg: *m,
@@ -393,7 +393,7 @@ impl Decoder<'_> {
         speed: &Speed,
         options: &MotionOptions,
         report: &mut ValidationReport,
-    ) -> Step {
+    ) -> DecodedStep {
         let (opts, cell, file) = (self.opts, self.cell, &tp.name);
         let want_rtcp = opts.remote_tcp(cell);
         let want_coord = opts.coordinated(cell);
@@ -434,7 +434,7 @@ impl Decoder<'_> {
             );
         }
         let (joints, from_cartesian) = self.arm_joints(tp, pos, &label, report);
-        Step::Motion(Box::new(Motion {
+        DecodedStep::Motion(Box::new(Motion {
             file: file.clone(),
             line,
             label,

@@ -116,7 +116,7 @@ pub use decode::{fanuc_steps, parse_config, validate_fanuc};
 pub use read::parse_ls;
 
 use crate::program::contract::Controller;
-use crate::program::validate::{Step, ValidationReport};
+use crate::program::validate::{DecodedStep, ValidationReport};
 use crate::program::{ProgramOptions, ProgramSettings};
 use std::path::Path;
 
@@ -1443,7 +1443,7 @@ impl Controller for Fanuc {
         cell: &CellLayout,
         opts: &FanucOptions,
         report: &mut ValidationReport,
-    ) -> Option<Vec<Step>> {
+    ) -> Option<Vec<DecodedStep>> {
         Some(fanuc_steps(read, cell, opts, report))
     }
 }

@@ -1,4 +1,4 @@
-//! KUKA programs as [`Step`]s: the `.src`/`.dat` pair read by
+//! KUKA programs as [`DecodedStep`]s: the `.src`/`.dat` pair read by
 //! [`parse_krl`](crate::program::kuka::read::parse_krl), each position
 //! decoded (`E6AXIS`, or `E6POS` with its Status and Turn bits). With the
 //! arc process the file's own safety is checked too: each bead's ignition
@@ -24,7 +24,7 @@ use crate::program::kuka::KukaOptions;
 use crate::robot::{CellLayout, Joints};
 
 use crate::program::validate::ProblemKind;
-use crate::program::validate::{push, Step, ValidationReport};
+use crate::program::validate::{push, DecodedStep, ValidationReport};
 
 use handshake::{handshake_form, loop_end, read_handshake};
 use supervision::Supervision;
@@ -32,7 +32,7 @@ use supervision::Supervision;
 /// Validates a KUKA program read by
 /// [`parse_krl`](crate::program::kuka::read::parse_krl) against `cell`
 /// with the frames, tool/base numbers and process of `opts` (as the
-/// [`Step`]s of the module doc). `E6POS` targets are decoded with the
+/// [`DecodedStep`]s of the module doc). `E6POS` targets are decoded with the
 /// Status bits (branch, checked against the cell's) and, for `PTP`, the
 /// Turn bits (each of A1, A4, A6 the value of that sign nearest zero inside
 /// its travel); a `LIN` ignores Turn as the controller does and takes the
@@ -48,7 +48,7 @@ pub fn validate_kuka(
     Kuka::validate(program, cell, opts, planned)
 }
 
-/// The [`Step`]s of a KUKA program (motions decoded, process on and off,
+/// The [`DecodedStep`]s of a KUKA program (motions decoded, process on and off,
 /// waits, payloads) in execution order, with the problems of the file
 /// itself (frames, triggers, ignition handshake, arc-loss supervision and
 /// its handler, end times) added to `report_out`. The cell's robot must be
@@ -58,7 +58,7 @@ pub(crate) fn kuka_steps(
     cell: &CellLayout,
     opts: &KukaOptions,
     report_out: &mut ValidationReport,
-) -> Vec<Step> {
+) -> Vec<DecodedStep> {
     let mut d = Decoder::new(program, cell, opts, std::mem::take(report_out));
     let stmts = &program.statements;
     let mut next = 0;
@@ -127,7 +127,7 @@ struct Decoder<'a> {
     /// An endless turn written modulo 360°: the controller takes the
     /// shortest way from where the table is.
     modulo: bool,
-    steps: Vec<Step>,
+    steps: Vec<DecodedStep>,
     report: ValidationReport,
     /// `$VEL.CP` (mm/s), once stated.
     vel: Option<f64>,
@@ -308,7 +308,7 @@ impl<'a> Decoder<'a> {
         match &st.op {
             KrlOp::LoadMass(m) => self.mass = Some((*m, line)),
             KrlOp::LoadCm(c) => match self.mass.take() {
-                Some((m, _)) => self.steps.push(Step::Payload {
+                Some((m, _)) => self.steps.push(DecodedStep::Payload {
                     file: src.to_string(),
                     line,
                     mass_kg: m,
@@ -320,7 +320,7 @@ impl<'a> Decoder<'a> {
                 if self.arc_is_on {
                     self.crater = Some((*s, line));
                 } else {
-                    self.steps.push(Step::Wait {
+                    self.steps.push(DecodedStep::Wait {
                         file: src.to_string(),
                         line,
                         seconds: Some(*s),
@@ -330,7 +330,7 @@ impl<'a> Decoder<'a> {
             }
             // a wait for an input, with or without the ignition timer
             KrlOp::WaitIn(input) | KrlOp::WaitInOrTimer { input, .. } => {
-                self.steps.push(Step::Wait {
+                self.steps.push(DecodedStep::Wait {
                     file: src.to_string(),
                     line,
                     seconds: None,
@@ -369,7 +369,7 @@ impl<'a> Decoder<'a> {
         let src = self.src();
         match read_handshake(block, self.opts, &self.on, &self.off, src, &mut self.report) {
             Some(h) if self.arc => {
-                self.steps.push(Step::ProcessOn {
+                self.steps.push(DecodedStep::ProcessOn {
                     file: src.to_string(),
                     line: h.on_line,
                 });
@@ -422,7 +422,7 @@ impl<'a> Decoder<'a> {
     fn switch(&mut self, text: &str, line: usize) {
         let src = self.src();
         if same(text, &self.on) {
-            self.steps.push(Step::ProcessOn {
+            self.steps.push(DecodedStep::ProcessOn {
                 file: src.to_string(),
                 line,
             });
@@ -436,7 +436,7 @@ impl<'a> Decoder<'a> {
                 );
             }
         } else if same(text, &self.off) {
-            self.steps.push(Step::ProcessOff {
+            self.steps.push(DecodedStep::ProcessOff {
                 file: src.to_string(),
                 line,
             });
@@ -459,7 +459,7 @@ impl<'a> Decoder<'a> {
 
     /// After the main routine: what is left open is reported, and the
     /// arc-loss handler checked. The steps and the report.
-    fn finish(mut self) -> (Vec<Step>, ValidationReport) {
+    fn finish(mut self) -> (Vec<DecodedStep>, ValidationReport) {
         let src = self.src();
         for (_, action, l) in std::mem::take(&mut self.pending) {
             self.instruction(l, format!("trigger `{action}` without a motion after it"));
@@ -631,7 +631,7 @@ mod tests {
         let motions: Vec<&Motion> = steps
             .iter()
             .filter_map(|s| match s {
-                Step::Motion(m) => Some(m.as_ref()),
+                DecodedStep::Motion(m) => Some(m.as_ref()),
                 _ => None,
             })
             .collect();
@@ -648,11 +648,13 @@ mod tests {
         let rest: Vec<String> = steps
             .iter()
             .filter_map(|s| match s {
-                Step::Motion(_) => None,
-                Step::ProcessOn { .. } => Some("on".into()),
-                Step::ProcessOff { .. } => Some("off".into()),
-                Step::Wait { seconds, input, .. } => Some(format!("wait {seconds:?} {input:?}")),
-                Step::Payload {
+                DecodedStep::Motion(_) => None,
+                DecodedStep::ProcessOn { .. } => Some("on".into()),
+                DecodedStep::ProcessOff { .. } => Some("off".into()),
+                DecodedStep::Wait { seconds, input, .. } => {
+                    Some(format!("wait {seconds:?} {input:?}"))
+                }
+                DecodedStep::Payload {
                     mass_kg, cog_mm, ..
                 } => Some(format!("load {mass_kg} {}", cog_mm.z)),
             })
@@ -671,10 +673,10 @@ mod tests {
             ]
         );
         // each set-up is before its bead's approach (the first PTP after home)
-        let pos = |pred: &dyn Fn(&Step) -> bool| steps.iter().position(pred).unwrap();
-        let wait7 = pos(&|s| matches!(s, Step::Wait { input: Some(7), .. }));
+        let pos = |pred: &dyn Fn(&DecodedStep) -> bool| steps.iter().position(pred).unwrap();
+        let wait7 = pos(&|s| matches!(s, DecodedStep::Wait { input: Some(7), .. }));
         assert!(
-            matches!(&steps[wait7 + 1], Step::Motion(m) if m.kind == MoveKind::Joint && m.label == "P11"),
+            matches!(&steps[wait7 + 1], DecodedStep::Motion(m) if m.kind == MoveKind::Joint && m.label == "P11"),
             "{:?}",
             steps[wait7 + 1]
         );

@@ -135,7 +135,7 @@ pub use read::parse_krl;
 
 use crate::program::contract::{read_file, Controller};
 use crate::program::split::{split_to_budget, Budget};
-use crate::program::validate::{Step, ValidationReport};
+use crate::program::validate::{DecodedStep, ValidationReport};
 use crate::program::{ProgramOptions, ProgramSettings};
 use std::path::Path;
 
@@ -1329,7 +1329,7 @@ impl Controller for Kuka {
         cell: &CellLayout,
         opts: &KukaOptions,
         report: &mut ValidationReport,
-    ) -> Option<Vec<Step>> {
+    ) -> Option<Vec<DecodedStep>> {
         Some(decode::kuka_steps(read, cell, opts, report))
     }
 }

@@ -1,4 +1,4 @@
-//! The one checker of decoded [`Step`]s (module doc of
+//! The one checker of decoded [`DecodedStep`]s (module doc of
 //! [`validate`](super)): bead points, joint limits, speeds, configuration
 //! consistency, deposition points against the plan, process on and off.
 
@@ -16,7 +16,8 @@ use nalgebra::UnitQuaternion;
 use super::between::{check_between, InterpolatedMove};
 use super::ProblemKind;
 use super::{
-    deposition_point, push, Motion, MotionSpeed, Step, ValidationReport, NAMES, REACH_TOLERANCE_MM,
+    deposition_point, push, DecodedStep, Motion, MotionSpeed, ValidationReport, NAMES,
+    REACH_TOLERANCE_MM,
 };
 
 /// A motion as the checker keeps it for the next move: its joints (rad),
@@ -27,7 +28,7 @@ type Reached = (Joints, Option<[f64; 2]>, Option<Point3>);
 /// counts to `report`. `planned`: the planned deposition points (part
 /// frame, mm), one per bead motion in execution order.
 pub fn check_steps(
-    steps: &[Step],
+    steps: &[DecodedStep],
     cell: &CellLayout,
     planned: Option<&[Point3]>,
     common: &crate::program::ProgramOptions,
@@ -49,10 +50,10 @@ pub fn check_steps(
     };
     for (i, s) in steps.iter().enumerate() {
         match s {
-            Step::ProcessOn { file, line } => checker.process_on(file, *line, report),
-            Step::ProcessOff { file, line } => checker.process_off(file, *line, report),
-            Step::Wait { .. } | Step::Payload { .. } => {}
-            Step::Motion(m) => checker.motion(i, m, report),
+            DecodedStep::ProcessOn { file, line } => checker.process_on(file, *line, report),
+            DecodedStep::ProcessOff { file, line } => checker.process_off(file, *line, report),
+            DecodedStep::Wait { .. } | DecodedStep::Payload { .. } => {}
+            DecodedStep::Motion(m) => checker.motion(i, m, report),
         }
     }
     checker.finish(steps, report);
@@ -60,24 +61,24 @@ pub fn check_steps(
 
 /// Which motions of `steps` are bead points: made with the process on, or
 /// the last motion before the process starts.
-fn bead_points(steps: &[Step]) -> Vec<bool> {
+fn bead_points(steps: &[DecodedStep]) -> Vec<bool> {
     let mut bead = vec![false; steps.len()];
     let mut on = false;
     let mut last_motion: Option<usize> = None;
     for (i, s) in steps.iter().enumerate() {
         match s {
-            Step::Motion(_) => {
+            DecodedStep::Motion(_) => {
                 bead[i] = on;
                 last_motion = Some(i);
             }
-            Step::ProcessOn { .. } => {
+            DecodedStep::ProcessOn { .. } => {
                 if let Some(k) = last_motion {
                     bead[k] = true;
                 }
                 on = true;
             }
-            Step::ProcessOff { .. } => on = false,
-            Step::Wait { .. } | Step::Payload { .. } => {}
+            DecodedStep::ProcessOff { .. } => on = false,
+            DecodedStep::Wait { .. } | DecodedStep::Payload { .. } => {}
         }
     }
     bead
@@ -449,7 +450,7 @@ impl Checker<'_> {
 
     /// After the last step: a bead never stopped, the set-up, and the plan
     /// built to its end.
-    fn finish(self, steps: &[Step], report: &mut ValidationReport) {
+    fn finish(self, steps: &[DecodedStep], report: &mut ValidationReport) {
         if let Some((file, line)) = self.arc_on {
             push(
                 report,
@@ -568,7 +569,7 @@ const HOME_TOLERANCE_RAD: f64 = 0.01 * PI / 180.0;
 /// deposition points, capsules of `bead_radius_mm`; the substrate is not in
 /// the files and is not checked). `bead[i]`: step `i` is a bead motion.
 fn check_setup(
-    steps: &[Step],
+    steps: &[DecodedStep],
     cell: &CellLayout,
     common: &ProgramOptions,
     bead: &[bool],
@@ -586,7 +587,7 @@ fn check_setup(
     let mut last_mass: Option<f64> = None;
     for s in steps {
         match s {
-            Step::ProcessOn { file, line } => {
+            DecodedStep::ProcessOn { file, line } => {
                 let k = beads_started;
                 let mut missing = Vec::new();
                 if k > 0 && common.dwell_s > 0.0 && waited_s + 0.005 < common.dwell_s {
@@ -620,13 +621,13 @@ fn check_setup(
                 beads_started += 1;
                 on = true;
             }
-            Step::ProcessOff { .. } => {
+            DecodedStep::ProcessOff { .. } => {
                 on = false;
                 waited_s = 0.0;
                 waited_input = false;
                 payload = false;
             }
-            Step::Wait {
+            DecodedStep::Wait {
                 file,
                 line,
                 seconds,
@@ -646,7 +647,7 @@ fn check_setup(
                     waited_input = true;
                 }
             }
-            Step::Payload {
+            DecodedStep::Payload {
                 file,
                 line,
                 mass_kg,
@@ -696,7 +697,7 @@ fn check_setup(
                 last_mass = Some(*mass_kg);
                 payload = true;
             }
-            Step::Motion(_) => {}
+            DecodedStep::Motion(_) => {}
         }
     }
     if common.transit_check {
@@ -709,7 +710,7 @@ fn check_setup(
 /// whole program's, or those of one group of a build cut to the memory
 /// budget (each group starts and ends at home).
 pub(crate) fn check_home_ends(
-    steps: &[Step],
+    steps: &[DecodedStep],
     cell: &CellLayout,
     common: &ProgramOptions,
     ends: [bool; 2],
@@ -719,7 +720,7 @@ pub(crate) fn check_home_ends(
         .iter()
         .enumerate()
         .filter_map(|(i, s)| match s {
-            Step::Motion(m) => Some((i, m.as_ref())),
+            DecodedStep::Motion(m) => Some((i, m.as_ref())),
             _ => None,
         })
         .collect();
@@ -790,7 +791,7 @@ pub(crate) fn check_home_ends(
 
 /// Every arc-off joint move against the wall of the beads before it.
 fn check_transits(
-    steps: &[Step],
+    steps: &[DecodedStep],
     cell: &CellLayout,
     common: &ProgramOptions,
     bead: &[bool],
@@ -805,10 +806,10 @@ fn check_transits(
     let mut prev: Option<(Joints, Option<[f64; 2]>)> = None;
     for (i, s) in steps.iter().enumerate() {
         match s {
-            Step::ProcessOff { .. } if !current.is_empty() => {
+            DecodedStep::ProcessOff { .. } if !current.is_empty() => {
                 beads.push(&std::mem::take(&mut current));
             }
-            Step::Motion(m) => {
+            DecodedStep::Motion(m) => {
                 let Some(q) = m.joints else {
                     prev = None;
                     continue;

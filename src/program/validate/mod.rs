@@ -9,7 +9,7 @@
 //! linear moves), and that every bead starts and stops once. Every problem
 //! names its file and line; the report lists them all.
 //!
-//! Each controller's reader turns its files into the same [`Step`]s (motions
+//! Each controller's reader turns its files into the same [`DecodedStep`]s (motions
 //! with decoded joints, process on and off, in execution order); one checker
 //! ([`check_steps`], in `check`) validates them; the decoders of FANUC,
 //! KUKA and ABB files are `fanuc`, `kuka` and `abb`, one a controller,
@@ -212,9 +212,11 @@ pub struct Motion {
     pub speed: MotionSpeed,
 }
 
-/// One step of a program in execution order.
+/// One step of a program as a controller's decoder reads it back from its
+/// files, in execution order (the checker's input; not the path stage's
+/// [`Step`](crate::path::strategy::Step)).
 #[derive(Debug, Clone, PartialEq)]
-pub enum Step {
+pub enum DecodedStep {
     /// A motion.
     Motion(Box<Motion>),
     /// The process (arc) starts here.

@@ -9,7 +9,7 @@ use super::{same, Decoder};
 use crate::math::Isometry3;
 use crate::program::kuka::read::{KrlOp, KrlPosition, KrlStatement, KrlValue};
 use crate::program::validate::{arm_of, decode_pose, push, wrist_of_j5};
-use crate::program::validate::{Motion, MotionSpeed, ProblemKind, Step, ValidationReport};
+use crate::program::validate::{DecodedStep, Motion, MotionSpeed, ProblemKind, ValidationReport};
 use crate::program::MoveKind;
 use crate::robot::orientation::KukaAbc;
 use crate::robot::{CellLayout, Configuration, Joints};
@@ -71,17 +71,17 @@ impl Decoder<'_> {
 
     /// The pending triggers' switches: those at the motion's start pushed
     /// as steps, those at its end returned (to follow its steps).
-    fn triggered(&mut self) -> Vec<Step> {
+    fn triggered(&mut self) -> Vec<DecodedStep> {
         let src = self.src();
         let mut after = Vec::new();
         for (distance, action, l) in std::mem::take(&mut self.pending) {
             let step = if same(&action, &self.on) {
-                Step::ProcessOn {
+                DecodedStep::ProcessOn {
                     file: src.to_string(),
                     line: l,
                 }
             } else if same(&action, &self.off) {
-                Step::ProcessOff {
+                DecodedStep::ProcessOff {
                     file: src.to_string(),
                     line: l,
                 }
@@ -107,7 +107,7 @@ impl Decoder<'_> {
         kind: MoveKind,
         linear: bool,
         report_out: &mut ValidationReport,
-    ) -> Step {
+    ) -> DecodedStep {
         let (src, dat) = (self.src(), &self.program.dat_file);
         let cell = self.cell;
         let speed = if linear {
@@ -184,7 +184,7 @@ impl Decoder<'_> {
             speed => speed,
         };
         self.prev_q = joints.or(self.prev_q);
-        Step::Motion(Box::new(Motion {
+        DecodedStep::Motion(Box::new(Motion {
             file: src.to_string(),
             line,
             label: pos.name.clone(),
