@@ -14,7 +14,7 @@ use super::setup::LayerSetup;
 use super::{degree, sqp, subsample, LayerPoints};
 use super::{
     ConfigurationChoice, ConfigurationChoiceReport, LayerPlan, LayerQuality, LayerStatus,
-    ObjectiveReport, OptimiseOptions, Parameterisation, PlannedPoint, RzLaw, SolverReport,
+    ObjectiveReport, OptimiseOptions, Parameterisation, PlannedPoint, SolvedRzLaw, SolverReport,
 };
 use crate::math::tol;
 use crate::robot::cell::CellLayout;
@@ -244,7 +244,7 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
             point: 0,
             error: crate::robot::RobotError::NonFinite { what: "not solved" },
         }),
-        law: RzLaw::PointByPoint,
+        law: SolvedRzLaw::PointByPoint,
         violation: f64::INFINITY,
         converged: true,
         iterations: 0,
@@ -255,15 +255,15 @@ fn optimise_branch(setup: &LayerSetup, cfg: Configuration, seed: &Seed) -> Branc
     };
     match opts.parameterisation {
         Parameterisation::Fixed { r_z_rad } => {
-            outcome.law = RzLaw::Fixed { r_z_rad };
+            outcome.law = SolvedRzLaw::Fixed { r_z_rad };
             outcome.eval = problem.evaluate(&vec![r_z_rad; p]);
         }
         Parameterisation::PointByPoint => {
-            outcome.law = RzLaw::PointByPoint;
+            outcome.law = SolvedRzLaw::PointByPoint;
             outcome.eval = point_by_point(&problem, seed.r[0], setup.anchor.map(|a| a.r_z));
         }
         Parameterisation::SmoothingSpline { smoothness } => {
-            outcome.law = RzLaw::SmoothingSpline;
+            outcome.law = SolvedRzLaw::SmoothingSpline;
             let basis = Basis::PerPoint { points: p };
             let scale = scale_of(&problem, &seed.r, smoothness);
             match sqp::solve(

@@ -7,7 +7,7 @@
 
 use super::parameterisation::Basis;
 use super::problem::{Evaluation, PointFailure};
-use super::{sqp, RzLaw};
+use super::{sqp, SolvedRzLaw};
 use crate::math::tol;
 use crate::robot::ik::Configuration;
 use crate::robot::Joints;
@@ -16,7 +16,7 @@ use crate::robot::Joints;
 pub(super) struct BranchOutcome {
     pub(super) cfg: Configuration,
     pub(super) eval: Result<Evaluation, PointFailure>,
-    pub(super) law: RzLaw,
+    pub(super) law: SolvedRzLaw,
     pub(super) violation: f64,
     pub(super) converged: bool,
     pub(super) iterations: usize,

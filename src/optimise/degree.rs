@@ -7,7 +7,7 @@ use super::branch_types::{Best, BranchOutcome, Degrees};
 use super::parameterisation::Basis;
 use super::problem::{Evaluation, LayerProblem, PointFailure};
 use super::setup::LayerSetup;
-use super::{sqp, RzLaw, SqpOptions};
+use super::{sqp, SolvedRzLaw, SqpOptions};
 use crate::math::tol;
 
 /// Floor of the model step (rad) within whose reach constraints are looked
@@ -33,7 +33,7 @@ pub(super) fn record(
     outcome: &mut BranchOutcome,
 ) {
     outcome.converged = best.res.converged;
-    outcome.law = RzLaw::Polynomial {
+    outcome.law = SolvedRzLaw::Polynomial {
         degree: best.degree,
         cylindrical: setup.cylindrical,
         coefficients_deg: best

@@ -131,8 +131,8 @@ pub use options::{
     SqpOptions, DEFAULT_STOP_RELATIVE_GAIN,
 };
 pub use outcome::{
-    Binding, ConfigurationChoiceReport, Constraint, LayerPlan, LayerQuality, LayerStatus,
-    ObjectiveReport, OptimiseError, Plan, PlannedPoint, RzLaw, SolverReport, Transition,
+    BindingConstraint, ConfigurationChoiceReport, Constraint, LayerPlan, LayerQuality, LayerStatus,
+    ObjectiveReport, OptimiseError, Plan, PlannedPoint, SolvedRzLaw, SolverReport, Transition,
 };
 
 pub use spiral::optimise_spiral;

@@ -103,7 +103,7 @@ impl fmt::Display for Constraint {
 
 /// The most violated constraint of a layer.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Binding {
+pub struct BindingConstraint {
     /// Point index within the layer.
     pub point: usize,
     /// Which constraint.
@@ -113,7 +113,7 @@ pub struct Binding {
     pub violation: f64,
 }
 
-impl fmt::Display for Binding {
+impl fmt::Display for BindingConstraint {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.constraint {
             Constraint::Dexterity => write!(
@@ -149,12 +149,12 @@ pub enum LayerStatus {
     /// kept and its binding constraint named.
     Infeasible {
         /// The most violated constraint.
-        binding: Binding,
+        binding: BindingConstraint,
     },
     /// `R_Z` was not optimised (fixed) and a constraint fails.
     FixedViolates {
         /// The most violated constraint.
-        binding: Binding,
+        binding: BindingConstraint,
     },
     /// No branch has a joint solution at some point of the layer.
     NoSolution {
@@ -193,7 +193,7 @@ pub struct ConfigurationChoiceReport {
 /// `point_by_point`) with the variant's fields.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[serde(tag = "family", rename_all = "snake_case")]
-pub enum RzLaw {
+pub enum SolvedRzLaw {
     /// Constant.
     Fixed {
         /// `R_Z` (rad).
@@ -299,7 +299,7 @@ pub struct LayerPlan {
     /// The branch and why.
     pub configuration: ConfigurationChoiceReport,
     /// The `R_Z` law.
-    pub law: RzLaw,
+    pub law: SolvedRzLaw,
     /// One per point, same order as the input.
     pub points: Vec<PlannedPoint>,
     /// Objective values.

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use nalgebra::{Matrix6, Vector6};
 
 use crate::optimise::options::Objective;
-use crate::optimise::outcome::{Binding, Constraint};
+use crate::optimise::outcome::{BindingConstraint, Constraint};
 use crate::optimise::parameterisation::Basis;
 use crate::optimise::qp::Row;
 use crate::robot::cell::{CellLayout, CellPoint, CellPose, TorchPointFrame};
@@ -630,11 +630,11 @@ impl<'a> LayerProblem<'a> {
 
     /// The most violated constraint at `e` (the bounds themselves), if any
     /// is violated by more than `tol`.
-    pub fn binding(&self, e: &Evaluation, tol: f64) -> Option<Binding> {
-        let mut worst: Option<Binding> = None;
+    pub fn binding(&self, e: &Evaluation, tol: f64) -> Option<BindingConstraint> {
+        let mut worst: Option<BindingConstraint> = None;
         self.constraints(e, false, false, &mut |m, c, v, _, _| {
             if v > tol && worst.is_none_or(|w| v > w.violation) {
-                worst = Some(Binding {
+                worst = Some(BindingConstraint {
                     point: m,
                     constraint: c,
                     violation: v,

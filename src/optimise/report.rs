@@ -7,8 +7,8 @@ use std::time::Instant;
 use super::problem::{encoder_sigma_rad, Evaluation, LayerProblem};
 use super::setup::LayerSetup;
 use super::{
-    path_point, Binding, ConfigurationChoiceReport, Constraint, LayerPlan, LayerQuality,
-    LayerStatus, ObjectiveReport, PlannedPoint, RzLaw, SolverReport,
+    path_point, BindingConstraint, ConfigurationChoiceReport, Constraint, LayerPlan, LayerQuality,
+    LayerStatus, ObjectiveReport, PlannedPoint, SolvedRzLaw, SolverReport,
 };
 use crate::robot::cell::CellLayout;
 use crate::robot::model::Joints;
@@ -42,7 +42,7 @@ pub(super) fn finish(
     layer: usize,
     problem: &LayerProblem,
     e: Evaluation,
-    law: RzLaw,
+    law: SolvedRzLaw,
     converged: bool,
     iterations: usize,
     fixed: bool,
@@ -85,7 +85,7 @@ pub(super) fn finish(
     problem.exact_dexterity(&mut e);
     let binding = problem.binding(&e, BINDING_VIOLATION).or_else(|| {
         violations.first().map(|v| {
-            // the amount in the units of `Binding::violation`: rad past a
+            // the amount in the units of `BindingConstraint::violation`: rad past a
             // bound, rad over one step for a speed, relative for dexterity
             let (constraint, violation) = match v.kind {
                 ViolationKind::JointLimit {
@@ -119,7 +119,7 @@ pub(super) fn finish(
                 }
                 _ => (Constraint::Dexterity, 0.0),
             };
-            Binding {
+            BindingConstraint {
                 point: v.point,
                 constraint,
                 violation,

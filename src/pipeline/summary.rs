@@ -7,7 +7,7 @@
 use serde::Serialize;
 
 use crate::optimise::positioner::{PositionerLaw, PositionerSeed};
-use crate::optimise::RzLaw;
+use crate::optimise::SolvedRzLaw;
 use crate::path::distance_map::DistanceStats;
 pub use crate::program::cell_check::CollisionSummary;
 use crate::toolaxis::NormalMethod;
@@ -237,7 +237,7 @@ pub struct LayerSummary {
     /// Why that branch.
     pub configuration_reason: String,
     /// The `R_Z` law found.
-    pub law: RzLaw,
+    pub law: SolvedRzLaw,
     /// Points in the layer.
     pub points: usize,
     /// The objective's terms.

@@ -65,7 +65,7 @@ fn a_binding_reads_as_placement_json_has_it() {
         count: 1,
         status: crate::program::LayerRefusal::Infeasible(
             crate::optimise::LayerStatus::Infeasible {
-                binding: crate::optimise::Binding {
+                binding: crate::optimise::BindingConstraint {
                     point: 3,
                     constraint: Constraint::JointLimit { joint: 5 },
                     violation: 1f64.to_radians(),

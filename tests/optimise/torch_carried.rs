@@ -414,7 +414,7 @@ fn every_sample_part_at_its_own_grid_in_every_torch_carried_cell() {
 /// and the law kept is the lowest degree of that objective.
 #[test]
 fn a_law_whose_degrees_gain_nothing_stops_raising() {
-    use waam_slicer::optimise::RzLaw;
+    use waam_slicer::optimise::SolvedRzLaw;
     let part = Part::read(part_path("hemisphere.toml")).unwrap();
     let cell = Cell::read(part_path("cells/robowam_torch_carried.toml")).unwrap();
     let opts = PlanOptions {
@@ -428,7 +428,7 @@ fn a_law_whose_degrees_gain_nothing_stops_raising() {
     let p = plan_part(&part, &cell, &opts).unwrap();
     assert!(p.is_feasible(), "{:?}", p.refusal());
     for l in &p.plan.layers {
-        let RzLaw::Polynomial {
+        let SolvedRzLaw::Polynomial {
             degree,
             objective_per_degree,
             ..
