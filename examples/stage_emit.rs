@@ -11,7 +11,8 @@
 
 use waam_slicer::math::UnitVector3;
 use waam_slicer::path::slice;
-use waam_slicer::program::contract::{Controller, Fanuc};
+use waam_slicer::program::contract::Controller;
+use waam_slicer::program::fanuc::Fanuc;
 use waam_slicer::program::fanuc::FanucOptions;
 use waam_slicer::program::{build_program, TravelSpeed};
 use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};

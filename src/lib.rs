@@ -131,8 +131,8 @@ pub use fit::{FitOptions, FitReport, StartEnd};
 pub use pipeline::FittedPart;
 pub use pipeline::{
     check_program, place_part, plan_part, plan_part_with, slice_part, slice_part_with, Cell,
-    Control, Part, PlaceRequest, PlacedCell, PlanOptions, PlannedPart, ProgramFormat, RzLaw,
-    SliceOverrides, SlicedPart,
+    Control, Part, PlaceRequest, PlacedCell, PlanOptions, PlannedPart, RzLaw, SliceOverrides,
+    SlicedPart,
 };
 pub use place::PlaceOptions;
 pub use replan::{replan_part, replan_part_with, replan_planned, Measured, ReplannedPart};

@@ -10,8 +10,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 use waam_slicer::program::ProgramError;
+use waam_slicer::robot::Vendor;
 use waam_slicer::util::atomic::write_atomic;
-use waam_slicer::{plan_part_with, Cell, Error, Part, PlanOptions, PlannedPart, ProgramFormat};
+use waam_slicer::{plan_part_with, Cell, Error, Part, PlanOptions, PlannedPart};
 
 /// Runs the command; prints errors itself and returns the exit code.
 pub fn run(a: &PlanArgs, quiet: bool) -> ExitCode {
@@ -32,7 +33,7 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     let t0 = Instant::now();
     let part = Part::read(&a.part).map_err(|e| input(e.to_string()))?;
     let cell = Cell::read(&a.cell).map_err(|e| input(e.to_string()))?;
-    let format: Option<ProgramFormat> = match a.format.as_deref() {
+    let format: Option<Vendor> = match a.format.as_deref() {
         Some(f) => Some(f.parse().map_err(|e| input(format!("--format {e}")))?),
         None => None,
     };
@@ -57,7 +58,7 @@ fn plan(a: &PlanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     let planned = match plan_part_with(&part, &cell, &opts, &spinner.control()) {
         Ok(p) => p,
         Err(Error::Program(e @ ProgramError::VendorMismatch { .. })) => {
-            let name = format.map(ProgramFormat::name).unwrap_or_default();
+            let name = format.map(Vendor::key).unwrap_or_default();
             return Err((2, format!("--format {name}: {e}")));
         }
         Err(e) => return Err(input(e.to_string())),

@@ -12,8 +12,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 use waam_slicer::program::ProgramError;
 use waam_slicer::replan::ReplanOptions;
+use waam_slicer::robot::Vendor;
 use waam_slicer::util::atomic::write_atomic;
-use waam_slicer::{replan_part_with, Cell, Error, Measured, Part, PlanOptions, ProgramFormat};
+use waam_slicer::{replan_part_with, Cell, Error, Measured, Part, PlanOptions};
 
 /// Runs the command; prints errors itself and returns the exit code.
 pub fn run(a: &ReplanArgs, quiet: bool) -> ExitCode {
@@ -33,7 +34,7 @@ fn replan(a: &ReplanArgs, quiet: bool) -> Result<bool, (u8, String)> {
     let part = Part::read(&a.part).map_err(|e| input(e.to_string()))?;
     let cell = Cell::read(&a.cell).map_err(|e| input(e.to_string()))?;
     let measured = Measured::read(&a.measured).map_err(|e| input(e.to_string()))?;
-    let format: Option<ProgramFormat> = match a.format.as_deref() {
+    let format: Option<Vendor> = match a.format.as_deref() {
         Some(f) => Some(f.parse().map_err(|e| input(format!("--format {e}")))?),
         None => None,
     };

@@ -539,8 +539,9 @@ pub fn parse_cell_file(text: &str, origin: &str) -> Result<CellFile, CellFileErr
     })
 }
 
-/// The `[program]` table: its vendor sub-tables (`fanuc`, `kuka`, `abb`)
-/// are each vendor's emitter options, the rest the vendor-independent
+/// The `[program]` table: its vendor sub-tables (`[program.<key>]`, each
+/// registered vendor's, [`crate::program::registry`]) are each vendor's
+/// emitter options, the rest the vendor-independent
 /// [`ProgramOptions`]; unknown keys are errors, and the home position must
 /// lie inside the cell's joint travel.
 fn program_settings(
@@ -548,24 +549,12 @@ fn program_settings(
     mut table: toml::Table,
     cell: Option<&CellLayout>,
 ) -> Result<ProgramSettings, CellFileError> {
-    fn sub<T: serde::de::DeserializeOwned + Default>(
-        path: &str,
-        table: &mut toml::Table,
-        key: &str,
-    ) -> Result<T, CellFileError> {
-        match table.remove(key) {
-            None => Ok(T::default()),
-            Some(v) => v
-                .try_into()
-                .map_err(|e: toml::de::Error| CellFileError::Syntax {
-                    path: path.to_string(),
-                    message: format!("[program.{key}]: {}", e.message()),
-                }),
-        }
-    }
-    let fanuc: crate::program::fanuc::FanucOptions = sub(path, &mut table, "fanuc")?;
-    let kuka: crate::program::kuka::KukaOptions = sub(path, &mut table, "kuka")?;
-    let abb: crate::program::abb::AbbOptions = sub(path, &mut table, "abb")?;
+    let mut settings = ProgramSettings::take_vendor_tables(&mut table).map_err(
+        |(key, e): (&str, toml::de::Error)| CellFileError::Syntax {
+            path: path.to_string(),
+            message: format!("[program.{key}]: {}", e.message()),
+        },
+    )?;
     let common: ProgramOptions =
         toml::Value::Table(table)
             .try_into()
@@ -602,9 +591,9 @@ fn program_settings(
         }
         err
     })?;
-    fanuc.validate().map_err(|e| prefixed("fanuc", e))?;
-    kuka.validate().map_err(|e| prefixed("kuka", e))?;
-    abb.validate().map_err(|e| prefixed("abb", e))?;
+    settings
+        .check_vendor_options()
+        .map_err(|(key, e)| prefixed(key, e))?;
     if let Some((c, h)) = cell.and_then(|c| Some((c, common.home(c)?))) {
         let limits = &c.robot().limits;
         if let Some(j) = (0..6).find(|&j| !limits[j].contains(h.joints[j])) {
@@ -621,12 +610,8 @@ fn program_settings(
             });
         }
     }
-    Ok(ProgramSettings {
-        common,
-        fanuc,
-        kuka,
-        abb,
-    })
+    settings.common = common;
+    Ok(settings)
 }
 
 /// A placed cell file's text: `text` (the cell file as read, `file` naming

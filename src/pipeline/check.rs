@@ -9,8 +9,9 @@
 use std::path::Path as FsPath;
 
 use super::Cell;
-use crate::program::contract::{check_files, files_on_disk};
-use crate::program::fanuc::TpProgram;
+use crate::program::registry::{
+    check_files, files_on_disk, is_main_extension, main_extensions_text,
+};
 use crate::program::split::parse_group_name;
 use crate::program::validate::ValidationReport;
 use crate::program::ProgramError;
@@ -49,18 +50,8 @@ pub fn check_program(path: impl AsRef<FsPath>, cell: &Cell) -> Result<Validation
     )?)
 }
 
-/// The FANUC program at `main` and every program it calls, read from the
-/// same folder (`NAME.ls`), each once, in the order first called.
-///
-/// # Errors
-/// [`ProgramError::Read`] naming the file (and the line for a parse error).
-pub fn read_fanuc_with_calls(main: &FsPath) -> Result<Vec<TpProgram>, ProgramError> {
-    use crate::program::contract::Controller;
-    use crate::program::fanuc::Fanuc;
-    Fanuc::read(&Fanuc::files_on_disk(main)?)
-}
-
-/// The one program in folder `dir`: its `.ls`, `.src` or `.mod` files,
+/// The one program in folder `dir`: its files of a main extension
+/// ([`is_main_extension`]: `.ls`, `.src` or `.mod`),
 /// their group suffix set aside ([`parse_group_name`]), must name one program; its main file
 /// (`NAME`, else its first group).
 ///
@@ -78,7 +69,7 @@ fn program_in_folder(dir: &FsPath) -> Result<std::path::PathBuf, ProgramError> {
     for entry in entries.flatten() {
         let path = entry.path();
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-        if !matches!(ext, "ls" | "src" | "mod") {
+        if !is_main_extension(ext) {
             continue;
         }
         let Some(stem) = path.file_stem().and_then(|s| s.to_str()) else {
@@ -97,9 +88,10 @@ fn program_in_folder(dir: &FsPath) -> Result<std::path::PathBuf, ProgramError> {
     names.sort();
     names.dedup();
     match names.as_slice() {
-        [] => Err(read_error(
-            "no program file (.ls, .src or .mod) in this folder".into(),
-        )),
+        [] => Err(read_error(format!(
+            "no program file ({}) in this folder",
+            main_extensions_text()
+        ))),
         [name] => Ok(files
             .iter()
             .find(|(s, _)| s == name)

@@ -35,7 +35,7 @@ use std::path::Path as FsPath;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-pub use check::{check_program, read_fanuc_with_calls};
+pub use check::check_program;
 pub use fitted::FittedPart;
 pub use options::DEFAULT_MAX_POINTS;
 pub use options::{
@@ -47,7 +47,7 @@ pub use sliced::{slice_part, slice_part_with, SliceTimes, SlicedPart};
 
 use crate::io::cell_file::{parse_cell_file, CellFile, CellFileError};
 use crate::io::part_file::{parse_part, read_part_file, PartFileError};
-use crate::robot::RobotModel;
+use crate::robot::{RobotModel, Vendor};
 
 pub use crate::io::part_file::Part;
 
@@ -159,8 +159,8 @@ impl Cell {
     }
 
     /// The program format of the robot's controller.
-    pub fn native_format(&self) -> ProgramFormat {
-        ProgramFormat::of_vendor(self.robot().vendor)
+    pub fn native_format(&self) -> Vendor {
+        self.robot().vendor
     }
 }
 

@@ -140,87 +140,13 @@ impl SliceOverrides {
     }
 }
 
-/// A robot program format: the vendor whose controller runs it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum ProgramFormat {
-    /// FANUC TP ASCII `.ls` (over `max_positions`: groups of whole
-    /// beads the cell loads in turn).
-    Fanuc,
-    /// KUKA KRL `.src` + `.dat` (over `max_file_bytes`: several programs).
-    Kuka,
-    /// ABB RAPID `.mod` (over `max_file_bytes`: a main module loading part
-    /// modules in turn).
-    Abb,
-}
+/// The plan's program format by its former name: the [`Vendor`] whose
+/// controller runs it (parsed from `fanuc`, `kuka`, `abb` through the
+/// registry, [`crate::program::registry`]). Deprecated: name [`Vendor`];
+/// kept while callers still use this name.
+pub type ProgramFormat = Vendor;
 
-impl ProgramFormat {
-    /// The format of `vendor`'s controllers.
-    pub fn of_vendor(vendor: Vendor) -> Self {
-        match vendor {
-            Vendor::Fanuc => Self::Fanuc,
-            Vendor::Kuka => Self::Kuka,
-            Vendor::Abb => Self::Abb,
-        }
-    }
-
-    /// The vendor whose controller runs this format.
-    pub fn vendor(self) -> Vendor {
-        match self {
-            Self::Fanuc => Vendor::Fanuc,
-            Self::Kuka => Vendor::Kuka,
-            Self::Abb => Vendor::Abb,
-        }
-    }
-
-    /// The name on the command line and in files: `fanuc`, `kuka`, `abb`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Fanuc => "fanuc",
-            Self::Kuka => "kuka",
-            Self::Abb => "abb",
-        }
-    }
-
-    /// The emitter's name in messages, e.g. `FANUC TP`.
-    pub fn emitter(self) -> &'static str {
-        match self {
-            Self::Fanuc => crate::program::fanuc::EMITTER,
-            Self::Kuka => crate::program::kuka::EMITTER,
-            Self::Abb => crate::program::abb::EMITTER,
-        }
-    }
-}
-
-impl fmt::Display for ProgramFormat {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A word that names no [`ProgramFormat`] or `R_Z` law.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("`{given}`: expected {expected}")]
-pub struct ParseOptionError {
-    /// What was given.
-    pub given: String,
-    /// What is accepted.
-    pub expected: &'static str,
-}
-
-impl FromStr for ProgramFormat {
-    type Err = ParseOptionError;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "fanuc" => Ok(Self::Fanuc),
-            "kuka" => Ok(Self::Kuka),
-            "abb" => Ok(Self::Abb),
-            _ => Err(ParseOptionError {
-                given: s.to_string(),
-                expected: "fanuc, kuka or abb",
-            }),
-        }
-    }
-}
+pub use crate::program::registry::ParseOptionError;
 
 /// The `R_Z` law of a plan in its written form: `fixed:DEG`, `poly:N` (most
 /// degree 0..=8, raised while it pays, SPEC §7), `spline` or `point` (the
@@ -302,7 +228,7 @@ pub struct PlanOptions {
     /// format is asked: checked against the cell's robot before any work
     /// (another vendor's is refused), kept as [`PlannedPart::format`](crate::PlannedPart::format)
     /// and written by [`PlannedPart::write_programs`](crate::PlannedPart::write_programs).
-    pub format: Option<ProgramFormat>,
+    pub format: Option<Vendor>,
     /// The optimiser's options, used as given (the `R_Z` law in
     /// `parameterisation`, see [`PlanOptions::with_rz`]; the torch-carried
     /// cell's positioner in `positioner`) but for `travel_speed_mm_s`, which

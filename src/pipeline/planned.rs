@@ -13,7 +13,7 @@ use super::summary::{
     PlanSummary, PositionerSummary, QualitySummary, SolverSummary, TransitionSummary,
     UnbuildableLayer, UnbuildableProof,
 };
-use super::{slice_part_with, Cell, Control, Part, PlanOptions, ProgramFormat, RzLaw, SlicedPart};
+use super::{slice_part_with, Cell, Control, Part, PlanOptions, RzLaw, SlicedPart};
 use crate::optimise::{
     layer_points, optimise_with, trajectory_inputs, LayerPlan, LayerPoints, OptimiseOptions, Plan,
 };
@@ -21,6 +21,7 @@ use crate::program::{
     build_program_with, check_vendor, write_files, LayerRefusal, Program, ProgramError, TravelSpeed,
 };
 use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
+use crate::robot::Vendor;
 use crate::Error;
 
 /// Wall-clock time of each planning stage (s).
@@ -61,7 +62,7 @@ pub struct PlannedPart {
     pub rz: RzLaw,
     /// The program format the plan writes: [`PlanOptions::format`], else the
     /// cell robot's vendor's.
-    pub format: ProgramFormat,
+    pub format: Vendor,
     /// The optimised plan, one entry per layer.
     pub plan: Plan,
     /// The program model when every layer is feasible and the trajectory
@@ -134,7 +135,7 @@ pub fn plan_part_with(
     control: &Control,
 ) -> Result<PlannedPart, Error> {
     let format = opts.format.unwrap_or_else(|| cell.native_format());
-    check_vendor(&cell.layout, format.vendor(), format.emitter())?;
+    check_vendor(&cell.layout, format, format.emitter())?;
     let t = Instant::now();
     // Slicing is the first tenth of a plan's progress.
     let sliced = slice_part_with(part, &opts.slice, &control.within(0.0, 0.1))?;
@@ -378,11 +379,11 @@ impl PlannedPart {
     /// ([`PlannedPart::program`]'s error).
     pub fn program_files(&self) -> Result<Vec<crate::program::EmittedFile>, Error> {
         let format = self.format;
-        check_vendor(&self.cell.layout, format.vendor(), format.emitter())?;
+        check_vendor(&self.cell.layout, format, format.emitter())?;
         check_every_layer(&self.layers, &self.plan)?;
         let program = self.program.as_ref().map_err(Clone::clone)?;
         let settings = &self.cell.program;
-        Ok(crate::program::contract::emit(program, settings)?)
+        Ok(crate::program::registry::emit(program, settings)?)
     }
 
     /// Writes the robot program in the plan's [`PlannedPart::format`] into
@@ -444,26 +445,10 @@ impl PlannedPart {
 
     /// The options of the cycle time ([`crate::program::cycle`]) for the
     /// plan's format: the joint moves' speed as its emitter writes them
-    /// (FANUC `approach_percent`, KUKA `ptp_percent`, ABB `MoveAbsJ` at
-    /// `approach_speed_mm_s`), the assumed path acceleration.
+    /// ([`Controller::cycle_options`](crate::program::contract::Controller::cycle_options)),
+    /// the assumed path acceleration.
     pub fn cycle_options(&self) -> crate::program::cycle::CycleOptions {
-        use crate::program::cycle::CycleOptions;
-        let p = &self.cell.program;
-        match self.format {
-            ProgramFormat::Fanuc => CycleOptions {
-                joint_speed_fraction: f64::from(p.fanuc.approach_percent) / 100.0,
-                ..CycleOptions::default()
-            },
-            ProgramFormat::Kuka => CycleOptions {
-                joint_speed_fraction: f64::from(p.kuka.ptp_percent) / 100.0,
-                ..CycleOptions::default()
-            },
-            ProgramFormat::Abb => CycleOptions {
-                joint_speed_fraction: 1.0,
-                joint_move_tcp_speed_mm_s: Some(p.abb.approach_speed_mm_s),
-                ..CycleOptions::default()
-            },
-        }
+        self.format.cycle_options(&self.cell.program)
     }
 
     /// The cycle time of the program (s, per move, layer and build;

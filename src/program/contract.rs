@@ -3,26 +3,25 @@
 //! [`Program`] to files), its reader (files back to the controller's own
 //! program model) and its decoder (that model to the checker's [`DecodedStep`]s,
 //! checked by the one [`check_steps`]).
-//! FANUC, KUKA and ABB each implement [`Controller`] in their own folder;
-//! [`with_controller`] is the one place that turns a [`Vendor`] into its
-//! implementation, so nothing else spells out the vendor list.
+//! Each vendor implements [`Controller`] in its own folder; the registry
+//! ([`crate::program::registry`]) lists them and is the one place that
+//! turns a [`Vendor`] into its implementation, so nothing else spells out
+//! the vendor list.
 //!
 //! Each controller states its memory budget ([`Controller::budget`]); a
 //! build over it is emitted as groups the cell runs in turn
-//! ([`crate::program::split`]), and [`check_files`] reads such a set back
+//! ([`crate::program::split`]), and [`check_files`](crate::program::registry::check_files) reads such a set back
 //! and checks it as one build ([`validate_build`]).
 
 use std::path::Path;
 
 use crate::math::Point3;
-pub use crate::program::abb::Abb;
-pub use crate::program::fanuc::Fanuc;
-pub use crate::program::kuka::Kuka;
+use crate::program::cycle::CycleOptions;
 use crate::program::split::{parse_group_name, Budget};
 use crate::program::validate::{
     check_home_ends, check_steps, push, vendor_matches, DecodedStep, ProblemKind, ValidationReport,
 };
-use crate::program::{EmittedFile, Program, ProgramError, ProgramOptions, ProgramSettings};
+use crate::program::{EmittedFile, Program, ProgramError, ProgramOptions};
 use crate::robot::{CellLayout, Vendor};
 
 /// A robot controller's program format: options, emit, read, decode.
@@ -32,18 +31,39 @@ use crate::robot::{CellLayout, Vendor};
 pub trait Controller {
     /// The controller's vendor: only that vendor's arms are written or read.
     const VENDOR: Vendor;
+    /// The vendor's key: its table in a cell file (`[program.<key>]`) and
+    /// its name on the command line (`--format <key>`), lower case.
+    const KEY: &'static str;
     /// The format's name in messages, e.g. `FANUC TP`.
     const EMITTER: &'static str;
-    /// Extensions of the format's files, lower case without the dot.
+    /// Extensions of the format's files, lower case without the dot; the
+    /// first is the main (entry) file's.
     const EXTENSIONS: &'static [&'static str];
-    /// The emitter's options.
-    type Options: Clone + std::fmt::Debug;
+    /// The emitter's options: the cell file's `[program.<key>]` table.
+    type Options: Clone
+        + std::fmt::Debug
+        + Default
+        + PartialEq
+        + serde::Serialize
+        + serde::de::DeserializeOwned;
     /// The files read back: the controller's program model.
     type Read;
 
-    /// The emitter's options from a cell file's `[program]` table, the
-    /// vendor-neutral set-up (`common`) included.
-    fn options(settings: &ProgramSettings) -> Self::Options;
+    /// The emitter's options `own` (its `[program.<key>]` table) with the
+    /// vendor-neutral set-up `common` (the rest of the `[program]` table)
+    /// set in.
+    fn with_common(own: &Self::Options, common: &ProgramOptions) -> Self::Options;
+
+    /// Checks the emitter's options (its own keys, not `common`).
+    ///
+    /// # Errors
+    /// [`ProgramError::InvalidOptions`] naming the field.
+    fn check_options(opts: &Self::Options) -> Result<(), ProgramError>;
+
+    /// The options of the cycle time ([`crate::program::cycle`]) for this
+    /// format: the joint moves' speed as the emitter writes them, the
+    /// assumed path acceleration.
+    fn cycle_options(opts: &Self::Options) -> CycleOptions;
 
     /// The vendor-neutral set-up inside the options.
     fn common(opts: &Self::Options) -> &ProgramOptions;
@@ -278,25 +298,6 @@ pub fn validate_build<C: Controller>(
     Ok(report)
 }
 
-/// Something done with one controller's implementation, chosen at run time
-/// by [`with_controller`].
-pub trait ControllerTask {
-    /// What the task returns.
-    type Output;
-    /// Runs the task with controller `C`.
-    fn run<C: Controller>(self) -> Self::Output;
-}
-
-/// Runs `task` with the implementation of `vendor`'s controller: the one
-/// place the vendor list is spelt out.
-pub fn with_controller<T: ControllerTask>(vendor: Vendor, task: T) -> T::Output {
-    match vendor {
-        Vendor::Fanuc => task.run::<Fanuc>(),
-        Vendor::Kuka => task.run::<Kuka>(),
-        Vendor::Abb => task.run::<Abb>(),
-    }
-}
-
 /// The stroke of `cell`'s positioner turn on its robot's controller
 /// ([`TorchCarriedCell::turn_stroke`](crate::robot::cell::TorchCarriedCell::turn_stroke));
 /// `None` without a positioner.
@@ -320,137 +321,6 @@ pub fn turn_modulo(cell: &CellLayout) -> bool {
     }
 }
 
-/// Every vendor with a program format, in the order of messages.
-pub const VENDORS: [Vendor; 3] = [Vendor::Fanuc, Vendor::Kuka, Vendor::Abb];
-
-/// The vendor whose format uses files with extension `ext` (any case, no
-/// dot).
-pub fn vendor_of_extension(ext: &str) -> Option<Vendor> {
-    struct Owns<'a>(&'a str);
-    impl ControllerTask for Owns<'_> {
-        type Output = bool;
-        fn run<C: Controller>(self) -> bool {
-            C::EXTENSIONS.iter().any(|e| e.eq_ignore_ascii_case(self.0))
-        }
-    }
-    VENDORS.into_iter().find(|v| with_controller(*v, Owns(ext)))
-}
-
-/// The files of `program` in its robot's format, with that format's
-/// options from `settings`.
-///
-/// # Errors
-/// As [`Controller::emit`].
-pub fn emit(
-    program: &Program,
-    settings: &ProgramSettings,
-) -> Result<Vec<EmittedFile>, ProgramError> {
-    struct Emit<'a>(&'a Program, &'a ProgramSettings);
-    impl ControllerTask for Emit<'_> {
-        type Output = Result<Vec<EmittedFile>, ProgramError>;
-        fn run<C: Controller>(self) -> Self::Output {
-            C::emit(self.0, &C::options(self.1))
-        }
-    }
-    with_controller(program.cell.robot().vendor, Emit(program, settings))
-}
-
-/// Reads `files` as a program of `vendor`'s format — one program, or a
-/// build cut into groups ([`validate_build`]) — and validates it against
-/// `cell` with the options of `settings`.
-///
-/// # Errors
-/// [`ProgramError::Read`] naming the file and line that cannot be read.
-pub fn check_files(
-    vendor: Vendor,
-    files: &[EmittedFile],
-    cell: &CellLayout,
-    settings: &ProgramSettings,
-    planned: Option<&[Point3]>,
-) -> Result<ValidationReport, ProgramError> {
-    struct Check<'a> {
-        files: &'a [EmittedFile],
-        cell: &'a CellLayout,
-        settings: &'a ProgramSettings,
-        planned: Option<&'a [Point3]>,
-    }
-    impl ControllerTask for Check<'_> {
-        type Output = Result<ValidationReport, ProgramError>;
-        fn run<C: Controller>(self) -> Self::Output {
-            validate_build::<C>(
-                self.files,
-                self.cell,
-                &C::options(self.settings),
-                self.planned,
-            )
-        }
-    }
-    with_controller(
-        vendor,
-        Check {
-            files,
-            cell,
-            settings,
-            planned,
-        },
-    )
-}
-
-/// The files of the program on disk at `path`, and its vendor (from the
-/// extension).
-///
-/// # Errors
-/// [`ProgramError::Read`] naming the file: an extension of no format, or a
-/// file that cannot be read.
-pub fn files_on_disk(path: &Path) -> Result<(Vendor, Vec<EmittedFile>), ProgramError> {
-    struct OnDisk<'a>(&'a Path);
-    impl ControllerTask for OnDisk<'_> {
-        type Output = Result<Vec<EmittedFile>, ProgramError>;
-        fn run<C: Controller>(self) -> Self::Output {
-            C::files_on_disk(self.0)
-        }
-    }
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    let vendor = vendor_of_extension(ext).ok_or_else(|| ProgramError::Read {
-        file: path.display().to_string(),
-        line: 0,
-        reason: format!(
-            "unknown program type `.{}`; expected .ls (FANUC), .src/.dat (KUKA) or .mod (ABB)",
-            ext.to_ascii_lowercase()
-        ),
-    })?;
-    // a build cut into groups: `NAME.ext` stands for its groups when only
-    // they are on disk; any group brings its siblings, in order
-    let first_group = |p: &Path| {
-        let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or("");
-        p.with_file_name(format!(
-            "{}.{ext}",
-            crate::program::split::group_name(stem, 1)
-        ))
-    };
-    let path = if !path.exists() && first_group(path).exists() {
-        first_group(path)
-    } else {
-        path.to_path_buf()
-    };
-    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
-    let Some((base, _)) = parse_group_name(stem) else {
-        return Ok((vendor, with_controller(vendor, OnDisk(&path))?));
-    };
-    let mut files = Vec::new();
-    for k in 1.. {
-        let p = path.with_file_name(format!(
-            "{}.{ext}",
-            crate::program::split::group_name(base, k)
-        ));
-        if !p.exists() {
-            break;
-        }
-        files.extend(with_controller(vendor, OnDisk(&p))?);
-    }
-    Ok((vendor, files))
-}
-
 /// Reads the text of `path` as an [`EmittedFile`] named by its file name.
 ///
 /// # Errors
@@ -465,36 +335,4 @@ pub fn read_file(path: &Path) -> Result<EmittedFile, ProgramError> {
         name: path.display().to_string(),
         text,
     })
-}
-/// The vendor's name as written in messages (`FANUC`, `KUKA`, `ABB`).
-pub fn vendor_name(vendor: Vendor) -> &'static str {
-    match vendor {
-        Vendor::Fanuc => "FANUC",
-        Vendor::Kuka => "KUKA",
-        Vendor::Abb => "ABB",
-    }
-}
-
-/// Checks that `cell`'s robot is a `vendor` arm, the only one whose joints
-/// (controller convention, rad) and flange poses the `emitter` (e.g. `KUKA
-/// KRL`) may write or read.
-///
-/// # Errors
-/// [`ProgramError::VendorMismatch`] naming both vendors and the robot.
-pub fn check_vendor(
-    cell: &CellLayout,
-    vendor: Vendor,
-    emitter: &'static str,
-) -> Result<(), ProgramError> {
-    let robot = cell.robot();
-    if robot.vendor == vendor {
-        Ok(())
-    } else {
-        Err(ProgramError::VendorMismatch {
-            emitter,
-            emitter_vendor: vendor_name(vendor),
-            robot: robot.name.clone(),
-            robot_vendor: vendor_name(robot.vendor),
-        })
-    }
 }

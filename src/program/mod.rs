@@ -10,8 +10,12 @@
 //!
 //! | piece | module | entry points |
 //! |---|---|---|
-//! | the program as data, feasibility check | this module | [`build_program`], [`Program`], [`ProgramPoint`], [`ArcFlag`] |
-//! | the vendor contract: options, emit, read, decode, one dispatch | [`contract`] | [`contract::Controller`], [`contract::emit`], [`contract::check_files`] |
+//! | the program as data (its vocabulary) | [`model`] | [`Program`], [`ProgramPoint`], [`ArcFlag`], [`EmittedFile`] |
+//! | the program's options, the stage's errors | [`options`], [`error`] | [`ProgramOptions`], [`ProcessControl`], [`ProgramError`] |
+//! | feasibility check and assembly | [`builder`] | [`build_program`], [`build_program_with`] |
+//! | the controller's pose and interpolation (thinner and checker) | [`pose`] | [`pose::ControllerPose`], [`pose::interpolate`] |
+//! | the vendor contract: options, emit, read, decode | [`contract`] | [`contract::Controller`], [`contract::validate_build`] |
+//! | the registry: the one vendor list, dispatch by vendor, `[program.<key>]` tables | [`registry`] | [`registry::ProgramSettings`], [`registry::emit`], [`registry::check_files`] |
 //! | FANUC TP ASCII `.ls` (emitter, reader, decoder) | [`fanuc`] | [`fanuc::Fanuc`], [`fanuc::fanuc_files`], [`fanuc::parse_ls`], [`fanuc::validate_fanuc`] |
 //! | KUKA KRL `.src` + `.dat` | [`kuka`] | [`kuka::Kuka`], [`kuka::kuka_files`], [`kuka::parse_krl`], [`kuka::validate_kuka`] |
 //! | ABB RAPID `.mod` | [`abb`] | [`abb::Abb`], [`abb::abb_files`], [`abb::parse_mod`], [`abb::validate_abb`] |
@@ -21,15 +25,14 @@
 //! | the whole cell against collisions along every motion | [`cell_check`] | [`cell_check::check_cell`] |
 //! | the build's cycle time (per move, layer, build) | [`cycle`] | [`cycle::cycle_time`] |
 //! | the one checker of decoded steps (file + cell) | [`validate`] | [`validate::check_steps`], [`validate::DecodedStep`] |
-//! | approach and retract points | this module | [`build_program_with`], [`ProgramOptions`] |
 //! | arc-off transits against the wall | [`transit`] | [`transit::joint_move_clearance`] |
 //! | tool and work frames of every emitter | [`frames`] | [`frames::ToolFrames`], [`frames::held_tool`] |
 //! | number formatting | [`fmt`] | [`fmt::Fixed`] |
 //!
 //! Each vendor's folder holds its emitter (`mod.rs`), its reader
 //! (`read.rs`) and its decoder into the checker's steps (`decode.rs`), and
-//! implements [`contract::Controller`]; nothing outside [`contract`]
-//! chooses among vendors.
+//! implements [`contract::Controller`]; nothing outside the vendors'
+//! folders and [`registry`] chooses among vendors.
 //!
 //! JSON of every point: [`Program`] implements `serde::Serialize`; serialise
 //! it with any serde format (the command-line tool uses `serde_json`).
@@ -54,18 +57,19 @@ pub mod model;
 pub mod moves;
 pub mod options;
 pub mod pose;
+pub mod registry;
 pub mod split;
 pub mod transit;
 pub mod validate;
 
 pub use builder::{build_program, build_program_with};
-pub use contract::{check_vendor, vendor_name};
 pub use error::{LayerRefusal, ProgramError};
 pub use kinds::{MoveKind, PositionMode};
 pub(crate) use model::render;
 pub use model::{
-    check_name, joint_move_target, joints_move, move_start, opens_bead, positioner_moves,
-    segment_length_mm, write_files, ArcFlag, BeadSetup, EmittedFile, Payload, Program,
-    ProgramPoint, TravelSpeed, JOINT_STILL_RAD, POSITIONER_STILL_DEG,
+    check_name, check_vendor, joint_move_target, joints_move, move_start, opens_bead,
+    positioner_moves, segment_length_mm, write_files, ArcFlag, BeadSetup, EmittedFile, Payload,
+    Program, ProgramPoint, TravelSpeed, JOINT_STILL_RAD, POSITIONER_STILL_DEG,
 };
-pub use options::{HomePosition, ProcessControl, ProgramOptions, ProgramSettings};
+pub use options::{HomePosition, ProcessControl, ProgramOptions};
+pub use registry::ProgramSettings;

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use crate::math::{Point3, UnitVector3, Vector3};
 use crate::program::{HomePosition, ProgramError, ProgramOptions};
 use crate::robot::positioner::PositionerJoints;
-use crate::robot::{CellLayout, Configuration, Joints};
+use crate::robot::{CellLayout, Configuration, Joints, Vendor};
 
 /// What a point is for: a bead point with its arc switching meaning, or a
 /// transit point with the arc off (rs-opw's `PathFlags`: approach, trace,
@@ -437,4 +437,28 @@ pub(crate) fn render(
         path: "<memory>".into(),
         source: std::io::Error::other(e).into(),
     })
+}
+
+/// Checks that `cell`'s robot is a `vendor` arm, the only one whose joints
+/// (controller convention, rad) and flange poses the `emitter` (e.g. `KUKA
+/// KRL`) may write or read.
+///
+/// # Errors
+/// [`ProgramError::VendorMismatch`] naming both vendors and the robot.
+pub fn check_vendor(
+    cell: &CellLayout,
+    vendor: Vendor,
+    emitter: &'static str,
+) -> Result<(), ProgramError> {
+    let robot = cell.robot();
+    if robot.vendor == vendor {
+        Ok(())
+    } else {
+        Err(ProgramError::VendorMismatch {
+            emitter,
+            emitter_vendor: vendor.display_name(),
+            robot: robot.name.clone(),
+            robot_vendor: robot.vendor.display_name(),
+        })
+    }
 }

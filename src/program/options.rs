@@ -5,13 +5,13 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::program::{abb, cell_check, fanuc, kuka, ProgramError};
+use crate::program::{cell_check, ProgramError};
 use crate::robot::positioner::PositionerJoints;
 use crate::robot::CellLayout;
 use crate::robot::Joints;
 
 /// Options of [`build_program_with`](crate::program::build_program_with), and the vendor-independent keys of a
-/// cell file's `[program]` table (see [`ProgramSettings`]). Plain data.
+/// cell file's `[program]` table (see [`ProgramSettings`](crate::program::ProgramSettings)). Plain data.
 ///
 /// Every program is built the same way whatever the controller: an optional
 /// home move first and last, one bead per layer between an approach and a
@@ -48,7 +48,7 @@ pub struct ProgramOptions {
     /// Interpass wait: before each bead after the first, the program waits
     /// for this digital input to be on (the interpass temperature is
     /// reached): FANUC `DI[n]`, KUKA `$IN[n]`, ABB the signal of
-    /// [`abb::AbbOptions`]. `None` (default): no wait.
+    /// [`abb::AbbOptions`](crate::program::abb::AbbOptions). `None` (default): no wait.
     pub interpass_input: Option<u32>,
     /// Payload update every this many layers in the part-carried cell (the
     /// robot carries the part as it grows; 0: never). Before bead 0 and
@@ -305,49 +305,6 @@ impl ProcessControl {
                 Ok(())
             }
             _ => Ok(()),
-        }
-    }
-}
-
-/// A cell file's `[program]` table: the vendor-independent
-/// [`ProgramOptions`] and each vendor's emitter options
-/// (`[program.fanuc]`, `[program.kuka]`, `[program.abb]`), whose `common`
-/// field is set from the former by [`ProgramSettings::fanuc`] and its
-/// siblings.
-#[derive(Debug, Clone, PartialEq, Default, Serialize)]
-pub struct ProgramSettings {
-    /// The vendor-independent options.
-    pub common: ProgramOptions,
-    /// `[program.fanuc]`.
-    pub fanuc: fanuc::FanucOptions,
-    /// `[program.kuka]`.
-    pub kuka: kuka::KukaOptions,
-    /// `[program.abb]`.
-    pub abb: abb::AbbOptions,
-}
-
-impl ProgramSettings {
-    /// The FANUC emitter's options, `common` set.
-    pub fn fanuc(&self) -> fanuc::FanucOptions {
-        fanuc::FanucOptions {
-            common: self.common,
-            ..self.fanuc.clone()
-        }
-    }
-
-    /// The KUKA emitter's options, `common` set.
-    pub fn kuka(&self) -> kuka::KukaOptions {
-        kuka::KukaOptions {
-            common: self.common,
-            ..self.kuka.clone()
-        }
-    }
-
-    /// The ABB emitter's options, `common` set.
-    pub fn abb(&self) -> abb::AbbOptions {
-        abb::AbbOptions {
-            common: self.common,
-            ..self.abb.clone()
         }
     }
 }

@@ -49,7 +49,7 @@ impl PyCell {
     /// The program format of the robot's controller: `fanuc`, `kuka` or `abb`.
     #[getter]
     fn vendor(&self) -> &'static str {
-        self.cell.native_format().name()
+        self.cell.native_format().key()
     }
 
     /// `True` when the torch is carried over a positioner: planned joints

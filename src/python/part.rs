@@ -303,7 +303,7 @@ impl PyPart {
         let format = match format {
             None => None,
             Some(s) => Some(
-                s.parse::<crate::pipeline::ProgramFormat>()
+                s.parse::<crate::robot::Vendor>()
                     .map_err(|e| waam_error(format!("format = {s:?}: {e}")))?,
             ),
         };

@@ -1,13 +1,23 @@
 //! Facts about each vendor's robot controller that the program stage's
 //! emitters, decoders and checker share: how it names an arm's
 //! configuration ([`elbow_positive_cos`]) and whether it moves a
-//! part-carried arm about a fixed tool ([`Vendor::moves_about_fixed_tool`]).
+//! part-carried arm about a fixed tool ([`Vendor::moves_about_fixed_tool`])
+//! and its name in messages ([`Vendor::display_name`]).
 //! They belong with the robot presets ([`Vendor`], [`JointConvention`](crate::robot::JointConvention)):
 //! a new vendor states them here next to its preset.
 
 use crate::robot::{ArmSide, Configuration, Elbow, Vendor};
 
 impl Vendor {
+    /// The vendor's name as written in messages (`FANUC`, `KUKA`, `ABB`).
+    pub fn display_name(self) -> &'static str {
+        match self {
+            Vendor::Fanuc => "FANUC",
+            Vendor::Kuka => "KUKA",
+            Vendor::Abb => "ABB",
+        }
+    }
+
     /// `true` when the controller always moves a part-carried arm's linear
     /// moves about the fixed torch (KUKA's external TCP, ABB's stationary
     /// tool): the path is linear over the part. `false` (FANUC): only with

@@ -11,9 +11,10 @@ use crate::shared::part_path;
 use waam_slicer::io::joints_csv::read_joints_csv;
 use waam_slicer::optimise::{Constraint, LayerStatus};
 use waam_slicer::program::{LayerRefusal, ProgramError};
+use waam_slicer::robot::Vendor;
 use waam_slicer::{
     check_program, plan_part, plan_part_with, slice_part, Cell, Control, Error, ErrorKind, Part,
-    PlanOptions, ProgramFormat, SliceOverrides,
+    PlanOptions, SliceOverrides,
 };
 
 fn small(points: usize) -> PlanOptions {
@@ -36,7 +37,7 @@ fn one_call_plan_writes_a_program_that_reads_back_clean() {
     assert!((o.max_mm - o.min_mm) < 1e-4 * sliced.path.delta_mm, "{o:?}");
     let planned = plan_part(&part, &cell, &small(120)).unwrap();
     assert!(planned.is_feasible(), "{:?}", planned.refusal());
-    assert_eq!(planned.format, ProgramFormat::Fanuc);
+    assert_eq!(planned.format, Vendor::Fanuc);
     let dir = tempfile::tempdir().unwrap();
     let files = planned.write_programs(dir.path()).unwrap();
     assert_eq!(files[0], dir.path().join("HEMISPHERE.ls"));
@@ -123,7 +124,7 @@ fn another_vendors_format_is_refused_before_planning() {
     let part = Part::read(part_path("hemisphere.toml")).unwrap();
     let cell = Cell::read(part_path("cells/robowam_part_carried.toml")).unwrap();
     let opts = PlanOptions {
-        format: Some(ProgramFormat::Kuka),
+        format: Some(Vendor::Kuka),
         ..small(60)
     };
     let e = plan_part(&part, &cell, &opts).unwrap_err();

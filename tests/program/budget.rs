@@ -21,11 +21,12 @@
 
 use waam_slicer::program::abb::loader::read_loader;
 use waam_slicer::program::abb::{AbbOptions, DEFAULT_MAX_FILE_BYTES as ABB_DEFAULT};
-use waam_slicer::program::contract::{
-    check_files, emit, files_on_disk, validate_build, Abb, Controller, Fanuc, Kuka,
-};
+use waam_slicer::program::contract::{validate_build, Controller};
 use waam_slicer::program::fanuc::{write_ls, FanucOptions, Instruction, Op, TpProgram};
 use waam_slicer::program::kuka::{KukaOptions, DEFAULT_MAX_FILE_BYTES as KUKA_DEFAULT};
+use waam_slicer::program::registry::{
+    check_files, emit, files_on_disk, Abb, Fanuc, Kuka, Registered,
+};
 use waam_slicer::program::split::{bead_blocks, split_to_budget};
 use waam_slicer::program::validate::{ProblemKind, ValidationReport};
 use waam_slicer::program::{
@@ -74,7 +75,7 @@ fn build(
 
 /// What the whole program occupies against `C`'s budget, emitted with
 /// `settings`.
-fn whole_size<C: Controller>(prog: &Program, settings: &ProgramSettings) -> usize {
+fn whole_size<C: Registered>(prog: &Program, settings: &ProgramSettings) -> usize {
     let files = C::emit(prog, &C::options(settings)).unwrap();
     let read = C::read(&files).unwrap();
     C::occupied(&files, &read)
@@ -82,7 +83,7 @@ fn whole_size<C: Controller>(prog: &Program, settings: &ProgramSettings) -> usiz
 
 /// The budget-cut round trip of module doc for controller `C` in `file`'s
 /// cell, at a budget of about half the whole program.
-fn groups_round_trip<C: Controller>(file: &str, set_budget: fn(&mut ProgramSettings, usize)) {
+fn groups_round_trip<C: Registered>(file: &str, set_budget: fn(&mut ProgramSettings, usize)) {
     let (cell, prog, planned, mut settings) = build(file);
     let whole = whole_size::<C>(&prog, &settings);
     // a candidate group measured as one program (at the default budget)

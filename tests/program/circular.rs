@@ -17,7 +17,7 @@
 //!   `ArcC` with the same two targets (RAPID reference, MoveC: "the
 //!   orientation of the circle point is not critical").
 
-use waam_slicer::program::contract::{check_files, emit};
+use waam_slicer::program::registry::{check_files, emit};
 use waam_slicer::program::ProgramSettings;
 
 use crate::fixture::{cell, hemisphere, law, trajectory, TS_MM_S};

@@ -4,8 +4,9 @@
 //! every sample cell, through the cell file's own `[program]` settings.
 
 use waam_slicer::io::cell_file::read_cell_file;
-use waam_slicer::program::contract::{
-    check_files, emit, files_on_disk, vendor_of_extension, Abb, Controller, Fanuc, Kuka,
+use waam_slicer::program::contract::Controller;
+use waam_slicer::program::registry::{
+    check_files, emit, files_on_disk, vendor_of_extension, Abb, Fanuc, Kuka, Registered,
 };
 use waam_slicer::program::{write_files, EmittedFile, Program};
 use waam_slicer::robot::Vendor;
@@ -33,7 +34,7 @@ fn each_extension_names_its_vendor() {
 
 /// The files `emit` writes for `prog` with the cell file's settings are
 /// those of `C`'s emitter with `C`'s options from the same settings.
-fn same_as_direct<C: Controller>(
+fn same_as_direct<C: Registered>(
     prog: &Program,
     settings: &waam_slicer::program::ProgramSettings,
 ) -> Vec<EmittedFile> {

@@ -307,7 +307,7 @@ fn groups_start_and_end_at_home_with_their_setup() {
         fanuc: opts.clone(),
         ..Default::default()
     };
-    let r = waam_slicer::program::contract::check_files(
+    let r = waam_slicer::program::registry::check_files(
         waam_slicer::robot::Vendor::Fanuc,
         &files,
         &cell,

@@ -7,9 +7,9 @@
 //! their motions in order are the uncut program's; a bead longer than N is
 //! refused with the numbers.
 
-use waam_slicer::program::contract::check_files;
 use waam_slicer::program::fanuc::parse_ls;
 use waam_slicer::program::fanuc::{fanuc_files, ArmPosition, FanucOptions, Op, TpProgram};
+use waam_slicer::program::registry::check_files;
 use waam_slicer::program::{MoveKind, ProgramError, ProgramSettings};
 use waam_slicer::robot::Vendor;
 

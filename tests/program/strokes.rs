@@ -11,7 +11,8 @@
 //!   consecutive E2 values are more than 180° apart (modulo 360°).
 
 use waam_slicer::io::cell_file::parse_cell_file;
-use waam_slicer::program::contract::{emit, Controller, Fanuc};
+use waam_slicer::program::contract::Controller;
+use waam_slicer::program::registry::{emit, Fanuc};
 use waam_slicer::program::{Program, ProgramSettings};
 use waam_slicer::robot::CellLayout;
 

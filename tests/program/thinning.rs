@@ -6,7 +6,7 @@
 //! by slerp: ABB RAPID reference, MoveL "the TCP moves linearly … the tool
 //! reorients in even steps"; KUKA `$ORI_TYPE = #VAR`).
 
-use waam_slicer::program::contract::{check_files, emit};
+use waam_slicer::program::registry::{check_files, emit};
 use waam_slicer::program::ProgramSettings;
 
 use crate::fixture::{cell, hemisphere, law, trajectory, TS_MM_S};

@@ -267,7 +267,8 @@ pub fn validate_abb(
     opts: &AbbOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
-    use crate::program::contract::{Abb, Controller};
+    use crate::program::abb::Abb;
+    use crate::program::contract::Controller;
     Abb::validate(module, cell, opts, planned)
 }
 

@@ -141,9 +141,10 @@ pub use decode::validate_abb;
 pub use read::parse_mod;
 
 use crate::program::contract::{groups_by_name, read_file, Controller};
+use crate::program::cycle::CycleOptions;
 use crate::program::split::{split_to_budget, Budget};
 use crate::program::validate::{DecodedStep, ValidationReport};
-use crate::program::{ProgramOptions, ProgramSettings};
+use crate::program::ProgramOptions;
 use std::path::Path;
 
 use std::io::Write;
@@ -1196,13 +1197,29 @@ pub struct Abb;
 
 impl Controller for Abb {
     const VENDOR: Vendor = Vendor::Abb;
+    const KEY: &'static str = "abb";
     const EMITTER: &'static str = EMITTER;
     const EXTENSIONS: &'static [&'static str] = &["mod"];
     type Options = AbbOptions;
     type Read = read::RapidModule;
 
-    fn options(settings: &ProgramSettings) -> AbbOptions {
-        settings.abb()
+    fn with_common(own: &AbbOptions, common: &ProgramOptions) -> AbbOptions {
+        AbbOptions {
+            common: *common,
+            ..own.clone()
+        }
+    }
+
+    fn check_options(opts: &AbbOptions) -> Result<(), ProgramError> {
+        opts.validate()
+    }
+
+    fn cycle_options(opts: &AbbOptions) -> CycleOptions {
+        CycleOptions {
+            joint_speed_fraction: 1.0,
+            joint_move_tcp_speed_mm_s: Some(opts.approach_speed_mm_s),
+            ..CycleOptions::default()
+        }
     }
 
     fn common(opts: &AbbOptions) -> &ProgramOptions {

@@ -22,7 +22,8 @@ use std::collections::HashMap;
 use std::f64::consts::TAU;
 
 use crate::math::{Isometry3, Point3};
-use crate::program::contract::{validate_decoded, Fanuc};
+use crate::program::contract::validate_decoded;
+use crate::program::fanuc::Fanuc;
 use crate::program::fanuc::{
     parse_frame_remark, ArmPosition, FanucFrames, FanucOptions, FrameKind, MotionOptions, MoveKind,
     Op, PayloadField, Position, Speed, TpProgram,

@@ -116,8 +116,9 @@ pub use decode::{fanuc_steps, parse_config, validate_fanuc};
 pub use read::parse_ls;
 
 use crate::program::contract::Controller;
+use crate::program::cycle::CycleOptions;
 use crate::program::validate::{DecodedStep, ValidationReport};
-use crate::program::{ProgramOptions, ProgramSettings};
+use crate::program::ProgramOptions;
 use std::path::Path;
 
 use std::io::Write;
@@ -1393,15 +1394,39 @@ pub fn fanuc_files(
 #[derive(Debug, Clone, Copy)]
 pub struct Fanuc;
 
+/// The FANUC program at `main` and every program it calls, read from the
+/// same folder (`NAME.ls`), each once, in the order first called.
+///
+/// # Errors
+/// [`ProgramError::Read`] naming the file (and the line for a parse error).
+pub fn read_with_calls(main: &Path) -> Result<Vec<TpProgram>, ProgramError> {
+    Fanuc::read(&Fanuc::files_on_disk(main)?)
+}
+
 impl Controller for Fanuc {
     const VENDOR: Vendor = Vendor::Fanuc;
+    const KEY: &'static str = "fanuc";
     const EMITTER: &'static str = EMITTER;
     const EXTENSIONS: &'static [&'static str] = &["ls"];
     type Options = FanucOptions;
     type Read = Vec<TpProgram>;
 
-    fn options(settings: &ProgramSettings) -> FanucOptions {
-        settings.fanuc()
+    fn with_common(own: &FanucOptions, common: &ProgramOptions) -> FanucOptions {
+        FanucOptions {
+            common: *common,
+            ..own.clone()
+        }
+    }
+
+    fn check_options(opts: &FanucOptions) -> Result<(), ProgramError> {
+        opts.validate()
+    }
+
+    fn cycle_options(opts: &FanucOptions) -> CycleOptions {
+        CycleOptions {
+            joint_speed_fraction: f64::from(opts.approach_percent) / 100.0,
+            ..CycleOptions::default()
+        }
     }
 
     fn common(opts: &FanucOptions) -> &ProgramOptions {

@@ -44,7 +44,8 @@ pub fn validate_kuka(
     opts: &KukaOptions,
     planned: Option<&[Point3]>,
 ) -> ValidationReport {
-    use crate::program::contract::{Controller, Kuka};
+    use crate::program::contract::Controller;
+    use crate::program::kuka::Kuka;
     Kuka::validate(program, cell, opts, planned)
 }
 

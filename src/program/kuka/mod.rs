@@ -134,9 +134,10 @@ pub use decode::validate_kuka;
 pub use read::parse_krl;
 
 use crate::program::contract::{read_file, Controller};
+use crate::program::cycle::CycleOptions;
 use crate::program::split::{split_to_budget, Budget};
 use crate::program::validate::{DecodedStep, ValidationReport};
-use crate::program::{ProgramOptions, ProgramSettings};
+use crate::program::ProgramOptions;
 use std::path::Path;
 
 use std::io::Write;
@@ -1268,13 +1269,28 @@ pub struct Kuka;
 
 impl Controller for Kuka {
     const VENDOR: Vendor = Vendor::Kuka;
+    const KEY: &'static str = "kuka";
     const EMITTER: &'static str = EMITTER;
     const EXTENSIONS: &'static [&'static str] = &["src", "dat"];
     type Options = KukaOptions;
     type Read = read::KrlProgram;
 
-    fn options(settings: &ProgramSettings) -> KukaOptions {
-        settings.kuka()
+    fn with_common(own: &KukaOptions, common: &ProgramOptions) -> KukaOptions {
+        KukaOptions {
+            common: *common,
+            ..own.clone()
+        }
+    }
+
+    fn check_options(opts: &KukaOptions) -> Result<(), ProgramError> {
+        opts.validate()
+    }
+
+    fn cycle_options(opts: &KukaOptions) -> CycleOptions {
+        CycleOptions {
+            joint_speed_fraction: f64::from(opts.ptp_percent) / 100.0,
+            ..CycleOptions::default()
+        }
     }
 
     fn common(opts: &KukaOptions) -> &ProgramOptions {
