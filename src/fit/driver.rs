@@ -4,10 +4,11 @@
 //! fits the radius law (and wall thickness) and measures the residuals.
 
 use super::options::units_warning;
+use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
-use super::report;
 use super::section::{fit_circle, fit_plane, plane_basis, CircleFit, SectionPoint};
 use super::topology::{self, median_edge, Surfaces};
+use super::{repair, report};
 use super::{smooth, FitError, FitOptions, StartEnd, TubeMesh, Units};
 use crate::geometry::guide::{CubicSpline, GuideCurve};
 use crate::math::{Point3, UnitVector3, Vector3};
@@ -85,8 +86,26 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
         in_mm = mesh.scaled(opts.units.mm_per_unit());
         &in_mm
     };
-    match fit_in_mm(mesh, opts) {
+    let repaired = repair::repair(mesh);
+    if repaired.mesh.triangles.is_empty() {
+        return Err(FitError::Stl {
+            file: mesh.file.clone(),
+            reason: "no triangle left after welding and dropping zero-area triangles".into(),
+        });
+    }
+    match fit_in_mm(&repaired.mesh, opts) {
         Ok(mut fit) => {
+            fit.vertex_distance_mm = repaired
+                .vertex_of
+                .iter()
+                .map(|r| r.and_then(|r| fit.vertex_distance_mm.get(r as usize).copied().flatten()))
+                .collect();
+            fit.report.repair = RepairReport {
+                welded_vertices: repaired.welded,
+                weld_tolerance_mm: repaired.weld_tolerance_mm,
+                degenerate_triangles: repaired.degenerate,
+                left_out: repaired.left_out,
+            };
             fit.report.units = opts.units;
             fit.report.warnings.extend(warning);
             Ok(fit)

@@ -27,6 +27,7 @@ mod mesh;
 mod options;
 mod outcome;
 mod output;
+mod repair;
 mod report;
 pub mod section;
 pub mod smooth;
@@ -35,7 +36,7 @@ pub mod topology;
 pub use driver::fit_tube;
 pub use mesh::{TubeMesh, MAX_MESH_BYTES};
 pub use options::{FitOptions, StartEnd, Units};
-pub use outcome::{FitReport, StationReport, TubeFit, WallReport};
+pub use outcome::{FitReport, LeftOut, RepairReport, StationReport, TubeFit, WallReport};
 
 /// Errors of the fit stage; each names the mesh file, and the station
 /// (index along the guide from the start end, and its `t` in mm) when there

@@ -196,10 +196,39 @@ pub struct FitReport {
     pub wall: Option<WallReport>,
     /// The stations.
     pub stations: Vec<StationReport>,
+    /// What was repaired before the fit.
+    pub repair: RepairReport,
     /// The unit of the mesh file's coordinates; every length of this report
     /// is in mm.
     pub units: Units,
     /// What the fit noticed but did not refuse (a size suggesting another
     /// unit).
     pub warnings: Vec<String>,
+}
+
+/// A separate piece of the mesh left out of the fit (mesh frame, mm).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct LeftOut {
+    /// Its triangles.
+    pub triangles: usize,
+    /// Its area (mm²).
+    pub area_mm2: f64,
+    /// Its share of the mesh's area (0 to 1).
+    pub area_fraction: f64,
+    /// Its area-weighted centroid (mm).
+    pub centroid_mm: [f64; 3],
+}
+
+/// What the fit repaired in the mesh before fitting it.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct RepairReport {
+    /// Vertices welded into another within the weld tolerance (duplicated
+    /// seam vertices).
+    pub welded_vertices: usize,
+    /// The weld tolerance (mm): a millionth of the bounding box's diagonal.
+    pub weld_tolerance_mm: f64,
+    /// Triangles dropped for a zero area or a repeated vertex.
+    pub degenerate_triangles: usize,
+    /// Separate pieces holding under 1 % of the area, left out.
+    pub left_out: Vec<LeftOut>,
 }

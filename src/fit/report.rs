@@ -162,6 +162,7 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> (FitReport, Vec<Option<f
         substrate_distance_mm: None,
         wall,
         stations,
+        repair: Default::default(),
         units: Default::default(),
         warnings: Vec::new(),
     };

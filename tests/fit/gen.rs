@@ -379,3 +379,53 @@ pub fn y_branch(r: f64, h: f64, n: usize) -> (Vec<Point3>, Vec<[u32; 3]>) {
 pub fn in_metres(v: &[Point3]) -> Vec<Point3> {
     v.iter().map(|p| p / 1000.0).collect()
 }
+
+/// An untidy export of `(v, f)`: the seam (the first vertex of every ring of
+/// `around`) duplicated for the triangles that close the ring, a zero-area
+/// triangle per ring, every third triangle's winding flipped, and a stray
+/// right triangle of legs `side` and `2 side` at `stray`.
+pub fn untidy(
+    v: &[Point3],
+    f: &[[u32; 3]],
+    around: usize,
+    stray: Point3,
+    side: f64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let mut v = v.to_vec();
+    let rings = v.len() / around;
+    // Seam copies, nudged by far less than the weld tolerance.
+    let copy: Vec<u32> = (0..rings)
+        .map(|i| {
+            v.push(v[i * around] + Vector3::new(1e-9, 0.0, 0.0));
+            (v.len() - 1) as u32
+        })
+        .collect();
+    let mut out = Vec::with_capacity(f.len() + rings + 1);
+    for (k, t) in f.iter().enumerate() {
+        // A triangle touching the ring's last point uses the seam's copy.
+        let closes = t.iter().any(|&i| i as usize % around == around - 1);
+        let mut t = t.map(|i| {
+            if closes && i as usize % around == 0 {
+                copy[i as usize / around]
+            } else {
+                i
+            }
+        });
+        if k % 3 == 0 {
+            t.swap(1, 2);
+        }
+        out.push(t);
+    }
+    for i in 0..rings.saturating_sub(1) {
+        let a = (i * around) as u32;
+        out.push([a, a, a + around as u32]);
+    }
+    let s = v.len() as u32;
+    v.extend([
+        stray,
+        stray + Vector3::new(side, 0.0, 0.0),
+        stray + Vector3::new(0.0, 2.0 * side, 0.0),
+    ]);
+    out.push([s, s + 1, s + 2]);
+    (v, out)
+}

@@ -8,6 +8,7 @@ mod cli;
 mod common;
 mod gen;
 mod page;
+mod real;
 mod substrate;
 mod units;
 
