@@ -324,3 +324,51 @@ pub fn abb_mod(selector: u8, text: &str) {
         ),
     }
 }
+
+// ---------------------------------------------------------------------------
+// The mesh fit (`waam fit`) and the replan's scan reader.
+
+use waam_slicer::fit::{fit_tube, FitOptions, TubeMesh, Units};
+use waam_slicer::Measured;
+
+/// Fit target: first byte: the mesh's unit (mm, cm, in, m); rest: STL
+/// bytes → `TubeMesh::from_stl_bytes` → `fit_tube` (a bounded fit: at most
+/// 4 refits). Errors must name the file; an accepted fit has finite guide
+/// points, radii, residuals and per-vertex distances, one per vertex read.
+pub fn fit_stl(units: u8, bytes: &[u8]) {
+    let mesh = match TubeMesh::from_stl_bytes(bytes, "fuzz.stl") {
+        Ok(m) => m,
+        Err(e) => {
+            assert!(e.to_string().contains("fuzz.stl"), "error does not name the file: {e}");
+            return;
+        }
+    };
+    let opts = FitOptions {
+        units: Units::ALL[units as usize % Units::ALL.len()],
+        max_iterations: 4,
+        check_surface: false,
+        ..FitOptions::default()
+    };
+    match fit_tube(&mesh, &opts) {
+        Ok(fit) => {
+            assert!(fit.guide_points.iter().all(finite), "non-finite guide point");
+            assert!(fit.radius_mm.iter().all(|r| r.is_finite() && *r > 0.0));
+            assert!(fit.report.rms_mm.is_finite() && fit.report.max_mm.is_finite());
+            assert_eq!(fit.vertex_distance_mm.len(), mesh.vertices.len());
+            assert!(fit.vertex_distance_mm.iter().flatten().all(|d| d.is_finite()));
+        }
+        Err(e) => assert!(e.to_string().contains("fuzz.stl"), "error does not name the file: {e}"),
+    }
+}
+
+/// Scan target: text → `Measured::from_csv_str`; errors must name the
+/// origin; accepted points and height errors are finite and not empty.
+pub fn scan(text: &str) {
+    match Measured::from_csv_str(text, "fuzz-scan.csv") {
+        Ok(Measured::Points(p)) => assert!(!p.is_empty() && p.iter().all(finite)),
+        Ok(Measured::HeightErrors(h)) => {
+            assert!(!h.is_empty() && h.iter().all(|e| e.dh_mm.is_finite()))
+        }
+        Err(e) => assert!(e.to_string().contains("fuzz-scan.csv"), "error does not name the scan: {e}"),
+    }
+}
