@@ -197,7 +197,9 @@ struct Sample {
 }
 
 /// Estimates layer `after_layer`'s height error from `measured`. `path` is
-/// the nominal path, `frames` its local frames (part frame).
+/// the nominal path, `frames` its local frames (part frame): the rows
+/// gathered onto the layer's points, the scan refused when it is not of
+/// this layer, then smoothed along the layer and its gaps filled.
 pub(super) fn estimate(
     path: &Path,
     frames: &[Vec<LocalFrame>],
@@ -207,128 +209,213 @@ pub(super) fn estimate(
 ) -> Result<ScanEstimate, ReplanError> {
     let layer = &path.layers[after_layer];
     let fr = &frames[after_layer];
-    let n = layer.points.len();
     let delta = path.delta_mm;
     let limit = opts
         .outlier_distance_mm
         .unwrap_or_else(|| (3.0 * delta).max(3.0));
     let positions: Vec<Point3> = layer.points.iter().map(|p| p.position).collect();
-    let mut outliers = Vec::new();
-    let mut outlier_count = 0usize;
-    let mut sum = vec![0.0; n];
-    let mut weight = vec![0.0; n];
-    let mut errors_used: Vec<f64> = Vec::new();
-    let mut across_used: Vec<f64> = Vec::new();
-    let mut distances: Vec<f64> = Vec::new();
     let smooth = matches!(measured, Measured::Points(_));
-    match measured {
-        Measured::Points(points) => {
-            let index = SegmentIndex::new(vec![(positions.clone(), layer.closed)]);
-            let samples: Vec<(Option<Sample>, f64)> = points
-                .par_iter()
-                .map(|q| {
-                    let Some(near) = index.nearest(q) else {
-                        return (None, f64::INFINITY);
-                    };
-                    let j = near.id.segment;
-                    let k = if j + 1 < n { j + 1 } else { 0 };
-                    let s = near.s.clamp(0.0, 1.0);
-                    let foot = positions[j] + (positions[k] - positions[j]) * s;
-                    let b = blend(&fr[j].build, &fr[k].build, s);
-                    let nrm = blend(&fr[j].normal, &fr[k].normal, s);
-                    let d = q - foot;
-                    let dist = d.norm();
-                    if !(dist <= limit) {
-                        return (None, dist);
-                    }
-                    let sample = Sample {
-                        column: j,
-                        s,
-                        error: d.dot(&b),
-                        across: d.dot(&nrm),
-                    };
-                    (Some(sample), dist)
-                })
-                .collect();
-            for (row, ((sample, dist), q)) in samples.into_iter().zip(points).enumerate() {
-                distances.push(dist);
-                match sample {
-                    Some(smp) => {
-                        let k = if smp.column + 1 < n {
-                            smp.column + 1
-                        } else {
-                            0
-                        };
-                        sum[smp.column] += (1.0 - smp.s) * smp.error;
-                        weight[smp.column] += 1.0 - smp.s;
-                        sum[k] += smp.s * smp.error;
-                        weight[k] += smp.s;
-                        errors_used.push(smp.error);
-                        across_used.push(smp.across);
-                    }
-                    None => {
-                        outlier_count += 1;
-                        if outliers.len() < MAX_LISTED_OUTLIERS {
-                            outliers.push(Outlier {
-                                row,
-                                position_mm: *q,
-                                distance_mm: dist,
-                            });
-                        }
-                    }
-                }
-            }
-        }
+    let mut g = match measured {
+        Measured::Points(points) => gather_points(points, &positions, fr, layer.closed, limit),
         Measured::HeightErrors(rows) => {
-            for (row, r) in rows.iter().enumerate() {
-                if r.layer != after_layer {
-                    return Err(ReplanError::ScanOfAnotherLayer {
+            gather_height_errors(rows, &positions, fr, after_layer, limit)?
+        }
+    };
+    let checked = refuse_other_scans(path, after_layer, measured, &mut g, limit, opts)?;
+    let error_mm = smoothed(&positions, layer.closed, &g, smooth, opts);
+    Ok(ScanEstimate {
+        error_mm,
+        covered_points: checked.covered_points,
+        inliers: checked.inliers,
+        outliers: g.outliers,
+        outlier_count: g.outlier_count,
+        outlier_distance_mm: limit,
+        median_error_mm: checked.median_error_mm,
+        median_wall_offset_mm: checked.median_wall_offset_mm,
+    })
+}
+
+/// The scan rows gathered onto the layer's points: per point the weighted
+/// sum of the errors and the weights, the errors and offsets across the
+/// wall used (mm), every row's distance to the layer (mm), the outliers.
+struct Gathered {
+    sum: Vec<f64>,
+    weight: Vec<f64>,
+    errors_used: Vec<f64>,
+    across_used: Vec<f64>,
+    distances: Vec<f64>,
+    outliers: Vec<Outlier>,
+    outlier_count: usize,
+}
+
+impl Gathered {
+    fn new(n: usize) -> Self {
+        Self {
+            sum: vec![0.0; n],
+            weight: vec![0.0; n],
+            errors_used: Vec::new(),
+            across_used: Vec::new(),
+            distances: Vec::new(),
+            outliers: Vec::new(),
+            outlier_count: 0,
+        }
+    }
+}
+
+/// Scan points (part frame, mm) gathered onto the layer of `positions`
+/// (frames `fr`): each point's foot on the layer, its error along the
+/// blended build direction shared between the segment's two ends; points
+/// farther than `limit` (mm) are outliers.
+fn gather_points(
+    points: &[Point3],
+    positions: &[Point3],
+    fr: &[LocalFrame],
+    closed: bool,
+    limit: f64,
+) -> Gathered {
+    let n = positions.len();
+    let mut g = Gathered::new(n);
+    let index = SegmentIndex::new(vec![(positions.to_vec(), closed)]);
+    let samples: Vec<(Option<Sample>, f64)> = points
+        .par_iter()
+        .map(|q| {
+            let Some(near) = index.nearest(q) else {
+                return (None, f64::INFINITY);
+            };
+            let j = near.id.segment;
+            let k = if j + 1 < n { j + 1 } else { 0 };
+            let s = near.s.clamp(0.0, 1.0);
+            let foot = positions[j] + (positions[k] - positions[j]) * s;
+            let b = blend(&fr[j].build, &fr[k].build, s);
+            let nrm = blend(&fr[j].normal, &fr[k].normal, s);
+            let d = q - foot;
+            let dist = d.norm();
+            if !(dist <= limit) {
+                return (None, dist);
+            }
+            let sample = Sample {
+                column: j,
+                s,
+                error: d.dot(&b),
+                across: d.dot(&nrm),
+            };
+            (Some(sample), dist)
+        })
+        .collect();
+    for (row, ((sample, dist), q)) in samples.into_iter().zip(points).enumerate() {
+        g.distances.push(dist);
+        match sample {
+            Some(smp) => {
+                let k = if smp.column + 1 < n {
+                    smp.column + 1
+                } else {
+                    0
+                };
+                g.sum[smp.column] += (1.0 - smp.s) * smp.error;
+                g.weight[smp.column] += 1.0 - smp.s;
+                g.sum[k] += smp.s * smp.error;
+                g.weight[k] += smp.s;
+                g.errors_used.push(smp.error);
+                g.across_used.push(smp.across);
+            }
+            None => {
+                g.outlier_count += 1;
+                if g.outliers.len() < MAX_LISTED_OUTLIERS {
+                    g.outliers.push(Outlier {
                         row,
-                        scan_layer: r.layer,
-                        after_layer,
+                        position_mm: *q,
+                        distance_mm: dist,
                     });
                 }
-                if r.point >= n {
-                    return Err(ReplanError::ScanPoint {
-                        row,
-                        point: r.point,
-                        points: n,
-                        after_layer,
-                    });
-                }
-                let dist = r.dh_mm.abs();
-                distances.push(dist);
-                if dist > limit {
-                    outlier_count += 1;
-                    if outliers.len() < MAX_LISTED_OUTLIERS {
-                        outliers.push(Outlier {
-                            row,
-                            position_mm: positions[r.point] + fr[r.point].build * r.dh_mm,
-                            distance_mm: dist,
-                        });
-                    }
-                    continue;
-                }
-                sum[r.point] += r.dh_mm;
-                weight[r.point] += 1.0;
-                errors_used.push(r.dh_mm);
-                across_used.push(0.0);
             }
         }
     }
+    g
+}
+
+/// Height-error rows gathered onto the layer's points; a row of another
+/// layer or point is refused, a row whose error exceeds `limit` (mm) is an
+/// outlier.
+fn gather_height_errors(
+    rows: &[HeightError],
+    positions: &[Point3],
+    fr: &[LocalFrame],
+    after_layer: usize,
+    limit: f64,
+) -> Result<Gathered, ReplanError> {
+    let n = positions.len();
+    let mut g = Gathered::new(n);
+    for (row, r) in rows.iter().enumerate() {
+        if r.layer != after_layer {
+            return Err(ReplanError::ScanOfAnotherLayer {
+                row,
+                scan_layer: r.layer,
+                after_layer,
+            });
+        }
+        if r.point >= n {
+            return Err(ReplanError::ScanPoint {
+                row,
+                point: r.point,
+                points: n,
+                after_layer,
+            });
+        }
+        let dist = r.dh_mm.abs();
+        g.distances.push(dist);
+        if dist > limit {
+            g.outlier_count += 1;
+            if g.outliers.len() < MAX_LISTED_OUTLIERS {
+                g.outliers.push(Outlier {
+                    row,
+                    position_mm: positions[r.point] + fr[r.point].build * r.dh_mm,
+                    distance_mm: dist,
+                });
+            }
+            continue;
+        }
+        g.sum[r.point] += r.dh_mm;
+        g.weight[r.point] += 1.0;
+        g.errors_used.push(r.dh_mm);
+        g.across_used.push(0.0);
+    }
+    Ok(g)
+}
+
+/// What the checks of a scan measured.
+struct ScanChecks {
+    inliers: usize,
+    median_error_mm: f64,
+    median_wall_offset_mm: f64,
+    covered_points: usize,
+}
+
+/// Refuses a scan of another part (too few rows near the layer, or beside
+/// the wall), of another layer (median error beyond the limit; the hint
+/// names the layer it fits) or covering too little of the layer.
+fn refuse_other_scans(
+    path: &Path,
+    after_layer: usize,
+    measured: &Measured,
+    g: &mut Gathered,
+    limit: f64,
+    opts: &ReplanOptions,
+) -> Result<ScanChecks, ReplanError> {
+    let delta = path.delta_mm;
+    let n = path.layers[after_layer].points.len();
     let total = measured.len();
-    let inliers = total - outlier_count;
+    let inliers = total - g.outlier_count;
     if (inliers as f64) < opts.min_inlier_fraction * total as f64 || inliers == 0 {
         return Err(ReplanError::WrongPart {
             after_layer,
-            outside: outlier_count,
+            outside: g.outlier_count,
             total,
             limit_mm: limit,
-            median_distance_mm: median(&mut distances),
+            median_distance_mm: median(&mut g.distances),
         });
     }
-    let median_error_mm = median(&mut errors_used);
-    let median_wall_offset_mm = median(&mut across_used);
+    let median_error_mm = median(&mut g.errors_used);
+    let median_wall_offset_mm = median(&mut g.across_used);
     let wall_limit = opts.max_wall_offset_mm.unwrap_or(delta);
     if median_wall_offset_mm.abs() > wall_limit {
         return Err(ReplanError::WallOffset {
@@ -355,7 +442,7 @@ pub(super) fn estimate(
             },
         });
     }
-    let covered_points = weight.iter().filter(|w| **w > 0.0).count();
+    let covered_points = g.weight.iter().filter(|w| **w > 0.0).count();
     if (covered_points as f64) < opts.min_coverage * n as f64 {
         return Err(ReplanError::TooLittleCoverage {
             after_layer,
@@ -364,6 +451,26 @@ pub(super) fn estimate(
             min_fraction: opts.min_coverage,
         });
     }
+    Ok(ScanChecks {
+        inliers,
+        median_error_mm,
+        median_wall_offset_mm,
+        covered_points,
+    })
+}
+
+/// Each point's error (mm): a weighted local line through the points'
+/// means over the along-layer window (a scan; `smooth`), then the gaps
+/// filled, zero where nothing is known.
+fn smoothed(
+    positions: &[Point3],
+    closed: bool,
+    g: &Gathered,
+    smooth: bool,
+    opts: &ReplanOptions,
+) -> Vec<f64> {
+    let n = positions.len();
+    let (sum, weight) = (&g.sum, &g.weight);
     // Average over the along-layer window (a scan), then fill the gaps.
     let spacing = if n > 1 {
         let len: f64 = positions.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
@@ -386,7 +493,7 @@ pub(super) fn estimate(
             let (mut s0, mut s1, mut s2, mut t0, mut t1) = (0.0, 0.0, 0.0, 0.0, 0.0);
             for k in -(w as isize)..=(w as isize) {
                 let j = i as isize + k;
-                let j = if layer.closed {
+                let j = if closed {
                     j.rem_euclid(n as isize) as usize
                 } else if j < 0 || j >= n as isize {
                     continue;
@@ -414,18 +521,8 @@ pub(super) fn estimate(
             })
         })
         .collect();
-    fill_gaps(&mut value, layer.closed);
-    let error_mm = value.into_iter().map(|v| v.unwrap_or(0.0)).collect();
-    Ok(ScanEstimate {
-        error_mm,
-        covered_points,
-        inliers,
-        outliers,
-        outlier_count,
-        outlier_distance_mm: limit,
-        median_error_mm,
-        median_wall_offset_mm,
-    })
+    fill_gaps(&mut value, closed);
+    value.into_iter().map(|v| v.unwrap_or(0.0)).collect()
 }
 
 /// `(1 − s) a + s b`, normalised.
