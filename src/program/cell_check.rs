@@ -911,18 +911,49 @@ pub fn check_cell(
     layers: &[LayerPoints],
     scene: &CellScene,
 ) -> Result<CellClearance, ProgramError> {
-    let checker = Checker::new(&program.cell, scene, layers);
-    let index: HashMap<usize, usize> = layers
-        .iter()
-        .enumerate()
-        .map(|(i, l)| (l.layer, i))
-        .collect();
-    let mut stats = CellClearance::default();
-    let mut memory = Memory::default();
-    let mut per_layer: Vec<(usize, Closest)> = Vec::new();
-    let mut slot: HashMap<usize, usize> = HashMap::new();
-    let mut best_of = |layer: usize, per_layer: &mut Vec<(usize, Closest)>| -> usize {
-        *slot.entry(layer).or_insert_with(|| {
+    let mut walk = Walk::new(Checker::new(&program.cell, scene, layers), layers);
+    walk.beads(trajectory)?;
+    walk.other_motions(program, scene)?;
+    Ok(walk.finish())
+}
+
+/// The walk of [`check_cell`] along a program's motions, in program order:
+/// the checker and what it has measured so far (per layer, the closest
+/// approach; the counts).
+struct Walk<'a> {
+    checker: Checker<'a>,
+    /// Layer number → index in the layers checked.
+    index: HashMap<usize, usize>,
+    stats: CellClearance,
+    memory: Memory,
+    /// Per layer met, in the order met: its closest approach.
+    per_layer: Vec<(usize, Closest)>,
+    /// Layer number → index in `per_layer`.
+    slot: HashMap<usize, usize>,
+}
+
+impl<'a> Walk<'a> {
+    fn new(checker: Checker<'a>, layers: &[LayerPoints]) -> Self {
+        let index: HashMap<usize, usize> = layers
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (l.layer, i))
+            .collect();
+        Self {
+            checker,
+            index,
+            stats: CellClearance::default(),
+            memory: Memory::default(),
+            per_layer: Vec::new(),
+            slot: HashMap::new(),
+        }
+    }
+
+    /// The index in `per_layer` of `layer`'s closest approach (added, at
+    /// infinity, when the layer is met first).
+    fn best_of(&mut self, layer: usize) -> usize {
+        let per_layer = &mut self.per_layer;
+        *self.slot.entry(layer).or_insert_with(|| {
             per_layer.push((
                 layer,
                 Closest {
@@ -932,28 +963,22 @@ pub fn check_cell(
             ));
             per_layer.len() - 1
         })
-    };
-    let refuse =
-        |place: &Place, hit: (String, String, f64), clearance: f64| ProgramError::Collision {
-            layer: place.layer,
-            point: place.point,
-            motion: place.motion,
-            body_a: hit.0,
-            body_b: hit.1,
-            distance_mm: hit.2,
-            clearance_mm: clearance,
-        };
-    // a motion sampled by swept distance, both ends included
-    let mut run = |from: Sample,
-                   to: Sample,
-                   skip_first: bool,
-                   place: &Place,
-                   per_layer: &mut Vec<(usize, Closest)>,
-                   memory: &mut Memory,
-                   stats: &mut CellClearance|
-     -> Result<(), ProgramError> {
-        let k = best_of(place.layer, per_layer);
-        let hull: Vec<&Local> = match index
+    }
+
+    /// A motion from `from` to `to` sampled by swept distance, both ends
+    /// included (the first left out with `skip_first`); refused at the
+    /// first sample closer than the clearance.
+    fn run(
+        &mut self,
+        from: Sample,
+        to: Sample,
+        skip_first: bool,
+        place: &Place,
+    ) -> Result<(), ProgramError> {
+        let k = self.best_of(place.layer);
+        let checker = &self.checker;
+        let hull: Vec<&Local> = match self
+            .index
             .get(&place.layer)
             .and_then(|&i| checker.partial.get(i))
         {
@@ -975,149 +1000,160 @@ pub fn check_cell(
             if let Some(hit) = checker.check(
                 &sample,
                 (place.layer, &hull),
-                &mut per_layer[k].1,
-                memory,
-                stats,
+                &mut self.per_layer[k].1,
+                &mut self.memory,
+                &mut self.stats,
             ) {
-                return Err(refuse(place, hit, checker.clearance));
+                return Err(refusal(place, hit, checker.clearance));
             }
         }
         Ok(())
-    };
+    }
 
-    // the beads: every planned point, sampled by swept distance between
-    // consecutive points of a layer
-    let tp = &trajectory.points;
-    let mut prev: Option<(usize, Sample)> = None;
-    let mut last_sampled: Option<Sample> = None;
-    let mut swept = 0.0;
-    for (i, jp) in tp.iter().enumerate() {
-        let Some(q) = jp.joints.as_ref() else {
-            continue;
-        };
-        let s = Sample {
-            q,
-            qp: jp.positioner,
-        };
-        let new_layer = prev.as_ref().is_none_or(|(l, _)| *l != jp.layer);
-        if new_layer {
-            swept = 0.0;
-            last_sampled = None;
-        } else if let Some((_, p)) = &prev {
-            swept += checker.swept_mm(p, &s);
-        }
-        // the first point of a layer, then whenever the swept distance
-        // since the last sample reaches the step (the motion between the
-        // two sampled points sampled in turn), and the layer's last point
-        let is_last = tp.get(i + 1).is_none_or(|n| n.layer != jp.layer);
-        if last_sampled.is_none() || swept >= SAMPLE_STEP_MM || is_last {
-            let place = Place {
-                layer: jp.layer,
-                point: Some(jp.point),
-                motion: "bead",
+    /// The beads: every planned point, sampled by swept distance between
+    /// consecutive points of a layer.
+    fn beads(&mut self, trajectory: &JointTrajectory) -> Result<(), ProgramError> {
+        let tp = &trajectory.points;
+        let mut prev: Option<(usize, Sample)> = None;
+        let mut last_sampled: Option<Sample> = None;
+        let mut swept = 0.0;
+        for (i, jp) in tp.iter().enumerate() {
+            let Some(q) = jp.joints.as_ref() else {
+                continue;
             };
-            let from = last_sampled.unwrap_or(s);
-            run(
-                from,
-                s,
-                last_sampled.is_some(),
-                &place,
-                &mut per_layer,
-                &mut memory,
-                &mut stats,
-            )?;
-            last_sampled = Some(s);
-            swept = 0.0;
+            let s = Sample {
+                q,
+                qp: jp.positioner,
+            };
+            let new_layer = prev.as_ref().is_none_or(|(l, _)| *l != jp.layer);
+            if new_layer {
+                swept = 0.0;
+                last_sampled = None;
+            } else if let Some((_, p)) = &prev {
+                swept += self.checker.swept_mm(p, &s);
+            }
+            // the first point of a layer, then whenever the swept distance
+            // since the last sample reaches the step (the motion between the
+            // two sampled points sampled in turn), and the layer's last point
+            let is_last = tp.get(i + 1).is_none_or(|n| n.layer != jp.layer);
+            if last_sampled.is_none() || swept >= SAMPLE_STEP_MM || is_last {
+                let place = Place {
+                    layer: jp.layer,
+                    point: Some(jp.point),
+                    motion: "bead",
+                };
+                let from = last_sampled.unwrap_or(s);
+                self.run(from, s, last_sampled.is_some(), &place)?;
+                last_sampled = Some(s);
+                swept = 0.0;
+            }
+            prev = Some((jp.layer, s));
         }
-        prev = Some((jp.layer, s));
+        Ok(())
     }
 
-    // every other motion of the program: home → first point, approach →
-    // first point, last point → retract, the transits, last → home
-    let pts = &program.points;
-    let home = program.home.as_ref();
-    if let (Some(h), Some(first)) = (home.filter(|_| scene.transits), pts.first()) {
-        run(
-            Sample {
-                q: &h.joints,
-                qp: h.positioner,
-            },
-            Sample {
-                q: &first.joints,
-                qp: first.positioner,
-            },
-            false,
-            &Place {
-                layer: first.layer,
-                point: None,
-                motion: "home move",
-            },
-            &mut per_layer,
-            &mut memory,
-            &mut stats,
-        )?;
-    }
-    for w in pts.windows(2) {
-        let (a, b) = (&w[0], &w[1]);
-        let same_bead = a.arc.is_bead() && b.arc.is_bead() && a.layer == b.layer;
-        if same_bead {
-            continue;
+    /// Every other motion of the program: home → first point, approach →
+    /// first point, last point → retract, the transits, last → home (the
+    /// home moves and transits only with `scene.transits`).
+    fn other_motions(&mut self, program: &Program, scene: &CellScene) -> Result<(), ProgramError> {
+        let pts = &program.points;
+        let home = program.home.as_ref();
+        if let (Some(h), Some(first)) = (home.filter(|_| scene.transits), pts.first()) {
+            self.run(
+                Sample {
+                    q: &h.joints,
+                    qp: h.positioner,
+                },
+                Sample {
+                    q: &first.joints,
+                    qp: first.positioner,
+                },
+                false,
+                &Place {
+                    layer: first.layer,
+                    point: None,
+                    motion: "home move",
+                },
+            )?;
         }
-        let motion = match (a.arc, b.arc) {
-            (ArcFlag::Approach, ArcFlag::Start) => "approach",
-            (ArcFlag::End, ArcFlag::Retract) => "retract",
-            _ if !scene.transits => continue,
-            _ => "arc-off transit",
-        };
-        run(
-            Sample {
-                q: &a.joints,
-                qp: a.positioner,
-            },
-            Sample {
-                q: &b.joints,
-                qp: b.positioner,
-            },
-            false,
-            &Place {
-                layer: b.layer,
-                point: Some(b.point),
-                motion,
-            },
-            &mut per_layer,
-            &mut memory,
-            &mut stats,
-        )?;
+        for w in pts.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            let same_bead = a.arc.is_bead() && b.arc.is_bead() && a.layer == b.layer;
+            if same_bead {
+                continue;
+            }
+            let motion = match (a.arc, b.arc) {
+                (ArcFlag::Approach, ArcFlag::Start) => "approach",
+                (ArcFlag::End, ArcFlag::Retract) => "retract",
+                _ if !scene.transits => continue,
+                _ => "arc-off transit",
+            };
+            self.run(
+                Sample {
+                    q: &a.joints,
+                    qp: a.positioner,
+                },
+                Sample {
+                    q: &b.joints,
+                    qp: b.positioner,
+                },
+                false,
+                &Place {
+                    layer: b.layer,
+                    point: Some(b.point),
+                    motion,
+                },
+            )?;
+        }
+        if let (Some(h), Some(last)) = (home.filter(|_| scene.transits), pts.last()) {
+            self.run(
+                Sample {
+                    q: &last.joints,
+                    qp: last.positioner,
+                },
+                Sample {
+                    q: &h.joints,
+                    qp: h.positioner,
+                },
+                false,
+                &Place {
+                    layer: last.layer,
+                    point: None,
+                    motion: "home move",
+                },
+            )?;
+        }
+        Ok(())
     }
-    if let (Some(h), Some(last)) = (home.filter(|_| scene.transits), pts.last()) {
-        run(
-            Sample {
-                q: &last.joints,
-                qp: last.positioner,
-            },
-            Sample {
-                q: &h.joints,
-                qp: h.positioner,
-            },
-            false,
-            &Place {
-                layer: last.layer,
-                point: None,
-                motion: "home move",
-            },
-            &mut per_layer,
-            &mut memory,
-            &mut stats,
-        )?;
+
+    /// What the walk measured: per layer (in layer order) its closest
+    /// approach and pair, and the counts.
+    fn finish(self) -> CellClearance {
+        let mut stats = self.stats;
+        stats.layers = self
+            .per_layer
+            .into_iter()
+            .map(|(layer, c)| LayerClearance {
+                layer,
+                closest_approach_mm: c.distance_mm,
+                closest_pair: c.pair,
+            })
+            .collect();
+        stats.layers.sort_by_key(|l| l.layer);
+        stats
     }
-    stats.layers = per_layer
-        .into_iter()
-        .map(|(layer, c)| LayerClearance {
-            layer,
-            closest_approach_mm: c.distance_mm,
-            closest_pair: c.pair,
-        })
-        .collect();
-    stats.layers.sort_by_key(|l| l.layer);
-    Ok(stats)
+}
+
+/// The refusal of a sample at `place` where the pair `hit` (its two bodies
+/// and their distance, mm) comes closer than `clearance` (mm).
+fn refusal(place: &Place, hit: (String, String, f64), clearance: f64) -> ProgramError {
+    ProgramError::Collision {
+        layer: place.layer,
+        point: place.point,
+        motion: place.motion,
+        body_a: hit.0,
+        body_b: hit.1,
+        distance_mm: hit.2,
+        clearance_mm: clearance,
+    }
 }

@@ -137,170 +137,17 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
     let total = path.num_points();
     let k = stride(total, input.options.max_points);
     let delta = path.delta_mm;
-    let nl = path.layers.len();
-
-    let mut layer_start = Vec::with_capacity(nl + 1);
-    let (mut pos, mut tool, mut normal, mut build) = (vec![], vec![], vec![], vec![]);
-    let mut dev = vec![];
-    let mut lean = vec![];
-    let mut speed = vec![];
-    let mut rz = vec![];
-    let mut margin = vec![];
-    // the build direction's tilt from the vertical in the world (torch carried)
-    let mut tilt = vec![];
-    let torch_carried = match input.plan.as_ref().map(|pv| pv.cell) {
-        Some(CellLayout::TorchCarried(c)) => Some(c),
-        _ => None,
-    };
-    let robot = input.plan.as_ref().map(|pv| pv.cell.robot());
-    for (l, layer) in path.layers.iter().enumerate() {
-        layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
-        for i in kept(layer.points.len(), k) {
-            let p = &layer.points[i];
-            let f = &input.frames[l][i];
-            pos.extend([
-                p.position.x as f32,
-                p.position.y as f32,
-                p.position.z as f32,
-            ]);
-            for (out, v) in [
-                (&mut tool, f.tool),
-                (&mut normal, f.normal),
-                (&mut build, f.build),
-            ] {
-                let u = v.try_normalize(0.0).unwrap_or_else(Vector3::zeros);
-                out.extend([unit_i8(u.x), unit_i8(u.y), unit_i8(u.z)]);
-            }
-            dev.push(match input.map.points[l][i] {
-                Some((d, false)) => (d - delta) as f32,
-                _ => f32::NAN,
-            });
-            let t = f.tool.try_normalize(0.0).unwrap_or_else(Vector3::z);
-            lean.push(t.z.clamp(-1.0, 1.0).acos().to_degrees() as f32);
-            if let Some(pr) = input.process {
-                speed.push(pr.points[l][i].travel_speed_mm_s as f32);
-            }
-            if let (Some(pv), Some(robot)) = (&input.plan, robot) {
-                let pp = &pv.plan.layers[l].points[i];
-                rz.push(pp.r_z.to_degrees() as f32);
-                margin.push(match pp.joints {
-                    Some(q) => limit_margin_rad(robot, &q).to_degrees() as f32,
-                    None => f32::NAN,
-                });
-                if let Some(c) = torch_carried {
-                    let cp = &pv.layers[l].points[i];
-                    tilt.push(match pp.positioner.or(cp.positioner) {
-                        Some(e) => c.build_tilt(cp, &e).to_degrees() as f32,
-                        None => f32::NAN,
-                    });
-                }
-            }
-        }
-    }
-    layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
+    let drawn = drawn_points(input, k);
+    let (layer_start, pos, tool, normal, build) = (
+        drawn.layer_start,
+        drawn.pos,
+        drawn.tool,
+        drawn.normal,
+        drawn.build,
+    );
     let shown = pos.len() / 3;
-
-    let mut fields = vec![
-        Field {
-            key: "deviation",
-            name: "interlayer distance − Delta",
-            unit: "mm",
-            diverging: true,
-            // 2 % of Delta: a constant-distance path's rounding noise stays neutral
-            min_half_range: 0.02 * delta,
-            values: dev,
-        },
-        Field {
-            key: "lean",
-            name: "lean of the tool axis from part Z",
-            unit: "deg",
-            diverging: false,
-            min_half_range: 0.0,
-            values: lean,
-        },
-    ];
-    if input.process.is_some() {
-        fields.push(Field {
-            key: "speed",
-            name: "travel speed",
-            unit: "mm/s",
-            diverging: false,
-            min_half_range: 0.0,
-            values: speed,
-        });
-    }
-    if input.plan.is_some() {
-        fields.push(Field {
-            key: "rz",
-            name: "R_Z (free angle about the tool axis)",
-            unit: "deg",
-            diverging: false,
-            min_half_range: 0.0,
-            values: rz,
-        });
-        fields.push(Field {
-            key: "margin",
-            name: "smallest joint-limit margin",
-            unit: "deg",
-            diverging: false,
-            min_half_range: 0.0,
-            values: margin,
-        });
-        if torch_carried.is_some() {
-            fields.push(Field {
-                key: "tilt",
-                name: "build direction from the vertical (positioner)",
-                unit: "deg",
-                diverging: false,
-                min_half_range: 0.0,
-                values: tilt,
-            });
-        }
-    }
-
-    let mut marks: Vec<Mark> = vec![];
-    if let Some(pv) = &input.plan {
-        marks.extend(pv.plan.violations().map(|v| Mark {
-            layer: v.layer,
-            point: v.point,
-            text: v.to_string(),
-        }));
-    }
-    // a collision refusal marks its point (the layer's first for a home move)
-    if let Some(pv) = &input.plan {
-        if let Some(e @ ProgramError::Collision { layer, point, .. }) = pv.refusal {
-            if let Some(l) = pv.layers.iter().position(|lp| lp.layer == *layer) {
-                let n = path.layers[l].points.len();
-                marks.push(Mark {
-                    layer: l,
-                    point: point.unwrap_or(0).min(n.saturating_sub(1)),
-                    text: format!("collision: {e}"),
-                });
-            }
-        }
-    }
-    if let Some(pr) = input.process {
-        marks.extend(pr.violations.iter().map(|v| Mark {
-            layer: v.layer,
-            point: v.point,
-            text: format!(
-                "layer {}, point {}: travel speed window: {:?} (local distance {:.3} mm{})",
-                v.layer,
-                v.point,
-                v.side,
-                v.delta_mm,
-                v.needed_mm_s
-                    .map(|s| format!(", needs {s:.2} mm/s"))
-                    .unwrap_or_default()
-            ),
-        }));
-    }
-    // A mark names a point of the path; anything else is dropped (counted).
-    marks.retain(|m| {
-        path.layers
-            .get(m.layer)
-            .is_some_and(|l| m.point < l.points.len())
-    });
+    let fields = fields(input, drawn.values);
+    let mut marks = marks(input);
     let marks_total = marks.len();
     marks.truncate(input.options.max_marks);
 
@@ -375,6 +222,224 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
         fit: None,
     };
     script_safe_json(&data)
+}
+
+/// The drawn points of the path (every `k`-th point of each layer and its
+/// last, part frame): each layer's first drawn point, positions (mm), unit
+/// tool, normal and build vectors (× 127), and the colour fields' values.
+struct Drawn {
+    layer_start: Vec<u32>,
+    pos: Vec<f32>,
+    tool: Vec<i8>,
+    normal: Vec<i8>,
+    build: Vec<i8>,
+    values: FieldValues,
+}
+
+/// Per drawn point, the values of the colour fields (empty when the input
+/// has no process or plan for them).
+#[derive(Default)]
+struct FieldValues {
+    /// Interlayer distance − Delta (mm).
+    dev: Vec<f32>,
+    /// Lean of the tool axis from part Z (deg).
+    lean: Vec<f32>,
+    /// Travel speed (mm/s).
+    speed: Vec<f32>,
+    /// `R_Z` (deg).
+    rz: Vec<f32>,
+    /// Smallest joint-limit margin (deg).
+    margin: Vec<f32>,
+    /// The build direction's tilt from the vertical in the world (deg;
+    /// torch carried).
+    tilt: Vec<f32>,
+    /// Whether the cell is torch carried (the tilt field is drawn).
+    torch_carried: bool,
+}
+
+/// The path's points drawn at stride `k`, with their vectors and fields.
+fn drawn_points(input: &ReportInput, k: usize) -> Drawn {
+    let path = input.path;
+    let delta = path.delta_mm;
+    let nl = path.layers.len();
+
+    let mut layer_start = Vec::with_capacity(nl + 1);
+    let (mut pos, mut tool, mut normal, mut build) = (vec![], vec![], vec![], vec![]);
+    let mut v = FieldValues::default();
+    let torch_carried = match input.plan.as_ref().map(|pv| pv.cell) {
+        Some(CellLayout::TorchCarried(c)) => Some(c),
+        _ => None,
+    };
+    let robot = input.plan.as_ref().map(|pv| pv.cell.robot());
+    for (l, layer) in path.layers.iter().enumerate() {
+        layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
+        for i in kept(layer.points.len(), k) {
+            let p = &layer.points[i];
+            let f = &input.frames[l][i];
+            pos.extend([
+                p.position.x as f32,
+                p.position.y as f32,
+                p.position.z as f32,
+            ]);
+            for (out, v) in [
+                (&mut tool, f.tool),
+                (&mut normal, f.normal),
+                (&mut build, f.build),
+            ] {
+                let u = v.try_normalize(0.0).unwrap_or_else(Vector3::zeros);
+                out.extend([unit_i8(u.x), unit_i8(u.y), unit_i8(u.z)]);
+            }
+            v.dev.push(match input.map.points[l][i] {
+                Some((d, false)) => (d - delta) as f32,
+                _ => f32::NAN,
+            });
+            let t = f.tool.try_normalize(0.0).unwrap_or_else(Vector3::z);
+            v.lean.push(t.z.clamp(-1.0, 1.0).acos().to_degrees() as f32);
+            if let Some(pr) = input.process {
+                v.speed.push(pr.points[l][i].travel_speed_mm_s as f32);
+            }
+            if let (Some(pv), Some(robot)) = (&input.plan, robot) {
+                let pp = &pv.plan.layers[l].points[i];
+                v.rz.push(pp.r_z.to_degrees() as f32);
+                v.margin.push(match pp.joints {
+                    Some(q) => limit_margin_rad(robot, &q).to_degrees() as f32,
+                    None => f32::NAN,
+                });
+                if let Some(c) = torch_carried {
+                    let cp = &pv.layers[l].points[i];
+                    v.tilt.push(match pp.positioner.or(cp.positioner) {
+                        Some(e) => c.build_tilt(cp, &e).to_degrees() as f32,
+                        None => f32::NAN,
+                    });
+                }
+            }
+        }
+    }
+    layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
+    layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
+    v.torch_carried = torch_carried.is_some();
+    Drawn {
+        layer_start,
+        pos,
+        tool,
+        normal,
+        build,
+        values: v,
+    }
+}
+
+/// The colour fields of the path's page, from their values per drawn point.
+fn fields(input: &ReportInput, v: FieldValues) -> Vec<Field> {
+    let delta = input.path.delta_mm;
+    let mut fields = vec![
+        Field {
+            key: "deviation",
+            name: "interlayer distance − Delta",
+            unit: "mm",
+            diverging: true,
+            // 2 % of Delta: a constant-distance path's rounding noise stays neutral
+            min_half_range: 0.02 * delta,
+            values: v.dev,
+        },
+        Field {
+            key: "lean",
+            name: "lean of the tool axis from part Z",
+            unit: "deg",
+            diverging: false,
+            min_half_range: 0.0,
+            values: v.lean,
+        },
+    ];
+    if input.process.is_some() {
+        fields.push(Field {
+            key: "speed",
+            name: "travel speed",
+            unit: "mm/s",
+            diverging: false,
+            min_half_range: 0.0,
+            values: v.speed,
+        });
+    }
+    if input.plan.is_some() {
+        fields.push(Field {
+            key: "rz",
+            name: "R_Z (free angle about the tool axis)",
+            unit: "deg",
+            diverging: false,
+            min_half_range: 0.0,
+            values: v.rz,
+        });
+        fields.push(Field {
+            key: "margin",
+            name: "smallest joint-limit margin",
+            unit: "deg",
+            diverging: false,
+            min_half_range: 0.0,
+            values: v.margin,
+        });
+        if v.torch_carried {
+            fields.push(Field {
+                key: "tilt",
+                name: "build direction from the vertical (positioner)",
+                unit: "deg",
+                diverging: false,
+                min_half_range: 0.0,
+                values: v.tilt,
+            });
+        }
+    }
+    fields
+}
+
+/// The marks of the path's page: the plan's violations, a collision
+/// refusal, the process window's violations; only those naming a point of
+/// the path.
+fn marks(input: &ReportInput) -> Vec<Mark> {
+    let path = input.path;
+    let mut marks: Vec<Mark> = vec![];
+    if let Some(pv) = &input.plan {
+        marks.extend(pv.plan.violations().map(|v| Mark {
+            layer: v.layer,
+            point: v.point,
+            text: v.to_string(),
+        }));
+    }
+    // a collision refusal marks its point (the layer's first for a home move)
+    if let Some(pv) = &input.plan {
+        if let Some(e @ ProgramError::Collision { layer, point, .. }) = pv.refusal {
+            if let Some(l) = pv.layers.iter().position(|lp| lp.layer == *layer) {
+                let n = path.layers[l].points.len();
+                marks.push(Mark {
+                    layer: l,
+                    point: point.unwrap_or(0).min(n.saturating_sub(1)),
+                    text: format!("collision: {e}"),
+                });
+            }
+        }
+    }
+    if let Some(pr) = input.process {
+        marks.extend(pr.violations.iter().map(|v| Mark {
+            layer: v.layer,
+            point: v.point,
+            text: format!(
+                "layer {}, point {}: travel speed window: {:?} (local distance {:.3} mm{})",
+                v.layer,
+                v.point,
+                v.side,
+                v.delta_mm,
+                v.needed_mm_s
+                    .map(|s| format!(", needs {s:.2} mm/s"))
+                    .unwrap_or_default()
+            ),
+        }));
+    }
+    // A mark names a point of the path; anything else is dropped (counted).
+    marks.retain(|m| {
+        path.layers
+            .get(m.layer)
+            .is_some_and(|l| m.point < l.points.len())
+    });
+    marks
 }
 
 /// Smallest distance of `q` to its joint limits (rad; negative outside),

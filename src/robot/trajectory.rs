@@ -14,7 +14,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 use crate::math::{Point3, UnitVector3};
-use crate::robot::cell::{CellLayout, CellPoint};
+use crate::robot::cell::{CellLayout, CellPoint, CellPose, TorchCarriedCell};
 use crate::robot::ik::Configuration;
 use crate::robot::indices::{dexterity_warm, SvdWarmStart};
 use crate::robot::model::Joints;
@@ -369,30 +369,7 @@ fn trajectory(
     opts: &TrajectoryOptions,
     measures: bool,
 ) -> Result<JointTrajectory, RobotError> {
-    opts.validate()?;
-    if !(travel_speed_mm_s > 0.0 && travel_speed_mm_s.is_finite()) {
-        return Err(RobotError::InvalidOptions {
-            field: "travel_speed_mm_s",
-            value: travel_speed_mm_s,
-            reason: "must be finite and > 0",
-        });
-    }
-    for p in points {
-        if !(p.position_mm.iter().all(|v| v.is_finite()) && p.r_z.is_finite()) {
-            return Err(RobotError::BadPathPoint {
-                layer: p.layer,
-                point: p.point,
-                reason: "non-finite position or R_Z",
-            });
-        }
-        if !p.tool_axis.iter().all(|v| v.is_finite()) {
-            return Err(RobotError::BadPathPoint {
-                layer: p.layer,
-                point: p.point,
-                reason: "non-finite tool axis",
-            });
-        }
-    }
+    check_inputs(points, travel_speed_mm_s, opts)?;
     let robot = cell.robot();
     let hose_limit = match cell {
         CellLayout::TorchCarried(c) => Some(c.max_hose_torsion_rad),
@@ -402,8 +379,6 @@ fn trajectory(
     let mut out: Vec<JointPoint> = Vec::with_capacity(points.len());
     let mut prev_q: Option<Joints> = None;
     let mut prev_q8 = 0.0;
-    let sin_wrist = opts.wrist_singularity_margin_rad.sin();
-    let sin_elbow = opts.elbow_singularity_margin_rad.sin();
     let mut warm = SvdWarmStart::default();
 
     for (idx, p) in points.iter().enumerate() {
@@ -458,84 +433,21 @@ fn trajectory(
             });
         }
         // speeds, within a layer
-        let mut speed = [0.0; 6];
-        let mut dt = 0.0;
-        if idx > 0 {
-            let pp = &points[idx - 1];
-            if pp.layer == p.layer {
-                if let (Some(qprev), d) =
-                    (out[idx - 1].joints, (p.position_mm - pp.position_mm).norm())
-                {
-                    if d > 0.0 {
-                        dt = d / travel_speed_mm_s;
-                        for j in 0..6 {
-                            speed[j] = (q[j] - qprev[j]) / dt;
-                            if speed[j].abs() > robot.max_speed_rad_s[j] {
-                                violation(ViolationKind::JointSpeed {
-                                    joint: j + 1,
-                                    speed_rad_s: speed[j].abs(),
-                                    max_rad_s: robot.max_speed_rad_s[j],
-                                });
-                            }
-                        }
-                        if let (CellLayout::TorchCarried(c), Some(qp), Some(qpp)) =
-                            (cell, pose.positioner, out[idx - 1].positioner)
-                        {
-                            for k in 0..2 {
-                                let s = ((qp[k] - qpp[k]) / dt).abs();
-                                if s > c.positioner.max_speed_rad_s[k] {
-                                    violation(ViolationKind::JointSpeed {
-                                        joint: 7 + k,
-                                        speed_rad_s: s,
-                                        max_rad_s: c.positioner.max_speed_rad_s[k],
-                                    });
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let (speed, dt) = joint_speeds(
+            cell,
+            points,
+            &out,
+            idx,
+            &q,
+            pose.positioner,
+            travel_speed_mm_s,
+            &mut violation,
+        );
         if let (CellLayout::TorchCarried(c), Some(qp)) = (cell, pose.positioner) {
-            let tilt = c.build_tilt(&cp, &qp);
-            // rounding of the chain of rotations: [`BUILD_TILT_ROUNDING_RAD`]
-            if tilt > c.max_vertical_error_rad + BUILD_TILT_ROUNDING_RAD {
-                violation(ViolationKind::BuildTilt {
-                    tilt_rad: tilt,
-                    max_rad: c.max_vertical_error_rad,
-                });
-            }
-            for (k, (l, v)) in c.positioner.limits.iter().zip(qp).enumerate() {
-                if !l.contains(v) {
-                    violation(ViolationKind::JointLimit {
-                        joint: 7 + k,
-                        value_rad: v,
-                        lower_rad: l.lower_rad,
-                        upper_rad: l.upper_rad,
-                    });
-                }
-            }
+            positioner_checks(c, &cp, &qp, &mut violation);
         }
         // singularities
-        let sm = robot.singularity_measures(&q);
-        if sm.wrist_sin_j5 < sin_wrist {
-            violation(ViolationKind::Singularity {
-                kind: SingularityKind::Wrist,
-                measure: sm.wrist_sin_j5,
-            });
-        }
-        if sm.elbow_cos < sin_elbow {
-            violation(ViolationKind::Singularity {
-                kind: SingularityKind::Elbow,
-                measure: sm.elbow_cos,
-            });
-        }
-        if sm.shoulder_distance_mm < opts.shoulder_singularity_margin_mm {
-            violation(ViolationKind::Singularity {
-                kind: SingularityKind::Shoulder,
-                measure: sm.shoulder_distance_mm,
-            });
-        }
+        singularity_checks(cell, &q, opts, &mut violation);
         // hose
         if let Some(max) = hose_limit {
             let tor = (q[3] + q[5]).abs();
@@ -547,17 +459,7 @@ fn trajectory(
             }
         }
         let (dex, dq_drz) = if measures {
-            let jac = robot.jacobian(&q);
-            let dex = dexterity_warm(&jac, opts.dexterity_length_scale_mm, &mut warm);
-            let dq_drz = if opts.with_derivatives {
-                // the Jacobian above, and its dexterity as a bound for the
-                // singularity test (same answers as `cell.dq_drz(&pose, &q)`)
-                cell.dq_drz_from(&pose, &jac, Some((dex, opts.dexterity_length_scale_mm)))
-                    .ok()
-            } else {
-                None
-            };
-            (dex, dq_drz)
+            point_measures(cell, &pose, &q, opts, &mut warm)
         } else {
             (0.0, None)
         };
@@ -578,4 +480,178 @@ fn trajectory(
         points: out,
         report,
     })
+}
+
+/// Refuses a travel speed that is not finite and positive, and a path
+/// point whose position, `R_Z` or tool axis is not finite.
+fn check_inputs(
+    points: &[PathPointInput],
+    travel_speed_mm_s: f64,
+    opts: &TrajectoryOptions,
+) -> Result<(), RobotError> {
+    opts.validate()?;
+    if !(travel_speed_mm_s > 0.0 && travel_speed_mm_s.is_finite()) {
+        return Err(RobotError::InvalidOptions {
+            field: "travel_speed_mm_s",
+            value: travel_speed_mm_s,
+            reason: "must be finite and > 0",
+        });
+    }
+    for p in points {
+        if !(p.position_mm.iter().all(|v| v.is_finite()) && p.r_z.is_finite()) {
+            return Err(RobotError::BadPathPoint {
+                layer: p.layer,
+                point: p.point,
+                reason: "non-finite position or R_Z",
+            });
+        }
+        if !p.tool_axis.iter().all(|v| v.is_finite()) {
+            return Err(RobotError::BadPathPoint {
+                layer: p.layer,
+                point: p.point,
+                reason: "non-finite tool axis",
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Joint speeds (rad/s) from the previous point of the same layer to point
+/// `idx` at joints `q` (positioner joints `positioner`), and the time
+/// between them (s) at `travel_speed_mm_s`; zeros at a layer's first point.
+/// Reports every arm and positioner joint over its maximum speed.
+#[allow(clippy::too_many_arguments)]
+fn joint_speeds(
+    cell: &CellLayout,
+    points: &[PathPointInput],
+    out: &[JointPoint],
+    idx: usize,
+    q: &Joints,
+    positioner: Option<PositionerJoints>,
+    travel_speed_mm_s: f64,
+    violation: &mut dyn FnMut(ViolationKind),
+) -> ([f64; 6], f64) {
+    let p = &points[idx];
+    let robot = cell.robot();
+    let mut speed = [0.0; 6];
+    let mut dt = 0.0;
+    if idx > 0 {
+        let pp = &points[idx - 1];
+        if pp.layer == p.layer {
+            if let (Some(qprev), d) = (out[idx - 1].joints, (p.position_mm - pp.position_mm).norm())
+            {
+                if d > 0.0 {
+                    dt = d / travel_speed_mm_s;
+                    for j in 0..6 {
+                        speed[j] = (q[j] - qprev[j]) / dt;
+                        if speed[j].abs() > robot.max_speed_rad_s[j] {
+                            violation(ViolationKind::JointSpeed {
+                                joint: j + 1,
+                                speed_rad_s: speed[j].abs(),
+                                max_rad_s: robot.max_speed_rad_s[j],
+                            });
+                        }
+                    }
+                    if let (CellLayout::TorchCarried(c), Some(qp), Some(qpp)) =
+                        (cell, positioner, out[idx - 1].positioner)
+                    {
+                        for k in 0..2 {
+                            let s = ((qp[k] - qpp[k]) / dt).abs();
+                            if s > c.positioner.max_speed_rad_s[k] {
+                                violation(ViolationKind::JointSpeed {
+                                    joint: 7 + k,
+                                    speed_rad_s: s,
+                                    max_rad_s: c.positioner.max_speed_rad_s[k],
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    (speed, dt)
+}
+
+/// Reports the build direction's tilt from the vertical beyond the cone
+/// and the positioner's joint limits at positioner joints `qp` (rad).
+fn positioner_checks(
+    c: &TorchCarriedCell,
+    cp: &CellPoint,
+    qp: &PositionerJoints,
+    violation: &mut dyn FnMut(ViolationKind),
+) {
+    let tilt = c.build_tilt(cp, qp);
+    // rounding of the chain of rotations: [`BUILD_TILT_ROUNDING_RAD`]
+    if tilt > c.max_vertical_error_rad + BUILD_TILT_ROUNDING_RAD {
+        violation(ViolationKind::BuildTilt {
+            tilt_rad: tilt,
+            max_rad: c.max_vertical_error_rad,
+        });
+    }
+    for (k, (l, v)) in c.positioner.limits.iter().zip(*qp).enumerate() {
+        if !l.contains(v) {
+            violation(ViolationKind::JointLimit {
+                joint: 7 + k,
+                value_rad: v,
+                lower_rad: l.lower_rad,
+                upper_rad: l.upper_rad,
+            });
+        }
+    }
+}
+
+/// Reports the wrist, elbow and shoulder singularities of joints `q`
+/// closer than the options' margins.
+fn singularity_checks(
+    cell: &CellLayout,
+    q: &Joints,
+    opts: &TrajectoryOptions,
+    violation: &mut dyn FnMut(ViolationKind),
+) {
+    let robot = cell.robot();
+    let sin_wrist = opts.wrist_singularity_margin_rad.sin();
+    let sin_elbow = opts.elbow_singularity_margin_rad.sin();
+    let sm = robot.singularity_measures(q);
+    if sm.wrist_sin_j5 < sin_wrist {
+        violation(ViolationKind::Singularity {
+            kind: SingularityKind::Wrist,
+            measure: sm.wrist_sin_j5,
+        });
+    }
+    if sm.elbow_cos < sin_elbow {
+        violation(ViolationKind::Singularity {
+            kind: SingularityKind::Elbow,
+            measure: sm.elbow_cos,
+        });
+    }
+    if sm.shoulder_distance_mm < opts.shoulder_singularity_margin_mm {
+        violation(ViolationKind::Singularity {
+            kind: SingularityKind::Shoulder,
+            measure: sm.shoulder_distance_mm,
+        });
+    }
+}
+
+/// The dexterity of joints `q` (warm-started along the trajectory) and,
+/// with `opts.with_derivatives`, `dq/dR_Z` at `pose`.
+fn point_measures(
+    cell: &CellLayout,
+    pose: &CellPose,
+    q: &Joints,
+    opts: &TrajectoryOptions,
+    warm: &mut SvdWarmStart,
+) -> (f64, Option<Joints>) {
+    let robot = cell.robot();
+    let jac = robot.jacobian(q);
+    let dex = dexterity_warm(&jac, opts.dexterity_length_scale_mm, warm);
+    let dq_drz = if opts.with_derivatives {
+        // the Jacobian above, and its dexterity as a bound for the
+        // singularity test (same answers as `cell.dq_drz(&pose, &q)`)
+        cell.dq_drz_from(pose, &jac, Some((dex, opts.dexterity_length_scale_mm)))
+            .ok()
+    } else {
+        None
+    };
+    (dex, dq_drz)
 }

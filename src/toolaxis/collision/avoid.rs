@@ -6,10 +6,11 @@ use super::clearance::{check_shape, layer_clearances, substrate_shape, summarise
 use super::torch::Torch;
 use super::{CollisionOptions, CollisionReport, LayerClearance};
 use crate::geometry::Substrate;
-use crate::math::{tol, Point3, Vector3};
+use crate::math::{tol, Isometry3, Point3, Vector3};
 use crate::path::Path;
 use crate::toolaxis::rules::{angle, smooth_angles};
 use crate::toolaxis::{LocalFrame, ToolAxisError};
+use parry3d_f64::shape::Shape;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -164,216 +165,9 @@ pub fn avoid_collisions(
     let sub = substrate
         .filter(|_| copts.check_substrate)
         .and_then(|s| substrate_shape(path, s));
-    struct LayerOut {
-        frames: Vec<LocalFrame>,
-        before: LayerClearance,
-        after: LayerClearance,
-        corrected: usize,
-        max_corr: f64,
-        unresolved: Vec<usize>,
-    }
     let outs = (0..path.layers.len())
         .into_par_iter()
-        .map(|li| -> Result<LayerOut, ToolAxisError> {
-            let layer = &path.layers[li];
-            let obstacles = Obstacles::new(path, layer.slice, sub.as_ref(), copts.bead_radius_mm);
-            let fr = &frames[li];
-            let nominal: Vec<Vector3> = fr.iter().map(|f| f.tool).collect();
-            let c0 = layer_clearances(&obstacles, torch, path, li, &nominal)?;
-            let before = summarise(li, &c0);
-            let n = fr.len();
-            let positions: Vec<Point3> = layer.points.iter().map(|p| p.position).collect();
-            // Arc length along the layer (mm).
-            let mut s = vec![0.0; n];
-            for i in 1..n {
-                s[i] = s[i - 1] + (positions[i] - positions[i - 1]).norm();
-            }
-            let total = s[n - 1]
-                + if layer.closed {
-                    (positions[0] - positions[n - 1]).norm()
-                } else {
-                    0.0
-                };
-            let dist = |i: usize, j: usize| {
-                let d = (s[i] - s[j]).abs();
-                if layer.closed {
-                    d.min(total - d)
-                } else {
-                    d
-                }
-            };
-            // Required corrections per point, and the blended field.
-            let mut need: Vec<[f64; 2]> = vec![[0.0, 0.0]; n];
-            let mut unresolved = vec![false; n];
-            let mut current = c0.clone();
-            let mut axes = nominal.clone();
-            let mut blended: Vec<[f64; 2]> = vec![[0.0, 0.0]; n];
-            for _round in 0..aopts.rounds {
-                let todo: Vec<usize> = (0..n)
-                    .filter(|&i| current[i] < aopts.margin_mm && !unresolved[i])
-                    .collect();
-                if todo.is_empty() {
-                    break;
-                }
-                let mut hint = 1;
-                for &i in &todo {
-                    let start = blended[i][0].hypot(blended[i][1]);
-                    let rings = (aopts.cone_half_angle_rad / aopts.step_rad).floor() as usize;
-                    let first = ((start / aopts.step_rad).floor() as usize + 1).max(1);
-                    if first > rings {
-                        unresolved[i] = true;
-                        continue;
-                    }
-                    // Ring `r`: the direction in the middle of its longest run
-                    // of clear azimuths (the bisector of the free arc), if any.
-                    let m = aopts.azimuths;
-                    let dir_of = |r: usize, k: usize| {
-                        let theta = r as f64 * aopts.step_rad;
-                        let phi = std::f64::consts::TAU * k as f64 / m as f64;
-                        [theta * phi.cos(), theta * phi.sin()]
-                    };
-                    let ring = |r: usize| -> Result<Option<[f64; 2]>, ToolAxisError> {
-                        let mut clear = Vec::with_capacity(m);
-                        for k in 0..m {
-                            let dir = corrected(&fr[i], &nominal[i], &dir_of(r, k));
-                            clear.push(obstacles.is_clear(
-                                torch,
-                                &positions[i],
-                                &dir,
-                                aopts.margin_mm,
-                            )?);
-                        }
-                        if clear.iter().all(|&c| c) {
-                            // No obstacle in reach: keep the tilt along t.
-                            return Ok(Some(dir_of(r, 0)));
-                        }
-                        // Longest circular run of clear azimuths.
-                        let start = clear.iter().position(|&c| !c).expect("one blocked");
-                        let (mut best, mut run) = (None::<(usize, usize)>, None::<(usize, usize)>);
-                        for step in 1..=m {
-                            let k = (start + step) % m;
-                            if clear[k] {
-                                run = Some(run.map_or((k, 1), |(s0, len)| (s0, len + 1)));
-                                let cur = run.expect("just set");
-                                if best.is_none_or(|b| cur.1 > b.1) {
-                                    best = Some(cur);
-                                }
-                            } else {
-                                run = None;
-                            }
-                        }
-                        Ok(best.map(|(s0, len)| {
-                            // Middle of the run (half-step for even lengths).
-                            let mid = s0 as f64 + 0.5 * (len as f64 - 1.0);
-                            let theta = r as f64 * aopts.step_rad;
-                            let phi = std::f64::consts::TAU * mid / m as f64;
-                            [theta * phi.cos(), theta * phi.sin()]
-                        }))
-                    };
-                    // Smallest clearing ring, searched from the previous
-                    // point's answer (neighbours need similar tilts): down
-                    // while rings clear, else up until one does.
-                    let mut found: Option<[f64; 2]> = None;
-                    let mut r = hint.clamp(first, rings);
-                    if let Some(c) = ring(r)? {
-                        found = Some(c);
-                        while r > first {
-                            match ring(r - 1)? {
-                                Some(c) => {
-                                    r -= 1;
-                                    found = Some(c);
-                                }
-                                None => break,
-                            }
-                        }
-                    } else {
-                        while r < rings {
-                            r += 1;
-                            if let Some(c) = ring(r)? {
-                                found = Some(c);
-                                break;
-                            }
-                        }
-                    }
-                    hint = r;
-                    match found {
-                        Some(c) => need[i] = c,
-                        None => {
-                            // Best effort: the clearest direction of the widest ring.
-                            unresolved[i] = true;
-                            let mut best: Option<([f64; 2], f64)> = None;
-                            for k in 0..m {
-                                let c = dir_of(rings, k);
-                                let dir = corrected(&fr[i], &nominal[i], &c);
-                                let cl = obstacles.clearance(torch, &positions[i], &dir)?;
-                                if best.is_none_or(|b| cl > b.1) {
-                                    best = Some((c, cl));
-                                }
-                            }
-                            if let Some((c, _)) = best {
-                                need[i] = c;
-                            }
-                        }
-                    }
-                }
-                // Upper envelope: |c_i| = max_j (|c_j| - rate d_ij), direction of the argmax.
-                let sources: Vec<usize> = (0..n)
-                    .filter(|&j| need[j][0] != 0.0 || need[j][1] != 0.0)
-                    .collect();
-                for (i, bl) in blended.iter_mut().enumerate() {
-                    let mut best = (0.0, [0.0, 0.0]);
-                    for &j in &sources {
-                        let m = need[j][0].hypot(need[j][1]);
-                        let v = m - aopts.max_rate_rad_per_mm * dist(i, j);
-                        if v > best.0 {
-                            best = (v, [need[j][0] / m * v, need[j][1] / m * v]);
-                        }
-                    }
-                    *bl = best.1;
-                }
-                for i in 0..n {
-                    axes[i] = corrected(&fr[i], &nominal[i], &blended[i]);
-                }
-                current = layer_clearances(&obstacles, torch, path, li, &axes)?;
-            }
-            // Smooth the correction field (local coordinates) to the rate.
-            let mut pairs: Vec<(f64, f64)> = blended.iter().map(|c| (c[0], c[1])).collect();
-            if smooth_angles(
-                &positions,
-                &mut pairs,
-                layer.bead_wraps(),
-                aopts.max_rate_rad_per_mm,
-            ) > 0
-            {
-                for (b, p) in blended.iter_mut().zip(&pairs) {
-                    *b = [p.0, p.1];
-                }
-                for i in 0..n {
-                    axes[i] = corrected(&fr[i], &nominal[i], &blended[i]);
-                }
-            }
-            let c1 = layer_clearances(&obstacles, torch, path, li, &axes)?;
-            let after = summarise(li, &c1);
-            let mut out_frames = fr.clone();
-            let mut corrected_count = 0;
-            let mut max_corr: f64 = 0.0;
-            for (f, a) in out_frames.iter_mut().zip(&axes) {
-                let d = angle(&f.tool, a);
-                if d > tol::AXIS_MOVED_RAD {
-                    corrected_count += 1;
-                }
-                max_corr = max_corr.max(d);
-                f.tool = *a;
-            }
-            Ok(LayerOut {
-                frames: out_frames,
-                before,
-                after,
-                corrected: corrected_count,
-                max_corr,
-                unresolved: (0..n).filter(|&i| unresolved[i] || c1[i] <= 0.0).collect(),
-            })
-        })
+        .map(|li| avoid_in_layer(path, &frames[li], li, sub.as_ref(), torch, copts, aopts))
         .collect::<Result<Vec<_>, ToolAxisError>>()?;
     let mut new_frames = Vec::with_capacity(outs.len());
     let mut before = Vec::with_capacity(outs.len());
@@ -404,4 +198,289 @@ pub fn avoid_collisions(
             unresolved,
         },
     ))
+}
+
+/// One layer's frames after the avoidance, and what it did.
+struct LayerOut {
+    frames: Vec<LocalFrame>,
+    before: LayerClearance,
+    after: LayerClearance,
+    /// Points whose tool axis moved.
+    corrected: usize,
+    /// Largest correction (rad).
+    max_corr: f64,
+    /// Points left short of the clearance.
+    unresolved: Vec<usize>,
+}
+
+/// Layer `li`'s tool axes (frames `fr`) tilted clear of the part built
+/// below it and the substrate `sub`, in rounds: the points short of the
+/// margin searched for their smallest clearing tilt, the tilts blended
+/// along the layer at the rate bound, then smoothed.
+fn avoid_in_layer(
+    path: &Path,
+    fr: &[LocalFrame],
+    li: usize,
+    sub: Option<&(Isometry3, Box<dyn Shape>)>,
+    torch: &Torch,
+    copts: &CollisionOptions,
+    aopts: &AvoidanceOptions,
+) -> Result<LayerOut, ToolAxisError> {
+    let layer = &path.layers[li];
+    let obstacles = Obstacles::new(path, layer.slice, sub, copts.bead_radius_mm);
+    let nominal: Vec<Vector3> = fr.iter().map(|f| f.tool).collect();
+    let c0 = layer_clearances(&obstacles, torch, path, li, &nominal)?;
+    let before = summarise(li, &c0);
+    let n = fr.len();
+    let positions: Vec<Point3> = layer.points.iter().map(|p| p.position).collect();
+    let along = ArcLength::of(&positions, layer.closed);
+    // Required corrections per point, and the blended field.
+    let mut need: Vec<[f64; 2]> = vec![[0.0, 0.0]; n];
+    let mut unresolved = vec![false; n];
+    let mut current = c0.clone();
+    let mut axes = nominal.clone();
+    let mut blended: Vec<[f64; 2]> = vec![[0.0, 0.0]; n];
+    for _round in 0..aopts.rounds {
+        let todo: Vec<usize> = (0..n)
+            .filter(|&i| current[i] < aopts.margin_mm && !unresolved[i])
+            .collect();
+        if todo.is_empty() {
+            break;
+        }
+        let mut hint = 1;
+        for &i in &todo {
+            let cone = Cone {
+                obstacles: &obstacles,
+                torch,
+                frame: &fr[i],
+                nominal: &nominal[i],
+                position: &positions[i],
+                aopts,
+            };
+            let start = blended[i][0].hypot(blended[i][1]);
+            let (tilt, missed) = cone.clearing_tilt(start, &mut hint)?;
+            if missed {
+                unresolved[i] = true;
+            }
+            if let Some(c) = tilt {
+                need[i] = c;
+            }
+        }
+        upper_envelope(&need, &mut blended, &along, aopts.max_rate_rad_per_mm);
+        for i in 0..n {
+            axes[i] = corrected(&fr[i], &nominal[i], &blended[i]);
+        }
+        current = layer_clearances(&obstacles, torch, path, li, &axes)?;
+    }
+    // Smooth the correction field (local coordinates) to the rate.
+    let mut pairs: Vec<(f64, f64)> = blended.iter().map(|c| (c[0], c[1])).collect();
+    if smooth_angles(
+        &positions,
+        &mut pairs,
+        layer.bead_wraps(),
+        aopts.max_rate_rad_per_mm,
+    ) > 0
+    {
+        for (b, p) in blended.iter_mut().zip(&pairs) {
+            *b = [p.0, p.1];
+        }
+        for i in 0..n {
+            axes[i] = corrected(&fr[i], &nominal[i], &blended[i]);
+        }
+    }
+    let c1 = layer_clearances(&obstacles, torch, path, li, &axes)?;
+    let after = summarise(li, &c1);
+    let mut out_frames = fr.to_vec();
+    let mut corrected_count = 0;
+    let mut max_corr: f64 = 0.0;
+    for (f, a) in out_frames.iter_mut().zip(&axes) {
+        let d = angle(&f.tool, a);
+        if d > tol::AXIS_MOVED_RAD {
+            corrected_count += 1;
+        }
+        max_corr = max_corr.max(d);
+        f.tool = *a;
+    }
+    Ok(LayerOut {
+        frames: out_frames,
+        before,
+        after,
+        corrected: corrected_count,
+        max_corr,
+        unresolved: (0..n).filter(|&i| unresolved[i] || c1[i] <= 0.0).collect(),
+    })
+}
+
+/// Arc length along a layer (mm): per point from the first, and the
+/// layer's whole length (closing segment included when closed).
+struct ArcLength {
+    s: Vec<f64>,
+    total: f64,
+    closed: bool,
+}
+
+impl ArcLength {
+    fn of(positions: &[Point3], closed: bool) -> Self {
+        let n = positions.len();
+        let mut s = vec![0.0; n];
+        for i in 1..n {
+            s[i] = s[i - 1] + (positions[i] - positions[i - 1]).norm();
+        }
+        let total = s[n - 1]
+            + if closed {
+                (positions[0] - positions[n - 1]).norm()
+            } else {
+                0.0
+            };
+        Self { s, total, closed }
+    }
+
+    /// Distance along the layer between points `i` and `j` (mm; the
+    /// shorter way round a closed layer).
+    fn dist(&self, i: usize, j: usize) -> f64 {
+        let d = (self.s[i] - self.s[j]).abs();
+        if self.closed {
+            d.min(self.total - d)
+        } else {
+            d
+        }
+    }
+}
+
+/// The upper envelope of the needed corrections at `rate` (rad/mm):
+/// `|c_i| = max_j (|c_j| - rate d_ij)`, in the direction of the argmax.
+fn upper_envelope(need: &[[f64; 2]], blended: &mut [[f64; 2]], along: &ArcLength, rate: f64) {
+    let sources: Vec<usize> = (0..need.len())
+        .filter(|&j| need[j][0] != 0.0 || need[j][1] != 0.0)
+        .collect();
+    for (i, bl) in blended.iter_mut().enumerate() {
+        let mut best = (0.0, [0.0, 0.0]);
+        for &j in &sources {
+            let m = need[j][0].hypot(need[j][1]);
+            let v = m - rate * along.dist(i, j);
+            if v > best.0 {
+                best = (v, [need[j][0] / m * v, need[j][1] / m * v]);
+            }
+        }
+        *bl = best.1;
+    }
+}
+
+/// The search cone of one point: its frame, nominal axis and position, the
+/// obstacles and the torch.
+struct Cone<'a> {
+    obstacles: &'a Obstacles<'a>,
+    torch: &'a Torch,
+    frame: &'a LocalFrame,
+    nominal: &'a Vector3,
+    position: &'a Point3,
+    aopts: &'a AvoidanceOptions,
+}
+
+impl Cone<'_> {
+    /// The correction of ring `r` at azimuth `k` (`angle · (cos φ, sin φ)`).
+    fn dir_of(&self, r: usize, k: usize) -> [f64; 2] {
+        let theta = r as f64 * self.aopts.step_rad;
+        let phi = std::f64::consts::TAU * k as f64 / self.aopts.azimuths as f64;
+        [theta * phi.cos(), theta * phi.sin()]
+    }
+
+    /// Ring `r`: the direction in the middle of its longest run of clear
+    /// azimuths (the bisector of the free arc), if any.
+    fn ring(&self, r: usize) -> Result<Option<[f64; 2]>, ToolAxisError> {
+        let aopts = self.aopts;
+        let m = aopts.azimuths;
+        let mut clear = Vec::with_capacity(m);
+        for k in 0..m {
+            let dir = corrected(self.frame, self.nominal, &self.dir_of(r, k));
+            clear.push(self.obstacles.is_clear(
+                self.torch,
+                self.position,
+                &dir,
+                aopts.margin_mm,
+            )?);
+        }
+        if clear.iter().all(|&c| c) {
+            // No obstacle in reach: keep the tilt along t.
+            return Ok(Some(self.dir_of(r, 0)));
+        }
+        // Longest circular run of clear azimuths.
+        let start = clear.iter().position(|&c| !c).expect("one blocked");
+        let (mut best, mut run) = (None::<(usize, usize)>, None::<(usize, usize)>);
+        for step in 1..=m {
+            let k = (start + step) % m;
+            if clear[k] {
+                run = Some(run.map_or((k, 1), |(s0, len)| (s0, len + 1)));
+                let cur = run.expect("just set");
+                if best.is_none_or(|b| cur.1 > b.1) {
+                    best = Some(cur);
+                }
+            } else {
+                run = None;
+            }
+        }
+        Ok(best.map(|(s0, len)| {
+            // Middle of the run (half-step for even lengths).
+            let mid = s0 as f64 + 0.5 * (len as f64 - 1.0);
+            let theta = r as f64 * aopts.step_rad;
+            let phi = std::f64::consts::TAU * mid / m as f64;
+            [theta * phi.cos(), theta * phi.sin()]
+        }))
+    }
+
+    /// The smallest clearing tilt beyond the current one (`start`, rad),
+    /// searched from the previous point's ring `hint` (neighbours need
+    /// similar tilts; updated): down while rings clear, else up until one
+    /// does. Returns the tilt (or, when no ring clears, the clearest
+    /// direction of the widest ring) and whether the point stays short of
+    /// the margin.
+    fn clearing_tilt(
+        &self,
+        start: f64,
+        hint: &mut usize,
+    ) -> Result<(Option<[f64; 2]>, bool), ToolAxisError> {
+        let aopts = self.aopts;
+        let rings = (aopts.cone_half_angle_rad / aopts.step_rad).floor() as usize;
+        let first = ((start / aopts.step_rad).floor() as usize + 1).max(1);
+        if first > rings {
+            return Ok((None, true));
+        }
+        let mut found: Option<[f64; 2]> = None;
+        let mut r = (*hint).clamp(first, rings);
+        if let Some(c) = self.ring(r)? {
+            found = Some(c);
+            while r > first {
+                match self.ring(r - 1)? {
+                    Some(c) => {
+                        r -= 1;
+                        found = Some(c);
+                    }
+                    None => break,
+                }
+            }
+        } else {
+            while r < rings {
+                r += 1;
+                if let Some(c) = self.ring(r)? {
+                    found = Some(c);
+                    break;
+                }
+            }
+        }
+        *hint = r;
+        if found.is_some() {
+            return Ok((found, false));
+        }
+        // Best effort: the clearest direction of the widest ring.
+        let mut best: Option<([f64; 2], f64)> = None;
+        for k in 0..aopts.azimuths {
+            let c = self.dir_of(rings, k);
+            let dir = corrected(self.frame, self.nominal, &c);
+            let cl = self.obstacles.clearance(self.torch, self.position, &dir)?;
+            if best.is_none_or(|b| cl > b.1) {
+                best = Some((c, cl));
+            }
+        }
+        Ok((best.map(|(c, _)| c), true))
+    }
 }
