@@ -136,10 +136,8 @@ impl Error {
             | Error::PartFile(PartFileError::Io { .. })
             | Error::Io { .. }
             | Error::CellFile(CellFileError::Io { .. })
-            | Error::Report(crate::report::ReportError::Io { .. }) => ErrorKind::Io,
-            Error::Fit(FitError::Stl { reason, .. }) if reason.starts_with("cannot") => {
-                ErrorKind::Io
-            }
+            | Error::Report(crate::report::ReportError::Io { .. })
+            | Error::Fit(FitError::StlIo { .. }) => ErrorKind::Io,
             _ => ErrorKind::Input,
         }
     }

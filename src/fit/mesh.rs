@@ -24,22 +24,27 @@ impl TubeMesh {
     /// Reads a binary or ASCII STL file.
     ///
     /// # Errors
-    /// [`FitError::Stl`] naming the file: missing, over [`MAX_MESH_BYTES`],
-    /// unreadable, or without a usable triangle.
+    /// [`FitError::StlIo`] naming the file when it cannot be opened or
+    /// read; [`FitError::Stl`] when it is over [`MAX_MESH_BYTES`],
+    /// unreadable as STL, or without a usable triangle.
     pub fn read_stl(path: &Path) -> Result<Self, FitError> {
         let file = path.display().to_string();
         let bad = |reason: String| FitError::Stl {
             file: file.clone(),
             reason,
         };
-        let meta = std::fs::metadata(path).map_err(|e| bad(format!("cannot open: {e}")))?;
+        let io = |reason: String| FitError::StlIo {
+            file: file.clone(),
+            reason,
+        };
+        let meta = std::fs::metadata(path).map_err(|e| io(format!("cannot open: {e}")))?;
         if meta.len() > MAX_MESH_BYTES {
             return Err(bad(format!(
                 "{} bytes; the limit for a mesh is {MAX_MESH_BYTES}",
                 meta.len()
             )));
         }
-        let bytes = std::fs::read(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+        let bytes = std::fs::read(path).map_err(|e| io(format!("cannot read: {e}")))?;
         Self::from_stl_bytes(&bytes, &file)
     }
 

@@ -52,6 +52,16 @@ pub enum FitError {
         /// What is wrong.
         reason: String,
     },
+    /// The STL file cannot be opened or read (an I/O failure: missing,
+    /// permissions, disk), as opposed to [`FitError::Stl`], a file read
+    /// whose content is wrong.
+    #[error("{file}: {reason}")]
+    StlIo {
+        /// The mesh file.
+        file: String,
+        /// What failed (`cannot open: ...`, `cannot read: ...`).
+        reason: String,
+    },
     /// An option has an unusable value.
     #[error("{file}: fit option `{field}`: {reason}")]
     InvalidOption {

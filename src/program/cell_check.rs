@@ -42,7 +42,7 @@
 //! **Drawn as checked**: the report's 3-D view ([`crate::report`]) draws
 //! the arm's capsules, the table, the tilt body and the keep-out boxes from
 //! this module's body outlines (the same capsules, poses and radii), and
-//! highlights each layer's [`LayerClearance::closest_pair`].
+//! highlights each layer's [`LayerCellClearance::closest_pair`].
 //!
 //! **Motions**: every bead point's planned joints; the linear moves into
 //! and out of each bead, the arc-off joint moves between beads and the
@@ -200,7 +200,7 @@ pub struct CellScene {
 
 /// The closest approach of one layer's motions.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct LayerClearance {
+pub struct LayerCellClearance {
     /// Layer index.
     pub layer: usize,
     /// Smallest distance between two bodies of a checked pair along the
@@ -215,7 +215,7 @@ pub struct LayerClearance {
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct CellClearance {
     /// One entry per layer, in program order.
-    pub layers: Vec<LayerClearance>,
+    pub layers: Vec<LayerCellClearance>,
     /// Samples (arm poses) checked.
     pub samples: usize,
     /// Pair distances computed exactly (the rest were culled).
@@ -421,7 +421,7 @@ pub(crate) enum OutlineKind {
 /// (the report's 3-D view): robot base frame, mm.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BodyOutline {
-    /// The body's name, as [`LayerClearance::closest_pair`] and
+    /// The body's name, as [`LayerCellClearance::closest_pair`] and
     /// [`ProgramError::Collision`] name it.
     pub name: String,
     /// Its solid.
@@ -1133,7 +1133,7 @@ impl<'a> Walk<'a> {
         stats.layers = self
             .per_layer
             .into_iter()
-            .map(|(layer, c)| LayerClearance {
+            .map(|(layer, c)| LayerCellClearance {
                 layer,
                 closest_approach_mm: c.distance_mm,
                 closest_pair: c.pair,

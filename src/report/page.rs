@@ -150,7 +150,7 @@ pub(super) struct BodyData {
     pub b: Option<[f64; 3]>,
 }
 
-/// A layer's closest approach (`CellClearance`'s `LayerClearance`).
+/// A layer's closest approach (`CellClearance`'s `LayerCellClearance`).
 #[derive(Serialize, Debug, Clone, PartialEq)]
 pub(crate) struct ClosestData {
     /// The layer's number (`LayerPoints::layer`).
