@@ -38,8 +38,7 @@ pub(crate) fn slice_positions(
     opts: &SliceOptions,
 ) -> Result<Path, PathError> {
     opts.validate()?;
-    let range = tube.range();
-    let length_mm = tube.arc_length(range.t_max);
+    let length_mm = tube.arc_length(tube.range().t_max);
     if opts.delta_mm >= length_mm {
         return Err(PathError::DeltaTooLarge {
             delta_mm: opts.delta_mm,
@@ -51,73 +50,190 @@ pub(crate) fn slice_positions(
     if opts.strategy == Strategy::Spiral {
         return spiral_path(tube, first, opts, length_mm);
     }
-    let vs: Vec<f64> = first.iter().map(|p| p.v).collect();
-    let t_first: Vec<f64> = first.iter().map(|p| p.t).collect();
-    let t_hi = match opts.end {
-        EndRule::WholeLayers => range.t_max,
-        EndRule::Truncate(_) | EndRule::EvaluableRange => range.eval_max(),
-    };
-    let open_layers_allowed = matches!(opts.strategy, Strategy::Planar | Strategy::Perpendicular);
-
-    // Each computed layer: per column, its t and position (computed once).
-    let mut raw: Vec<Vec<Option<(f64, Point3)>>> =
-        vec![first.iter().map(|p| Some((p.t, p.position))).collect()];
-    let mut cursor = t_first.clone();
-    // Each column's last step in t (first guess of the next root find).
-    let mut last_step: Vec<Option<f64>> = vec![None; grid];
-    let mut alive = vec![true; grid];
-    let mut report = SliceReport {
-        grid_points: grid,
-        ..SliceReport::default()
-    };
-    let z_base = first.iter().map(|p| p.position.z).fold(f64::MIN, f64::max);
-    let s_base = t_first
-        .iter()
-        .map(|&t| tube.arc_length(t))
-        .fold(f64::MAX, f64::min);
-    let mut total_points = grid;
-
+    let mut march = March::new(tube, opts, &first, grid);
     for n in 1.. {
-        if opts.max_layers.is_some_and(|m| n >= m) {
-            report.stop = StopReason::MaxLayers;
+        if let Some(stop) = march.layer(n)? {
+            march.report.stop = stop;
             break;
         }
-        let below = raw.last().expect("first layer present");
+    }
+    march.finish(length_mm)
+}
+
+/// The layer loop's state: each column's profile angle and cursor in `t`,
+/// and the layers computed so far (per column, `t` and position).
+struct March<'a> {
+    tube: &'a Tube,
+    opts: &'a SliceOptions,
+    /// Each column's profile angle `v` (rad).
+    vs: Vec<f64>,
+    /// Each column's `t` on the first layer.
+    t_first: Vec<f64>,
+    /// Highest `t` a root find may reach.
+    t_hi: f64,
+    /// Planar and perpendicular slices may leave the part: open layers.
+    open_layers_allowed: bool,
+    /// Each computed layer: per column, its t and position (computed once).
+    raw: Vec<Vec<Option<(f64, Point3)>>>,
+    /// Each column's last `t`.
+    cursor: Vec<f64>,
+    /// Each column's last step in t (first guess of the next root find).
+    last_step: Vec<Option<f64>>,
+    /// Columns that may still have points.
+    alive: Vec<bool>,
+    report: SliceReport,
+    /// Highest Z of the first layer (mm; planar slices).
+    z_base: f64,
+    /// Lowest guide arc length of the first layer (mm; perpendicular slices).
+    s_base: f64,
+    /// Columns (points a layer of the computation grid).
+    grid: usize,
+    /// Points computed so far, the grid's of every layer.
+    total_points: usize,
+}
+
+impl<'a> March<'a> {
+    /// The loop's start on the first layer `first`, of `grid` columns.
+    fn new(
+        tube: &'a Tube,
+        opts: &'a SliceOptions,
+        first: &[crate::geometry::CurvePoint],
+        grid: usize,
+    ) -> Self {
+        let range = tube.range();
+        let vs: Vec<f64> = first.iter().map(|p| p.v).collect();
+        let t_first: Vec<f64> = first.iter().map(|p| p.t).collect();
+        let t_hi = match opts.end {
+            EndRule::WholeLayers => range.t_max,
+            EndRule::Truncate(_) | EndRule::EvaluableRange => range.eval_max(),
+        };
+        let open_layers_allowed =
+            matches!(opts.strategy, Strategy::Planar | Strategy::Perpendicular);
+        let raw: Vec<Vec<Option<(f64, Point3)>>> =
+            vec![first.iter().map(|p| Some((p.t, p.position))).collect()];
+        let cursor = t_first.clone();
+        let report = SliceReport {
+            grid_points: grid,
+            ..SliceReport::default()
+        };
+        let z_base = first.iter().map(|p| p.position.z).fold(f64::MIN, f64::max);
+        let s_base = t_first
+            .iter()
+            .map(|&t| tube.arc_length(t))
+            .fold(f64::MAX, f64::min);
+        Self {
+            tube,
+            opts,
+            vs,
+            t_first,
+            t_hi,
+            open_layers_allowed,
+            raw,
+            cursor,
+            last_step: vec![None; grid],
+            alive: vec![true; grid],
+            report,
+            z_base,
+            s_base,
+            grid,
+            total_points: grid,
+        }
+    }
+
+    /// Computes layer `n` against the last one and keeps it, or says why
+    /// the generation stops.
+    fn layer(&mut self, n: usize) -> Result<Option<StopReason>, PathError> {
+        let opts = self.opts;
+        if opts.max_layers.is_some_and(|m| n >= m) {
+            return Ok(Some(StopReason::MaxLayers));
+        }
+        let below = self.raw.last().expect("first layer present");
         let (index, hints) = below_index(below);
+        let steps = self.root_finds(n, &index, &hints);
+        let (mut layer, ended) = self.collect_steps(n, steps)?;
+        if let Some(stop) = self.end_rules(n, &ended)? {
+            return Ok(Some(stop));
+        }
+        for &i in &ended {
+            self.alive[i] = false;
+        }
+        if layer.iter().all(Option::is_none) {
+            return Ok(Some(
+                if self.open_layers_allowed && opts.strategy == Strategy::Perpendicular {
+                    StopReason::ReachedEnd
+                } else {
+                    StopReason::NoMorePoints
+                },
+            ));
+        }
+        if let EndRule::Truncate(plane) = opts.end {
+            let inside = layer.iter().zip(&self.vs).any(|(t, &v)| {
+                t.is_some_and(|t| (self.tube.point(t, v) - plane.point).dot(&plane.normal) <= 0.0)
+            });
+            if !inside {
+                return Ok(Some(StopReason::PastEndPlane));
+            }
+        }
+        let positions = self.positions(n, &mut layer, &index, &hints)?;
+        self.keep(n, &layer, &positions)?;
+        Ok(None)
+    }
+
+    /// Each column's next step on layer `n`, in parallel (order kept).
+    fn root_finds(
+        &self,
+        n: usize,
+        index: &SegmentIndex,
+        hints: &[Option<SegmentId>],
+    ) -> Vec<Result<Step, RootFailure>> {
+        let (tube, opts) = (self.tube, self.opts);
         let layer_t = match opts.strategy {
-            Strategy::Perpendicular => tube.t_at_arc_length(s_base + n as f64 * opts.delta_mm),
+            Strategy::Perpendicular => tube.t_at_arc_length(self.s_base + n as f64 * opts.delta_mm),
             _ => f64::NAN,
         };
-        let z = z_base + n as f64 * opts.delta_mm;
-        let steps: Vec<Result<Step, RootFailure>> = (0..grid)
+        let z = self.z_base + n as f64 * opts.delta_mm;
+        (0..self.grid)
             .into_par_iter()
             .map(|i| {
-                if !alive[i] {
+                if !self.alive[i] {
                     return Ok(Step::End);
                 }
-                let (v, t0) = (vs[i], cursor[i]);
+                let (v, t0) = (self.vs[i], self.cursor[i]);
                 match opts.strategy {
                     Strategy::Constant => match hints[i] {
                         Some(h) => constant_distance::next_t(
                             tube,
-                            &index,
+                            index,
                             h,
                             v,
                             t0,
                             opts.delta_mm,
-                            t_hi,
-                            last_step[i],
+                            self.t_hi,
+                            self.last_step[i],
                         ),
                         None => Ok(Step::End),
                     },
-                    Strategy::Iso => iso_parametric::next_t(tube, v, t0, opts.delta_mm, t_hi),
-                    Strategy::Planar => planar_z::next_t(tube, v, t0, z, t_hi),
-                    Strategy::Perpendicular => Ok(normal_to_guide::step(layer_t, t_first[i], t_hi)),
+                    Strategy::Iso => iso_parametric::next_t(tube, v, t0, opts.delta_mm, self.t_hi),
+                    Strategy::Planar => planar_z::next_t(tube, v, t0, z, self.t_hi),
+                    Strategy::Perpendicular => {
+                        Ok(normal_to_guide::step(layer_t, self.t_first[i], self.t_hi))
+                    }
                     Strategy::Spiral => Ok(Step::End),
                 }
             })
-            .collect();
-        let mut layer = vec![None; grid];
+            .collect()
+    }
+
+    /// The steps of layer `n` as each column's `t` (`None`: no point) and
+    /// the columns that ended, counted in the report; a failed root find
+    /// names its layer and point.
+    #[allow(clippy::type_complexity)]
+    fn collect_steps(
+        &mut self,
+        n: usize,
+        steps: Vec<Result<Step, RootFailure>>,
+    ) -> Result<(Vec<Option<f64>>, Vec<usize>), PathError> {
+        let mut layer = vec![None; self.grid];
         let mut ended = Vec::new();
         for (i, s) in steps.into_iter().enumerate() {
             match s {
@@ -128,14 +244,14 @@ pub(crate) fn slice_positions(
                 }) => {
                     layer[i] = Some(t);
                     if evaluations > 0 {
-                        report.root_finds += 1;
-                        report.evaluations += evaluations;
-                        report.max_residual_mm = report.max_residual_mm.max(residual);
+                        self.report.root_finds += 1;
+                        self.report.evaluations += evaluations;
+                        self.report.max_residual_mm = self.report.max_residual_mm.max(residual);
                     }
                 }
                 Ok(Step::Skip) => {}
                 Ok(Step::End) => {
-                    if alive[i] {
+                    if self.alive[i] {
                         ended.push(i);
                     }
                 }
@@ -143,138 +259,158 @@ pub(crate) fn slice_positions(
                     return Err(PathError::NoRoot {
                         layer: n,
                         point: i,
-                        v: vs[i],
-                        t_lo: cursor[i],
-                        t_hi,
-                        delta_mm: opts.delta_mm,
+                        v: self.vs[i],
+                        t_lo: self.cursor[i],
+                        t_hi: self.t_hi,
+                        delta_mm: self.opts.delta_mm,
                         reason: failure_reason(e),
                     })
                 }
             }
         }
-        // End rules.
-        if !ended.is_empty() && !open_layers_allowed {
-            match opts.end {
-                EndRule::WholeLayers => {
-                    report.stop = StopReason::ReachedEnd;
-                    break;
-                }
-                EndRule::EvaluableRange => {
-                    report.stop = StopReason::EvaluableRange;
-                    break;
-                }
-                EndRule::Truncate(plane) => {
-                    for &i in &ended {
-                        let p = tube.point(cursor[i], vs[i]);
-                        if (p - plane.point).dot(&plane.normal) <= 0.0 {
-                            return Err(PathError::ExtensionTooShort {
-                                layer: n,
-                                point: i,
-                                t_eval_max: t_hi,
-                            });
-                        }
+        Ok((layer, ended))
+    }
+
+    /// The end rules where columns `ended` on layer `n` of a strategy whose
+    /// layers stay whole: stop at the end or the evaluable range; with an
+    /// end plane, a column must have ended beyond it.
+    fn end_rules(&self, n: usize, ended: &[usize]) -> Result<Option<StopReason>, PathError> {
+        if ended.is_empty() || self.open_layers_allowed {
+            return Ok(None);
+        }
+        match self.opts.end {
+            EndRule::WholeLayers => Ok(Some(StopReason::ReachedEnd)),
+            EndRule::EvaluableRange => Ok(Some(StopReason::EvaluableRange)),
+            EndRule::Truncate(plane) => {
+                for &i in ended {
+                    let p = self.tube.point(self.cursor[i], self.vs[i]);
+                    if (p - plane.point).dot(&plane.normal) <= 0.0 {
+                        return Err(PathError::ExtensionTooShort {
+                            layer: n,
+                            point: i,
+                            t_eval_max: self.t_hi,
+                        });
                     }
                 }
+                Ok(None)
             }
         }
-        for &i in &ended {
-            alive[i] = false;
-        }
-        if layer.iter().all(Option::is_none) {
-            report.stop = if open_layers_allowed && opts.strategy == Strategy::Perpendicular {
-                StopReason::ReachedEnd
-            } else {
-                StopReason::NoMorePoints
-            };
-            break;
-        }
-        if let EndRule::Truncate(plane) = opts.end {
-            let inside = layer.iter().zip(&vs).any(|(t, &v)| {
-                t.is_some_and(|t| (tube.point(t, v) - plane.point).dot(&plane.normal) <= 0.0)
-            });
-            if !inside {
-                report.stop = StopReason::PastEndPlane;
-                break;
-            }
-        }
-        // Positions of the new points, computed once (reused as the layer
-        // below and in the output).
+    }
+
+    /// Positions of the new points, computed once (reused as the layer
+    /// below and in the output); a whole constant-distance layer's turning
+    /// is reported and, with smoothing, bounded (its `t` updated).
+    fn positions(
+        &mut self,
+        n: usize,
+        layer: &mut [Option<f64>],
+        index: &SegmentIndex,
+        hints: &[Option<SegmentId>],
+    ) -> Result<Vec<Option<Point3>>, PathError> {
+        let (tube, opts) = (self.tube, self.opts);
         let mut positions: Vec<Option<Point3>> = layer
             .par_iter()
-            .zip(&vs)
+            .zip(&self.vs)
             .map(|(t, &v)| t.map(|t| tube.point(t, v)))
             .collect();
         if opts.strategy == Strategy::Constant && layer.iter().all(Option::is_some) {
-            let mut ts: Vec<f64> = layer.iter().map(|t| t.expect("all present")).collect();
             let pts: Vec<Point3> = positions.iter().map(|p| p.expect("all present")).collect();
             let before = super::smooth::turning_angles(&pts, true)
                 .into_iter()
                 .fold(0.0, f64::max);
-            report.max_turn_before_rad = report.max_turn_before_rad.max(before);
+            self.report.max_turn_before_rad = self.report.max_turn_before_rad.max(before);
             let mut after = before;
             if let Some(sm) = opts.smoothing {
-                let hint_list: Vec<SegmentId> = hints
-                    .iter()
-                    .map(|h| {
-                        h.unwrap_or(SegmentId {
-                            polyline: 0,
-                            segment: 0,
-                        })
-                    })
-                    .collect();
-                let out = super::smooth::smooth_layer(
-                    tube,
-                    &vs,
-                    &mut ts,
-                    true,
-                    &index,
-                    &hint_list,
-                    opts.delta_mm,
-                    &sm,
-                );
-                // Past the end plane the extension may fold (the torus curls
-                // back): only the kinks of the points that will be kept count.
-                let kept_ok = || match opts.end {
-                    EndRule::Truncate(plane) => {
-                        let angles = super::smooth::turning_angles(&pts, true);
-                        pts.iter()
-                            .zip(angles)
-                            .filter(|(p, _)| (*p - plane.point).dot(&plane.normal) <= 0.0)
-                            .all(|(_, a)| a <= sm.max_turn_rad)
-                    }
-                    _ => false,
-                };
-                if !out.met && kept_ok() {
-                    // Nothing to fix where the layer is kept.
-                } else if !out.met {
-                    return Err(PathError::SmoothingInfeasible {
-                        layer: n,
-                        bound_deg: sm.max_turn_rad.to_degrees(),
-                        tolerance_pct: 100.0 * sm.tolerance,
-                        before_deg: out.max_turn_before_rad.to_degrees(),
-                        reached_deg: out.max_turn_after_rad.to_degrees(),
-                    });
-                }
-                after = out.max_turn_after_rad;
-                for (slot, t) in layer.iter_mut().zip(&ts) {
-                    *slot = Some(*t);
-                }
+                after = self.smooth(n, &sm, layer, &pts, index, hints)?;
                 positions = layer
                     .par_iter()
-                    .zip(&vs)
+                    .zip(&self.vs)
                     .map(|(t, &v)| t.map(|t| tube.point(t, v)))
                     .collect();
             }
-            report.max_turn_after_rad = report.max_turn_after_rad.max(after);
+            self.report.max_turn_after_rad = self.report.max_turn_after_rad.max(after);
         }
+        Ok(positions)
+    }
+
+    /// Smooths the whole layer `n` (points `pts`, parameters `layer`,
+    /// updated) against the layer below (SPEC §3.4); returns its largest
+    /// turning after (rad).
+    fn smooth(
+        &self,
+        n: usize,
+        sm: &super::smooth::Smoothing,
+        layer: &mut [Option<f64>],
+        pts: &[Point3],
+        index: &SegmentIndex,
+        hints: &[Option<SegmentId>],
+    ) -> Result<f64, PathError> {
+        let opts = self.opts;
+        let mut ts: Vec<f64> = layer.iter().map(|t| t.expect("all present")).collect();
+        let hint_list: Vec<SegmentId> = hints
+            .iter()
+            .map(|h| {
+                h.unwrap_or(SegmentId {
+                    polyline: 0,
+                    segment: 0,
+                })
+            })
+            .collect();
+        let out = super::smooth::smooth_layer(
+            self.tube,
+            &self.vs,
+            &mut ts,
+            true,
+            index,
+            &hint_list,
+            opts.delta_mm,
+            sm,
+        );
+        // Past the end plane the extension may fold (the torus curls
+        // back): only the kinks of the points that will be kept count.
+        let kept_ok = || match opts.end {
+            EndRule::Truncate(plane) => {
+                let angles = super::smooth::turning_angles(pts, true);
+                pts.iter()
+                    .zip(angles)
+                    .filter(|(p, _)| (*p - plane.point).dot(&plane.normal) <= 0.0)
+                    .all(|(_, a)| a <= sm.max_turn_rad)
+            }
+            _ => false,
+        };
+        if !out.met && kept_ok() {
+            // Nothing to fix where the layer is kept.
+        } else if !out.met {
+            return Err(PathError::SmoothingInfeasible {
+                layer: n,
+                bound_deg: sm.max_turn_rad.to_degrees(),
+                tolerance_pct: 100.0 * sm.tolerance,
+                before_deg: out.max_turn_before_rad.to_degrees(),
+                reached_deg: out.max_turn_after_rad.to_degrees(),
+            });
+        }
+        for (slot, t) in layer.iter_mut().zip(&ts) {
+            *slot = Some(*t);
+        }
+        Ok(out.max_turn_after_rad)
+    }
+
+    /// Keeps layer `n` (each column's `t` and position): the columns'
+    /// cursors move on, and the path's point count is checked.
+    fn keep(
+        &mut self,
+        n: usize,
+        layer: &[Option<f64>],
+        positions: &[Option<Point3>],
+    ) -> Result<(), PathError> {
         for (i, t) in layer.iter().enumerate() {
             if let Some(t) = t {
-                last_step[i] = Some(*t - cursor[i]);
-                cursor[i] = *t;
+                self.last_step[i] = Some(*t - self.cursor[i]);
+                self.cursor[i] = *t;
             }
         }
-        total_points += grid;
-        if total_points > MAX_POINTS_PER_PATH {
+        self.total_points += self.grid;
+        if self.total_points > MAX_POINTS_PER_PATH {
             return Err(PathError::TooManyPoints {
                 limit: MAX_POINTS_PER_PATH,
                 layer: n,
@@ -282,26 +418,34 @@ pub(crate) fn slice_positions(
         }
         let with_positions: Vec<Option<(f64, Point3)>> = layer
             .iter()
-            .zip(&positions)
+            .zip(positions)
             .map(|(t, p)| t.zip(*p))
             .collect();
-        raw.push(with_positions);
+        self.raw.push(with_positions);
+        Ok(())
     }
-    if raw.len() < 2 {
-        return Err(PathError::DeltaTooLarge {
+
+    /// The path from the layers computed (at least two, else `Delta` is
+    /// larger than the part, of guide length `length_mm`).
+    fn finish(self, length_mm: f64) -> Result<Path, PathError> {
+        let opts = self.opts;
+        if self.raw.len() < 2 {
+            return Err(PathError::DeltaTooLarge {
+                delta_mm: opts.delta_mm,
+                length_mm,
+            });
+        }
+        let mut report = self.report;
+        let mut layers = assemble(&self.vs, self.raw, opts, &mut report);
+        align_seams(&mut layers, opts);
+        Ok(Path {
+            strategy: opts.strategy,
             delta_mm: opts.delta_mm,
-            length_mm,
-        });
+            layers,
+            report,
+            spiral: None,
+        })
     }
-    let mut layers = assemble(&vs, raw, opts, &mut report);
-    align_seams(&mut layers, opts);
-    Ok(Path {
-        strategy: opts.strategy,
-        delta_mm: opts.delta_mm,
-        layers,
-        report,
-        spiral: None,
-    })
 }
 
 fn failure_reason(e: RootFailure) -> &'static str {
