@@ -122,6 +122,13 @@ pub struct GridArgs {
     /// Refuse a run estimated at more computed points than this (default 5000000).
     #[arg(long, value_name = "N")]
     pub max_points: Option<u64>,
+    /// A layer's vertex turning more than DEG degrees is a corner (default: the part file's, 10).
+    #[arg(long, value_name = "DEG")]
+    pub corner_threshold: Option<f64>,
+    /// Keep the aligned, staggered seams on layers with corners instead of starting them at
+    /// their sharpest corner.
+    #[arg(long)]
+    pub no_corner_seams: bool,
 }
 
 impl GridArgs {
@@ -136,6 +143,12 @@ impl GridArgs {
             o.discretisation = Some(Discretisation::ChordError(e));
         }
         o.max_points = self.max_points.or(o.max_points);
+        if let Some(d) = self.corner_threshold {
+            o.corner_threshold_rad = Some(d.to_radians());
+        }
+        if self.no_corner_seams {
+            o.seams_on_corners = Some(false);
+        }
     }
 }
 

@@ -86,6 +86,8 @@ impl TubeFit {
                     points: Some(400),
                     chord_mm: None,
                     max_spacing_mm: None,
+                    corner_threshold_deg: None,
+                    seams_on_corners: None,
                 },
                 Some(ToolAxisSpec {
                     max_axis_rate_deg_per_mm: Some(Scalar::Number(10.0)),

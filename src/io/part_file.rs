@@ -268,6 +268,15 @@ pub struct SlicingSpec {
     pub chord_mm: Option<f64>,
     /// Max point spacing (mm).
     pub max_spacing_mm: Option<f64>,
+    /// A vertex of a layer turning more than this is a corner (deg, in
+    /// (0, 180); default 10), where it also turns more than 4 times the
+    /// layer's median turning (SPEC §3.4).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corner_threshold_deg: Option<Scalar>,
+    /// Start and end each closed layer that has corners at its sharpest one
+    /// (default `true`; SPEC §3.3).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seams_on_corners: Option<bool>,
 }
 
 /// How the torch axis is set, as written (`[tool_axis]`, degrees; SPEC §4).
@@ -373,6 +382,10 @@ pub struct Slicing {
     pub delta_mm: f64,
     /// Discretisation of each layer.
     pub discretisation: Discretisation,
+    /// Corner threshold (rad, in (0, π)).
+    pub corner_threshold_rad: f64,
+    /// Closed layers with corners start and end at their sharpest one.
+    pub seams_on_corners: bool,
 }
 
 /// A validated part.
@@ -405,11 +418,13 @@ pub struct Part {
 
 impl Part {
     /// The part's default slicing options: its strategy, `Delta` and
-    /// discretisation; truncation by its end plane when it has one, else whole
-    /// layers; seams aligned.
+    /// discretisation and corners; truncation by its end plane when it has
+    /// one, else whole layers; seams aligned.
     pub fn slice_options(&self) -> SliceOptions {
         let mut o = SliceOptions::new(self.slicing.strategy, self.slicing.delta_mm);
         o.discretisation = self.slicing.discretisation;
+        o.corner_threshold_rad = self.slicing.corner_threshold_rad;
+        o.seams_on_corners = self.slicing.seams_on_corners;
         o.end = match self.end_plane {
             Some(p) => EndRule::Truncate(p),
             None => EndRule::WholeLayers,
@@ -839,10 +854,23 @@ impl Ctx<'_> {
                 ));
             }
         };
+        let corner_threshold_rad = match &s.corner_threshold_deg {
+            Some(v) => {
+                let field = "slicing.corner_threshold_deg";
+                let d = self.positive(field, v)?;
+                if d >= 180.0 {
+                    return Err(self.field(field, &format!("must be below 180 degrees, got {d}")));
+                }
+                d.to_radians()
+            }
+            None => crate::path::SEAM_CORNER_RAD,
+        };
         Ok(Slicing {
             strategy: s.strategy,
             delta_mm: s.delta_mm,
             discretisation,
+            corner_threshold_rad,
+            seams_on_corners: s.seams_on_corners.unwrap_or(true),
         })
     }
 

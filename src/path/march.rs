@@ -699,14 +699,29 @@ fn decimate(points: Vec<PathPoint>, closed: bool, d: Discretisation) -> Vec<Path
         .collect()
 }
 
-/// Rotates closed layers so each starts next to the end of the layer below,
-/// then by the stagger angle.
+/// Rotates closed layers so each starts on its sharpest corner where it has
+/// corners and `seams_on_corners` is set (SPEC §3.3, §3.4); the others but
+/// the first so each starts next to the end of the layer below, then by the
+/// stagger angle.
 fn align_seams(layers: &mut [Layer], opts: &SliceOptions) {
-    for k in 1..layers.len() {
+    for k in 0..layers.len() {
         if !layers[k].closed {
             continue;
         }
         let n = layers[k].points.len();
+        if opts.seams_on_corners {
+            let positions: Vec<Point3> = layers[k].points.iter().map(|p| p.position).collect();
+            if let Some(start) =
+                super::corners::corner_seam_start(&positions, opts.corner_threshold_rad)
+            {
+                layers[k].points.rotate_left(start);
+                continue;
+            }
+        }
+        if k == 0 {
+            // the first layer keeps the substrate's start
+            continue;
+        }
         let mut start = 0;
         if opts.align_seams {
             let end = layers[k - 1]

@@ -7,6 +7,7 @@
 //! layer below [thesis §2.3, eq. 2.20–2.27]. Also the distance map (SPEC §3.2),
 //! truncation by an end plane (§3.5) and seams (§3.3).
 
+pub mod corners;
 pub mod distance_map;
 mod estimate;
 pub mod index;
@@ -14,6 +15,7 @@ mod march;
 pub mod smooth;
 pub mod strategy;
 
+pub use corners::Corner;
 pub use distance_map::{distance_map, spiral_distance_map, DistanceMap, DistanceStats};
 pub use estimate::{estimate_work, WorkEstimate, BYTES_PER_POINT};
 pub use march::slice;
@@ -94,8 +96,19 @@ pub struct SliceOptions {
     /// Rotate each closed layer so it starts at the point closest to the end
     /// of the layer below (SPEC §3.3).
     pub align_seams: bool,
-    /// Extra rotation of the start of layer `k` by `k × stagger` (rad of `v`).
+    /// Extra rotation of the start of layer `k` by `k × stagger` (rad of `v`);
+    /// not applied to a layer whose seam is put on a corner.
     pub stagger_rad: f64,
+    /// A vertex of a layer turning more than this is a corner (rad, in
+    /// (0, π)), where it also turns more than [`SEAM_CORNER_OVER_MEDIAN`]
+    /// times the layer's median turning ([`Layer::corners`]). Default
+    /// [`SEAM_CORNER_RAD`].
+    pub corner_threshold_rad: f64,
+    /// Start and end each closed layer that has corners at its sharpest one
+    /// ([`corners::corner_seam_start`]), so that the bead turns no corner at
+    /// its ends; layers without corners keep `align_seams` and the stagger.
+    /// Default on.
+    pub seams_on_corners: bool,
     /// Spiral only: profile angle `v` where the spiral starts (rad).
     pub spiral_start_rad: f64,
     /// Spiral only: travel toward decreasing `v` instead of increasing.
@@ -107,7 +120,8 @@ pub struct SliceOptions {
 
 impl SliceOptions {
     /// Options with the given strategy and `Delta`, 500 points per layer,
-    /// whole layers, seams aligned.
+    /// whole layers, seams aligned, and on the sharpest corner of a layer
+    /// that has corners above [`SEAM_CORNER_RAD`].
     pub fn new(strategy: Strategy, delta_mm: f64) -> Self {
         Self {
             strategy,
@@ -117,6 +131,8 @@ impl SliceOptions {
             max_layers: None,
             align_seams: true,
             stagger_rad: 0.0,
+            corner_threshold_rad: SEAM_CORNER_RAD,
+            seams_on_corners: true,
             spiral_start_rad: 0.0,
             spiral_reverse: false,
             smoothing: None,
@@ -174,6 +190,13 @@ impl SliceOptions {
         if !self.stagger_rad.is_finite() {
             return bad("stagger", "must be finite".into());
         }
+        let c = self.corner_threshold_rad;
+        if !(c > 0.0 && c < std::f64::consts::PI) {
+            return bad(
+                "corner_threshold",
+                format!("must be in (0, 180) deg, got {} deg", c.to_degrees()),
+            );
+        }
         if self.max_layers == Some(0) {
             return bad("max_layers", "must be at least 1".into());
         }
@@ -219,9 +242,10 @@ pub struct Layer {
 
 /// A seam of a closed layer turning more than this is a corner (rad, 10°),
 /// where it also turns more than [`SEAM_CORNER_OVER_MEDIAN`] times the
-/// layer's median turning. The sample parts' smooth seams turn 0.1–1° at
-/// 400 points a layer; the corners constant-distance layers grow (SPEC
-/// §3.4), onto which the aligned seams of §3.3 settle, turn 10–113°.
+/// layer's median turning; also the default corner threshold of
+/// [`SliceOptions::corner_threshold_rad`]. The sample parts' smooth seams
+/// turn 0.1–1° at 400 points a layer; the corners constant-distance layers
+/// grow (SPEC §3.4), onto which the seams are put (§3.3), turn 10–113°.
 pub const SEAM_CORNER_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
 
 /// A corner seam turns more than this many times the layer's median turning
@@ -247,18 +271,8 @@ impl Layer {
         let positions: Vec<Point3> = self.points.iter().map(|p| p.position).collect();
         let turns = smooth::turning_angles(&positions, true);
         let n = turns.len();
-        turns[0].max(turns[n - 1]) <= corner_turn_rad(&turns)
+        turns[0].max(turns[n - 1]) <= corners::corner_bar_rad(&turns, SEAM_CORNER_RAD)
     }
-}
-
-/// The turning angle above which a vertex of a closed layer is a corner
-/// (rad), from the layer's turning angles `turns`: [`SEAM_CORNER_RAD`], or
-/// [`SEAM_CORNER_OVER_MEDIAN`] times their median where more.
-pub(crate) fn corner_turn_rad(turns: &[f64]) -> f64 {
-    let mut sorted = turns.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
-    SEAM_CORNER_RAD.max(SEAM_CORNER_OVER_MEDIAN * median)
 }
 
 /// Why the generation stopped (`summary.json`: its snake_case name).

@@ -29,6 +29,12 @@ pub struct SliceOverrides {
     /// Rotate the start of layer `k` by `k × stagger` (rad of `v`); setting it
     /// turns seam alignment off.
     pub stagger_rad: Option<f64>,
+    /// A vertex of a layer turning more than this is a corner (rad, in
+    /// (0, π)).
+    pub corner_threshold_rad: Option<f64>,
+    /// Whether closed layers with corners start and end at their sharpest
+    /// one (`Some(false)` keeps the aligned and staggered seams everywhere).
+    pub seams_on_corners: Option<bool>,
     /// Spiral only: profile angle where the spiral starts (rad).
     pub spiral_start_rad: Option<f64>,
     /// Spiral only: travel toward decreasing profile angle.
@@ -120,6 +126,12 @@ impl SliceOverrides {
         if let Some(s) = self.stagger_rad {
             o.stagger_rad = s;
             o.align_seams = false;
+        }
+        if let Some(c) = self.corner_threshold_rad {
+            o.corner_threshold_rad = c;
+        }
+        if let Some(on) = self.seams_on_corners {
+            o.seams_on_corners = on;
         }
         if let Some(s) = self.spiral_start_rad {
             o.spiral_start_rad = s;

@@ -8,7 +8,8 @@ use serde::ser::{SerializeMap, SerializeStruct};
 use serde::Serialize;
 
 use super::summary::{
-    DistanceSummary, PathSummary, ProcessSummary, SliceSummary, SlicerSummary, ToolAxesSummary,
+    CornerSummary, CornersSummary, DistanceSummary, PathSummary, ProcessSummary, SliceSummary,
+    SlicerSummary, ToolAxesSummary,
 };
 use super::{Control, Part, SliceOverrides};
 use crate::path::{distance_map, DistanceMap, Path, SliceOptions};
@@ -141,8 +142,8 @@ pub fn slice_part_with(
 impl SlicedPart {
     /// What `slice` and `plan` report of the path (the shared part of
     /// `summary.json`): strategy, Delta, layers, slices, points, arc starts,
-    /// bead length (mm), process estimates, tool-axis report and the local
-    /// interlayer distances overall and per layer.
+    /// bead length (mm), process estimates, tool-axis report, the local
+    /// interlayer distances overall and per layer, and the layers' corners.
     pub fn path_summary(&self) -> PathSummary {
         let (path, map, params, axes) = (&self.path, &self.map, &self.process, &self.axes);
         let est = self.process_plan.estimates;
@@ -175,6 +176,33 @@ impl SlicedPart {
                 overall: map.overall,
                 per_layer: map.per_layer.clone(),
             },
+            corners: self.corners_summary(),
+        }
+    }
+
+    /// The layers' corners above the options' threshold, per layer, with
+    /// the build direction's jump across each (`summary.json`'s `corners`).
+    pub fn corners_summary(&self) -> CornersSummary {
+        let threshold = self.options.corner_threshold_rad;
+        let per_layer: Vec<Vec<CornerSummary>> = self
+            .path
+            .layers
+            .iter()
+            .zip(&self.axes.frames)
+            .map(|(layer, frames)| {
+                layer
+                    .corners(threshold)
+                    .iter()
+                    .map(|c| CornerSummary::of(layer, frames, c))
+                    .collect()
+            })
+            .collect();
+        CornersSummary {
+            threshold_deg: threshold.to_degrees(),
+            seams_on_corners: self.options.seams_on_corners,
+            layers_with_corners: per_layer.iter().filter(|c| !c.is_empty()).count(),
+            count: per_layer.iter().map(Vec::len).sum(),
+            per_layer,
         }
     }
 

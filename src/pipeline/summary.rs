@@ -37,6 +37,70 @@ pub struct PathSummary {
     /// The local interlayer distance, overall and per layer (mm; `null` on
     /// the first slice).
     pub distance: DistanceSummary,
+    /// The layers' corners (SPEC §3.4, §9).
+    pub corners: CornersSummary,
+}
+
+/// The layers' corners: where a layer's polyline turns more than the
+/// threshold ([`Layer::corners`](crate::path::Layer::corners)).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CornersSummary {
+    /// A vertex turning more than this (deg), and more than 4 times its
+    /// layer's median turning, is a corner.
+    pub threshold_deg: f64,
+    /// Closed layers with corners start and end at their sharpest one.
+    pub seams_on_corners: bool,
+    /// Layers with at least one corner.
+    pub layers_with_corners: usize,
+    /// Corners in all.
+    pub count: usize,
+    /// Per layer, in path order, its corners (empty: none).
+    pub per_layer: Vec<Vec<CornerSummary>>,
+}
+
+/// One corner of a layer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CornerSummary {
+    /// The point where the layer turns most within the corner.
+    pub point: usize,
+    /// The corner's first and last vertices, in deposition order (equal for
+    /// a one-vertex corner; the first above the last where the corner
+    /// wraps round a closed layer's seam).
+    pub vertices: [usize; 2],
+    /// Turning angle of the polyline across the corner (deg).
+    pub turning_deg: f64,
+    /// Angle between the build directions `b` at the points either side of
+    /// the corner (deg): how far the part must turn under the torch across it.
+    pub build_jump_deg: f64,
+    /// The layer's seam (its last point and its first) lies on the corner.
+    pub on_seam: bool,
+}
+
+impl CornerSummary {
+    /// The summary of `corner` of `layer`, whose frames are `frames` (one
+    /// per point, part frame).
+    pub fn of(
+        layer: &crate::path::Layer,
+        frames: &[crate::toolaxis::LocalFrame],
+        corner: &crate::path::Corner,
+    ) -> Self {
+        let n = layer.points.len();
+        let (before, after) = if layer.closed {
+            ((corner.first + n - 1) % n, (corner.last + 1) % n)
+        } else {
+            (corner.first.saturating_sub(1), (corner.last + 1).min(n - 1))
+        };
+        Self {
+            point: corner.point,
+            vertices: [corner.first, corner.last],
+            turning_deg: corner.turn_rad.to_degrees(),
+            build_jump_deg: frames[before]
+                .build
+                .angle(&frames[after].build)
+                .to_degrees(),
+            on_seam: layer.closed && corner.on_seam(n),
+        }
+    }
 }
 
 /// Process parameters and the build's estimates.

@@ -4,6 +4,7 @@
 mod common;
 
 mod cli;
+mod corners;
 mod discretisation;
 mod smoothing;
 mod spiral;
