@@ -274,7 +274,8 @@ pub struct SlicingSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub corner_threshold_deg: Option<Scalar>,
     /// Start and end each closed layer that has corners at its sharpest one
-    /// (default `true`; SPEC §3.3).
+    /// (SPEC §3.3). Default: on in a torch-carried cell and when slicing
+    /// alone, off in a part-carried cell ([`SliceOverrides::for_cell`](crate::SliceOverrides::for_cell)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seams_on_corners: Option<bool>,
 }
@@ -384,8 +385,9 @@ pub struct Slicing {
     pub discretisation: Discretisation,
     /// Corner threshold (rad, in (0, π)).
     pub corner_threshold_rad: f64,
-    /// Closed layers with corners start and end at their sharpest one.
-    pub seams_on_corners: bool,
+    /// Closed layers with corners start and end at their sharpest one
+    /// (`None`: as the cell has it, [`SliceOverrides::for_cell`](crate::SliceOverrides::for_cell)).
+    pub seams_on_corners: Option<bool>,
 }
 
 /// A validated part.
@@ -418,13 +420,14 @@ pub struct Part {
 
 impl Part {
     /// The part's default slicing options: its strategy, `Delta` and
-    /// discretisation and corners; truncation by its end plane when it has
-    /// one, else whole layers; seams aligned.
+    /// discretisation and corners (seams on corners unless the file says
+    /// otherwise); truncation by its end plane when it has one, else whole
+    /// layers; seams aligned.
     pub fn slice_options(&self) -> SliceOptions {
         let mut o = SliceOptions::new(self.slicing.strategy, self.slicing.delta_mm);
         o.discretisation = self.slicing.discretisation;
         o.corner_threshold_rad = self.slicing.corner_threshold_rad;
-        o.seams_on_corners = self.slicing.seams_on_corners;
+        o.seams_on_corners = self.slicing.seams_on_corners.unwrap_or(true);
         o.end = match self.end_plane {
             Some(p) => EndRule::Truncate(p),
             None => EndRule::WholeLayers,
@@ -870,7 +873,7 @@ impl Ctx<'_> {
             delta_mm: s.delta_mm,
             discretisation,
             corner_threshold_rad,
-            seams_on_corners: s.seams_on_corners.unwrap_or(true),
+            seams_on_corners: s.seams_on_corners,
         })
     }
 

@@ -141,6 +141,27 @@ impl SliceOverrides {
         o
     }
 
+    /// These overrides for a plan of `part` in `cell`: where neither they
+    /// nor the part file say whether seams go on corners, on in a
+    /// torch-carried cell and off in a part-carried one. The torch-carried
+    /// cell's positioner keeps `b` within the cone of the vertical, which
+    /// no positioner speed does across a corner inside a bead (SPEC §9); in
+    /// the part-carried cell the arm turns the part through a corner within
+    /// the tool axis's rate bound, and moving the seams there cost the
+    /// S-bend its placement in the ROBOWAM part-carried cell (issue 19's
+    /// done-when test: no placement with seams on corners, as after commit
+    /// 72338a1's smaller move).
+    pub fn for_cell(&self, part: &super::Part, cell: &super::Cell) -> SliceOverrides {
+        let mut o = self.clone();
+        if o.seams_on_corners.is_none() && part.slicing.seams_on_corners.is_none() {
+            o.seams_on_corners = Some(matches!(
+                cell.layout,
+                crate::robot::CellLayout::TorchCarried(_)
+            ));
+        }
+        o
+    }
+
     /// `base` (a part's process parameters) with the process and travel-speed
     /// overrides applied (not yet validated).
     pub fn apply_process(&self, base: &ProcessParameters) -> ProcessParameters {

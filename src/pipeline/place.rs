@@ -134,7 +134,7 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
         }
     };
     let bounds = placement_bounds(cell, half)?;
-    let sliced = slice_part_with(part, &req.slice, &Default::default())?;
+    let sliced = slice_part_with(part, &req.slice.for_cell(part, cell), &Default::default())?;
     let layers = layer_points(&sliced.path, &sliced.axes.frames);
     let optimise = OptimiseOptions {
         travel_speed_mm_s: sliced.process.travel_speed_mm_s,

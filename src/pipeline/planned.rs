@@ -138,7 +138,11 @@ pub fn plan_part_with(
     check_vendor(&cell.layout, format, format.emitter())?;
     let t = Instant::now();
     // Slicing is the first tenth of a plan's progress.
-    let sliced = slice_part_with(part, &opts.slice, &control.within(0.0, 0.1))?;
+    let sliced = slice_part_with(
+        part,
+        &opts.slice.for_cell(part, cell),
+        &control.within(0.0, 0.1),
+    )?;
     let t_slice = t.elapsed().as_secs_f64() - sliced.times.tool_axes;
     // Reach up front, with this part's own extent (the cell reader allowed
     // a generic 1 m part): a point out of reach fails before optimising.

@@ -71,7 +71,7 @@ pub fn replan_part_with(
     let format = opts.format.unwrap_or_else(|| cell.native_format());
     check_vendor(&cell.layout, format.vendor(), format.emitter())?;
     replan.validate()?;
-    let sliced = slice_part_with(part, &opts.slice, &Control::default())?;
+    let sliced = slice_part_with(part, &opts.slice.for_cell(part, cell), &Control::default())?;
     let radius = sliced
         .path
         .layers

@@ -454,7 +454,10 @@ fn a_law_whose_degrees_gain_nothing_stops_raising() {
 }
 
 /// Layer `n` of a sample part at its own grid, a sample cell and the
-/// options its plan uses.
+/// options its plan uses. The seams are those before seams went on corners
+/// (`seams_on_corners` off): these tests show the positioner's laws on
+/// layers whose corner lies inside the bead, where no smooth law keeps `b`
+/// in the cone (with the seams on their corners those layers plan outright).
 fn sample_layer(
     part_file: &str,
     cell_file: &str,
@@ -466,7 +469,12 @@ fn sample_layer(
 ) {
     use waam_slicer::optimise::{layer_points, OptimiseOptions};
     let part = Part::read(part_path(part_file)).unwrap();
-    let sliced = waam_slicer::slice_part(&part).unwrap();
+    let today = SliceOverrides {
+        seams_on_corners: Some(false),
+        ..SliceOverrides::default()
+    };
+    let sliced =
+        waam_slicer::slice_part_with(&part, &today, &waam_slicer::Control::default()).unwrap();
     let layer = layer_points(&sliced.path, &sliced.axes.frames).swap_remove(n);
     let cell = Cell::read(part_path(&format!("cells/{cell_file}"))).unwrap();
     let opts = OptimiseOptions {

@@ -45,6 +45,8 @@ fn plan_program(part: &str, cell: &CellLayout, layers_max: usize) -> Result<Prog
     let p = load_part(part);
     let mut so = p.slice_options();
     so.delta_mm = 5.0;
+    // seams on corners as `plan_part` has them: in torch-carried cells only
+    so.seams_on_corners = matches!(cell, CellLayout::TorchCarried(_));
     let path = slice(&p.tube, &p.substrate, &so).map_err(|e| e.to_string())?;
     let frames = local_frames(&path, &p.tube);
     let mut layers = layer_points(&path, &frames);
@@ -175,18 +177,26 @@ fn the_validator_accepts_our_programs_for_every_feasible_part_and_cell() {
         // the parts of revolution only since the cell file gives the
         // positioner speeds (90°/s tilt, 180°/s turn; unlimited before, when
         // the table followed b as fast as it turned): quarter torus (layer
-        // 10) and torus on cylinder (layer 4) J4 speed, elbow (layer 19) the
-        // cone by 0.4°, helix (layer 1) J4 speed; general tube: J6 speed
-        // at layer 4
+        // 10) and torus on cylinder (layer 4) J4 speed; the elbow (layer 19,
+        // the cone by 0.4°), the helix (layer 1, J4 speed) and the general
+        // tube (layer 4, J6 speed) plan since the seams went on corners
         (
             tc,
-            &["hemisphere.toml", "nozzle.toml", "half-catenoid.toml"][..],
+            &[
+                "hemisphere.toml",
+                "nozzle.toml",
+                "half-catenoid.toml",
+                "elbow.toml",
+                "general-tube.toml",
+                "helix.toml",
+            ][..],
         ),
         (
             "kuka_kr16_2_torch_carried.toml",
             // the quarter torus and the general tube plan since the
             // positioner's laws (before them its turn J8 passed 180°/s at the
-            // pole of b); helix: J4 speed at layer 1
+            // pole of b); the helix (J4 speed at layer 1 before) since the
+            // seams went on corners
             &[
                 "hemisphere.toml",
                 "nozzle.toml",
@@ -195,14 +205,15 @@ fn the_validator_accepts_our_programs_for_every_feasible_part_and_cell() {
                 "general-tube.toml",
                 "torus-on-cylinder.toml",
                 "elbow.toml",
+                "helix.toml",
             ][..],
         ),
         ("kuka_kr16_2_part_carried.toml", &SAMPLE_PARTS[..7]),
         ("abb_irb2600_part_carried.toml", &SAMPLE_PARTS[..7]),
         (
             "abb_irb2600_torch_carried.toml",
-            // as the KUKA torch-carried cell (same positioner); helix: J6
-            // speed at layer 1
+            // as the KUKA torch-carried cell (same positioner); the helix
+            // (J6 speed at layer 1 before) since the seams went on corners
             &[
                 "hemisphere.toml",
                 "nozzle.toml",
@@ -211,6 +222,7 @@ fn the_validator_accepts_our_programs_for_every_feasible_part_and_cell() {
                 "general-tube.toml",
                 "torus-on-cylinder.toml",
                 "elbow.toml",
+                "helix.toml",
             ][..],
         ),
     ] {
