@@ -11,6 +11,11 @@
 //! later stages take unchanged; the front door is
 //! [`Part::from_mesh`](crate::Part::from_mesh).
 //!
+//! A mesh in another unit ([`FitOptions::units`]: cm, m, in) is converted
+//! to mm first, and repaired ([`repair`]: duplicated seam vertices welded,
+//! zero-area triangles dropped, separate pieces under 1 % of the area left
+//! out and named in the report); winding and normals are never read.
+//!
 //! The pieces (STYLE §10): the problem of one section — a least-squares
 //! circle in the plane normal to the guide ([`section`]); the smoothing fit of
 //! the guide and radius law by a natural cubic spline ([`smooth`]); the options
@@ -27,7 +32,7 @@ mod mesh;
 mod options;
 mod outcome;
 mod output;
-mod repair;
+pub mod repair;
 mod report;
 pub mod section;
 pub mod smooth;
