@@ -316,7 +316,6 @@ fn drawn_points(input: &ReportInput, k: usize) -> Drawn {
         }
     }
     layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
-    layer_start.push(u32::try_from(pos.len() / 3).unwrap_or(u32::MAX));
     v.torch_carried = torch_carried.is_some();
     Drawn {
         layer_start,

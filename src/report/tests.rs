@@ -189,6 +189,18 @@ fn report_is_self_contained_and_fills_every_slot() {
     assert!(html.contains("\"plan\":null"));
 }
 
+/// `layer_start` holds each layer's first drawn point, then the total: one
+/// entry more than the layers, no more (the viewer reads it by layer).
+#[test]
+fn layer_start_holds_each_layers_first_point_then_the_total() {
+    let (path, frames, map) = cylinder(6, 40, 20.0, 2.0);
+    let input = ReportInput::new("cyl", &path, &frames, &map, 3.0);
+    let data: serde_json::Value = serde_json::from_str(&report_data(&input).unwrap()).unwrap();
+    let starts: Vec<u32> = [0, 40, 80, 120, 160, 200, 240].to_vec();
+    let bytes: Vec<u8> = starts.iter().flat_map(|v| v.to_le_bytes()).collect();
+    assert_eq!(data["layer_start"].as_str().unwrap(), base64(&bytes));
+}
+
 #[test]
 fn mismatched_inputs_name_the_input_and_layer() {
     let (path, mut frames, map) = cylinder(4, 10, 20.0, 2.0);
