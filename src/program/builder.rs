@@ -6,7 +6,7 @@
 
 use crate::math::Point3;
 use crate::program::{
-    check_name, contract, joints_move, moves, split, transit, ArcFlag, BeadSetup, HomePosition,
+    check_name, joints_move, moves, pose, split, transit, ArcFlag, BeadSetup, HomePosition,
     Program, ProgramError, ProgramOptions, ProgramPoint, TravelSpeed,
 };
 use crate::robot::cell::CellPoint;
@@ -285,7 +285,7 @@ fn unwind_turns(
     let CellLayout::TorchCarried(c) = cell else {
         return Ok(());
     };
-    let stroke = contract::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
+    let stroke = pose::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
     let mut at = home.and_then(|h| h.positioner).map_or(0.0, |q| q[1]);
     for b in blocks(points) {
         let turns: Vec<f64> = points[b.first..=b.last]
@@ -334,7 +334,7 @@ fn check_home(cell: &CellLayout, h: &HomePosition) -> Result<(), ProgramError> {
         return Err(bad(format!("J{} = {:.3}°", j + 1, v.to_degrees())));
     }
     if let (CellLayout::TorchCarried(c), Some(qp)) = (cell, h.positioner) {
-        let turn = contract::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
+        let turn = pose::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
         let stroke = [c.positioner.limits[0], turn];
         for (i, (l, v)) in stroke.iter().zip(qp).enumerate() {
             if !l.contains(v) {

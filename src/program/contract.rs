@@ -298,29 +298,6 @@ pub fn validate_build<C: Controller>(
     Ok(report)
 }
 
-/// The stroke of `cell`'s positioner turn on its robot's controller
-/// ([`TorchCarriedCell::turn_stroke`](crate::robot::cell::TorchCarriedCell::turn_stroke));
-/// `None` without a positioner.
-pub fn turn_stroke(cell: &CellLayout) -> Option<crate::robot::JointLimit> {
-    match cell {
-        CellLayout::TorchCarried(c) => Some(c.turn_stroke()),
-        CellLayout::PartCarried(_) => None,
-    }
-}
-
-/// `true` when `cell`'s robot controller turns endless axes modulo 360°
-/// ([`Vendor::turns_endless_axes_modulo`]) and its positioner's turn is
-/// endless without a stated stroke: the turn is then written modulo 360°.
-pub fn turn_modulo(cell: &CellLayout) -> bool {
-    match cell {
-        CellLayout::TorchCarried(c) => {
-            c.robot.vendor.turns_endless_axes_modulo()
-                && c.positioner.turn_stroke(true) == crate::robot::JointLimit::UNLIMITED
-        }
-        CellLayout::PartCarried(_) => false,
-    }
-}
-
 /// Reads the text of `path` as an [`EmittedFile`] named by its file name.
 ///
 /// # Errors

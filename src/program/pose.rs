@@ -5,7 +5,9 @@
 //! orientation in the frame the move is programmed in, extra axes in rad),
 //! in which frame ([`moves_in_part_frame`]), how it interpolates a linear
 //! or circular move ([`interpolate`], [`arc_length`]) and the arm's pose
-//! for a controller pose and back ([`controller_pose_at`], [`flange_of`]).
+//! for a controller pose and back ([`controller_pose_at`], [`flange_of`]),
+//! and the stroke the controller gives the positioner's turn
+//! ([`turn_stroke`], [`turn_modulo`]).
 //! A leaf: it imports no other module of the program stage but the
 //! options and the frames.
 
@@ -227,5 +229,28 @@ pub fn moves_in_part_frame(cell: &CellLayout, opts: &ProgramOptions) -> bool {
         CellLayout::PartCarried(_) => {
             opts.remote_tcp || cell.robot().vendor.moves_about_fixed_tool()
         }
+    }
+}
+
+/// The stroke of `cell`'s positioner turn on its robot's controller
+/// ([`TorchCarriedCell::turn_stroke`](crate::robot::cell::TorchCarriedCell::turn_stroke));
+/// `None` without a positioner.
+pub fn turn_stroke(cell: &CellLayout) -> Option<crate::robot::JointLimit> {
+    match cell {
+        CellLayout::TorchCarried(c) => Some(c.turn_stroke()),
+        CellLayout::PartCarried(_) => None,
+    }
+}
+
+/// `true` when `cell`'s robot controller turns endless axes modulo 360°
+/// ([`Vendor::turns_endless_axes_modulo`](crate::robot::Vendor::turns_endless_axes_modulo)) and its positioner's turn is
+/// endless without a stated stroke: the turn is then written modulo 360°.
+pub fn turn_modulo(cell: &CellLayout) -> bool {
+    match cell {
+        CellLayout::TorchCarried(c) => {
+            c.robot.vendor.turns_endless_axes_modulo()
+                && c.positioner.turn_stroke(true) == crate::robot::JointLimit::UNLIMITED
+        }
+        CellLayout::PartCarried(_) => false,
     }
 }

@@ -173,7 +173,7 @@ impl<'a> Decoder<'a> {
         // An endless turn written modulo 360°: the controller takes the
         // shortest way from where the table is (home's turn before the first
         // motion).
-        let modulo = crate::program::contract::turn_modulo(cell);
+        let modulo = crate::program::pose::turn_modulo(cell);
         let turn_at: f64 = opts
             .common
             .home(cell)

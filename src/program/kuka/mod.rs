@@ -1131,7 +1131,7 @@ pub fn write_dat(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     let (_, tool) = opts.frames(&program.cell);
     // An endless turn written modulo 360° (the controller's infinitely
     // rotating axis takes the shortest way, at most 180° a motion).
-    let modulo = crate::program::contract::turn_modulo(&program.cell);
+    let modulo = crate::program::pose::turn_modulo(&program.cell);
     let ext_of = |q: Option<[f64; 2]>| {
         let mut e = q.unwrap_or([0.0; 2]).map(f64::to_degrees);
         if modulo {

@@ -245,8 +245,8 @@ impl Checker<'_> {
                     format!("{}: no positioner values", m.label),
                 ),
                 Some(qp) => {
-                    let turn = crate::program::contract::turn_stroke(cell)
-                        .unwrap_or(c.positioner.limits[1]);
+                    let turn =
+                        crate::program::pose::turn_stroke(cell).unwrap_or(c.positioner.limits[1]);
                     let travel = [c.positioner.limits[0], turn];
                     for (n, l) in travel.iter().enumerate() {
                         if !l.contains(qp[n]) {
@@ -726,7 +726,7 @@ pub(crate) fn check_home_ends(
         .collect();
     if let Some(h) = common.home(cell) {
         // an endless turn written modulo 360° is home at any whole turn
-        let modulo = crate::program::contract::turn_modulo(cell);
+        let modulo = crate::program::pose::turn_modulo(cell);
         let turn_difference = |n: usize, d: f64| {
             if modulo && n == 1 {
                 crate::robot::ik::wrap_pi(d)
