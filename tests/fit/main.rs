@@ -94,12 +94,11 @@ fn errors(truth: &Truth, fitted: &FittedPart) -> Errors {
 fn run(truth: &Truth, h: f64, noise: f64, seed: u64) -> Errors {
     let (v, f) = gen::mesh(truth, h, noise, 0.0, seed);
     let tris = f.len();
-    let start = std::time::Instant::now();
     let fitted = fit_mesh(v, f, &format!("{}.stl", truth.name), &FitOptions::default())
         .unwrap_or_else(|e| panic!("{} h = {h} noise = {noise}: {e}", truth.name));
     let e = errors(truth, &fitted);
     eprintln!(
-        "{:<16} h {h:>3} noise {noise:>3}: {tris:>7} tri, {:>2} it, guide rms {:.4} max {:.4}, radius rms {:.4} max {:.4}, vertex rms {:.4} max {:.4}, surface->mesh {:.4}, {:.2} s",
+        "{:<16} h {h:>3} noise {noise:>3}: {tris:>7} tri, {:>2} it, guide rms {:.4} max {:.4}, radius rms {:.4} max {:.4}, vertex rms {:.4} max {:.4}, surface->mesh {:.4}",
         truth.name,
         fitted.report().iterations,
         e.guide_rms,
@@ -109,7 +108,6 @@ fn run(truth: &Truth, h: f64, noise: f64, seed: u64) -> Errors {
         e.vertex_rms,
         e.vertex_max,
         fitted.report().surface_to_mesh_max_mm.unwrap_or(f64::NAN),
-        start.elapsed().as_secs_f64()
     );
     e
 }

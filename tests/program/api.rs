@@ -280,9 +280,14 @@ fn a_run_over_the_point_budget_is_refused_before_any_work() {
         discretisation: Some(waam_slicer::path::Discretisation::Points(2000)),
         ..SliceOverrides::default()
     };
-    let t = std::time::Instant::now();
-    let e = waam_slicer::slice_part_with(&part, &o, &Control::default()).unwrap_err();
-    assert!(t.elapsed().as_secs_f64() < 2.0);
+    // refused before any work: no stage of the run reports progress
+    let reports = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    let seen = reports.clone();
+    let control = Control::default().with_progress(move |_, _| {
+        seen.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    });
+    let e = waam_slicer::slice_part_with(&part, &o, &control).unwrap_err();
+    assert_eq!(reports.load(std::sync::atomic::Ordering::Relaxed), 0);
     match &e {
         Error::OverBudget { points, budget, .. } => {
             assert!(*points > 10_000_000 && *budget == waam_slicer::pipeline::DEFAULT_MAX_POINTS)

@@ -91,14 +91,14 @@ fn long_unary_chains_are_refused() {
 /// differentiation refuses them at once.
 #[test]
 fn expression_whose_derivatives_explode_is_refused_quickly() {
-    let start = std::time::Instant::now();
+    // the refusal is the work bound's ("too complex"): without it both
+    // expressions are differentiated in full (tens of seconds, GBs)
     let chain = vec!["t"; 24].join("/");
     let msg = expression_error(&chain);
     assert!(msg.contains("too complex"), "{msg}");
     let nested = format!("{}t{}", "t/(t*(".repeat(7), "))".repeat(7));
     let msg = expression_error(&nested);
     assert!(msg.contains("too complex"), "{msg}");
-    assert!(start.elapsed().as_secs_f64() < 5.0, "{:?}", start.elapsed());
 }
 
 /// What the limits must not refuse: the sample parts' kind of expressions.
