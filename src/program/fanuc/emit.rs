@@ -367,7 +367,7 @@ pub struct Position {
 }
 
 /// A TP program as data: what [`write_ls`] prints and
-/// [`parse_ls`] reads.
+/// [`parse_ls`](super::read::parse_ls) reads.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TpProgram {
     /// `/PROG` name.

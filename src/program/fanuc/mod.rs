@@ -27,8 +27,8 @@
 //!   ([`split`](crate::program::split)); a layer that does not fit alone
 //!   is refused with the numbers.
 //!
-//! * With approach and retract points ([`ArcFlag::Approach`],
-//!   [`ArcFlag::Retract`]) a bead is `J P[a] 10% FINE` (approach point, arc
+//! * With approach and retract points ([`ArcFlag::Approach`](crate::program::ArcFlag::Approach),
+//!   [`ArcFlag::Retract`](crate::program::ArcFlag::Retract)) a bead is `J P[a] 10% FINE` (approach point, arc
 //!   off), `L P[s] ... FINE` (into the bead), `Arc Start`, the bead, `Arc
 //!   End`, `L P[r] ... FINE` (retract); the joint move from one layer's
 //!   retract point to the next layer's approach point is the arc-off

@@ -289,7 +289,7 @@ pub(super) fn is_identity(iso: &Isometry3) -> bool {
 /// The frames a set of TP programs assumes (mm): `UFRAME[user_frame]` =
 /// `base_from_user` (robot base = world frame), `UTOOL[tool_frame]` =
 /// `flange_from_tool` (flange = FANUC faceplate frame). Stated in each
-/// program's header remarks ([`frame_remarks`]) and checked by the
+/// program's header remarks ([`frame_remarks`](super::emit::frame_remarks)) and checked by the
 /// validator.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FanucFrames {
