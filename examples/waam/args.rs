@@ -230,7 +230,7 @@ pub struct PlanArgs {
     /// Robot program format written when the plan is feasible; default:
     /// the cell robot's vendor. Another vendor's format is refused (exit 2):
     /// the joints are in the cell robot's controller convention.
-    #[arg(long, value_parser = ["fanuc", "kuka", "abb"])]
+    #[arg(long, value_parser = vendor_keys())]
     pub format: Option<String>,
     /// R_Z law: fixed:DEG, poly:N (max degree), spline, point.
     #[arg(long, default_value = "poly:4")]
@@ -353,7 +353,7 @@ pub struct ReplanArgs {
     #[command(flatten)]
     pub grid: GridArgs,
     /// Robot program format; default: the cell robot's vendor.
-    #[arg(long, value_parser = ["fanuc", "kuka", "abb"])]
+    #[arg(long, value_parser = vendor_keys())]
     pub format: Option<String>,
     /// R_Z law: fixed:DEG, poly:N (max degree), spline, point.
     #[arg(long, default_value = "poly:4")]
@@ -368,4 +368,14 @@ pub struct ReplanArgs {
     /// Output folder (default out/<part name>-replan-K).
     #[arg(long)]
     pub out: Option<PathBuf>,
+}
+
+/// The `--format` values: every registered vendor's key
+/// ([`Vendor::key`](waam_slicer::robot::Vendor::key)), in the registry's order.
+fn vendor_keys() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(
+        waam_slicer::program::registry::VENDORS
+            .iter()
+            .map(|v| v.key()),
+    )
 }
