@@ -37,15 +37,14 @@
 //! part.
 
 mod driver;
-mod error;
 mod options;
 mod outcome;
 mod rebuild;
 pub mod scan;
 pub mod summary;
 
+pub use crate::error::ReplanError;
 pub use driver::{replan_part, replan_part_with, replan_planned};
-pub use error::ReplanError;
 pub use options::ReplanOptions;
 pub use outcome::{program_name_for, ErrorStats, LayerCorrection, ReplanTimes, ReplannedPart};
 pub use scan::{HeightError, Measured, Outlier, ScanEstimate};

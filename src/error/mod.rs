@@ -14,6 +14,9 @@ use crate::program::ProgramError;
 use crate::robot::RobotError;
 use crate::toolaxis::ToolAxisError;
 
+mod replan;
+pub use replan::ReplanError;
+
 /// Any error of the library.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -59,7 +62,7 @@ pub enum Error {
     JointsCsv(#[from] JointsCsvError),
     /// The closed loop refused a scan or cannot replan the path.
     #[error(transparent)]
-    Replan(#[from] crate::replan::ReplanError),
+    Replan(#[from] ReplanError),
     /// A stage failed on a part read from a file: the file, then the stage's
     /// error (which names the field, layer or point).
     #[error("{file}: {source}")]

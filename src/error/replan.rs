@@ -1,4 +1,6 @@
-//! **Stage 9 — the closed loop's errors** ([`ReplanError`]): a scan file
+//! **The closed loop's errors** ([`ReplanError`], stage 9, re-exported by
+//! [`crate::replan`]; they live with the crate's error so that [`crate::Error`]
+//! wraps them without importing the room above it): a scan file
 //! that cannot be read, a refused scan (another part, another layer, too
 //! little coverage; the message names the distance), nothing left to
 //! replan, a point that cannot be placed.
