@@ -79,7 +79,7 @@ use crate::optimise::LayerPoints;
 use crate::program::{ArcFlag, Program, ProgramError};
 use crate::robot::chain::arm_chain;
 use crate::robot::trajectory::JointTrajectory;
-use crate::robot::{CellLayout, Joints, RobotModel, Vendor};
+use crate::robot::{CellLayout, Joints, RobotModel};
 
 /// Default `[program] collision_clearance_mm` (mm).
 pub const DEFAULT_CLEARANCE_MM: f64 = 10.0;
@@ -169,15 +169,15 @@ impl LinkRadii {
     /// not measured; a cell whose arm is bulkier should say so with
     /// `[[keep_out]]` margins. The J1 column is the base housing above
     /// the floor (about 300 mm across).
-    pub fn for_robot(robot: &RobotModel) -> Self {
-        match robot.vendor {
-            Vendor::Fanuc | Vendor::Kuka | Vendor::Abb => Self {
-                column_mm: 150.0,
-                upper_arm_mm: 100.0,
-                forearm_mm: 80.0,
-                wrist_mm: 60.0,
-                wrist_unit_mm: 250.0,
-            },
+    /// The three preset arms share one estimate, so `robot` does not choose
+    /// among them yet.
+    pub fn for_robot(_robot: &RobotModel) -> Self {
+        Self {
+            column_mm: 150.0,
+            upper_arm_mm: 100.0,
+            forearm_mm: 80.0,
+            wrist_mm: 60.0,
+            wrist_unit_mm: 250.0,
         }
     }
 }
