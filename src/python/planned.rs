@@ -205,7 +205,7 @@ impl PyPlannedPart {
     /// The program format written by default: the cell robot's vendor's.
     #[getter]
     fn format(&self) -> &'static str {
-        self.planned.format.name()
+        self.planned.format.key()
     }
 
     /// The content of `summary.json` (as the command-line `plan` writes it).
