@@ -13,6 +13,7 @@ mod plots;
 
 mod determinism;
 mod hostile_inputs;
+mod house;
 mod random_cells;
 mod reach;
 mod regressions;
