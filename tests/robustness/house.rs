@@ -248,7 +248,7 @@ fn references(src: &Source) -> Vec<Vec<String>> {
         v
     };
     let mut at = 0;
-    while let Some(p) = code[at..].find(|c: char| c == 'c' || c == 's') {
+    while let Some(p) = code[at..].find(['c', 's']) {
         let i = at + p;
         at = i + 1;
         if i > 0 && code[..i].ends_with(is_word) {
