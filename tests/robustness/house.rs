@@ -469,7 +469,8 @@ fn no_library_file_passes_a_thousand_lines_of_code() {
 }
 
 /// The closed set of vendors lives in one registry (STYLE §20): their folders
-/// under `program/`, the contract and its registry, and the robot presets.
+/// under `program/`, the contract and its registry, and the robot presets and
+/// facts (`robot::model`, `robot::controller`).
 #[test]
 fn only_the_vendor_registry_names_a_vendor() {
     const VENDORS: &[&str] = &["Fanuc", "Kuka", "Abb", "FANUC", "KUKA", "ABB"];
@@ -479,8 +480,7 @@ fn only_the_vendor_registry_names_a_vendor() {
             m.as_slice(),
             ["program", "fanuc" | "kuka" | "abb", ..]
                 | ["program", "contract" | "registry", ..]
-                | ["robot", "presets" | "model", ..]
-                | ["python", ..]
+                | ["robot", "controller" | "model", ..]
         )
     };
     let mut found = BTreeSet::new();
