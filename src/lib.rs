@@ -36,7 +36,10 @@
 //! | the front door: one call per job | [`pipeline`] | |
 //!
 //! A module imports only modules above it in this table (the leaf helpers
-//! from everywhere; tests aside); [`error`] gathers every stage's error.
+//! from everywhere; tests aside), and the children of one module form no
+//! import cycle; [`error`] gathers every stage's error and sits below the
+//! front door. `ARCHITECTURE.md` draws the rooms; `tests/robustness/house.rs`
+//! keeps the rule true.
 //!
 //! ## Units and frames
 //!
