@@ -38,9 +38,7 @@ use std::sync::Arc;
 pub use check::check_program;
 pub use fitted::FittedPart;
 pub use options::DEFAULT_MAX_POINTS;
-pub use options::{
-    AxisOverrides, ParseOptionError, PlanOptions, ProgramFormat, RzLaw, SliceOverrides,
-};
+pub use options::{AxisOverrides, ParseOptionError, PlanOptions, RzLaw, SliceOverrides};
 pub use place::{place_part, placement_bounds, PlaceRequest, PlacedCell, DEFAULT_HALF_BOX_MM};
 pub use planned::{plan_part, plan_part_with, program_name, PlanTimes, PlannedPart};
 pub use sliced::{slice_part, slice_part_with, SliceTimes, SlicedPart};

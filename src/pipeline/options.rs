@@ -173,12 +173,6 @@ impl SliceOverrides {
     }
 }
 
-/// The plan's program format by its former name: the [`Vendor`] whose
-/// controller runs it (parsed from `fanuc`, `kuka`, `abb` through the
-/// registry, [`crate::program::registry`]). Deprecated: name [`Vendor`];
-/// kept while callers still use this name.
-pub type ProgramFormat = Vendor;
-
 pub use crate::program::registry::ParseOptionError;
 
 /// The `R_Z` law of a plan in its written form: `fixed:DEG`, `poly:N` (most

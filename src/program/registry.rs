@@ -324,12 +324,6 @@ impl Vendor {
         with_controller(self, Emitter)
     }
 
-    /// The vendor itself: what the plan's format (a [`Vendor`]) runs on.
-    /// Kept for [`ProgramFormat`](crate::pipeline::ProgramFormat)'s callers.
-    pub fn vendor(self) -> Vendor {
-        self
-    }
-
     /// The options of the cycle time ([`crate::program::cycle`]) of this
     /// vendor's format with the options of `settings`
     /// ([`Controller::cycle_options`]).

@@ -13,8 +13,7 @@ use crate::optimise::{
     layer_points, optimise_with, trajectory_inputs, LayerPoints, OptimiseOptions, Plan, Transition,
 };
 use crate::pipeline::{
-    slice_part_with, Cell, Control, Part, PlanOptions, PlanTimes, PlannedPart, ProgramFormat,
-    RzLaw, SlicedPart,
+    slice_part_with, Cell, Control, Part, PlanOptions, PlanTimes, PlannedPart, RzLaw, SlicedPart,
 };
 use crate::process::PointProcess;
 use crate::program::cell_check::{check_cell, CellClearance, CellScene};
@@ -22,7 +21,7 @@ use crate::program::{
     build_program_with, check_vendor, LayerRefusal, Program, ProgramError, TravelSpeed,
 };
 use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
-use crate::robot::CellLayout;
+use crate::robot::{CellLayout, Vendor};
 use crate::Error;
 
 /// Replans the layers of `part` after `after_layer` from its measured top:
@@ -69,7 +68,7 @@ pub fn replan_part_with(
 ) -> Result<ReplannedPart, Error> {
     let t0 = Instant::now();
     let format = opts.format.unwrap_or_else(|| cell.native_format());
-    check_vendor(&cell.layout, format.vendor(), format.emitter())?;
+    check_vendor(&cell.layout, format, format.emitter())?;
     replan.validate()?;
     let sliced = slice_part_with(part, &opts.slice.for_cell(part, cell), &Control::default())?;
     let radius = sliced
@@ -157,7 +156,7 @@ fn replan_core(
     nominal: Option<(&[LayerPoints], &Plan)>,
     optimise: OptimiseOptions,
     rz: RzLaw,
-    format: ProgramFormat,
+    format: Vendor,
     measured: &Measured,
     k: usize,
     ropts: &ReplanOptions,
