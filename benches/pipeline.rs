@@ -9,10 +9,11 @@ mod pipeline {
     pub mod optimise;
     pub mod path;
     pub mod place;
+    pub mod program;
     pub mod robot;
 }
 
-use pipeline::{optimise, path, place, robot};
+use pipeline::{optimise, path, place, program, robot};
 
 criterion_group!(
     benches,
@@ -23,6 +24,7 @@ criterion_group!(
     optimise::whole_parts,
     optimise::plan_at_scale,
     optimise::torch_vs_part_carried,
-    place::hemisphere_in_kuka_part_carried
+    place::hemisphere_in_kuka_part_carried,
+    program::readers
 );
 criterion_main!(benches);

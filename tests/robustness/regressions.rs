@@ -140,10 +140,13 @@ fn deeply_nested_abb_aggregate_is_refused() {
     }
 }
 
-/// Probes of the program readers behind `waam check` with large inputs:
-/// each answers (accepts or refuses) in well under a second per megabyte.
+/// Probes of the program readers behind `waam check` with large inputs: a
+/// 1 MB line is refused naming its file, and programs with 20 000 repeated
+/// motions answer (read, or refused naming their file). How fast they
+/// answer is measured by the `program/readers` bench in `benches/`, not
+/// here (a wall-clock bound fails on a loaded box).
 #[test]
-fn program_readers_answer_large_inputs_quickly() {
+fn program_readers_answer_large_inputs() {
     use waam_slicer::program::{abb::parse_mod, fanuc::parse_ls, kuka::parse_krl};
     let golden = |name: &str| {
         std::fs::read_to_string(
@@ -153,11 +156,22 @@ fn program_readers_answer_large_inputs_quickly() {
         )
         .unwrap()
     };
+    let names_file = |e: String, file: &str| assert!(e.contains(file), "{file}: {e}");
     let long_line = "x".repeat(1 << 20);
-    let start = std::time::Instant::now();
-    let _ = parse_ls(&long_line, "long.ls");
-    let _ = parse_mod(&long_line, "long.mod");
-    let _ = parse_krl(&long_line, "long.src", &long_line, "long.dat");
+    names_file(
+        parse_ls(&long_line, "long.ls").unwrap_err().to_string(),
+        "long.ls",
+    );
+    names_file(
+        parse_mod(&long_line, "long.mod").unwrap_err().to_string(),
+        "long.mod",
+    );
+    names_file(
+        parse_krl(&long_line, "long.src", &long_line, "long.dat")
+            .unwrap_err()
+            .to_string(),
+        "long.",
+    );
     // a golden with its motion lines repeated 20 000 times
     let ls = golden("fanuc_cartesian_HEMI.ls");
     let motion = ls
@@ -166,15 +180,19 @@ fn program_readers_answer_large_inputs_quickly() {
         .unwrap()
         .to_string()
         + "\n";
-    let _ = parse_ls(&ls.replacen(&motion, &motion.repeat(20_000), 1), "many.ls");
+    if let Err(e) = parse_ls(&ls.replacen(&motion, &motion.repeat(20_000), 1), "many.ls") {
+        names_file(e.to_string(), "many.ls");
+    }
     let src = golden("kuka_cartesian_HEMI.src");
     let dat = golden("kuka_cartesian_HEMI.dat");
-    let _ = parse_krl(
+    if let Err(e) = parse_krl(
         &src.replacen("  LIN P2\n", &"  LIN P2\n".repeat(20_000), 1),
         "many.src",
         &dat,
         "many.dat",
-    );
+    ) {
+        names_file(e.to_string(), "many.");
+    }
     let m = golden("abb_HEMI.mod");
     let target = m
         .lines()
@@ -182,10 +200,7 @@ fn program_readers_answer_large_inputs_quickly() {
         .unwrap()
         .to_string()
         + "\n";
-    let _ = parse_mod(&m.replacen(&target, &target.repeat(20_000), 1), "many.mod");
-    assert!(
-        start.elapsed().as_secs_f64() < 10.0,
-        "{:?}",
-        start.elapsed()
-    );
+    if let Err(e) = parse_mod(&m.replacen(&target, &target.repeat(20_000), 1), "many.mod") {
+        names_file(e.to_string(), "many.mod");
+    }
 }
