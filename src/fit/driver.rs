@@ -70,6 +70,11 @@ const MAX_START_TILT_TAN: f64 = 10.0;
 /// cuts the tube inside the range.
 const EXTEND_BEFORE_MARGIN_MM: f64 = 1.0;
 
+/// A station whose ring of points leaves a gap wider than this around its
+/// circle (degrees) takes its neighbours' points too: fewer than six points
+/// around, as rings of a coarse mesh between its stations give.
+const WIDEN_GAP_DEG: f64 = 60.0;
+
 /// Fits a tube to `mesh`.
 ///
 /// # Errors
@@ -170,7 +175,7 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
                 ),
             });
         }
-        let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref());
+        let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
         if iterations > 1 {
             check_sections(mesh, &stations, opts)?;
         }
@@ -221,7 +226,7 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
         hints.as_deref(),
         PROJECT_PAST_END_RADII * r0,
     );
-    let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref());
+    let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
     check_sections(mesh, &stations, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick);
     let mut radius_mm = law(&|s| s.radius)?;
@@ -531,7 +536,13 @@ fn initial_guide(
     }
     pts.push(finish.centre);
     if pts.len() == 2 {
-        pts.insert(1, centroid(pts.iter().copied()));
+        // No level set between the ends (a coarse mesh, whose bands are
+        // wide): the cubic leaving each end along its normal.
+        let n = ((finish.centre - start.centre).norm() / (0.5 * knot_h))
+            .ceil()
+            .max(2.0) as usize;
+        let inner = end_cubic(start, finish, n);
+        pts.splice(1..1, inner);
     }
     if (pts[pts.len() - 1] - pts[0]).norm() < 1e-3 {
         return Err(FitError::NotATube {
@@ -546,6 +557,47 @@ fn initial_guide(
     pts.insert(0, before);
     pts.push(after);
     Ok(pts)
+}
+
+/// `n - 1` points evenly spaced in the parameter of the cubic (Hermite)
+/// from `start`'s centre to `finish`'s, leaving each along its end's normal
+/// with the length that makes it a circular arc when the normals allow one;
+/// the chord's midpoint when the normals are nearly opposed to the chord.
+fn end_cubic(start: &EndRing, finish: &EndRing, n: usize) -> Vec<Point3> {
+    let (p0, p1) = (start.centre, finish.centre);
+    let chord = p1 - p0;
+    let c = chord.norm();
+    let along = |n: &UnitVector3| {
+        let n = n.into_inner();
+        if n.dot(&chord) < 0.0 {
+            -n
+        } else {
+            n
+        }
+    };
+    let (d0, d1) = (along(&start.normal), along(&finish.normal));
+    let turn = d0.angle(&d1);
+    if d0.dot(&chord) < 0.3 * c || d1.dot(&chord) < 0.3 * c || turn > 0.75 * std::f64::consts::PI {
+        return vec![centroid([p0, p1].into_iter())];
+    }
+    // A circular arc of turn θ and chord c: end tangents of length
+    // 4 tan(θ / 4) R with R = c / (2 sin(θ / 2)); c when straight.
+    let m = if turn < 1e-6 {
+        c
+    } else {
+        4.0 * (turn / 4.0).tan() * c / (2.0 * (turn / 2.0).sin())
+    };
+    (1..n)
+        .map(|i| {
+            let u = i as f64 / n as f64;
+            let (u2, u3) = (u * u, u * u * u);
+            let h00 = 2.0 * u3 - 3.0 * u2 + 1.0;
+            let h10 = u3 - 2.0 * u2 + u;
+            let h01 = -2.0 * u3 + 3.0 * u2;
+            let h11 = u3 - u2;
+            Point3::from(p0.coords * h00 + d0 * (m * h10) + p1.coords * h01 + d1 * (m * h11))
+        })
+        .collect()
 }
 
 /// Guide parameter of the nearest guide point of every sample: Newton from
@@ -619,7 +671,8 @@ fn rotate(a: &Vector3, b: &Vector3, x: &Vector3) -> Vector3 {
 /// Stations every `spacing` mm over the tube's range; each takes the samples
 /// whose nearest guide parameter is nearest to it, carried into its normal
 /// plane by the minimal rotation of their own normal plane, and fits one
-/// circle per skin.
+/// circle per skin. A station whose ring is open (a coarse mesh) also takes
+/// its neighbours' samples, out to `reach` mm either side.
 fn sections(
     spline: &CubicSpline,
     range: (f64, f64),
@@ -627,6 +680,7 @@ fn sections(
     s: &Samples,
     t: &[f64],
     law: Option<&(Vec<f64>, Vec<f64>)>,
+    reach: f64,
 ) -> Vec<Station> {
     let law = law.map(|(k, v)| (k, v, smooth::natural_second_derivatives(k, v)));
     let slope_at = |t: f64| {
@@ -659,21 +713,56 @@ fn sections(
         });
     }
     // A station with under half the usual points is a partial ring (past an
-    // end cut obliquely): left out.
+    // end cut obliquely): left out, ...
     let mut counts: Vec<usize> = (0..=n)
         .map(|i| (0..s.skins).map(|k| bins[i * s.skins + k].len()).sum())
         .collect();
     let median = *counts.select_nth_unstable(n / 2).1;
+    // ... unless its ring is open: a coarse mesh (rings of vertices further
+    // apart than the stations) leaves stations with a partial ring or none.
+    // Those take the points of their neighbours too, out to `reach` mm either
+    // side, until every skin's ring is closed.
+    let widest = ((reach / step).ceil() as usize).max(1);
+    let closed = |fits: &[Option<CircleFit>]| {
+        fits.iter()
+            .all(|f| f.is_some_and(|f| f.max_gap_rad <= WIDEN_GAP_DEG.to_radians()))
+    };
     frames
         .par_iter()
         .enumerate()
         .map(|(i, (ti, c, _, e1, e2))| {
             let slope = slope_at(*ti);
-            let fits: Vec<Option<CircleFit>> = (0..s.skins)
+            let mut fits: Vec<Option<CircleFit>> = (0..s.skins)
                 .map(|k| fit_circle(&bins[i * s.skins + k], slope))
                 .collect();
-            let points = (0..s.skins).map(|k| bins[i * s.skins + k].len()).sum();
-            let all: Option<Vec<CircleFit>> = if 2 * points >= median {
+            let mut points = (0..s.skins).map(|k| bins[i * s.skins + k].len()).sum();
+            let mut full = 2 * points >= median;
+            if !closed(&fits) {
+                let mut wide: Vec<Vec<SectionPoint>> = (0..s.skins)
+                    .map(|k| bins[i * s.skins + k].clone())
+                    .collect();
+                for w in 1..=widest {
+                    for j in [i.checked_sub(w), Some(i + w).filter(|&j| j <= n)]
+                        .into_iter()
+                        .flatten()
+                    {
+                        for (k, pts) in wide.iter_mut().enumerate() {
+                            let dt = frames[j].0 - ti;
+                            pts.extend(bins[j * s.skins + k].iter().map(|p| SectionPoint {
+                                dt: p.dt + dt,
+                                ..*p
+                            }));
+                        }
+                    }
+                    let f: Vec<Option<CircleFit>> =
+                        wide.iter().map(|pts| fit_circle(pts, slope)).collect();
+                    if closed(&f) {
+                        (fits, points, full) = (f, wide.iter().map(Vec::len).sum(), true);
+                        break;
+                    }
+                }
+            }
+            let all: Option<Vec<CircleFit>> = if full {
                 fits.iter().copied().collect()
             } else {
                 None

@@ -172,3 +172,79 @@ fn an_untidy_export_fits_as_the_clean_mesh() {
         assert!((p - q).norm() < 1e-6, "{p} {q}");
     }
 }
+
+/// The author's elbow (`slide.scad`): a ring of radii 25.1 and 26.5 about a
+/// centre circle of radius 56.5 in the z = 0 plane, about the z axis, swept
+/// from 0 to 70 degrees. A point's distance from the centre circle (mm).
+fn from_elbow_circle(p: &Point3) -> f64 {
+    (p.x.hypot(p.y) - 56.5).hypot(p.z)
+}
+
+#[test]
+fn the_coarse_two_skin_elbow_lies_on_its_authors_torus() {
+    let fitted =
+        Part::from_mesh(data("breakout-coin-elbow-70.stl"), &FitOptions::default()).unwrap();
+    let fit = &fitted.fit;
+    let rep = fitted.report();
+    assert_eq!(rep.skins, 2);
+    // The guide runs along the author's centre circle, from 0 to 70 degrees.
+    let guide = fit.guide();
+    let (mut g2, mut gmax, mut m) = (0.0, 0.0_f64, 0);
+    // The fitted skins (the mid-surface's radius -/+ half the wall) against
+    // the author's radii, 36 points around at 200 stations.
+    let (mut s2, mut smax, mut n) = (0.0, 0.0_f64, 0);
+    for i in 0..=200 {
+        let t = fit.t_min + (fit.t_max - fit.t_min) * f64::from(i) / 200.0;
+        let c = waam_slicer::geometry::guide::GuideCurve::point(&guide, t);
+        let d = (c.x.hypot(c.y) - 56.5).hypot(c.z);
+        g2 += d * d;
+        gmax = gmax.max(d);
+        m += 1;
+        let tan = waam_slicer::geometry::guide::GuideCurve::d1(&guide, t).normalize();
+        let e1 = tan.cross(&Vector3::z()).normalize();
+        let e2 = tan.cross(&e1);
+        let half = 0.5 * fit.wall_thickness(t).unwrap();
+        for (r, truth) in [(fit.radius(t) - half, 25.1), (fit.radius(t) + half, 26.5)] {
+            for k in 0..36 {
+                let a = TAU * f64::from(k) / 36.0;
+                let p = c + (e1 * a.cos() + e2 * a.sin()) * r;
+                let d = from_elbow_circle(&p) - truth;
+                s2 += d * d;
+                smax = smax.max(d.abs());
+                n += 1;
+            }
+        }
+    }
+    let ends = [fit.t_min, fit.t_max].map(|t| {
+        let c = waam_slicer::geometry::guide::GuideCurve::point(&guide, t);
+        c.y.atan2(c.x).to_degrees()
+    });
+    let (g, s) = ((g2 / f64::from(m)).sqrt(), (s2 / f64::from(n)).sqrt());
+    eprintln!(
+        "elbow: guide {g:.4} mm RMS {gmax:.4} max; skins {s:.4} mm RMS {smax:.4} max; ends at {ends:?} degrees; fit residual {:.4} mm RMS; {} iterations",
+        rep.rms_mm, rep.iterations
+    );
+    // Either end may be the start (both lie at z = 0).
+    let (lo, hi) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
+    assert!(lo.abs() < 0.5 && (hi - 70.0).abs() < 0.5, "{ends:?}");
+    assert!(s <= 0.1 && smax <= 0.3, "{s} mm RMS, {smax} mm at most");
+    // The sliced points lie on the author's mid-surface (radius 25.8).
+    let sliced = waam_slicer::slice_part(&fitted.part).unwrap();
+    let (mut p2, mut pmax, mut np) = (0.0, 0.0_f64, 0);
+    for l in &sliced.path.layers {
+        for p in &l.points {
+            let d = from_elbow_circle(&p.position) - 25.8;
+            p2 += d * d;
+            pmax = pmax.max(d.abs());
+            np += 1;
+        }
+    }
+    let p = (p2 / np as f64).sqrt();
+    eprintln!(
+        "elbow sliced: {np} points {p:.4} mm RMS {pmax:.4} max from the author's mid-surface"
+    );
+    assert!(
+        np > 1000 && p <= 0.1 && pmax <= 0.3,
+        "{np} points, {p} mm RMS, {pmax} mm at most"
+    );
+}
