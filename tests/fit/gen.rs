@@ -429,3 +429,51 @@ pub fn untidy(
     out.push([s, s + 1, s + 2]);
     (v, out)
 }
+
+/// A coarse export of the tube, as CAD tools write one: rings of vertices on
+/// the true surface, as few as keep every facet within `chord_mm` of the
+/// surface (checked at each stretch's middle, eight points around), so that
+/// a straight leg is one stretch of long thin triangles and a bend a few;
+/// as many points around as the same chord height allows (at least 8).
+/// Returns the mesh and its points around.
+pub fn coarse(t: &Truth, chord_mm: f64) -> (Vec<Point3>, Vec<[u32; 3]>, usize) {
+    let rmax = (0..=100)
+        .map(|i| (t.radius)(t.length * i as f64 / 100.0))
+        .fold(0.0, f64::max);
+    let around = ((PI / (1.0 - chord_mm / rmax).acos()).ceil() as usize).max(8);
+    let m = (t.length / 0.1).ceil() as usize;
+    let fr = frames(t, m);
+    let point = |i: usize, a: f64| {
+        let (s, x, ti, n) = fr[i];
+        x + (n * a.cos() + ti.cross(&n) * a.sin()) * (t.radius)(s)
+    };
+    let within = |i0: usize, i1: usize| {
+        (0..8).all(|k| {
+            let a = TAU * k as f64 / 8.0;
+            let mid = Point3::from((point(i0, a).coords + point(i1, a).coords) / 2.0);
+            (mid - point((i0 + i1) / 2, a)).norm() <= chord_mm
+        })
+    };
+    let mut rings = vec![0];
+    for i in 2..=m {
+        let last = rings[rings.len() - 1];
+        if !within(last, i) && i - 1 > last {
+            rings.push(i - 1);
+        }
+    }
+    rings.push(m);
+    let v: Vec<Point3> = rings
+        .iter()
+        .flat_map(|&i| (0..around).map(move |j| (i, TAU * j as f64 / around as f64)))
+        .map(|(i, a)| point(i, a))
+        .collect();
+    let id = |i: usize, j: usize| (i * around + j % around) as u32;
+    let mut f = Vec::new();
+    for i in 0..rings.len() - 1 {
+        for j in 0..around {
+            f.push([id(i, j), id(i, j + 1), id(i + 1, j)]);
+            f.push([id(i, j + 1), id(i + 1, j + 1), id(i + 1, j)]);
+        }
+    }
+    (v, f, around)
+}

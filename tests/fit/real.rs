@@ -116,13 +116,26 @@ fn against_profile(fit: &waam_slicer::fit::TubeFit, profile: &[(f64, f64)]) -> (
     ((sum / n.max(1) as f64).sqrt(), max, n)
 }
 
-/// The author's own nozzle mesh (not in the repository: 3.9 MB), when the
-/// shared copy is there: `cargo test --test fit -- --ignored real_nozzle`.
+/// The author's own nozzle mesh (not in the repository: 3.9 MB), from the
+/// shared folder (`$WAAM_REAL_MESHES`, or `../shared/real-meshes` or
+/// `../../shared/real-meshes` from the clone):
+/// `cargo test --test fit -- --ignored real_nozzle`.
 #[test]
 #[ignore]
 fn real_nozzle_from_the_shared_folder_lies_on_its_authors_profile() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/real-meshes/rao-nozzle.stl");
+    // `$WAAM_REAL_MESHES`, or `shared/real-meshes` next to the clone or
+    // next to its worktrees' folder.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let path = std::env::var_os("WAAM_REAL_MESHES")
+        .map(std::path::PathBuf::from)
+        .into_iter()
+        .chain([
+            root.join("../shared/real-meshes"),
+            root.join("../../shared/real-meshes"),
+        ])
+        .map(|d| d.join("rao-nozzle.stl"))
+        .find(|p| p.exists())
+        .expect("rao-nozzle.stl: set WAAM_REAL_MESHES to the shared real-meshes folder");
     let opts = FitOptions {
         units: Units::M,
         ..FitOptions::default()
