@@ -67,18 +67,19 @@
 //! largest chord deviation of a dropped point (conservative). So
 //! `closest_approach_mm` is a distance measured at a sample, at most
 //! [`REPORT_TOLERANCE_MM`] above the smallest over the samples.
-
-use std::collections::HashMap;
-
 use parry3d_f64::query;
-use parry3d_f64::shape::{Capsule, ConvexPolyhedron, Cuboid, Cylinder, Shape};
+use parry3d_f64::shape::{Capsule, ConvexPolyhedron, Cuboid, Cylinder, Shape, SupportMap};
 use serde::{Deserialize, Serialize};
+
+mod support;
+mod walk;
+use support::ClusteredHull;
+pub use walk::check_cell;
 
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use crate::optimise::LayerPoints;
-use crate::program::{ArcFlag, Program, ProgramError};
+use crate::program::ProgramError;
 use crate::robot::chain::arm_chain;
-use crate::robot::trajectory::JointTrajectory;
 use crate::robot::{CellLayout, Joints, RobotModel};
 
 /// Default `[program] collision_clearance_mm` (mm).
@@ -286,17 +287,22 @@ struct Body<'a> {
     margin: f64,
     /// A capsule's segment ends (base frame), for its displacement.
     ends: Option<(Point3, Point3)>,
+    /// A hull's vertices in clusters: its support function, faster than
+    /// the shape's own and with the same answers.
+    support: Option<&'a ClusteredHull>,
 }
 
 /// What the culling remembers between samples: each body's last place and
-/// odometer (mm), each pair's last exact distance and the two odometers then.
+/// odometer (mm), each pair's last exact distance and the two odometers then
+/// (by the pair's index in the sample's list of pairs, the same list at
+/// every sample with the same bodies).
 #[derive(Default)]
 struct Memory {
     /// Which layer's hull the bodies are for (the part changes with it).
     layer: Option<usize>,
     places: Vec<(Point3, Point3, UnitQuaternion)>,
     odometer: Vec<f64>,
-    pairs: HashMap<(usize, usize), (f64, f64, f64)>,
+    pairs: Vec<Option<(f64, f64, f64)>>,
 }
 
 impl Memory {
@@ -310,31 +316,55 @@ impl Memory {
             self.pairs.clear();
             return;
         }
+        // the part's hulls share one pose: their turn is computed once
+        let mut turn: Option<([u64; 4], [u64; 4], f64)> = None;
         for (i, b) in bodies.iter().enumerate() {
             let now = place_of(b);
             let was = self.places[i];
             let moved = match b.ends {
                 Some(_) => (now.0 - was.0).norm().max((now.1 - was.1).norm()),
-                None => (now.0 - was.0).norm() + b.radius * was.2.angle_to(&now.2),
+                None => {
+                    let key = (bits(&was.2), bits(&now.2));
+                    let angle = match turn {
+                        Some((w, n, a)) if (w, n) == key => a,
+                        _ => {
+                            let a = was.2.angle_to(&now.2);
+                            turn = Some((key.0, key.1, a));
+                            a
+                        }
+                    };
+                    (now.0 - was.0).norm() + b.radius * angle
+                }
             };
             self.odometer[i] += moved;
             self.places[i] = now;
         }
     }
 
-    /// The pair's last exact distance less how far its bodies moved since.
-    fn lower_bound(&self, i: usize, j: usize) -> f64 {
+    /// Pair `k` (bodies `i`, `j`): its last exact distance less how far its
+    /// bodies moved since.
+    fn lower_bound(&self, k: usize, i: usize, j: usize) -> f64 {
         self.pairs
-            .get(&(i, j))
+            .get(k)
+            .copied()
+            .flatten()
             .map_or(f64::NEG_INFINITY, |(d, oi, oj)| {
                 d - (self.odometer[i] - oi) - (self.odometer[j] - oj)
             })
     }
 
-    fn remember(&mut self, i: usize, j: usize, d: f64) {
+    fn remember(&mut self, k: usize, i: usize, j: usize, d: f64) {
         let (oi, oj) = (self.odometer[i], self.odometer[j]);
-        self.pairs.insert((i, j), (d, oi, oj));
+        if self.pairs.len() <= k {
+            self.pairs.resize(k + 1, None);
+        }
+        self.pairs[k] = Some((d, oi, oj));
     }
+}
+
+/// A rotation's components, bit for bit.
+fn bits(q: &UnitQuaternion) -> [u64; 4] {
+    std::array::from_fn(|i| q.coords[i].to_bits())
 }
 
 /// A body's place: a capsule's ends, else its centre (twice) and rotation.
@@ -508,6 +538,7 @@ fn capsule_body<'a>(name: &'a str, c: &'a Capsule) -> Body<'a> {
         radius: 0.5 * (c.segment.b - c.segment.a).norm() + c.radius,
         margin: 0.0,
         ends: Some((c.segment.a, c.segment.b)),
+        support: None,
     }
 }
 
@@ -518,6 +549,8 @@ struct Local {
     radius: f64,
     /// Lowered from every distance to it (mm): the part's thinning.
     margin: f64,
+    /// A hull's clustered vertices ([`ClusteredHull`]).
+    support: Option<ClusteredHull>,
 }
 
 impl Local {
@@ -530,6 +563,7 @@ impl Local {
             radius: self.radius,
             margin: self.margin,
             ends: None,
+            support: self.support.as_ref(),
         }
     }
 }
@@ -538,6 +572,7 @@ impl Local {
 /// a degenerate set (fewer than four points off a plane).
 fn hull(points: &[Point3]) -> Option<Local> {
     let h = ConvexPolyhedron::from_convex_hull(points)?;
+    let support = Some(ClusteredHull::new(&h));
     let n = h.points().len().max(1) as f64;
     let centre = Point3::from(h.points().iter().map(|p| p.coords).sum::<Vector3>() / n);
     let radius = h
@@ -550,6 +585,7 @@ fn hull(points: &[Point3]) -> Option<Local> {
         centre,
         radius,
         margin: 0.0,
+        support,
     })
 }
 
@@ -697,6 +733,7 @@ impl<'a> Checker<'a> {
                     centre: Point3::from(centre.coords),
                     radius: half.norm(),
                     margin: 0.0,
+                    support: None,
                 }
             })
             .collect();
@@ -739,12 +776,14 @@ impl<'a> Checker<'a> {
             centre: Point3::origin(),
             radius: (TABLE_RADIUS_MM.powi(2) + half_t.powi(2)).sqrt(),
             margin: 0.0,
+            support: None,
         };
         let tilt = Local {
             shape: Box::new(tilt_capsule()),
             centre: Point3::origin(),
             radius: TABLE_RADIUS_MM + TILT_BODY_RADIUS_MM,
             margin: 0.0,
+            support: None,
         };
         let (bands, partial) = wall_bands(layers);
         Self {
@@ -803,6 +842,7 @@ impl<'a> Checker<'a> {
                 radius: k.radius,
                 margin: 0.0,
                 ends: None,
+                support: None,
             });
         }
         let mut pairs: Vec<(usize, usize)> = Vec::new(); // indices into `all`
@@ -863,17 +903,17 @@ impl<'a> Checker<'a> {
         }
         memory.advance(layer, &all);
         let mut hit: Option<(String, String, f64)> = None;
-        for (i, j) in pairs {
+        for (k, (i, j)) in pairs.into_iter().enumerate() {
             let (a, b) = (&all[i], &all[j]);
             let margin = a.margin + b.margin;
             let bound = ((a.centre - b.centre).norm() - a.radius - b.radius - margin)
-                .max(memory.lower_bound(i, j));
+                .max(memory.lower_bound(k, i, j));
             if bound > self.clearance && bound >= best.distance_mm - REPORT_TOLERANCE_MM {
                 stats.culled += 1;
                 continue;
             }
             stats.exact_queries += 1;
-            let Ok(mut d) = query::distance(&a.pose, a.shape, &b.pose, b.shape) else {
+            let Ok(mut d) = exact_distance(a, b) else {
                 continue;
             };
             if d <= 0.0 {
@@ -883,7 +923,7 @@ impl<'a> Checker<'a> {
                 }
             }
             d -= margin;
-            memory.remember(i, j, d);
+            memory.remember(k, i, j, d);
             if d < best.distance_mm {
                 best.distance_mm = d;
                 best.pair = Some((a.name.to_string(), b.name.to_string()));
@@ -893,254 +933,6 @@ impl<'a> Checker<'a> {
             }
         }
         hit
-    }
-}
-
-/// Checks every motion of `program` against the whole cell (module doc).
-///
-/// `trajectory` holds the planned joints of every bead point (the program's
-/// beads may be thinned); `layers` the layers in the same order, part frame.
-///
-/// # Errors
-/// [`ProgramError::Collision`] at the first sample (in program order) where
-/// a pair comes closer than `scene.clearance_mm`, naming its layer, point
-/// or move, the two bodies and the distance (negative: the depth).
-pub fn check_cell(
-    program: &Program,
-    trajectory: &JointTrajectory,
-    layers: &[LayerPoints],
-    scene: &CellScene,
-) -> Result<CellClearance, ProgramError> {
-    let mut walk = Walk::new(Checker::new(&program.cell, scene, layers), layers);
-    walk.beads(trajectory)?;
-    walk.other_motions(program, scene)?;
-    Ok(walk.finish())
-}
-
-/// The walk of [`check_cell`] along a program's motions, in program order:
-/// the checker and what it has measured so far (per layer, the closest
-/// approach; the counts).
-struct Walk<'a> {
-    checker: Checker<'a>,
-    /// Layer number → index in the layers checked.
-    index: HashMap<usize, usize>,
-    stats: CellClearance,
-    memory: Memory,
-    /// Per layer met, in the order met: its closest approach.
-    per_layer: Vec<(usize, Closest)>,
-    /// Layer number → index in `per_layer`.
-    slot: HashMap<usize, usize>,
-}
-
-impl<'a> Walk<'a> {
-    fn new(checker: Checker<'a>, layers: &[LayerPoints]) -> Self {
-        let index: HashMap<usize, usize> = layers
-            .iter()
-            .enumerate()
-            .map(|(i, l)| (l.layer, i))
-            .collect();
-        Self {
-            checker,
-            index,
-            stats: CellClearance::default(),
-            memory: Memory::default(),
-            per_layer: Vec::new(),
-            slot: HashMap::new(),
-        }
-    }
-
-    /// The index in `per_layer` of `layer`'s closest approach (added, at
-    /// infinity, when the layer is met first).
-    fn best_of(&mut self, layer: usize) -> usize {
-        let per_layer = &mut self.per_layer;
-        *self.slot.entry(layer).or_insert_with(|| {
-            per_layer.push((
-                layer,
-                Closest {
-                    distance_mm: f64::INFINITY,
-                    pair: None,
-                },
-            ));
-            per_layer.len() - 1
-        })
-    }
-
-    /// A motion from `from` to `to` sampled by swept distance, both ends
-    /// included (the first left out with `skip_first`); refused at the
-    /// first sample closer than the clearance.
-    fn run(
-        &mut self,
-        from: Sample,
-        to: Sample,
-        skip_first: bool,
-        place: &Place,
-    ) -> Result<(), ProgramError> {
-        let k = self.best_of(place.layer);
-        let checker = &self.checker;
-        let hull: Vec<&Local> = match self
-            .index
-            .get(&place.layer)
-            .and_then(|&i| checker.partial.get(i))
-        {
-            Some((before, own)) => checker.bands[..*before]
-                .iter()
-                .chain(own.as_ref())
-                .collect(),
-            None => Vec::new(),
-        };
-        let n = ((checker.swept_mm(&from, &to) / SAMPLE_STEP_MM).ceil() as usize).clamp(1, 100_000);
-        for i in usize::from(skip_first)..=n {
-            let s = i as f64 / n as f64;
-            let q: Joints = std::array::from_fn(|j| from.q[j] + s * (to.q[j] - from.q[j]));
-            let qp = match (from.qp, to.qp) {
-                (Some(a), Some(b)) => Some([a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])]),
-                (a, b) => a.or(b),
-            };
-            let sample = Sample { q: &q, qp };
-            if let Some(hit) = checker.check(
-                &sample,
-                (place.layer, &hull),
-                &mut self.per_layer[k].1,
-                &mut self.memory,
-                &mut self.stats,
-            ) {
-                return Err(refusal(place, hit, checker.clearance));
-            }
-        }
-        Ok(())
-    }
-
-    /// The beads: every planned point, sampled by swept distance between
-    /// consecutive points of a layer.
-    fn beads(&mut self, trajectory: &JointTrajectory) -> Result<(), ProgramError> {
-        let tp = &trajectory.points;
-        let mut prev: Option<(usize, Sample)> = None;
-        let mut last_sampled: Option<Sample> = None;
-        let mut swept = 0.0;
-        for (i, jp) in tp.iter().enumerate() {
-            let Some(q) = jp.joints.as_ref() else {
-                continue;
-            };
-            let s = Sample {
-                q,
-                qp: jp.positioner,
-            };
-            let new_layer = prev.as_ref().is_none_or(|(l, _)| *l != jp.layer);
-            if new_layer {
-                swept = 0.0;
-                last_sampled = None;
-            } else if let Some((_, p)) = &prev {
-                swept += self.checker.swept_mm(p, &s);
-            }
-            // the first point of a layer, then whenever the swept distance
-            // since the last sample reaches the step (the motion between the
-            // two sampled points sampled in turn), and the layer's last point
-            let is_last = tp.get(i + 1).is_none_or(|n| n.layer != jp.layer);
-            if last_sampled.is_none() || swept >= SAMPLE_STEP_MM || is_last {
-                let place = Place {
-                    layer: jp.layer,
-                    point: Some(jp.point),
-                    motion: "bead",
-                };
-                let from = last_sampled.unwrap_or(s);
-                self.run(from, s, last_sampled.is_some(), &place)?;
-                last_sampled = Some(s);
-                swept = 0.0;
-            }
-            prev = Some((jp.layer, s));
-        }
-        Ok(())
-    }
-
-    /// Every other motion of the program: home → first point, approach →
-    /// first point, last point → retract, the transits, last → home (the
-    /// home moves and transits only with `scene.transits`).
-    fn other_motions(&mut self, program: &Program, scene: &CellScene) -> Result<(), ProgramError> {
-        let pts = &program.points;
-        let home = program.home.as_ref();
-        if let (Some(h), Some(first)) = (home.filter(|_| scene.transits), pts.first()) {
-            self.run(
-                Sample {
-                    q: &h.joints,
-                    qp: h.positioner,
-                },
-                Sample {
-                    q: &first.joints,
-                    qp: first.positioner,
-                },
-                false,
-                &Place {
-                    layer: first.layer,
-                    point: None,
-                    motion: "home move",
-                },
-            )?;
-        }
-        for w in pts.windows(2) {
-            let (a, b) = (&w[0], &w[1]);
-            let same_bead = a.arc.is_bead() && b.arc.is_bead() && a.layer == b.layer;
-            if same_bead {
-                continue;
-            }
-            let motion = match (a.arc, b.arc) {
-                (ArcFlag::Approach, ArcFlag::Start) => "approach",
-                (ArcFlag::End, ArcFlag::Retract) => "retract",
-                _ if !scene.transits => continue,
-                _ => "arc-off transit",
-            };
-            self.run(
-                Sample {
-                    q: &a.joints,
-                    qp: a.positioner,
-                },
-                Sample {
-                    q: &b.joints,
-                    qp: b.positioner,
-                },
-                false,
-                &Place {
-                    layer: b.layer,
-                    point: Some(b.point),
-                    motion,
-                },
-            )?;
-        }
-        if let (Some(h), Some(last)) = (home.filter(|_| scene.transits), pts.last()) {
-            self.run(
-                Sample {
-                    q: &last.joints,
-                    qp: last.positioner,
-                },
-                Sample {
-                    q: &h.joints,
-                    qp: h.positioner,
-                },
-                false,
-                &Place {
-                    layer: last.layer,
-                    point: None,
-                    motion: "home move",
-                },
-            )?;
-        }
-        Ok(())
-    }
-
-    /// What the walk measured: per layer (in layer order) its closest
-    /// approach and pair, and the counts.
-    fn finish(self) -> CellClearance {
-        let mut stats = self.stats;
-        stats.layers = self
-            .per_layer
-            .into_iter()
-            .map(|(layer, c)| LayerCellClearance {
-                layer,
-                closest_approach_mm: c.distance_mm,
-                closest_pair: c.pair,
-            })
-            .collect();
-        stats.layers.sort_by_key(|l| l.layer);
-        stats
     }
 }
 
@@ -1156,4 +948,27 @@ fn refusal(place: &Place, hit: (String, String, f64), clearance: f64) -> Program
         distance_mm: hit.2,
         clearance_mm: clearance,
     }
+}
+
+/// The distance between two bodies (mm), as parry's `query::distance`
+/// answers it: for a hull, its support function is the clustered one
+/// ([`ClusteredHull`]: the same vertices), called the way parry's
+/// dispatcher calls it for two support-mapped shapes (no pair of the check
+/// holds a ball, two cuboids, two segments or a half-space).
+fn exact_distance(a: &Body, b: &Body) -> Result<f64, query::Unsupported> {
+    if a.support.is_none() && b.support.is_none() {
+        return query::distance(&a.pose, a.shape, &b.pose, b.shape);
+    }
+    let s1: &dyn SupportMap = match a.support {
+        Some(h) => h,
+        None => a.shape.as_support_map().ok_or(query::Unsupported)?,
+    };
+    let s2: &dyn SupportMap = match b.support {
+        Some(h) => h,
+        None => b.shape.as_support_map().ok_or(query::Unsupported)?,
+    };
+    let pos12 = a.pose.inv_mul(&b.pose);
+    Ok(query::details::distance_support_map_support_map(
+        &pos12, s1, s2,
+    ))
 }
