@@ -10,6 +10,8 @@
 
 use std::sync::OnceLock;
 
+use parry3d_f64::bounding_volume::Aabb;
+
 use crate::math::{Point3, Vector3};
 use crate::robot::{CellLayout, Joints};
 use crate::toolaxis::collision::{Torch, Wall};
@@ -349,7 +351,18 @@ impl TransitWall for WallPrefix<'_> {
         tool: &Vector3,
         margin_mm: f64,
     ) -> Result<bool, ToolAxisError> {
+        // a block whose segments' box lies farther from the torch's box than
+        // the margin and the capsules' radius is clear without asking parry
+        // (which would bound the same boxes, once per block); the slack
+        // keeps the skip off parry's rounding at that distance
+        let torch_box = torch.bounds(point, tool);
+        let reach = margin_mm + self.bead_radius_mm.max(0.0) + BOX_SLACK_MM;
         for b in self.blocks() {
+            if b.segment_bounds()
+                .is_some_and(|bb| box_gap(&bb, &torch_box) > reach)
+            {
+                continue;
+            }
             if !b.is_clear_with_radius(torch, point, tool, margin_mm, self.bead_radius_mm)? {
                 return Ok(false);
             }
@@ -377,6 +390,16 @@ impl TransitWall for WallPrefix<'_> {
         }
         Ok(axis - self.bead_radius_mm.max(0.0))
     }
+}
+
+/// How far beyond the margin a block's box must lie for
+/// [`WallPrefix`]'s `is_clear` to skip it (mm).
+const BOX_SLACK_MM: f64 = 1e-6;
+
+/// The distance between two boxes (mm; 0 when they overlap).
+fn box_gap(a: &Aabb, b: &Aabb) -> f64 {
+    let gap = Vector3::from_fn(|i, _| (a.mins[i] - b.maxs[i]).max(b.mins[i] - a.maxs[i]).max(0.0));
+    gap.norm()
 }
 
 fn point_segment_distance(p: &Point3, a: &Point3, b: &Point3) -> f64 {

@@ -14,26 +14,32 @@ use parry3d_f64::shape::{ConvexPolyhedron, SupportMap};
 
 use crate::math::{Point3, Vector3};
 
-/// Most vertices a cluster holds before it is split.
+/// Fewest vertices a cluster may hold before it is split.
 const CLUSTER_SIZE: usize = 8;
+
+/// Most clusters of a hull: larger hulls get larger clusters.
+const MAX_CLUSTERS: usize = 32;
 
 /// Relative rounding slack of the culling (of `|p| |dir|`): a dot product of
 /// three terms is computed within a few units of 1e-16 of it.
 const SLACK: f64 = 1e-9;
 
-/// One cluster: its vertices (indices into the hull's points, ascending)
-/// and their bounding sphere (hull frame, mm).
+/// One cluster: its bounding sphere (hull frame, mm) and its range in
+/// [`ClusteredHull::members`].
 #[derive(Debug, Clone)]
 struct Cluster {
     centre: Vector3,
     radius: f64,
-    members: Vec<usize>,
+    members: std::ops::Range<usize>,
 }
 
 /// A convex hull's vertices in clusters (hull frame, mm).
 #[derive(Debug, Clone)]
 pub(super) struct ClusteredHull {
     points: Vec<Point3>,
+    /// The vertices cluster by cluster, each with its index in `points`
+    /// (ascending within a cluster).
+    members: Vec<(Vector3, usize)>,
     clusters: Vec<Cluster>,
     /// The largest `|p|` over the vertices plus one (mm): the scale of the
     /// rounding slack.
@@ -42,16 +48,19 @@ pub(super) struct ClusteredHull {
 
 impl ClusteredHull {
     /// The clusters of `hull`'s vertices: split at the median along the
-    /// longest side of their box until at most [`CLUSTER_SIZE`] each.
+    /// longest side of their box until small enough, at most
+    /// [`MAX_CLUSTERS`] of them.
     pub(super) fn new(hull: &ConvexPolyhedron) -> Self {
         let points = hull.points().to_vec();
+        let cap = CLUSTER_SIZE.max(points.len().div_ceil(MAX_CLUSTERS / 2));
         let mut clusters = Vec::new();
+        let mut members = Vec::with_capacity(points.len());
         let mut stack = vec![(0..points.len()).collect::<Vec<usize>>()];
         while let Some(mut idx) = stack.pop() {
             if idx.is_empty() {
                 continue;
             }
-            if idx.len() <= CLUSTER_SIZE {
+            if idx.len() <= cap {
                 idx.sort_unstable();
                 let n = idx.len() as f64;
                 let centre = idx.iter().map(|&i| points[i].coords).sum::<Vector3>() / n;
@@ -59,10 +68,12 @@ impl ClusteredHull {
                     .iter()
                     .map(|&i| (points[i].coords - centre).norm())
                     .fold(0.0, f64::max);
+                let first = members.len();
+                members.extend(idx.iter().map(|&i| (points[i].coords, i)));
                 clusters.push(Cluster {
                     centre,
                     radius,
-                    members: idx,
+                    members: first..members.len(),
                 });
                 continue;
             }
@@ -82,6 +93,7 @@ impl ClusteredHull {
         let scale = 1.0 + points.iter().map(|p| p.coords.norm()).fold(0.0, f64::max);
         Self {
             points,
+            members,
             clusters,
             scale,
         }
@@ -89,33 +101,57 @@ impl ClusteredHull {
 
     /// The index of the vertex parry's scan returns along `dir`.
     fn support_id(&self, dir: &Vector3) -> usize {
-        if !dir.iter().all(|v| v.is_finite()) || self.clusters.is_empty() {
-            // parry's scan: no dot product beats the first vertex's
-            return 0;
+        let count = self.clusters.len();
+        if !dir.iter().all(|v| v.is_finite()) || count == 0 || count > MAX_CLUSTERS {
+            // parry's scan: no dot product beats the first vertex's with a
+            // direction not finite
+            return crate_scan(&self.points, dir);
         }
         let len = dir.norm();
         let slack = SLACK * self.scale * len;
-        let bound = |c: &Cluster| c.centre.dot(dir) + c.radius * len;
-        let first = (0..self.clusters.len())
-            .max_by(|&a, &b| bound(&self.clusters[a]).total_cmp(&bound(&self.clusters[b])))
-            .unwrap_or(0);
-        let mut best = (f64::NEG_INFINITY, usize::MAX);
-        let scan = |c: &Cluster, best: &mut (f64, usize)| {
-            for &i in &c.members {
-                let d = self.points[i].coords.dot(dir);
-                if d > best.0 || (d == best.0 && i < best.1) {
-                    *best = (d, i);
-                }
-            }
-        };
-        scan(&self.clusters[first], &mut best);
+        let mut bounds = [0.0; MAX_CLUSTERS];
+        let mut first = 0;
         for (k, c) in self.clusters.iter().enumerate() {
-            if k != first && bound(c) + slack >= best.0 {
-                scan(c, &mut best);
+            bounds[k] = c.centre.dot(dir) + c.radius * len;
+            if bounds[k] > bounds[first] {
+                first = k;
+            }
+        }
+        let mut best = (f64::NEG_INFINITY, usize::MAX);
+        self.scan(&self.clusters[first], dir, &mut best);
+        for (k, c) in self.clusters.iter().enumerate() {
+            if k != first && bounds[k] + slack >= best.0 {
+                self.scan(c, dir, &mut best);
             }
         }
         best.1
     }
+
+    /// Raises `best` (dot product, index) to the cluster's best vertex, the
+    /// lower index among equals.
+    fn scan(&self, c: &Cluster, dir: &Vector3, best: &mut (f64, usize)) {
+        for (p, i) in &self.members[c.members.clone()] {
+            let d = p.dot(dir);
+            if d > best.0 || (d == best.0 && *i < best.1) {
+                *best = (d, *i);
+            }
+        }
+    }
+}
+
+/// parry's scan (`point_cloud_support_point_id`): the first vertex of the
+/// largest dot product.
+fn crate_scan(points: &[Point3], dir: &Vector3) -> usize {
+    let mut best = 0;
+    let mut best_dot = points.first().map_or(0.0, |p| p.coords.dot(dir));
+    for (i, p) in points.iter().enumerate().skip(1) {
+        let d = p.coords.dot(dir);
+        if d > best_dot {
+            best_dot = d;
+            best = i;
+        }
+    }
+    best
 }
 
 impl SupportMap for ClusteredHull {

@@ -265,6 +265,12 @@ impl Wall {
         }
     }
 
+    /// The box around the beads' segments (part frame, mm; the capsules'
+    /// radius not included); `None` without a bead.
+    pub fn segment_bounds(&self) -> Option<Aabb> {
+        self.obstacles.built.as_ref().map(Polyline::local_aabb)
+    }
+
     /// `true` when there is no bead.
     pub fn is_empty(&self) -> bool {
         self.obstacles.built.is_none()

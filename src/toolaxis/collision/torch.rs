@@ -4,6 +4,7 @@
 
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, UnitVector3, Vector3};
 use crate::toolaxis::ToolAxisError;
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::shape::{ConvexPolyhedron, Cylinder, Shape};
 use serde::{Deserialize, Serialize};
 
@@ -179,6 +180,18 @@ fn frustum_points(r0: f64, z0: f64, r1: f64, z1: f64) -> Vec<Point3> {
 }
 
 impl Torch {
+    /// The box (part frame, mm) around every convex part of the torch with
+    /// its tip at `point` and its axis along `tool` (unit, towards the
+    /// torch; part frame), as parry bounds each part at that pose.
+    pub fn bounds(&self, point: &Point3, tool: &Vector3) -> Aabb {
+        let pose = part_from_torch(point, tool);
+        self.parts
+            .iter()
+            .map(|(local, part)| part.shape().compute_aabb(&(pose * local)))
+            .reduce(|a, b| a.merged(&b))
+            .unwrap_or_else(|| Aabb::new(*point, *point))
+    }
+
     /// Builds the collision shapes of a torch.
     ///
     /// # Errors
