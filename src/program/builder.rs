@@ -444,11 +444,33 @@ fn safe_transits(
             layers: vec![from.layer],
         })
     };
-    let first: Vec<Result<transit::TransitClearance, ProgramError>> =
-        (0..n).into_par_iter().map(|k| check(program, k)).collect();
+    // whether a transit touches, stopping at its first sample that does;
+    // the deepest sample only for a refusal's text
+    let touches = |program: &Program, k: usize| -> Result<bool, ProgramError> {
+        let Some((qb, pb)) = target(program, k) else {
+            return Ok(false);
+        };
+        let wall = decimated.wall(k + 1, opts.bead_radius_mm);
+        let from = &program.points[blocks[k].last];
+        transit::joint_move_touches(
+            &program.cell,
+            &wall,
+            &torch,
+            (&from.joints, from.positioner),
+            (&qb, pb),
+        )
+        .map_err(|e| ProgramError::Infeasible {
+            count: 1,
+            first: format!("layer {}: transit check: {e}", from.layer),
+            layers: vec![from.layer],
+        })
+    };
+    let first: Vec<Result<bool, ProgramError>> = (0..n)
+        .into_par_iter()
+        .map(|k| touches(program, k))
+        .collect();
     for (k, r) in first.into_iter().enumerate() {
-        let r = r?;
-        if r.min_clearance_mm > 0.0 {
+        if !r? {
             continue;
         }
         let layer = program.points[blocks[k].end].layer;
@@ -460,7 +482,7 @@ fn safe_transits(
         let layers: Vec<usize> = std::iter::once(layer)
             .chain(next_layer.filter(|&l| l != layer))
             .collect();
-        let refuse = |why: String| ProgramError::Infeasible {
+        let refuse = |r: transit::TransitClearance, why: String| ProgramError::Infeasible {
             count: 1,
             first: format!(
                 "layer {layer}: the arc-off joint move to {to_what} passes {:.1} mm into the \
@@ -480,6 +502,7 @@ fn safe_transits(
             .filter(|b| program.points[b.first].arc == ArcFlag::Approach);
         if opts.clearance_mm <= 0.0 || !has_retract {
             return Err(refuse(
+                check(program, k)?,
                 " and the program has no retract points to raise (clearance_mm = 0)".into(),
             ));
         }
@@ -517,7 +540,7 @@ fn safe_transits(
             if let Some((i, a)) = approach {
                 program.points[i] = a;
             }
-            if check(program, k)?.min_clearance_mm > 0.0 {
+            if !touches(program, k)? {
                 fixed = true;
             } else {
                 program.points[blocks[k].last] = old_retract;
@@ -527,11 +550,15 @@ fn safe_transits(
             }
         }
         if !fixed {
-            return Err(refuse(format!(
+            // the program is as it was: the deepest sample of the transit
+            return Err(refuse(
+                check(program, k)?,
+                format!(
                 ", even with the retract and approach points raised up to {} mm along the tool \
                  axis (transit_max_clearance_mm)",
                 opts.transit_max_clearance_mm
-            )));
+            ),
+            ));
         }
     }
     Ok(())

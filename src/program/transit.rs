@@ -89,16 +89,61 @@ pub fn joint_move_clearance(
     cell: &CellLayout,
     wall: &(impl TransitWall + ?Sized),
     torch: &Torch,
-    (qa, pa): (&Joints, Option<[f64; 2]>),
-    (qb, pb): (&Joints, Option<[f64; 2]>),
+    a: (&Joints, Option<[f64; 2]>),
+    b: (&Joints, Option<[f64; 2]>),
 ) -> Result<TransitClearance, String> {
     let mut best = TransitClearance {
         min_clearance_mm: f64::INFINITY,
         at_fraction: 0.0,
         tip_mm: Point3::origin(),
     };
+    walk_joint_move(cell, wall, torch, a, b, |s, c, tip| {
+        if c < best.min_clearance_mm {
+            best = TransitClearance {
+                min_clearance_mm: c,
+                at_fraction: s,
+                tip_mm: tip,
+            };
+        }
+        true
+    })?;
+    Ok(best)
+}
+
+/// Whether the torch touches `wall` along the joint move from `(qa, pa)`
+/// to `(qb, pb)`: [`joint_move_clearance`]'s `min_clearance_mm <= 0`, from
+/// the same samples, stopping at the first that touches.
+///
+/// # Errors
+/// As [`joint_move_clearance`].
+pub fn joint_move_touches(
+    cell: &CellLayout,
+    wall: &(impl TransitWall + ?Sized),
+    torch: &Torch,
+    a: (&Joints, Option<[f64; 2]>),
+    b: (&Joints, Option<[f64; 2]>),
+) -> Result<bool, String> {
+    let mut touches = false;
+    walk_joint_move(cell, wall, torch, a, b, |_, c, _| {
+        touches = c <= 0.0;
+        !touches
+    })?;
+    Ok(touches)
+}
+
+/// The samples of a joint move ([`joint_move_clearance`]): at each where
+/// the torch is not clear of the wall, `seen(fraction, clearance_mm, tip)`,
+/// which returns whether to go on.
+fn walk_joint_move(
+    cell: &CellLayout,
+    wall: &(impl TransitWall + ?Sized),
+    torch: &Torch,
+    (qa, pa): (&Joints, Option<[f64; 2]>),
+    (qb, pb): (&Joints, Option<[f64; 2]>),
+    mut seen: impl FnMut(f64, f64, Point3) -> bool,
+) -> Result<(), String> {
     if wall.is_empty() {
-        return Ok(best);
+        return Ok(());
     }
     let mut largest = qa
         .iter()
@@ -128,15 +173,11 @@ pub fn joint_move_clearance(
         let c = wall
             .clearance(torch, &tip, &axis)
             .map_err(|e| e.to_string())?;
-        if c < best.min_clearance_mm {
-            best = TransitClearance {
-                min_clearance_mm: c,
-                at_fraction: s,
-                tip_mm: tip,
-            };
+        if !seen(s, c, tip) {
+            break;
         }
     }
-    Ok(best)
+    Ok(())
 }
 
 /// The wall of `beads` (part frame, mm) for a transit check, as one
