@@ -25,6 +25,7 @@ criterion_group!(
     optimise::plan_at_scale,
     optimise::torch_vs_part_carried,
     place::hemisphere_in_kuka_part_carried,
-    program::readers
+    program::readers,
+    program::late_stages
 );
 criterion_main!(benches);
