@@ -98,10 +98,9 @@ pub fn late_stages(c: &mut Criterion) {
                         let planned = waam_slicer::plan_part(black_box(&p), &c, &opts).unwrap();
                         assert!(planned.program.is_ok(), "{part} in {cell}: no program");
                         let t = planned.times;
-                        ratios.borrow_mut().push([
-                            stage(&t, 1) / t.optimise,
-                            stage(&t, 2) / t.optimise,
-                        ]);
+                        ratios
+                            .borrow_mut()
+                            .push([stage(&t, 1) / t.optimise, stage(&t, 2) / t.optimise]);
                         total += Duration::from_secs_f64(stage(&t, which));
                     }
                     total

@@ -1,6 +1,6 @@
 //! **The whole cell checked for collisions** along a program's motions.
-//! Takes a [`Program`] (its approach, retract, transit and home moves), the
-//! planned joints of every bead point (a [`JointTrajectory`]: what the
+//! Takes a [`Program`](crate::program::Program) (its approach, retract, transit and home moves), the
+//! planned joints of every bead point (a [`JointTrajectory`](crate::robot::trajectory::JointTrajectory): what the
 //! thinned moves stay within `path_tolerance_mm` of), the layers (part
 //! frame, mm: the part's wall so far) and the cell's [`CellScene`] (robot
 //! base frame, mm); returns a [`CellClearance`] (the closest approach per
