@@ -70,6 +70,11 @@ const MAX_START_TILT_TAN: f64 = 10.0;
 /// cuts the tube inside the range.
 const EXTEND_BEFORE_MARGIN_MM: f64 = 1.0;
 
+/// Most knots a guide may have (dimensionless): the refit's least-squares
+/// system is dense in them (a thousand take about a second), and a mesh with
+/// one vertex metres away from its tube would otherwise ask for millions.
+const MAX_KNOTS: f64 = 1000.0;
+
 /// A station whose ring of points leaves a gap wider than this around its
 /// circle (degrees) takes its neighbours' points too: fewer than six points
 /// around, as rings of a coarse mesh between its stations give.
@@ -158,6 +163,17 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
         iterations += 1;
         let spline = spline_of(mesh, &guide)?;
         let range = tube_range(&guide);
+        let knots = (range.1 - range.0) / knot_h;
+        if knots > MAX_KNOTS {
+            return Err(FitError::Degenerate {
+                file: mesh.file.clone(),
+                station: 0,
+                reason: format!(
+                    "the guide is {:.1} mm long for an end radius of {r0:.3} mm: {knots:.0} knots {knot_h:.2} mm apart, over the limit of {MAX_KNOTS:.0} (a vertex far from the tube? a longer tube fits with a larger knot_spacing_mm)",
+                    range.1 - range.0
+                ),
+            });
+        }
         let t = project_all(
             &spline,
             range,

@@ -426,3 +426,19 @@ fn binary_and_ascii_stl_files_give_the_same_fit() {
     assert!(json["stations"].as_array().unwrap().len() > 10);
     Part::read(&files[0]).unwrap();
 }
+
+/// A vertex a kilometre from a 12 mm pipe (the fuzzer's `fit_stl` found one
+/// that took minutes in the refit): refused, naming the guide's length and
+/// the knot limit.
+#[test]
+fn a_vertex_far_from_the_tube_is_refused_naming_the_knot_limit() {
+    let truth = gen::straight();
+    let (mut v, f) = gen::mesh(&truth, 2.0, 0.0, 0.0, 3);
+    v[5].x += 1e6;
+    let e = fit_mesh(v, f, "far.stl", &FitOptions::default()).unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("far.stl") && text.contains("over the limit of 1000"),
+        "{text}"
+    );
+}
