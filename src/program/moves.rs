@@ -165,19 +165,23 @@ pub fn thin_beads(
             frame.rotation * crate::math::Vector3::z(),
         )
     };
-    let mut report = Thinning::default();
-    let mut kept: Vec<ProgramPoint> = Vec::with_capacity(program.points.len());
     let points = std::mem::take(&mut program.points);
+    // the beads (arc start ..= arc end), each thinned on its own, in
+    // parallel; then the program rebuilt in order
+    let mut beads: Vec<(usize, usize)> = Vec::new();
     let mut i = 0;
     while i < points.len() {
         if points[i].arc != ArcFlag::Start {
-            kept.push(points[i]);
             i += 1;
             continue;
         }
         let end = (i..points.len())
             .find(|&k| points[k].arc == ArcFlag::End)
             .unwrap_or(points.len() - 1);
+        beads.push((i, end));
+        i = end + 1;
+    }
+    let thin_one = |&(i, end): &(usize, usize)| -> Result<_, ProgramError> {
         let bead = &points[i..=end];
         let poses: Vec<ControllerPose> = bead
             .iter()
@@ -227,6 +231,19 @@ pub fn thin_beads(
             start = m.to();
         }
         c.moves = moves;
+        Ok(c)
+    };
+    let thinned: Vec<_> = {
+        use rayon::prelude::*;
+        beads.par_iter().map(thin_one).collect()
+    };
+    let mut report = Thinning::default();
+    let mut kept: Vec<ProgramPoint> = Vec::with_capacity(points.len());
+    let mut next = 0;
+    for (&(i, end), c) in beads.iter().zip(thinned) {
+        let c = c?;
+        kept.extend_from_slice(&points[next..i]);
+        let bead = &points[i..=end];
         report.bead_points_before += bead.len();
         report.max_path_error_mm = report.max_path_error_mm.max(c.max_path_error_mm);
         report.max_orientation_error_deg = report
@@ -244,8 +261,9 @@ pub fn thin_beads(
             kept.push(bead[m.to()]);
         }
         report.bead_points_after += c.programmed_indices().len();
-        i = end + 1;
+        next = end + 1;
     }
+    kept.extend_from_slice(&points[next..]);
     program.points = kept;
     Ok(Some(report))
 }

@@ -71,9 +71,7 @@ use parry3d_f64::query;
 use parry3d_f64::shape::{Capsule, ConvexPolyhedron, Cuboid, Cylinder, Shape, SupportMap};
 use serde::{Deserialize, Serialize};
 
-mod support;
 mod walk;
-use support::ClusteredHull;
 pub use walk::check_cell;
 
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
@@ -81,6 +79,7 @@ use crate::optimise::LayerPoints;
 use crate::program::ProgramError;
 use crate::robot::chain::arm_chain;
 use crate::robot::{CellLayout, Joints, RobotModel};
+use crate::toolaxis::collision::support::ClusteredHull;
 
 /// Default `[program] collision_clearance_mm` (mm).
 pub const DEFAULT_CLEARANCE_MM: f64 = 10.0;

@@ -25,9 +25,11 @@
 //! | the torch model ([`TorchSpec`], [`Torch`], [`part_from_torch`]) | `torch` |
 //! | clearance along a path ([`check_collisions`]) | `clearance` |
 //! | avoidance within a cone ([`avoid_collisions`]) | `avoid` |
+//! | hulls' support function over clustered vertices (parry's answers, faster) | `support` |
 
 mod avoid;
 mod clearance;
+pub(crate) mod support;
 mod torch;
 
 pub use avoid::{avoid_collisions, AvoidanceOptions, AvoidanceReport};

@@ -2,6 +2,7 @@
 //! the deposition point, `+Z` along the tool axis; mm), from a coaxial
 //! nozzle-and-body description or an STL hull, and its pose at a path point.
 
+use super::support::SupportedHull;
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, UnitVector3, Vector3};
 use crate::toolaxis::ToolAxisError;
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
@@ -143,7 +144,7 @@ pub struct Torch {
 /// One convex part of a torch.
 #[derive(Clone)]
 pub(super) enum TorchPart {
-    Hull(ConvexPolyhedron),
+    Hull(SupportedHull),
     Cylinder(Cylinder),
 }
 
@@ -199,10 +200,12 @@ impl Torch {
     pub fn new(spec: &TorchSpec) -> Result<Self, ToolAxisError> {
         spec.validate()?;
         let hull = |pts: &[Point3], field: &'static str| {
-            ConvexPolyhedron::from_convex_hull(pts).ok_or_else(|| ToolAxisError::InvalidTorch {
-                field,
-                reason: "degenerate (flat) convex hull".into(),
-            })
+            ConvexPolyhedron::from_convex_hull(pts)
+                .map(SupportedHull::new)
+                .ok_or_else(|| ToolAxisError::InvalidTorch {
+                    field,
+                    reason: "degenerate (flat) convex hull".into(),
+                })
         };
         let parts = match spec {
             TorchSpec::Nozzle {
