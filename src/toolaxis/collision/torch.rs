@@ -144,14 +144,14 @@ pub struct Torch {
 /// One convex part of a torch.
 #[derive(Clone)]
 pub(super) enum TorchPart {
-    Hull(SupportedHull),
+    Hull(Box<SupportedHull>),
     Cylinder(Cylinder),
 }
 
 impl TorchPart {
     pub(super) fn shape(&self) -> &dyn Shape {
         match self {
-            TorchPart::Hull(h) => h,
+            TorchPart::Hull(h) => h.as_ref(),
             TorchPart::Cylinder(c) => c,
         }
     }
@@ -201,7 +201,7 @@ impl Torch {
         spec.validate()?;
         let hull = |pts: &[Point3], field: &'static str| {
             ConvexPolyhedron::from_convex_hull(pts)
-                .map(SupportedHull::new)
+                .map(|h| Box::new(SupportedHull::new(h)))
                 .ok_or_else(|| ToolAxisError::InvalidTorch {
                     field,
                     reason: "degenerate (flat) convex hull".into(),
