@@ -47,6 +47,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 build_direction: Some(UnitVector3::new_normalize(f.build)),
                 r_z: -v,
                 positioner: None,
+                bead: 0,
             });
         }
     }

@@ -99,6 +99,7 @@ pub fn hemisphere_trajectory(c: &mut Criterion) {
                 build_direction: None,
                 positioner: None,
                 r_z: -v,
+                bead: 0,
             });
         }
     }

@@ -1,14 +1,18 @@
 //! `joints.csv`: one row per planned point, header
 //! `layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6` (+ `e1,e2` with a
-//! positioner) `,travel_speed_mm_s,bead_height_mm`. Position (mm) and tool
+//! positioner) `,travel_speed_mm_s,bead_height_mm,bead`. Position (mm) and tool
 //! axis in the part frame, `R_Z` and joints in degrees, joints in the
 //! robot's controller convention (FANUC J2/J3 for FANUC arms); a point
 //! without a joint solution has empty joint cells. The last two columns are
 //! the travel speed the program runs on the way to the point (mm/s) and the
 //! bead height the plan asks for there (mm: the point's local distance to
 //! the layer below, `Delta` on the first layer); every plan writes them, a
-//! replanned one ([`crate::replan`]) with its corrected values. Also reads
-//! such a file back (files without the last two columns too).
+//! replanned one ([`crate::replan`]) with its corrected values. The `bead`
+//! column numbers the beads of a layer: 0 for its first (or only) one, one
+//! more at each split at a corner, whose point is written once in each of
+//! the two beads ([`crate::optimise::split`]). Also reads such a file back
+//! (files without the `bead` column, or without the process columns and
+//! it, too).
 
 use std::io::Write;
 
@@ -20,6 +24,9 @@ pub const HEADER: &str = "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6";
 
 /// The process columns, last on every line (after `e1,e2` when present).
 pub const PROCESS_COLUMNS: &str = "travel_speed_mm_s,bead_height_mm";
+
+/// The bead column, last on every line written (after the process columns).
+pub const BEAD_COLUMN: &str = "bead";
 
 /// Writes `plan`'s points (made from `layers`); `positioner` adds `e1,e2`;
 /// `process[i][m]` is `[travel speed (mm/s), bead height (mm)]` of point `m`
@@ -39,7 +46,7 @@ pub fn write_joints_csv(
 ) -> std::io::Result<()> {
     write!(w, "{HEADER}")?;
     write!(w, "{}", if positioner { ",e1,e2" } else { "" })?;
-    writeln!(w, ",{PROCESS_COLUMNS}")?;
+    writeln!(w, ",{PROCESS_COLUMNS},{BEAD_COLUMN}")?;
     let mut row: Vec<u8> = Vec::with_capacity(256);
     for (i, (lp, l)) in layers.iter().zip(&plan.layers).enumerate() {
         for (m, (cp, pp)) in lp.points.iter().zip(&l.points).enumerate() {
@@ -50,7 +57,7 @@ pub fn write_joints_csv(
                 &mut row,
                 &Row {
                     layer: lp.layer,
-                    point: m,
+                    point: lp.first_point + m,
                     position_mm: [p.x, p.y, p.z],
                     tool_axis: [t.x, t.y, t.z],
                     rz_rad: pp.r_z,
@@ -61,6 +68,7 @@ pub fn write_joints_csv(
                         None
                     },
                     process: process.get(i).and_then(|l| l.get(m)).copied(),
+                    bead: lp.bead,
                 },
             );
             w.write_all(&row)?;
@@ -81,6 +89,8 @@ struct Row {
     positioner_rad: Option<Option<[f64; 2]>>,
     /// Travel speed (mm/s) and bead height (mm); `None`: empty cells.
     process: Option<[f64; 2]>,
+    /// The bead within the layer.
+    bead: usize,
 }
 
 /// Appends `r` as a line of `joints.csv` (degrees, 6 decimals).
@@ -122,6 +132,8 @@ fn push_row(out: &mut Vec<u8>, r: &Row) {
         }
         _ => out.extend_from_slice(b",,"),
     }
+    out.push(b',');
+    push_u64(out, r.bead as u64);
     out.push(b'\n');
 }
 
@@ -147,6 +159,9 @@ pub struct JointsRow {
     pub travel_speed_mm_s: Option<f64>,
     /// Bead height asked for at the point (mm); `None` as above.
     pub bead_height_mm: Option<f64>,
+    /// The bead within the layer (0 for its first, one more at each split
+    /// at a corner; 0 when the file has no `bead` column).
+    pub bead: usize,
 }
 
 /// Error reading `joints.csv`, naming the file, line and column.
@@ -173,8 +188,15 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
         reason,
     };
     let mut lines = text.lines().enumerate();
-    let (header, with_process) = match lines.next() {
-        Some((_, h)) => match h.strip_suffix(&format!(",{PROCESS_COLUMNS}")) {
+    let (header, with_bead) = match lines.next() {
+        Some((_, h)) => match h.strip_suffix(&format!(",{BEAD_COLUMN}")) {
+            Some(rest) => (Some(rest), true),
+            None => (Some(h), false),
+        },
+        None => (None, false),
+    };
+    let (header, with_process) = match header {
+        Some(h) => match h.strip_suffix(&format!(",{PROCESS_COLUMNS}")) {
             Some(rest) => (rest, true),
             None => (h, false),
         },
@@ -186,7 +208,7 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
         _ => {
             return Err(err(
                 1,
-                format!("expected the header `{HEADER}` (with `,e1,e2` for a positioner), then `,{PROCESS_COLUMNS}`"),
+                format!("expected the header `{HEADER}` (with `,e1,e2` for a positioner), then `,{PROCESS_COLUMNS},{BEAD_COLUMN}`"),
             ))
         }
     };
@@ -206,6 +228,7 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
         } else {
             Vec::new()
         })
+        .chain(with_bead.then_some(BEAD_COLUMN))
         .collect();
     let process_at = 15 + if positioner { 2 } else { 0 };
     let mut rows = Vec::new();
@@ -272,6 +295,11 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
             rz_deg: need(8)?,
             joints_deg,
             positioner_deg,
+            bead: if with_bead {
+                index(names.len() - 1)?
+            } else {
+                0
+            },
             travel_speed_mm_s: if with_process { num(process_at)? } else { None },
             bead_height_mm: if with_process {
                 num(process_at + 1)?
@@ -312,6 +340,7 @@ mod tests {
             Some(v) => v.iter().for_each(|x| s += &format!(",{x:.6}")),
             None => s += ",,",
         }
+        s += &format!(",{}", r.bead);
         s
     }
 
@@ -339,6 +368,7 @@ mod tests {
                     _ => Some(Some([next(3.2), next(6.4)])),
                 },
                 process: (i % 5 != 2).then(|| [next(20.0).abs(), next(3.0).abs()]),
+                bead: i % 3,
             };
             let mut ours = Vec::new();
             push_row(&mut ours, &r);
@@ -382,6 +412,7 @@ mod tests {
                 joints_rad: None,
                 positioner_rad: Some(None),
                 process: None,
+                bead: 0,
             },
             Row {
                 layer: 2,
@@ -392,15 +423,16 @@ mod tests {
                 joints_rad: Some([0.1, -0.2, 0.3, -0.4, 0.5, -3.0]),
                 positioner_rad: Some(Some([-0.5, 1.5])),
                 process: Some([8.5, 1.75]),
+                bead: 1,
             },
         ];
-        let mut text = format!("{HEADER},e1,e2,{PROCESS_COLUMNS}\n").into_bytes();
+        let mut text = format!("{HEADER},e1,e2,{PROCESS_COLUMNS},{BEAD_COLUMN}\n").into_bytes();
         for r in &rows {
             push_row(&mut text, r);
         }
         let text = String::from_utf8(text).unwrap();
         assert!(
-            text.contains("\n2,7,1045.747000,-630.155000,0.500000,0.000000,0.000000,1.000000,-90.000000,,,,,,,,,,\n"),
+            text.contains("\n2,7,1045.747000,-630.155000,0.500000,0.000000,0.000000,1.000000,-90.000000,,,,,,,,,,,0\n"),
             "{text}"
         );
         let back = read_joints_csv(&text, "joints.csv").unwrap();
@@ -413,14 +445,21 @@ mod tests {
         assert_eq!(back[0].travel_speed_mm_s, None);
         assert_eq!(back[1].travel_speed_mm_s, Some(8.5));
         assert_eq!(back[1].bead_height_mm, Some(1.75));
-        // a file written before the process columns still reads
-        let old: String = text
-            .lines()
-            .map(|l| {
-                let cells: Vec<&str> = l.split(',').collect();
-                cells[..cells.len() - 2].join(",") + "\n"
-            })
-            .collect();
+        assert_eq!((back[0].bead, back[1].bead), (0, 1));
+        // files written before the bead column, and before the process
+        // columns, still read
+        let without = |columns: usize| -> String {
+            text.lines()
+                .map(|l| {
+                    let cells: Vec<&str> = l.split(',').collect();
+                    cells[..cells.len() - columns].join(",") + "\n"
+                })
+                .collect()
+        };
+        let back = read_joints_csv(&without(1), "joints.csv").unwrap();
+        assert_eq!(back[1].bead_height_mm, Some(1.75));
+        assert_eq!(back[1].bead, 0);
+        let old = without(3);
         let back = read_joints_csv(&old, "joints.csv").unwrap();
         assert_eq!(back[1].bead_height_mm, None);
         assert!((back[1].positioner_deg.unwrap()[1] - 1.5f64.to_degrees()).abs() < 1e-6);

@@ -28,6 +28,7 @@
 //! | the point-by-point baseline [§4.1.4] | `point_by_point` | — |
 //! | a layer's status, objective figures and quality | `report` | — |
 //! | spiral paths, turn by turn | `spiral` | [`optimise_spiral`] |
+//! | a refused layer split into beads at its corners (torch-carried cell) | [`split`] | [`split_refused_layers`] |
 //! | the driver | here | [`optimise`], [`layer_points`], [`trajectory_inputs`] |
 //!
 //! How a layer is solved:
@@ -103,7 +104,7 @@
 //!         }
 //!     })
 //!     .collect();
-//! let plan = optimise(&cell, &[LayerPoints { layer: 0, points }], &OptimiseOptions::default()).unwrap();
+//! let plan = optimise(&cell, &[LayerPoints::whole(0, points)], &OptimiseOptions::default()).unwrap();
 //! assert!(plan.is_feasible());
 //! ```
 
@@ -121,6 +122,7 @@ mod report;
 mod seed;
 mod setup;
 mod spiral;
+pub mod split;
 mod sqp;
 mod subsample;
 #[cfg(test)]
@@ -136,6 +138,7 @@ pub use outcome::{
 };
 
 pub use spiral::optimise_spiral;
+pub use split::{split_refused_layers, BeadSplit, SplitPlan};
 
 use std::time::Instant;
 
@@ -150,21 +153,86 @@ use crate::toolaxis::LocalFrame;
 use branch::optimise_layer;
 use report::limit_distance;
 
-/// The points of one layer, as the cells see them (part frame).
+/// The points of one layer, or of one bead of a layer split at its corners
+/// ([`LayerPoints::split_at`]), as the cells see them (part frame).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LayerPoints {
     /// Layer index (reported back).
     pub layer: usize,
+    /// The bead within the layer: 0 for a layer's first (or only) bead, one
+    /// more at each split.
+    pub bead: usize,
+    /// Index, in the layer, of the first of `points` (0 for a whole layer).
+    pub first_point: usize,
     /// The points in deposition order.
     pub points: Vec<CellPoint>,
 }
 
 impl LayerPoints {
+    /// A whole layer: bead 0 from the layer's first point.
+    pub fn whole(layer: usize, points: Vec<CellPoint>) -> Self {
+        Self {
+            layer,
+            bead: 0,
+            first_point: 0,
+            points,
+        }
+    }
+
+    /// This whole layer split into beads at its points `splits` (indices in
+    /// the layer, increasing, each with a point either side): bead `k` ends
+    /// on split `k` and bead `k + 1` starts there, so the split point is in
+    /// both. The split point's tool axis and build direction in each bead
+    /// are its neighbour's within that bead (the one before it in the bead
+    /// that ends there, the one after in the bead that starts): one-sided,
+    /// so that neither bead's end takes a frame half way round the corner.
+    pub fn split_at(&self, splits: &[usize]) -> Vec<LayerPoints> {
+        let n = self.points.len();
+        let mut bounds: Vec<usize> = splits
+            .iter()
+            .copied()
+            .filter(|&s| s > 0 && s + 1 < n)
+            .collect();
+        bounds.dedup();
+        let mut beads = Vec::with_capacity(bounds.len() + 1);
+        let mut start = 0;
+        for (k, end) in bounds
+            .iter()
+            .copied()
+            .chain(std::iter::once(n - 1))
+            .enumerate()
+        {
+            let mut points = self.points[start..=end].to_vec();
+            let frame_of = |p: &CellPoint, from: &CellPoint| CellPoint {
+                tool_axis: from.tool_axis,
+                build_direction: from.build_direction,
+                ..*p
+            };
+            if k > 0 {
+                points[0] = frame_of(&points[0], &self.points[start + 1]);
+            }
+            if end + 1 < n {
+                let last = points.len() - 1;
+                points[last] = frame_of(&points[last], &self.points[end - 1]);
+            }
+            beads.push(LayerPoints {
+                layer: self.layer,
+                bead: k,
+                first_point: self.first_point + start,
+                points,
+            });
+            start = end;
+        }
+        beads
+    }
+
     /// The same layer with the positioner joints `[q7, q8]` (rad) planned
     /// for its points, one per point.
     pub fn with_positioner(&self, joints: &[crate::robot::positioner::PositionerJoints]) -> Self {
         Self {
             layer: self.layer,
+            bead: self.bead,
+            first_point: self.first_point,
             points: self
                 .points
                 .iter()
@@ -187,6 +255,8 @@ pub fn layer_points(path: &Path, frames: &[Vec<LocalFrame>]) -> Vec<LayerPoints>
         .enumerate()
         .map(|(i, (layer, fr))| LayerPoints {
             layer: i,
+            bead: 0,
+            first_point: 0,
             points: layer
                 .points
                 .iter()
@@ -215,7 +285,8 @@ pub fn trajectory_inputs(layers: &[LayerPoints], plan: &Plan) -> Vec<PathPointIn
                 .zip(&pl.points)
                 .enumerate()
                 .map(move |(m, (cp, pp))| {
-                    let mut p = path_point(lp.layer, m, cp, pp.r_z);
+                    let mut p = path_point(lp.layer, lp.first_point + m, cp, pp.r_z);
+                    p.bead = lp.bead;
                     // the positioner as planned (its laws live in the plan)
                     p.positioner = pp.positioner.or(p.positioner);
                     p
@@ -234,6 +305,7 @@ fn path_point(layer: usize, point: usize, cp: &CellPoint, r_z: f64) -> PathPoint
         build_direction: cp.build_direction,
         r_z,
         positioner: cp.positioner,
+        bead: 0,
     }
 }
 

@@ -64,10 +64,7 @@ pub fn optimise_spiral(
             })
         });
         let from = if anchor.is_some() { a - 1 } else { a };
-        let turn = LayerPoints {
-            layer: k,
-            points: spiral.points[from..b].to_vec(),
-        };
+        let turn = LayerPoints::whole(k, spiral.points[from..b].to_vec());
         let (mut plan, end_floor) = optimise_layer(cell, &turn, opts, anchor);
         floor = end_floor;
         if anchor.is_some() {

@@ -6,7 +6,9 @@
 //! half the turning from one point to the next, which no positioner follows.
 //! A bead that starts and ends at the corner does not turn it: the torch
 //! ends on one side, and the positioner and the wrist reorient during the
-//! arc-off move to the other.
+//! arc-off move to the other. A corner inside the bead (a closed layer's
+//! other corners, any corner of an open layer) is where a bead may be split
+//! ([`Layer::inside_corners`]): one bead ends on it, the next starts there.
 
 use super::{smooth, Layer, SEAM_CORNER_OVER_MEDIAN};
 use crate::math::Point3;
@@ -119,6 +121,25 @@ impl Layer {
     pub fn corners(&self, threshold_rad: f64) -> Vec<Corner> {
         let positions: Vec<Point3> = self.points.iter().map(|p| p.position).collect();
         polyline_corners(&positions, self.closed, threshold_rad)
+    }
+}
+
+impl Layer {
+    /// This layer's corners above `threshold_rad` (rad, > 0) that its bead
+    /// turns: every corner of an open layer (its ends turn nothing), the
+    /// corners of a closed layer that do not lie on its seam
+    /// ([`Corner::on_seam`]). Where one of them cannot be crossed, the bead
+    /// is split there: it ends on the corner's [`Corner::point`] and the
+    /// next one starts on it.
+    pub fn inside_corners(&self, threshold_rad: f64) -> Vec<Corner> {
+        let n = self.points.len();
+        let mut corners = self.corners(threshold_rad);
+        corners.retain(|c| {
+            // a split needs a bead on either side: not on an end point
+            let interior = c.point > 0 && c.point + 1 < n;
+            interior && !(self.closed && c.on_seam(n))
+        });
+        corners
     }
 }
 

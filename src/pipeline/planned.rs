@@ -10,12 +10,13 @@ use serde::Serialize;
 
 use super::summary::{
     deg6, finite, CellCheckSummary, CollisionSummary, CycleSummary, LayerSummary, ObjectiveSummary,
-    PlanSummary, PositionerSummary, QualitySummary, SolverSummary, TransitionSummary,
+    PlanSummary, PositionerSummary, QualitySummary, SolverSummary, SplitSummary, TransitionSummary,
     UnbuildableLayer, UnbuildableProof,
 };
 use super::{slice_part_with, Cell, Control, Part, PlanOptions, RzLaw, SlicedPart};
 use crate::optimise::{
-    layer_points, optimise_with, trajectory_inputs, LayerPlan, LayerPoints, OptimiseOptions, Plan,
+    layer_points, optimise_with, split_refused_layers, trajectory_inputs, LayerPlan, LayerPoints,
+    OptimiseOptions, Plan, SplitPlan,
 };
 use crate::program::{
     build_program_with, check_vendor, write_files, LayerRefusal, Program, ProgramError, TravelSpeed,
@@ -83,6 +84,11 @@ pub struct PlannedPart {
     /// [`crate::replan`]); `None`: the constant
     /// [`PlannedPart::travel_speed_mm_s`] everywhere.
     pub point_speeds_mm_s: Option<Vec<Vec<f64>>>,
+    /// The beads split at corners: where a layer could not be built as one
+    /// bead in a torch-carried cell with seams on corners, it is split at
+    /// its corners inside the bead, each split here (in path order), and
+    /// `layers` and `plan` hold its beads ([`crate::optimise::split`]).
+    pub splits: Vec<crate::optimise::BeadSplit>,
 }
 
 /// The program name for a part: its name in upper case, letters, digits and
@@ -178,6 +184,9 @@ pub fn plan_part_with(
         e => e.into(),
     })?;
     control.check("optimising")?;
+    let split = split_at_corners(cell, &sliced, layers, plan, &optimise_opts)?;
+    let (layers, plan) = (split.layers, split.plan);
+    control.check("optimising")?;
     control.report("program", 0.95);
     let t = Instant::now();
     let name = program_name(&part.name);
@@ -206,7 +215,52 @@ pub fn plan_part_with(
         program,
         point_speeds_mm_s: None,
         clearance,
+        splits: split.splits,
     })
+}
+
+/// The layers the plan could not build whole split at their corners inside
+/// the bead ([`Layer::inside_corners`](crate::path::Layer::inside_corners)),
+/// where every bead then plans ([`split_refused_layers`]): in a
+/// torch-carried cell with seams on corners only (part-carried cells turn
+/// the part through a corner within the tool axis's rate bound).
+fn split_at_corners(
+    cell: &Cell,
+    sliced: &SlicedPart,
+    layers: Vec<LayerPoints>,
+    plan: Plan,
+    opts: &OptimiseOptions,
+) -> Result<SplitPlan, Error> {
+    let torch_carried = matches!(cell.layout, crate::robot::CellLayout::TorchCarried(_));
+    if !(torch_carried && sliced.options.seams_on_corners) {
+        return Ok(SplitPlan {
+            layers,
+            plan,
+            splits: Vec::new(),
+        });
+    }
+    let threshold = sliced.options.corner_threshold_rad;
+    let path = &sliced.path;
+    let corners_of = |k: usize| -> Vec<usize> {
+        layers
+            .get(k)
+            .and_then(|lp| path.layers.get(lp.layer))
+            .map(|l| {
+                l.inside_corners(threshold)
+                    .iter()
+                    .map(|c| c.point)
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let points: Vec<Vec<usize>> = (0..layers.len()).map(corners_of).collect();
+    Ok(split_refused_layers(
+        &cell.layout,
+        layers,
+        plan,
+        &|k| points[k].clone(),
+        opts,
+    )?)
 }
 
 /// The program model of a plan, refused when a layer is infeasible or lost
@@ -250,9 +304,29 @@ pub(super) fn build(
         let per_layer = sliced
             .process_plan
             .layer_masses_kg(&sliced.path, &sliced.process);
+        // a split layer's beads share its mass by their lengths
+        let length = |l: &LayerPoints| -> f64 {
+            l.points
+                .windows(2)
+                .map(|w| (w[1].position_mm - w[0].position_mm).norm())
+                .sum()
+        };
+        let mut layer_length = std::collections::HashMap::new();
+        for l in layers {
+            *layer_length.entry(l.layer).or_insert(0.0) += length(l);
+        }
         let masses: Vec<f64> = layers
             .iter()
-            .map(|l| per_layer.get(l.layer).copied().unwrap_or(0.0))
+            .map(|l| {
+                let mass = per_layer.get(l.layer).copied().unwrap_or(0.0);
+                let whole = layer_length.get(&l.layer).copied().unwrap_or(0.0);
+                // (a whole layer's length over itself: exactly 1)
+                if whole > 0.0 {
+                    mass * length(l) / whole
+                } else {
+                    0.0
+                }
+            })
             .collect();
         program.set_payloads(common, &masses)?;
     }
@@ -364,7 +438,7 @@ impl PlannedPart {
                         let h = path
                             .layers
                             .get(lp.layer)
-                            .and_then(|l| l.points.get(m))
+                            .and_then(|l| l.points.get(lp.first_point + m))
                             .and_then(|p| p.delta)
                             .unwrap_or(path.delta_mm);
                         [v, h]
@@ -433,10 +507,13 @@ impl PlannedPart {
             .sliced
             .report_input(&title, substrate, self.sliced.path.delta_mm);
         let cycle = self.cycle_time();
+        let (layers, plan) = self.whole_layers();
+        let corners = self.sliced.corner_marks(&self.splits);
+        input.corners = &corners;
         input.plan = Some(crate::report::PlanView {
             cell: &self.cell.layout,
-            layers: &self.layers,
-            plan: &self.plan,
+            layers: &layers,
+            plan: &plan,
             travel_speed_mm_s: self.travel_speed_mm_s(),
             cycle: cycle.as_ref(),
             keep_out: &self.cell.keep_out,
@@ -445,6 +522,41 @@ impl PlannedPart {
         });
         crate::report::write_report(dest, &input)?;
         Ok(())
+    }
+
+    /// The plan with each layer split at its corners
+    /// ([`PlannedPart::splits`]) joined again into one entry a layer, as
+    /// the report draws the path: a split point, in both beads, is taken
+    /// once, from the bead that ends there; each layer's status, branch and
+    /// figures are its first bead's. The plan itself when nothing is split.
+    pub fn whole_layers(&self) -> (Vec<LayerPoints>, Plan) {
+        let mut layers: Vec<LayerPoints> = Vec::with_capacity(self.layers.len());
+        let mut plans: Vec<LayerPlan> = Vec::with_capacity(self.plan.layers.len());
+        for (lp, pl) in self.layers.iter().zip(&self.plan.layers) {
+            match (layers.last_mut(), plans.last_mut()) {
+                (Some(l), Some(p)) if lp.bead > 0 && l.layer == lp.layer => {
+                    l.points.extend(lp.points.iter().skip(1).copied());
+                    p.points.extend(pl.points.iter().skip(1).cloned());
+                    p.violations.extend(pl.violations.iter().cloned());
+                }
+                _ => {
+                    layers.push(lp.clone());
+                    plans.push(pl.clone());
+                }
+            }
+        }
+        let plan = Plan {
+            transitions: self
+                .plan
+                .transitions
+                .iter()
+                .filter(|t| t.from_layer != t.to_layer)
+                .copied()
+                .collect(),
+            layers: plans,
+            time_s: self.plan.time_s,
+        };
+        (layers, plan)
     }
 
     /// The options of the cycle time ([`crate::program::cycle`]) for the
@@ -463,6 +575,35 @@ impl PlannedPart {
             program,
             &self.cycle_options(),
         ))
+    }
+
+    /// The splits of [`PlannedPart::splits`] as `summary.json` lists them,
+    /// with the turning of the layer's polyline across each corner.
+    pub fn split_summaries(&self) -> Vec<SplitSummary> {
+        let threshold = self.sliced.options.corner_threshold_rad;
+        self.splits
+            .iter()
+            .map(|s| {
+                let turning = self
+                    .sliced
+                    .path
+                    .layers
+                    .get(s.layer)
+                    .and_then(|l| {
+                        l.inside_corners(threshold)
+                            .into_iter()
+                            .find(|c| c.point == s.point)
+                    })
+                    .map_or(f64::NAN, |c| c.turn_rad);
+                SplitSummary {
+                    layer: s.layer,
+                    point: s.point,
+                    bead: s.bead,
+                    turning_deg: turning.to_degrees(),
+                    why: s.why.clone(),
+                }
+            })
+            .collect()
     }
 
     /// The content of `plan`'s `summary.json`: the part and cell files, the
@@ -487,8 +628,10 @@ impl PlannedPart {
             layer_plans: plan
                 .layers
                 .iter()
-                .map(|l| {
+                .zip(&self.layers)
+                .map(|(l, lp)| {
                     let mut summary = layer_summary(l);
+                    summary.bead = lp.bead;
                     summary.cycle_time_s = cycle
                         .as_ref()
                         .and_then(|c| c.layers.iter().find(|lc| lc.layer == l.layer))
@@ -535,8 +678,13 @@ impl PlannedPart {
                 path_acceleration_mm_s2: options.path_acceleration_mm_s2,
                 layers: c.layers,
             }),
+            splits: self.split_summaries(),
             run_time_s: self.times,
-            path: self.sliced.path_summary(),
+            path: {
+                let mut path = self.sliced.path_summary();
+                path.arc_starts += self.splits.len();
+                path
+            },
         }
     }
 }
@@ -564,6 +712,7 @@ fn layer_summary(l: &LayerPlan) -> LayerSummary {
     let q = &l.quality;
     LayerSummary {
         layer: l.layer,
+        bead: 0,
         status: l.status.to_string(),
         feasible: l.status.is_feasible(),
         configuration: l.configuration.chosen.to_string(),
@@ -602,10 +751,17 @@ fn layer_summary(l: &LayerPlan) -> LayerSummary {
     }
 }
 
+/// `true` for 0 (a layer's first bead is not written).
+fn is_zero(k: &usize) -> bool {
+    *k == 0
+}
+
 /// One planned point as serialised.
 #[derive(Serialize)]
 struct PointView {
     layer: usize,
+    #[serde(skip_serializing_if = "is_zero")]
+    bead: usize,
     point: usize,
     position_mm: [f64; 3],
     rz_deg: f64,
@@ -626,7 +782,8 @@ impl Serialize for PlannedPart {
                     .enumerate()
                     .map(move |(m, (cp, pp))| PointView {
                         layer: lp.layer,
-                        point: m,
+                        bead: lp.bead,
+                        point: lp.first_point + m,
                         position_mm: cp.position_mm.coords.into(),
                         rz_deg: pp.r_z.to_degrees(),
                         joints_deg: pp.joints.map(|q| q.map(f64::to_degrees)),

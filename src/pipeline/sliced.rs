@@ -297,8 +297,38 @@ impl SlicedPart {
             self.path.strategy.name(),
             self.path.delta_mm
         );
-        crate::report::write_report(dest, &self.report_input(&title, substrate, width_mm))?;
+        let corners = self.corner_marks(&[]);
+        let mut input = self.report_input(&title, substrate, width_mm);
+        input.corners = &corners;
+        crate::report::write_report(dest, &input)?;
         Ok(())
+    }
+
+    /// The layers' corners above the options' threshold as the report
+    /// marks them, each flagged where `splits` split the layer's bead on it.
+    pub fn corner_marks(
+        &self,
+        splits: &[crate::optimise::BeadSplit],
+    ) -> Vec<crate::report::CornerMark> {
+        let threshold = self.options.corner_threshold_rad;
+        self.path
+            .layers
+            .iter()
+            .enumerate()
+            .flat_map(|(li, layer)| {
+                let n = layer.points.len();
+                layer
+                    .corners(threshold)
+                    .into_iter()
+                    .map(move |c| crate::report::CornerMark {
+                        layer: li,
+                        point: c.point,
+                        turning_deg: c.turn_rad.to_degrees(),
+                        on_seam: layer.closed && c.on_seam(n),
+                        split: splits.iter().any(|s| s.layer == li && s.point == c.point),
+                    })
+            })
+            .collect()
     }
 }
 

@@ -209,8 +209,11 @@ pub struct PlanSummary {
     pub violations: Vec<String>,
     /// Per layer.
     pub layer_plans: Vec<LayerSummary>,
-    /// Between consecutive layers.
+    /// Between consecutive layers (and the beads of a split layer).
     pub transitions: Vec<TransitionSummary>,
+    /// Where a layer's bead was split at a corner (torch-carried cells), in
+    /// path order; each split is one more arc start (`arc_starts`).
+    pub splits: Vec<SplitSummary>,
     /// Filled by the writer of the program files (`null` here).
     pub program: Option<()>,
     /// The program stage's refusal of a plan whose layers are all feasible
@@ -230,6 +233,27 @@ pub struct PlanSummary {
     /// The path, process, tool axes and distances.
     #[serde(flatten)]
     pub path: PathSummary,
+}
+
+/// `true` for 0.
+fn is_zero(k: &usize) -> bool {
+    *k == 0
+}
+
+/// One split of a layer's bead at a corner
+/// ([`BeadSplit`](crate::optimise::BeadSplit)).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SplitSummary {
+    /// The layer.
+    pub layer: usize,
+    /// The layer's point where one bead ends and the next starts.
+    pub point: usize,
+    /// The bead that starts there (1 for the layer's first split).
+    pub bead: usize,
+    /// Turning angle of the layer's polyline across the corner (deg).
+    pub turning_deg: f64,
+    /// Why the layer was split: how its plan as one bead failed.
+    pub why: String,
 }
 
 /// The whole-cell check's counts.
@@ -292,6 +316,10 @@ pub enum UnbuildableProof {
 pub struct LayerSummary {
     /// The layer.
     pub layer: usize,
+    /// The bead of a layer split at its corners (one entry per bead; not
+    /// written for a layer's first or only bead).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub bead: usize,
     /// Its status (`feasible`, or the binding constraint).
     pub status: String,
     /// Feasible.

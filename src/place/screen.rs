@@ -69,8 +69,8 @@ pub(crate) fn subsample(
                 points.extend(l.points.last().copied());
             }
             LayerPoints {
-                layer: l.layer,
                 points,
+                ..l.clone()
             }
         })
         .filter(|l| l.points.len() >= 3)

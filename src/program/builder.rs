@@ -129,8 +129,8 @@ pub fn build_program_with(
                 layers: vec![p.layer],
             });
         };
-        let first = i == 0 || points[i - 1].layer != p.layer;
-        let last = i + 1 == points.len() || points[i + 1].layer != p.layer;
+        let first = i == 0 || !points[i - 1].same_bead(p);
+        let last = i + 1 == points.len() || !points[i + 1].same_bead(p);
         if first && last {
             return Err(ProgramError::Mismatch {
                 index: i,
@@ -185,6 +185,7 @@ pub fn build_program_with(
         }
         out.push(ProgramPoint {
             layer: p.layer,
+            bead: p.bead,
             point: p.point,
             position_mm: p.position_mm,
             tool_axis: p.tool_axis,
@@ -240,6 +241,8 @@ pub fn build_program_with(
         .iter()
         .filter(|p| p.arc == ArcFlag::Start)
         .enumerate()
+        // a split bead waits as a layer's first does (`waam check` reads
+        // every bead's set-up alike)
         .map(|(k, p)| BeadSetup {
             layer: p.layer,
             payload: None,

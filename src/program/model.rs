@@ -51,8 +51,12 @@ impl ArcFlag {
 /// One point of a program.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ProgramPoint {
-    /// Layer index (= bead index of this layer).
+    /// Layer index.
     pub layer: usize,
+    /// The bead within the layer: 0 for its first (or only) bead, one more
+    /// at each split at a corner ([`PathPointInput::bead`](crate::robot::trajectory::PathPointInput::bead)).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub bead: usize,
     /// Point index within the layer (approach and retract points: the index
     /// of the bead point they are offset from).
     pub point: usize,
@@ -85,7 +89,31 @@ pub struct ProgramPoint {
     pub via: bool,
 }
 
-/// A buildable program: points in path order, one bead per layer.
+/// `true` for 0 (a layer's first bead is not written).
+fn is_zero(k: &usize) -> bool {
+    *k == 0
+}
+
+impl ProgramPoint {
+    /// Whether `other` is a point of the same bead (same layer and bead).
+    pub fn same_bead(&self, other: &ProgramPoint) -> bool {
+        self.layer == other.layer && self.bead == other.bead
+    }
+
+    /// The bead's name in the programs' comments: the layer index, with
+    /// `.k` for the `k`-th split bead of a layer split at its corners
+    /// (`12`, `12.1`).
+    pub fn bead_label(&self) -> String {
+        if self.bead == 0 {
+            self.layer.to_string()
+        } else {
+            format!("{}.{}", self.layer, self.bead)
+        }
+    }
+}
+
+/// A buildable program: points in path order, one bead per layer, or
+/// more where a layer is split at its corners.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Program {
     /// Program name (controller-safe: letters, digits, `_`, starting with a letter).

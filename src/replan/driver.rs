@@ -249,6 +249,7 @@ fn replan_core(
         program,
         point_speeds_mm_s: Some(point_speeds),
         clearance,
+        splits: Vec::new(),
     };
     Ok(ReplannedPart {
         planned,

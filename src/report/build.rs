@@ -6,8 +6,8 @@ use super::cell_view::{snapshot, CHAIN_POINTS};
 
 use super::encode::{f32s, i8s, u32s, unit_i8};
 use super::page::{
-    kept, script_safe_json, stride, BodyData, ClosestData, CollisionData, FieldData, MarkData,
-    PageData, PlanData,
+    kept, script_safe_json, stride, BodyData, ClosestData, CollisionData, CornerData, FieldData,
+    MarkData, PageData, PlanData,
 };
 use super::substrate::substrate_triangles;
 use super::{PlanView, ReportError, ReportInput};
@@ -163,6 +163,24 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             marks.len()
         ));
     }
+    let corners = corners(input);
+    if !corners.is_empty() {
+        let splits = corners.iter().filter(|c| c.split).count();
+        notes.push(format!(
+            "{} corners marked on {} layers (orange){}.",
+            corners.len(),
+            {
+                let mut layers: Vec<usize> = corners.iter().map(|c| c.layer).collect();
+                layers.dedup();
+                layers.len()
+            },
+            if splits > 0 {
+                format!("; the bead is split at {splits} of them (cyan): one bead ends there, the next starts there after an arc-off move")
+            } else {
+                String::new()
+            }
+        ));
+    }
 
     let (substrate, substrate_note) = substrate_triangles(input.substrate, &pos);
     if let Some(n) = substrate_note {
@@ -217,6 +235,7 @@ pub(crate) fn report_data(input: &ReportInput) -> Result<String, ReportError> {
             })
             .collect(),
         marks_total,
+        corners,
         plan,
         notes,
         fit: None,
@@ -388,6 +407,41 @@ fn fields(input: &ReportInput, v: FieldValues) -> Vec<Field> {
         }
     }
     fields
+}
+
+/// The layers' corners of the page ([`ReportInput::corners`]), those naming
+/// a point of the path, with their hover text.
+fn corners(input: &ReportInput) -> Vec<CornerData> {
+    input
+        .corners
+        .iter()
+        .filter_map(|c| {
+            let p = input
+                .path
+                .layers
+                .get(c.layer)?
+                .points
+                .get(c.point)?
+                .position;
+            let mut text = format!(
+                "layer {}, point {}: corner, turning {:.1}°",
+                c.layer, c.point, c.turning_deg
+            );
+            if c.on_seam {
+                text += ", on the seam";
+            }
+            if c.split {
+                text += "; the bead is split here";
+            }
+            Some(CornerData {
+                layer: c.layer,
+                point: c.point,
+                split: c.split,
+                text,
+                at: [p.x, p.y, p.z],
+            })
+        })
+        .collect()
 }
 
 /// The marks of the path's page: the plan's violations, a collision

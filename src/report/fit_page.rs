@@ -260,6 +260,7 @@ pub(super) fn fit_data(input: &FitReportInput) -> Result<String, ReportError> {
         substrate: substrate_tris.map(|t| f32s(&t)),
         marks: vec![],
         marks_total: 0,
+        corners: Vec::new(),
         plan: None,
         notes,
         fit: Some(FitData {

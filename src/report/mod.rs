@@ -102,6 +102,23 @@ impl Default for ReportOptions {
     }
 }
 
+/// A corner of a layer marked on the path ([`crate::path::Layer::corners`]),
+/// and whether the plan split the layer's bead there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CornerMark {
+    /// Layer index in the report's path.
+    pub layer: usize,
+    /// The layer's point where it turns most within the corner.
+    pub point: usize,
+    /// Turning angle of the polyline across the corner (deg).
+    pub turning_deg: f64,
+    /// The layer's seam lies on the corner.
+    pub on_seam: bool,
+    /// The plan split the layer's bead here: one bead ends on the point and
+    /// the next starts on it ([`crate::optimise::split`]).
+    pub split: bool,
+}
+
 /// A plan to show in the report: the cell it was made in, the layers it was
 /// made from (`optimise::layer_points` of the report's path and frames) and
 /// the plan.
@@ -155,6 +172,9 @@ pub struct ReportInput<'a> {
     pub process: Option<&'a ProcessPlan>,
     /// A plan to animate.
     pub plan: Option<PlanView<'a>>,
+    /// The layers' corners (and the plan's bead splits), marked on the
+    /// path; empty: none marked.
+    pub corners: &'a [CornerMark],
     /// Display bounds.
     pub options: ReportOptions,
 }
@@ -177,6 +197,7 @@ impl<'a> ReportInput<'a> {
             substrate: None,
             process: None,
             plan: None,
+            corners: &[],
             options: ReportOptions::default(),
         }
     }

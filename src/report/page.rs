@@ -56,6 +56,8 @@ pub(super) struct PageData<'a> {
     pub substrate: Option<String>,
     pub marks: Vec<MarkData<'a>>,
     pub marks_total: usize,
+    /// The layers' corners and the plan's bead splits.
+    pub corners: Vec<CornerData>,
     pub plan: Option<PlanData<'a>>,
     pub notes: Vec<String>,
     /// The mesh of a fit page (absent from a path's page).
@@ -84,6 +86,17 @@ pub(super) struct MarkData<'a> {
     pub layer: usize,
     pub point: usize,
     pub text: &'a str,
+    /// Part frame (mm).
+    pub at: [f64; 3],
+}
+
+/// A layer's corner (or a bead split on it), marked on the path.
+#[derive(Serialize)]
+pub(super) struct CornerData {
+    pub layer: usize,
+    pub point: usize,
+    pub split: bool,
+    pub text: String,
     /// Part frame (mm).
     pub at: [f64; 3],
 }

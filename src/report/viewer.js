@@ -81,6 +81,9 @@
   var marks = D.marks;
   var markText = {};
   marks.forEach(function (m) { var k = m.layer + ':' + m.point; markText[k] = (markText[k] ? markText[k] + '\n' : '') + m.text; });
+  // the layers' corners (orange) and the bead splits on them (cyan)
+  var corners = D.corners || [];
+  corners.forEach(function (m) { var k = m.layer + ':' + m.point; markText[k] = (markText[k] ? markText[k] + '\n' : '') + m.text; });
 
   var F = null;
   if (P) {
@@ -458,7 +461,7 @@
     setColours(fitMesh, cols);
   }
   // violation marks (rebuilt when the layer range changes)
-  var marksMesh = null;
+  var marksMesh = null, cornersMesh = null;
   function rebuildMarks() {
     var mp = [], mc = [];
     marks.forEach(function (m) {
@@ -466,6 +469,13 @@
       mp.push(m.at[0], m.at[1], m.at[2]); mc.push(1.0, 0.15, 0.2);
     });
     marksMesh = mp.length ? mesh([new Float32Array(mp), new Float32Array(mc)]) : null;
+    var cp = [], cc = [];
+    corners.forEach(function (m) {
+      if (m.layer < state.lo || m.layer > state.hi) return;
+      cp.push(m.at[0], m.at[1], m.at[2]);
+      if (m.split) cc.push(0.1, 0.8, 1.0); else cc.push(1.0, 0.6, 0.1);
+    });
+    cornersMesh = cp.length ? mesh([new Float32Array(cp), new Float32Array(cc)]) : null;
   }
   var hoverMesh = null;
 
@@ -672,6 +682,7 @@
       draw(flat, pathMesh, gl.LINES, segStart[state.lo], segStart[state.hi + 1] - segStart[state.lo], mvp, {});
       if (state.axes && !FIT) draw(flat, axesMesh, gl.LINES, axStart[state.lo], axStart[state.hi + 1] - axStart[state.lo], mvp, {});
       if (state.marks && marksMesh) draw(flat, marksMesh, gl.POINTS, 0, marksMesh.count, mvp, { size: 9 });
+      if (state.marks && cornersMesh) draw(flat, cornersMesh, gl.POINTS, 0, cornersMesh.count, mvp, { size: 7 });
       if (hoverMesh) draw(flat, hoverMesh, gl.POINTS, 0, 1, mvp, { size: 13 });
     }
     if (F && state.cell && (!only || only === 'cell')) {

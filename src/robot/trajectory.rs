@@ -45,6 +45,18 @@ pub struct PathPointInput {
     /// (torch-carried cell); `None`: `b` turned exactly vertical.
     #[serde(default)]
     pub positioner: Option<PositionerJoints>,
+    /// The bead within the layer: 0 for its first (or only) bead, one more
+    /// at each split at a corner (the points of a layer split in beads
+    /// share the split point, one in each bead).
+    #[serde(default)]
+    pub bead: usize,
+}
+
+impl PathPointInput {
+    /// Whether `other` is a point of the same bead (same layer and bead).
+    pub fn same_bead(&self, other: &PathPointInput) -> bool {
+        self.layer == other.layer && self.bead == other.bead
+    }
 }
 
 /// Options of [`joint_trajectory`]. Plain data.
@@ -290,6 +302,8 @@ impl fmt::Display for TrajectoryReport {
 pub struct JointPoint {
     /// Layer index.
     pub layer: usize,
+    /// The bead within the layer ([`PathPointInput::bead`]).
+    pub bead: usize,
     /// Point index within the layer.
     pub point: usize,
     /// Robot joints (rad), unwrapped along the path; `None` if no solution.
@@ -395,7 +409,7 @@ fn trajectory(
                 kind,
             })
         };
-        let new_layer = idx == 0 || points[idx - 1].layer != p.layer;
+        let new_layer = idx == 0 || !points[idx - 1].same_bead(p);
         let near = if new_layer && opts.rewind_between_layers {
             None
         } else {
@@ -408,6 +422,7 @@ fn trajectory(
                 violation(ViolationKind::NoSolution(e));
                 out.push(JointPoint {
                     layer: p.layer,
+                    bead: p.bead,
                     point: p.point,
                     joints: None,
                     positioner: None,
@@ -465,6 +480,7 @@ fn trajectory(
         };
         out.push(JointPoint {
             layer: p.layer,
+            bead: p.bead,
             point: p.point,
             joints: Some(q),
             positioner: pose.positioner,
@@ -537,7 +553,7 @@ fn joint_speeds(
     let mut dt = 0.0;
     if idx > 0 {
         let pp = &points[idx - 1];
-        if pp.layer == p.layer {
+        if pp.same_bead(p) {
             if let (Some(qprev), d) = (out[idx - 1].joints, (p.position_mm - pp.position_mm).norm())
             {
                 if d > 0.0 {

@@ -110,6 +110,7 @@ pub fn hemisphere_cell_points(
                 build_direction: None,
                 positioner: None,
                 r_z: r_z(layer, v),
+                bead: 0,
             });
         }
     }

@@ -28,10 +28,7 @@ fn circle_is_feasible_within_the_hose_limit_and_beats_the_thesis_cubic() {
     let cell = cell("robowam_torch_carried.toml");
     let plan = optimise(
         &cell,
-        &[LayerPoints {
-            layer: 0,
-            points: circle(),
-        }],
+        &[LayerPoints::whole(0, circle())],
         &OptimiseOptions {
             // as in the thesis: point index, degree 4, each degree warm-started
             parameterisation: Parameterisation::Polynomial {
@@ -64,6 +61,7 @@ fn circle_is_feasible_within_the_hose_limit_and_beats_the_thesis_cubic() {
                 build_direction: p.build_direction,
                 positioner: None,
                 r_z: rz.to_radians(),
+                bead: 0,
             }
         })
         .collect();

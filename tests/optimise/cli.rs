@@ -42,7 +42,7 @@ fn plan_refuses_fixed_zero_and_succeeds_with_a_linear_law() {
     let text = std::fs::read_to_string(good.join("joints.csv")).unwrap();
     assert_eq!(
         text.lines().next().unwrap(),
-        "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6,travel_speed_mm_s,bead_height_mm"
+        "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6,travel_speed_mm_s,bead_height_mm,bead"
     );
     assert!(text.lines().count() > 14 * 120);
     let summary: serde_json::Value =

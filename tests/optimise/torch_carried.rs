@@ -327,12 +327,10 @@ fn matrix(slice: &SliceOverrides) -> Vec<(String, usize, usize, usize)> {
             }
             let mut bad = 0;
             let mut proven = 0;
-            for l in &planned.plan.layers {
-                assert_eq!(
-                    l.points.len(),
-                    planned.layers[l.layer].points.len(),
-                    "{what}"
-                );
+            // one entry a bead (a layer split at its corners has several)
+            for (l, lp) in planned.plan.layers.iter().zip(&planned.layers) {
+                assert_eq!(l.layer, lp.layer, "{what}");
+                assert_eq!(l.points.len(), lp.points.len(), "{what}");
                 let law = l
                     .positioner
                     .as_ref()
@@ -356,12 +354,13 @@ fn matrix(slice: &SliceOverrides) -> Vec<(String, usize, usize, usize)> {
                     other => panic!("{what}: layer {} {other}", l.layer),
                 }
             }
+            let layers = planned.sliced.path.layers.len();
             eprintln!(
-                "{what}: {} layers, {} infeasible ({proven} proven unbuildable), {checked} points checked by FK",
-                planned.plan.layers.len(),
-                bad
+                "{what}: {layers} layers, {} infeasible ({proven} proven unbuildable), {} split, {checked} points checked by FK",
+                bad,
+                planned.splits.len()
             );
-            out.push((what, planned.plan.layers.len(), bad, proven));
+            out.push((what, layers, bad, proven));
         }
     }
     out

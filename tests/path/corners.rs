@@ -131,3 +131,56 @@ fn the_corner_threshold_is_read_from_the_part_file_and_the_options() {
         );
     }
 }
+
+/// A layer with two corners gets one split: the S-bend at its own grid
+/// (213 closed layers of 400 points) has two corners on each of its layers
+/// 168–175 and on no other; the seam lies on the sharper one (23–59°, or
+/// 14° on layer 168), so exactly one corner (10–13°) lies inside the bead,
+/// where the bead may be split: the layer's points split there give two
+/// beads, which share the corner point. The quarter torus's open layers
+/// 11–16 each turn one corner (77–112°), inside their bead (not on an end).
+#[test]
+fn a_layer_with_two_corners_has_one_inside_its_bead() {
+    use waam_slicer::optimise::{layer_points, LayerPoints};
+    let sliced = slice_part(&load_part("s-bend.toml")).unwrap();
+    let layers = &sliced.path.layers;
+    assert_eq!(layers.len(), 213);
+    let two: Vec<usize> = (0..layers.len())
+        .filter(|&li| layers[li].corners(SEAM_CORNER_RAD).len() >= 2)
+        .collect();
+    assert_eq!(two, (168..=175).collect::<Vec<_>>());
+    let whole = layer_points(&sliced.path, &sliced.axes.frames);
+    for li in two {
+        let l = &layers[li];
+        let n = l.points.len();
+        assert!(l.closed, "layer {li}");
+        let corners = l.corners(SEAM_CORNER_RAD);
+        assert_eq!(corners.iter().filter(|c| c.on_seam(n)).count(), 1);
+        let inside = l.inside_corners(SEAM_CORNER_RAD);
+        assert_eq!(inside.len(), 1, "layer {li}: {corners:?}");
+        let c = inside[0];
+        assert!(!c.on_seam(n) && c.point > 0 && c.point + 1 < n);
+        let sharper = sharpest(l).unwrap();
+        assert!(sharper.on_seam(n) && sharper.turn_rad > c.turn_rad);
+        let beads: Vec<LayerPoints> = whole[li].split_at(&[c.point]);
+        assert_eq!(beads.len(), 2, "layer {li}");
+        assert_eq!(
+            (beads[0].bead, beads[1].bead, beads[1].first_point),
+            (0, 1, c.point)
+        );
+        assert_eq!(beads[0].points.len() + beads[1].points.len(), n + 1);
+        assert_eq!(
+            beads[0].points.last().unwrap().position_mm,
+            beads[1].points[0].position_mm
+        );
+    }
+    let torus = slice_part(&load_part("quarter-torus.toml")).unwrap();
+    for li in 11..=16 {
+        let l = &torus.path.layers[li];
+        assert!(!l.closed, "layer {li}");
+        let inside = l.inside_corners(SEAM_CORNER_RAD);
+        assert_eq!(inside.len(), 1, "layer {li}");
+        let turn = inside[0].turn_rad.to_degrees();
+        assert!((75.0..115.0).contains(&turn), "layer {li}: {turn}");
+    }
+}

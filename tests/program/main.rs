@@ -10,6 +10,7 @@ mod cell_collision;
 mod cells;
 mod circular;
 mod contract;
+mod corner_splits;
 mod cycle;
 mod fanuc_controller;
 mod fixture;

@@ -245,6 +245,7 @@ fn trajectory_dq_drz_is_the_cells() {
                     build_direction: None,
                     positioner: None,
                     r_z: -v,
+                    bead: 0,
                 }
             })
         })
@@ -304,6 +305,7 @@ fn torch_carried_circle_is_reachable_and_reports_hose_torsion() {
                 build_direction: None,
                 positioner: None,
                 r_z: 0.0,
+                bead: 0,
             }
         })
         .collect();
@@ -352,6 +354,7 @@ fn torch_carried_circle_uncertainty_matches_thesis() {
                 build_direction: None,
                 positioner: None,
                 r_z: 0.0,
+                bead: 0,
             }
         })
         .collect();

@@ -15,6 +15,7 @@ fn point(layer: usize, point: usize, x: f64) -> PathPointInput {
         build_direction: None,
         positioner: None,
         r_z: 0.0,
+        bead: 0,
     }
 }
 

@@ -1041,7 +1041,12 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             // written with the circular move it is the circle point of
             (_, ArcFlag::On) if p.via => {}
             (_, ArcFlag::Approach) => {
-                writeln!(w, "    ! bead {} (layer {}): approach", p.layer, p.layer)?;
+                writeln!(
+                    w,
+                    "    ! bead {} (layer {}): approach",
+                    p.bead_label(),
+                    p.layer
+                )?;
                 abs_j(w, k)?;
             }
             (_, ArcFlag::Retract) => writeln!(w, "    MoveL p{k}, {v}, fine, {tw};")?,
@@ -1051,7 +1056,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
                 let v_in = match prev {
                     Some(a) if a.arc == ArcFlag::Approach => speeddata(a.speed_mm_s, None),
                     _ => {
-                        writeln!(w, "    ! bead {} (layer {})", p.layer, p.layer)?;
+                        writeln!(w, "    ! bead {} (layer {})", p.bead_label(), p.layer)?;
                         abs_j(w, k)?;
                         // MoveAbsJ has reached the point: the arc start is a
                         // zero-length move, never timed

@@ -195,7 +195,7 @@ impl LayerWalk {
 fn bead_motions<'p>(checker: &Checker, trajectory: &'p JointTrajectory) -> Vec<Motion<'p>> {
     let tp = &trajectory.points;
     let mut motions = Vec::new();
-    let mut prev: Option<(usize, Sample)> = None;
+    let mut prev: Option<((usize, usize), Sample)> = None;
     let mut last_sampled: Option<Sample> = None;
     let mut swept = 0.0;
     for (i, jp) in tp.iter().enumerate() {
@@ -206,14 +206,16 @@ fn bead_motions<'p>(checker: &Checker, trajectory: &'p JointTrajectory) -> Vec<M
             q,
             qp: jp.positioner,
         };
-        let new_layer = prev.as_ref().is_none_or(|(l, _)| *l != jp.layer);
+        let new_layer = prev.as_ref().is_none_or(|(l, _)| *l != (jp.layer, jp.bead));
         if new_layer {
             swept = 0.0;
             last_sampled = None;
         } else if let Some((_, p)) = &prev {
             swept += checker.swept_mm(p, &s);
         }
-        let is_last = tp.get(i + 1).is_none_or(|n| n.layer != jp.layer);
+        let is_last = tp
+            .get(i + 1)
+            .is_none_or(|n| (n.layer, n.bead) != (jp.layer, jp.bead));
         if last_sampled.is_none() || swept >= SAMPLE_STEP_MM || is_last {
             motions.push(Motion {
                 from: last_sampled.unwrap_or(s),
@@ -228,7 +230,7 @@ fn bead_motions<'p>(checker: &Checker, trajectory: &'p JointTrajectory) -> Vec<M
             last_sampled = Some(s);
             swept = 0.0;
         }
-        prev = Some((jp.layer, s));
+        prev = Some(((jp.layer, jp.bead), s));
     }
     motions
 }
@@ -259,7 +261,7 @@ fn other_motions<'p>(motions: &mut Vec<Motion<'p>>, program: &'p Program, scene:
     }
     for w in pts.windows(2) {
         let (a, b) = (&w[0], &w[1]);
-        let same_bead = a.arc.is_bead() && b.arc.is_bead() && a.layer == b.layer;
+        let same_bead = a.arc.is_bead() && b.arc.is_bead() && a.same_bead(b);
         if same_bead {
             continue;
         }

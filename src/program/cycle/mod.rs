@@ -337,8 +337,9 @@ pub fn cycle_time(program: &Program, opts: &CycleOptions) -> CycleTime {
     let mut i = 0;
     while i < points.len() {
         let layer = points[i].layer;
+        // one block a bead (a layer split at its corners has several)
         let end = (i..points.len())
-            .find(|&k| points[k].layer != layer)
+            .find(|&k| !points[k].same_bead(&points[i]))
             .unwrap_or(points.len());
         let block = &points[i..end];
         let mut lc = LayerCycle {

@@ -15,6 +15,7 @@ fn cell(name: &str) -> CellLayout {
 fn point(layer: usize, k: usize, x: f64, speed: f64, arc: ArcFlag, q: [f64; 6]) -> ProgramPoint {
     ProgramPoint {
         layer,
+        bead: 0,
         point: k,
         position_mm: Point3::new(x, 0.0, 0.0),
         tool_axis: Vector3::z_axis(),

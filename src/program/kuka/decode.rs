@@ -584,6 +584,7 @@ mod tests {
                     build_direction: None,
                     positioner: None,
                     r_z: 0.0,
+                    bead: 0,
                 });
             }
         }

@@ -274,7 +274,8 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                 writeln!(
                     w,
                     "  ; bead {} (layer {}): approach, arc off",
-                    p.layer, p.layer
+                    p.bead_label(),
+                    p.layer
                 )?;
                 restore_ptp(w, &mut extax)?;
                 writeln!(w, "  PTP {name}")?;
@@ -286,7 +287,12 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                         writeln!(w, "  LIN {name}")?;
                     }
                     _ => {
-                        writeln!(w, "  ; bead {} (layer {}), arc off", p.layer, p.layer)?;
+                        writeln!(
+                            w,
+                            "  ; bead {} (layer {}), arc off",
+                            p.bead_label(),
+                            p.layer
+                        )?;
                         restore_ptp(w, &mut extax)?;
                         writeln!(w, "  PTP {name}")?;
                     }
