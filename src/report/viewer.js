@@ -1081,6 +1081,16 @@
       var pick = q ? pickAt(q[0], q[1]) : null;
       out.pick = pick ? { vertex: pick.vertex, wanted: mid, layer: pick.layer, text: pick.text } : null;
       setRange(0, L - 1);
+      // the corners and splits marked: drawn, and named on hover
+      out.corners = { marked: cornersMesh ? cornersMesh.count : 0, splits: 0, split_pick: null };
+      var split = corners.filter(function (m) { return m.split; });
+      out.corners.splits = split.length;
+      if (split.length && !FIT) {
+        resetView(); updateMatrices();
+        var sq = project(mul(mul(proj, view), partMatrix()), split[0].at, cssSize());
+        var sp = sq ? pickAt(sq[0], sq[1]) : null;
+        out.corners.split_pick = sp ? sp.text : null;
+      }
       if (F) {
         state.cell = true;
         resetView();

@@ -701,3 +701,71 @@ fn the_closest_pair_is_highlighted_in_chromium() {
         );
     }
 }
+
+/// The layers' corners and the plan's bead splits are marked on the path
+/// (issue 45): the quarter torus's first 12 layers at its own grid in the
+/// ROBOWAM torch-carried cell, whose open layer 11 turns one corner (77°)
+/// inside its bead and is split there. The page data lists every corner of
+/// the path (layer, point, the split flagged), a note counts them, and in
+/// Chromium the page draws them and names the split on hover.
+#[test]
+fn corners_and_splits_are_marked_in_the_report() {
+    let part = waam_slicer::Part::read(repo("parts/quarter-torus.toml")).unwrap();
+    let cell = waam_slicer::Cell::read(repo("parts/cells/robowam_torch_carried.toml")).unwrap();
+    let opts = waam_slicer::PlanOptions {
+        slice: waam_slicer::SliceOverrides {
+            max_layers: Some(12),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let p = waam_slicer::plan_part(&part, &cell, &opts).unwrap();
+    assert!(p.is_feasible(), "{:?}", p.refusal());
+    let splits: Vec<(usize, usize)> = p.splits.iter().map(|s| (s.layer, s.point)).collect();
+    assert_eq!(splits.len(), 1, "{splits:?}");
+    assert_eq!(splits[0].0, 11);
+    let threshold = p.sliced.options.corner_threshold_rad;
+    let corners: Vec<(usize, usize)> = p
+        .sliced
+        .path
+        .layers
+        .iter()
+        .enumerate()
+        .flat_map(|(li, l)| l.corners(threshold).into_iter().map(move |c| (li, c.point)))
+        .collect();
+    assert!(corners.contains(&splits[0]));
+    let (dir, _keep) = out_dir();
+    let html = dir.join("corners.html");
+    p.write_report(&html, None).unwrap();
+    let d = page_data(&html);
+    let marked: Vec<(usize, usize, bool)> = d["corners"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            (
+                c["layer"].as_u64().unwrap() as usize,
+                c["point"].as_u64().unwrap() as usize,
+                c["split"].as_bool().unwrap(),
+            )
+        })
+        .collect();
+    let want: Vec<(usize, usize, bool)> = corners
+        .iter()
+        .map(|&(l, m)| (l, m, (l, m) == splits[0]))
+        .collect();
+    assert_eq!(marked, want);
+    let notes = d["notes"].to_string();
+    assert!(
+        notes.contains(&format!("{} corners marked", corners.len()))
+            && notes.contains("split at 1 of them"),
+        "{notes}"
+    );
+    let Some(browser) = chromium() else { return };
+    let r = open_and_check(&browser, &html);
+    let c = &r["corners"];
+    assert_eq!(c["marked"].as_u64(), Some(corners.len() as u64), "{r}");
+    assert_eq!(c["splits"], 1, "{r}");
+    let hover = c["split_pick"].as_str().unwrap_or_default();
+    assert!(hover.contains("the bead is split here"), "{r}");
+}
