@@ -289,6 +289,8 @@ struct Body<'a> {
     /// A hull's vertices in clusters: its support function, faster than
     /// the shape's own and with the same answers.
     support: Option<&'a ClusteredHull>,
+    /// An arm link's capsule, for a distance query on concrete types.
+    capsule: Option<&'a Capsule>,
 }
 
 /// What the culling remembers between samples: each body's last place and
@@ -538,6 +540,7 @@ fn capsule_body<'a>(name: &'a str, c: &'a Capsule) -> Body<'a> {
         margin: 0.0,
         ends: Some((c.segment.a, c.segment.b)),
         support: None,
+        capsule: Some(c),
     }
 }
 
@@ -563,6 +566,7 @@ impl Local {
             margin: self.margin,
             ends: None,
             support: self.support.as_ref(),
+            capsule: None,
         }
     }
 }
@@ -842,6 +846,7 @@ impl<'a> Checker<'a> {
                 margin: 0.0,
                 ends: None,
                 support: None,
+                capsule: None,
             });
         }
         let mut pairs: Vec<(usize, usize)> = Vec::new(); // indices into `all`
@@ -957,6 +962,14 @@ fn refusal(place: &Place, hit: (String, String, f64), clearance: f64) -> Program
 fn exact_distance(a: &Body, b: &Body) -> Result<f64, query::Unsupported> {
     if a.support.is_none() && b.support.is_none() {
         return query::distance(&a.pose, a.shape, &b.pose, b.shape);
+    }
+    if let (Some(c), Some(h)) = (a.capsule, b.support) {
+        // an arm link against a part hull, the check's common query: the
+        // same function on the concrete types (the same operations)
+        let pos12 = a.pose.inv_mul(&b.pose);
+        return Ok(query::details::distance_support_map_support_map(
+            &pos12, c, h,
+        ));
     }
     let s1: &dyn SupportMap = match a.support {
         Some(h) => h,
