@@ -632,9 +632,16 @@ impl PlannedPart {
                 .map(|(l, lp)| {
                     let mut summary = layer_summary(l);
                     summary.bead = lp.bead;
+                    // the cycle's entries are a bead each, in program
+                    // order: this bead's is its layer's `bead`-th
                     summary.cycle_time_s = cycle
                         .as_ref()
-                        .and_then(|c| c.layers.iter().find(|lc| lc.layer == l.layer))
+                        .and_then(|c| {
+                            c.layers
+                                .iter()
+                                .filter(|lc| lc.layer == l.layer)
+                                .nth(lp.bead)
+                        })
                         .map(|lc| lc.total_s);
                     if let Some(lc) = self
                         .clearance

@@ -87,6 +87,42 @@ fn the_quarter_torus_splits_each_corner_layer_once_and_plans_in_every_torch_carr
             .as_u64()
             .unwrap();
         assert_eq!(json["arc_starts"].as_u64().unwrap(), sliced_starts + 6);
+        // each bead's cycle time is its own: the cycle's entries, a bead
+        // each in program order, taken in turn within their layer
+        let cycle = json["cycle"]["layers"].as_array().unwrap();
+        let mut seen = std::collections::HashMap::<u64, usize>::new();
+        for lp in json["layer_plans"].as_array().unwrap() {
+            let layer = lp["layer"].as_u64().unwrap();
+            let bead = lp["bead"].as_u64().unwrap_or(0) as usize;
+            let k = seen.entry(layer).or_insert(0);
+            assert_eq!(bead, *k, "{what}: layer {layer}'s beads in order");
+            *k += 1;
+            let own = cycle
+                .iter()
+                .filter(|c| c["layer"].as_u64() == Some(layer))
+                .nth(bead)
+                .unwrap()["total_s"]
+                .as_f64();
+            assert_eq!(
+                lp["cycle_time_s"].as_f64(),
+                own,
+                "{what}: layer {layer} bead {bead}"
+            );
+        }
+        for &(li, _) in &want {
+            let beads: Vec<f64> = json["layer_plans"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|lp| lp["layer"].as_u64() == Some(li as u64))
+                .map(|lp| lp["cycle_time_s"].as_f64().unwrap())
+                .collect();
+            assert_eq!(beads.len(), 2, "{what} layer {li}");
+            assert_ne!(
+                beads[0], beads[1],
+                "{what} layer {li}: two beads, two cycle times"
+            );
+        }
         // the program: one bead a layer and one more a split
         let program = p.program.as_ref().unwrap();
         assert_eq!(program.num_beads(), 17 + 6, "{what}");
