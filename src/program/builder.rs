@@ -423,50 +423,40 @@ fn safe_transits(
             program.home.map(|h| (h.joints, h.positioner))
         }
     };
-    let check = |program: &Program, k: usize| -> Result<transit::TransitClearance, ProgramError> {
-        let inf = transit::TransitClearance {
-            min_clearance_mm: f64::INFINITY,
-            at_fraction: 0.0,
-            tip_mm: Point3::origin(),
-        };
-        let Some((qb, pb)) = target(program, k) else {
-            return Ok(inf);
-        };
-        let wall = decimated.wall(k + 1, opts.bead_radius_mm);
-        let from = &program.points[blocks[k].last];
-        transit::joint_move_clearance(
-            &program.cell,
-            &wall,
-            &torch,
-            (&from.joints, from.positioner),
-            (&qb, pb),
-        )
-        .map_err(|e| ProgramError::Infeasible {
-            count: 1,
-            first: format!("layer {}: transit check: {e}", from.layer),
-            layers: vec![from.layer],
+    // the joint move after bead k: the wall so far, the point it leaves
+    // from and the joints it goes to (none after the last bead without home)
+    let transit_of = |program: &Program, k: usize| {
+        target(program, k).map(|(qb, pb)| {
+            let wall = decimated.wall(k + 1, opts.bead_radius_mm);
+            (wall, program.points[blocks[k].last], qb, pb)
         })
     };
-    // whether a transit touches, stopping at its first sample that does;
-    // the deepest sample only for a refusal's text
+    let failed = |layer: usize, e: String| ProgramError::Infeasible {
+        count: 1,
+        first: format!("layer {layer}: transit check: {e}"),
+        layers: vec![layer],
+    };
+    // the deepest sample of a transit, for a refusal's text
+    let check = |program: &Program, k: usize| -> Result<transit::TransitClearance, ProgramError> {
+        let Some((wall, from, qb, pb)) = transit_of(program, k) else {
+            return Ok(transit::TransitClearance {
+                min_clearance_mm: f64::INFINITY,
+                at_fraction: 0.0,
+                tip_mm: Point3::origin(),
+            });
+        };
+        let a = (&from.joints, from.positioner);
+        transit::joint_move_clearance(&program.cell, &wall, &torch, a, (&qb, pb))
+            .map_err(|e| failed(from.layer, e))
+    };
+    // whether a transit touches, stopping at its first sample that does
     let touches = |program: &Program, k: usize| -> Result<bool, ProgramError> {
-        let Some((qb, pb)) = target(program, k) else {
+        let Some((wall, from, qb, pb)) = transit_of(program, k) else {
             return Ok(false);
         };
-        let wall = decimated.wall(k + 1, opts.bead_radius_mm);
-        let from = &program.points[blocks[k].last];
-        transit::joint_move_touches(
-            &program.cell,
-            &wall,
-            &torch,
-            (&from.joints, from.positioner),
-            (&qb, pb),
-        )
-        .map_err(|e| ProgramError::Infeasible {
-            count: 1,
-            first: format!("layer {}: transit check: {e}", from.layer),
-            layers: vec![from.layer],
-        })
+        let a = (&from.joints, from.positioner);
+        transit::joint_move_touches(&program.cell, &wall, &torch, a, (&qb, pb))
+            .map_err(|e| failed(from.layer, e))
     };
     let first: Vec<Result<bool, ProgramError>> = (0..n)
         .into_par_iter()
