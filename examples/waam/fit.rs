@@ -45,6 +45,17 @@ pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
                 ))
                 .unwrap_or_default()
         );
+        for (name, e) in [("start", &r.start), ("end", &r.end)] {
+            println!(
+                "{name:<11} {}, {} (tilt {:.1} deg), station {} (t = {:.2} mm), radius {:.3} mm",
+                e.kind.name(),
+                if e.oblique { "cut obliquely" } else { "square" },
+                e.tilt_deg,
+                e.station,
+                e.t_mm,
+                e.radius_mm
+            );
+        }
         println!(
             "residual    {:.4} mm RMS, {:.4} mm at most (vertices to the fitted surface)",
             r.rms_mm, r.max_mm

@@ -8,7 +8,7 @@ use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
 use super::section::{fit_circle, fit_plane, plane_basis, CircleFit, SectionPoint};
 use super::topology::{self, median_edge, Surfaces};
-use super::{repair, report};
+use super::{ends, repair, report};
 use super::{smooth, FitError, FitOptions, StartEnd, TubeMesh, Units};
 use crate::geometry::guide::{CubicSpline, GuideCurve};
 use crate::math::{Point3, UnitVector3, Vector3};
@@ -134,7 +134,7 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
 fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
     let surf = topology::surfaces(mesh, opts)?;
     let ends = end_rings(mesh, &surf)?;
-    let [start, finish] = choose_start(mesh, ends, opts)?;
+    let [mut start, mut finish] = choose_start(mesh, ends, opts)?;
     let samples = samples(mesh, &surf);
     let edge = median_edge(mesh, &surf.skins[0].triangles);
     let r0 = start.radius.min(finish.radius);
@@ -279,6 +279,23 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
         vertex_distance_mm: Vec::new(),
         report: FitReport::default(),
     };
+    let last = stations.len() - 1;
+    for (first, ring, t_end, station) in [
+        (true, &mut start, range.0, 0),
+        (false, &mut finish, range.1, last),
+    ] {
+        let shape = ends::classify(
+            mesh,
+            &surf,
+            ring,
+            first,
+            &spline.d1(t_end),
+            station,
+            t_end,
+            opts,
+        )?;
+        ring.shape = Some((shape, station, t_end));
+    }
     let ctx = report::Context {
         mesh,
         surfaces: &surf,
@@ -428,6 +445,7 @@ fn end_rings(mesh: &TubeMesh, surf: &Surfaces) -> Result<[EndRing; 2], FitError>
             normal: n0,
             radius: r0,
             capped: capped(0, l0),
+            shape: None,
             loops: vec![l0],
         };
         if let Some(other) = fitted.get(1) {

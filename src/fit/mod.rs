@@ -28,6 +28,7 @@
 //! refused with a [`FitError`] naming the file, the station and what was found.
 
 mod driver;
+pub mod ends;
 mod mesh;
 mod options;
 mod outcome;
@@ -39,9 +40,12 @@ pub mod smooth;
 pub mod topology;
 
 pub use driver::fit_tube;
+pub use ends::EndKind;
 pub use mesh::{TubeMesh, MAX_MESH_BYTES};
 pub use options::{FitOptions, StartEnd, Units};
-pub use outcome::{FitReport, LeftOut, RepairReport, StationReport, TubeFit, WallReport};
+pub use outcome::{
+    EndReport, FitReport, LeftOut, RepairReport, StationReport, TubeFit, WallReport,
+};
 
 /// Errors of the fit stage; each names the mesh file, and the station
 /// (index along the guide from the start end, and its `t` in mm) when there
@@ -165,6 +169,22 @@ pub enum FitError {
         hint: String,
         /// Why the fit failed.
         source: Box<FitError>,
+    },
+    /// An end of the tube is none of those the fit knows: open,
+    /// flat-capped, ring-capped (two skins), each cut square or obliquely
+    /// ([`ends`]).
+    #[error("{file}: the tube's {end} (station {station}, t = {t_mm:.2} mm) is not an open, flat-capped, ring-capped or obliquely cut end: {found}")]
+    UnknownEnd {
+        /// The mesh file.
+        file: String,
+        /// Which end: `start` (on the substrate) or `end`.
+        end: String,
+        /// The end's station (0 for the start).
+        station: usize,
+        /// Its guide parameter (mm from the start end).
+        t_mm: f64,
+        /// What was found.
+        found: String,
     },
     /// The fit could not be computed (too few points at a station, a
     /// singular system, no convergence to a usable guide).

@@ -3,6 +3,7 @@
 //! values the driver hands to the report builder (an open end's ring, a
 //! station's sections). Mesh frame = part frame, mm.
 
+use super::ends::{EndKind, EndShape};
 use super::section::CircleFit;
 use super::{smooth, Units};
 use crate::geometry::guide::CubicSpline;
@@ -80,6 +81,8 @@ pub(super) struct EndRing {
     pub normal: UnitVector3,
     pub radius: f64,
     pub capped: bool,
+    /// What [`classify`](super::ends::classify) found, once the guide is fitted.
+    pub shape: Option<(EndShape, usize, f64)>,
     /// The loop index of this end in each skin.
     pub loops: Vec<usize>,
 }
@@ -104,8 +107,22 @@ pub struct EndReport {
     pub normal: [f64; 3],
     /// Radius of its circle (mm; the mid-surface's for two skins).
     pub radius_mm: f64,
-    /// Whether a flat cap closes it.
+    /// Whether a flat cap closes it (a disc on one skin, a ring joining two).
     pub capped: bool,
+    /// How it is closed: open, flat-capped (one skin), ring-capped (two skins).
+    pub kind: EndKind,
+    /// Whether it is cut obliquely: its plane tilted from the tube's normal
+    /// plane by more than [`OBLIQUE_TILT_DEG`](super::ends::OBLIQUE_TILT_DEG).
+    pub oblique: bool,
+    /// The tilt of its plane from the tube's normal plane there (degrees):
+    /// the angle between the plane's normal and the rim's own axis, the
+    /// direction (searched within 17 degrees of the guide's tangent) along
+    /// which the rim looks most like a circle.
+    pub tilt_deg: f64,
+    /// Its station: 0 for the start, the last for the end.
+    pub station: usize,
+    /// Its guide parameter (mm from the start end).
+    pub t_mm: f64,
 }
 
 /// One station along the fitted guide.

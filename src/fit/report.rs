@@ -3,6 +3,7 @@
 //! [`FitReport`] (the `fit.json` that `waam fit` writes; every number is
 //! finite).
 
+use super::ends::{EndKind, OBLIQUE_TILT_DEG};
 use super::outcome::{EndReport, EndRing, FitReport, Station, StationReport, TubeFit, WallReport};
 use super::section::plane_basis;
 use super::smooth;
@@ -32,11 +33,18 @@ pub(super) struct Context<'a> {
 }
 
 fn end(e: &EndRing) -> EndReport {
+    let (shape, station, t_mm) = e.shape.map_or((None, 0, 0.0), |(s, i, t)| (Some(s), i, t));
+    let tilt_deg = shape.map_or(0.0, |s| s.tilt.to_degrees());
     EndReport {
         centre_mm: e.centre.coords.into(),
         normal: e.normal.into_inner().into(),
-        radius_mm: e.radius,
+        radius_mm: shape.map_or(e.radius, |s| s.radius),
         capped: e.capped,
+        kind: shape.map_or(EndKind::Open, |s| s.kind),
+        oblique: tilt_deg > OBLIQUE_TILT_DEG,
+        tilt_deg,
+        station,
+        t_mm,
     }
 }
 

@@ -233,15 +233,7 @@ pub fn surfaces(mesh: &TubeMesh, opts: &FitOptions) -> Result<Surfaces, FitError
                         ),
                     })
                 }
-                1 => {
-                    return Err(FitError::NotATube {
-                        file: mesh.file.clone(),
-                        found: format!(
-                            "a surface of {} triangles with one open end only: the other end is closed without a flat cap",
-                            face.len()
-                        ),
-                    })
-                }
+                1 => return Err(closed_end_error(mesh, &face, &loops[0], opts)),
                 2 => {
                     let pair = <[Vec<u32>; 2]>::try_from(loops).expect("two loops");
                     out.skins.push(Skin {
@@ -313,6 +305,74 @@ fn branch_error(mesh: &TubeMesh, tris: &[u32], loops: &[Vec<u32>]) -> FitError {
                 found,
             }
         }
+    }
+}
+
+/// The error of a surface with one open end: its other end is closed by a
+/// surface that is not flat (a dome, a cone). Names that end (`start` or
+/// `end`, as [`FitOptions::start`] would choose between the open rim and
+/// the far point) and the level set of the distance from the open rim where
+/// the closed end begins: the first whose ring is narrower than 0.97 times
+/// the widest before it.
+fn closed_end_error(mesh: &TubeMesh, tris: &[u32], rim: &[u32], opts: &FitOptions) -> FitError {
+    let pts: Vec<Point3> = rim.iter().map(|&v| mesh.vertices[v as usize]).collect();
+    let c = pts
+        .iter()
+        .fold(crate::math::Vector3::zeros(), |a, p| a + p.coords)
+        / pts.len() as f64;
+    let r = pts.iter().map(|p| (p.coords - c).norm()).sum::<f64>() / pts.len() as f64;
+    let width = (3.0 * median_edge(mesh, tris)).max(r / 3.0);
+    let sets = level_sets(mesh, tris, rim, width);
+    // Each band's ring: the mean distance of its vertices to its centroid.
+    let mut ring = vec![(0.0, 0usize); sets.bands.len()];
+    for (v, &d) in sets.distance.iter().enumerate() {
+        if d.is_finite() {
+            let k = (d / width) as usize;
+            ring[k].0 += (mesh.vertices[v] - sets.bands[k].centroid).norm();
+            ring[k].1 += 1;
+        }
+    }
+    let rho: Vec<f64> = ring.iter().map(|&(s, n)| s / n.max(1) as f64).collect();
+    let mut widest = 0.0_f64;
+    let k = rho
+        .iter()
+        .position(|&x| {
+            let narrower = widest > 0.0 && x < 0.97 * widest;
+            widest = widest.max(x);
+            narrower
+        })
+        .unwrap_or(rho.len().saturating_sub(1));
+    let far = sets
+        .distance
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| d.is_finite())
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map_or(Point3::from(c), |(v, _)| mesh.vertices[v]);
+    let dome_first = match opts.start {
+        crate::fit::StartEnd::Highest => far.z > c.z,
+        crate::fit::StartEnd::Near(p) => {
+            let p = Point3::new(p[0], p[1], p[2]);
+            (far - p).norm() < (Point3::from(c) - p).norm()
+        }
+        crate::fit::StartEnd::Lowest | crate::fit::StartEnd::Capped => far.z < c.z,
+    };
+    let found = format!(
+        "a surface of {} triangles with one open end only (radius {r:.2} mm): the other is closed by a surface that is not flat (a dome, a cone), {:.1} mm long",
+        tris.len(),
+        (sets.bands.len() - k) as f64 * width
+    );
+    let (station, t_mm) = if dome_first {
+        (0, 0.0)
+    } else {
+        (k, k as f64 * width)
+    };
+    FitError::UnknownEnd {
+        file: mesh.file.clone(),
+        end: super::ends::which(dome_first).into(),
+        station,
+        t_mm,
+        found: format!("{found} (stations are level sets of the distance from the open end, {width:.2} mm apart)"),
     }
 }
 

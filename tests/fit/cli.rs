@@ -27,6 +27,8 @@ fn fit_writes_a_part_that_slices() {
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
     assert!(report["rms_mm"].as_f64().unwrap() < 0.1, "{report}");
+    assert_eq!(report["start"]["kind"], "open", "{report}");
+    assert_eq!(report["end"]["oblique"], false, "{report}");
     let text = std::fs::read_to_string(out.join("part.toml")).unwrap();
     assert!(
         text.contains("kind = \"spline\"") && text.contains("name = \"s-bend\""),
@@ -64,6 +66,33 @@ fn fit_writes_a_part_that_slices() {
         String::from_utf8_lossy(&done.stderr)
     );
     assert!(planned.join("summary.json").exists());
+}
+
+/// The printout names each end's kind and cut.
+#[test]
+fn fit_prints_the_ends() {
+    let dir = tempfile::tempdir().unwrap();
+    let (v, f) = gen::oblique_pipe(12.0, 60.0, 30.0, 96, 1.0);
+    let stl = dir.path().join("oblique.stl");
+    std::fs::write(&stl, gen::binary_stl(&v, &f)).unwrap();
+    let done = waam()
+        .arg("fit")
+        .arg(&stl)
+        .arg("--out")
+        .arg(dir.path().join("o"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&done.stdout);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(
+        out.contains("start       open, square (tilt 0.0 deg), station 0")
+            && out.contains("end         open, cut obliquely (tilt 30.0 deg), station "),
+        "{out}"
+    );
 }
 
 #[test]

@@ -477,3 +477,126 @@ pub fn coarse(t: &Truth, chord_mm: f64) -> (Vec<Point3>, Vec<[u32; 3]>, usize) {
     }
     (v, f, around)
 }
+
+/// A mesh lofted through `rings` of the same number of points: consecutive
+/// rings joined by two triangles per quad (a ring of another shape, or two
+/// rings in one plane, make a flat face between them).
+pub fn lofted(rings: &[Vec<Point3>]) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let around = rings[0].len();
+    let v: Vec<Point3> = rings.iter().flatten().copied().collect();
+    let id = |i: usize, j: usize| (i * around + j % around) as u32;
+    let mut f = Vec::new();
+    for i in 0..rings.len() - 1 {
+        for j in 0..around {
+            f.push([id(i, j), id(i, j + 1), id(i + 1, j)]);
+            f.push([id(i, j + 1), id(i + 1, j + 1), id(i + 1, j)]);
+        }
+    }
+    (v, f)
+}
+
+/// A ring of `around` points about the z axis: at angle `a` (rad from +x),
+/// the point `at(a)`.
+pub fn ring_of(around: usize, at: impl Fn(f64) -> Point3) -> Vec<Point3> {
+    (0..around)
+        .map(|j| at(TAU * j as f64 / around as f64))
+        .collect()
+}
+
+/// A circle of radius `r` at height `z` about the z axis.
+pub fn circle_z(around: usize, r: f64, z: f64) -> Vec<Point3> {
+    ring_of(around, |a| Point3::new(r * a.cos(), r * a.sin(), z))
+}
+
+/// Rings of a straight pipe of radius `r` about the z axis from `z0` to
+/// `z1`, about `h` mm apart (both ends included).
+pub fn pipe_rings(around: usize, r: f64, z0: f64, z1: f64, h: f64) -> Vec<Vec<Point3>> {
+    let n = ((z1 - z0) / h).ceil().max(1.0) as usize;
+    (0..=n)
+        .map(|i| circle_z(around, r, z0 + (z1 - z0) * i as f64 / n as f64))
+        .collect()
+}
+
+/// Closes the ring of `around` vertices starting at `first` with a flat
+/// fan to a new vertex at `centre` (a flat cap).
+pub fn fan_cap(
+    v: &mut Vec<Point3>,
+    f: &mut Vec<[u32; 3]>,
+    first: u32,
+    around: u32,
+    centre: Point3,
+) {
+    v.push(centre);
+    let c = v.len() as u32 - 1;
+    for j in 0..around {
+        f.push([first + j, first + (j + 1) % around, c]);
+    }
+}
+
+/// A straight pipe of radius `r` about the z axis from z = 0 to the plane
+/// z = `len` + tan(`tilt_deg`) x: its top end cut obliquely (each line of
+/// the surface along z ends on the plane; the surface stays the cylinder).
+pub fn oblique_pipe(
+    r: f64,
+    len: f64,
+    tilt_deg: f64,
+    around: usize,
+    h: f64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let k = tilt_deg.to_radians().tan();
+    let n = (len / h).ceil() as usize;
+    let rings: Vec<Vec<Point3>> = (0..=n)
+        .map(|i| {
+            let u = i as f64 / n as f64;
+            ring_of(around, |a| {
+                let (x, y) = (r * a.cos(), r * a.sin());
+                Point3::new(x, y, u * (len + k * x))
+            })
+        })
+        .collect();
+    lofted(&rings)
+}
+
+/// A straight pipe of radius `r` about the z axis from z = 0 whose top end
+/// is a saddle: the rim at z = `len` + `amp` cos(2 a) (a pipe cut to meet
+/// another pipe): not a plane.
+pub fn saddle_pipe(
+    r: f64,
+    len: f64,
+    amp: f64,
+    around: usize,
+    h: f64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let n = (len / h).ceil() as usize;
+    let rings: Vec<Vec<Point3>> = (0..=n)
+        .map(|i| {
+            let u = i as f64 / n as f64;
+            ring_of(around, |a| {
+                Point3::new(r * a.cos(), r * a.sin(), u * (len + amp * (2.0 * a).cos()))
+            })
+        })
+        .collect();
+    lofted(&rings)
+}
+
+/// A straight pipe of radius `r` about the z axis from z = 0 (open) to
+/// z = `len`, closed there by a hemispherical dome (rings every `h` mm of
+/// arc, then a fan to the pole): a closed end that is not flat.
+pub fn domed_pipe(r: f64, len: f64, around: usize, h: f64) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let mut rings = pipe_rings(around, r, 0.0, len, h);
+    let m = ((FRAC_PI_2 * r / h).ceil() as usize).max(2);
+    for i in 1..m {
+        let phi = FRAC_PI_2 * i as f64 / m as f64;
+        rings.push(circle_z(around, r * phi.cos(), len + r * phi.sin()));
+    }
+    let (mut v, mut f) = lofted(&rings);
+    let last = (v.len() - around) as u32;
+    fan_cap(
+        &mut v,
+        &mut f,
+        last,
+        around as u32,
+        Point3::new(0.0, 0.0, len + r),
+    );
+    (v, f)
+}

@@ -6,6 +6,7 @@
 mod cli;
 #[path = "../common/mod.rs"]
 mod common;
+mod ends;
 mod gen;
 mod page;
 mod real;

@@ -4,7 +4,7 @@
 
 use crate::gen;
 use std::f64::consts::TAU;
-use waam_slicer::fit::{TubeMesh, Units};
+use waam_slicer::fit::{EndKind, TubeMesh, Units};
 use waam_slicer::math::{Point3, Vector3};
 use waam_slicer::{FitOptions, Part};
 
@@ -86,6 +86,10 @@ fn a_nozzle_exported_untidily_in_metres_lies_on_its_authors_profile() {
     let stray = rep.repair.left_out[0].centroid_mm;
     assert!((stray[0] - 200.0).abs() < 1.0, "{stray:?}");
     assert!(rep.warnings.is_empty(), "{:?}", rep.warnings);
+    // A surface of revolution cut at two x: two open square ends.
+    for e in [&rep.start, &rep.end] {
+        assert!(e.kind == EndKind::Open && e.tilt_deg < 1.0, "{e:?}");
+    }
     let (rms, max, n) = against_profile(&fitted.fit, &profile);
     eprintln!("nozzle against its profile: {rms:.4} mm RMS, {max:.4} mm at most, {n} points; fit residual {:.4} mm RMS", rep.rms_mm);
     assert!(n > 10_000, "{n}");
@@ -141,6 +145,11 @@ fn real_nozzle_from_the_shared_folder_lies_on_its_authors_profile() {
         ..FitOptions::default()
     };
     let fitted = Part::from_mesh(&path, &opts).unwrap();
+    // Both ends open (SOURCES.md: two boundary loops of 65 vertices), at
+    // x = -21.21 and 89.41 mm, normal to the axis.
+    for e in [&fitted.report().start, &fitted.report().end] {
+        assert!(e.kind == EndKind::Open && e.tilt_deg < 1.0, "{e:?}");
+    }
     let (rms, max, n) = against_profile(&fitted.fit, &nozzle_profile());
     eprintln!("real nozzle against its profile: {rms:.4} mm RMS, {max:.4} mm at most, {n} points; fit residual {:.4} mm RMS, repair {:?}", fitted.report().rms_mm, fitted.report().repair);
     assert!(rms <= 0.1 && max <= 0.3, "{rms} mm RMS, {max} mm at most");
