@@ -14,7 +14,7 @@ use waam_slicer::path::slice;
 use waam_slicer::program::contract::Controller;
 use waam_slicer::program::fanuc::Fanuc;
 use waam_slicer::program::fanuc::FanucOptions;
-use waam_slicer::program::{build_program, TravelSpeed};
+use waam_slicer::program::{build_program, PointFeed};
 use waam_slicer::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
 use waam_slicer::toolaxis::local_frames;
 use waam_slicer::{Cell, Part};
@@ -64,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &cell.layout,
         &points,
         &traj,
-        &TravelSpeed::Constant(speed),
+        &PointFeed::constant(speed, 10.0, points.len()),
     )?;
 
     let fanuc = FanucOptions::default();

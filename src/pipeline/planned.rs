@@ -19,7 +19,7 @@ use crate::optimise::{
     OptimiseOptions, Plan, SplitPlan,
 };
 use crate::program::{
-    build_program_with, check_vendor, write_files, LayerRefusal, Program, ProgramError, TravelSpeed,
+    build_program_with, check_vendor, write_files, LayerRefusal, PointFeed, Program, ProgramError,
 };
 use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
 use crate::robot::Vendor;
@@ -296,7 +296,8 @@ pub(super) fn build(
         &cell.layout,
         &inputs,
         &traj,
-        &TravelSpeed::Constant(speed),
+        // the nominal travel speed and the process's wire feed at every point
+        &PointFeed::constant(speed, sliced.process.wire_feed_speed_mm_s, inputs.len()),
         common,
     )?;
     if common.payload_every_layers > 0 {

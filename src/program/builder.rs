@@ -7,7 +7,7 @@
 use crate::math::Point3;
 use crate::program::{
     check_name, joints_move, moves, pose, split, transit, ArcFlag, BeadSetup, HomePosition,
-    Program, ProgramError, ProgramOptions, ProgramPoint, TravelSpeed,
+    PlannedPoint, PointFeed, Program, ProgramError, ProgramOptions, ProgramPoint,
 };
 use crate::robot::cell::CellPoint;
 use crate::robot::positioner::PositionerJoints;
@@ -19,11 +19,13 @@ use crate::robot::{CellLayout, Joints};
 /// `points` and `trajectory` must be the same path in the same order (the
 /// trajectory computed for these points by
 /// [`joint_trajectory`](crate::robot::trajectory::joint_trajectory) or an
-/// optimiser); each layer becomes one bead of at least two points. Joint
+/// optimiser); each layer becomes one bead of at least two points. `feed`
+/// gives each of them its travel speed and wire feed (mm/s, the move into
+/// the point; [`PointFeed::constant`] for the same everywhere). Joint
 /// speeds are re-checked at the given travel speeds.
 ///
 /// # Errors
-/// [`ProgramError::InvalidOptions`] for a bad name or speed,
+/// [`ProgramError::InvalidOptions`] for a bad name, speed or wire feed,
 /// [`ProgramError::Mismatch`] when the inputs differ in length, layer or
 /// point indices, or a layer has one point, and [`ProgramError::Infeasible`]
 /// when the trajectory reports violations or a point has no joints, naming
@@ -33,14 +35,14 @@ pub fn build_program(
     cell: &CellLayout,
     points: &[PathPointInput],
     trajectory: &JointTrajectory,
-    speed: &TravelSpeed,
+    feed: &[PointFeed],
 ) -> Result<Program, ProgramError> {
     build_program_with(
         name,
         cell,
         points,
         trajectory,
-        speed,
+        feed,
         &ProgramOptions::default(),
     )
 }
@@ -61,7 +63,7 @@ pub fn build_program_with(
     cell: &CellLayout,
     points: &[PathPointInput],
     trajectory: &JointTrajectory,
-    speed: &TravelSpeed,
+    feed: &[PointFeed],
     opts: &ProgramOptions,
 ) -> Result<Program, ProgramError> {
     opts.validate()?;
@@ -82,27 +84,31 @@ pub fn build_program_with(
             reason: "empty path".into(),
         });
     }
-    let speeds: Vec<f64> = match speed {
-        TravelSpeed::Constant(v) => vec![*v; points.len()],
-        TravelSpeed::PerPoint(v) => {
-            if v.len() != points.len() {
-                return Err(ProgramError::Mismatch {
-                    index: v.len().min(points.len()),
-                    reason: format!("{} speeds for {} points", v.len(), points.len()),
+    if feed.len() != points.len() {
+        return Err(ProgramError::Mismatch {
+            index: feed.len().min(points.len()),
+            reason: format!(
+                "{} speeds and wire feeds for {} points",
+                feed.len(),
+                points.len()
+            ),
+        });
+    }
+    for (i, f) in feed.iter().enumerate() {
+        for (field, v) in [
+            ("travel_speed_mm_s", f.travel_speed_mm_s),
+            ("wire_feed_mm_s", f.wire_feed_mm_s),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(ProgramError::InvalidOptions {
+                    field,
+                    value: format!("{v} (index {i})"),
+                    reason: "must be finite and > 0",
                 });
             }
-            v.clone()
-        }
-    };
-    for (i, v) in speeds.iter().enumerate() {
-        if !(v.is_finite() && *v > 0.0) {
-            return Err(ProgramError::InvalidOptions {
-                field: "travel_speed_mm_s",
-                value: format!("{v} (index {i})"),
-                reason: "must be finite and > 0",
-            });
         }
     }
+    let speeds: Vec<f64> = feed.iter().map(|f| f.travel_speed_mm_s).collect();
     if let Some(v) = trajectory.report.violations.first() {
         return Err(ProgramError::Infeasible {
             count: trajectory.report.violations.len(),
@@ -192,11 +198,9 @@ pub fn build_program_with(
             r_z: p.r_z,
             joints: q,
             positioner: jp.positioner,
-            speed_mm_s: if first && !last {
-                speeds[i + 1]
-            } else {
-                speeds[i]
-            },
+            // a bead's first point carries its first segment's feed
+            speed_mm_s: feed[if first && !last { i + 1 } else { i }].travel_speed_mm_s,
+            wire_feed_mm_s: feed[if first && !last { i + 1 } else { i }].wire_feed_mm_s,
             arc: if first {
                 ArcFlag::Start
             } else if last {
@@ -262,7 +266,16 @@ pub fn build_program_with(
     if opts.transit_check {
         safe_transits(&mut program, points, opts)?;
     }
-    program.planned = program.bead_points().map(|p| p.position_mm).collect();
+    program.planned = program
+        .bead_points()
+        .map(|p| PlannedPoint {
+            position_mm: p.position_mm,
+            feed: PointFeed {
+                travel_speed_mm_s: p.speed_mm_s,
+                wire_feed_mm_s: p.wire_feed_mm_s,
+            },
+        })
+        .collect();
     moves::thin_beads(&mut program, opts)?;
     Ok(program)
 }
@@ -649,6 +662,7 @@ fn clearance_point(
         joints: q,
         positioner: pose.positioner,
         speed_mm_s: opts.approach_speed_mm_s,
+        wire_feed_mm_s: 0.0,
         arc: flag,
         via: false,
         ..*p

@@ -15,13 +15,12 @@
 
 use std::path::Path;
 
-use crate::math::Point3;
 use crate::program::cycle::CycleOptions;
 use crate::program::split::{parse_group_name, Budget};
 use crate::program::validate::{
     check_home_ends, check_steps, push, vendor_matches, DecodedStep, ProblemKind, ValidationReport,
 };
-use crate::program::{EmittedFile, Program, ProgramError, ProgramOptions};
+use crate::program::{EmittedFile, PlannedPoint, Program, ProgramError, ProgramOptions};
 use crate::robot::{CellLayout, Vendor};
 
 /// A robot controller's program format: options, emit, read, decode.
@@ -150,7 +149,7 @@ pub trait Controller {
         read: &Self::Read,
         cell: &CellLayout,
         opts: &Self::Options,
-        planned: Option<&[Point3]>,
+        planned: Option<&[PlannedPoint]>,
     ) -> ValidationReport
     where
         Self: Sized,
@@ -167,7 +166,7 @@ pub(crate) fn validate_decoded<C: Controller>(
     cell: &CellLayout,
     main_file: &str,
     opts: &C::Options,
-    planned: Option<&[Point3]>,
+    planned: Option<&[PlannedPoint]>,
     decode: impl FnOnce(&mut ValidationReport) -> Option<Vec<DecodedStep>>,
 ) -> ValidationReport {
     let mut report = ValidationReport::default();
@@ -248,7 +247,7 @@ pub fn validate_build<C: Controller>(
     files: &[EmittedFile],
     cell: &CellLayout,
     opts: &C::Options,
-    planned: Option<&[Point3]>,
+    planned: Option<&[PlannedPoint]>,
 ) -> Result<ValidationReport, ProgramError> {
     let mut report = ValidationReport::default();
     let groups = C::groups(files, &mut report)?;

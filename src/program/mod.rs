@@ -1,7 +1,7 @@
 //! **Stage 7 — robot programs.** Takes a planned [`JointTrajectory`](crate::robot::trajectory::JointTrajectory) (joints
 //! per path point, rad), the path points it was computed for
 //! ([`PathPointInput`](crate::robot::trajectory::PathPointInput): layer structure, part-frame positions (mm), tool axes,
-//! `R_Z`), the [`CellLayout`](crate::robot::CellLayout) and the travel speeds (mm/s), checks that the plan is
+//! `R_Z`), the [`CellLayout`](crate::robot::CellLayout) and each point's travel speed and wire feed ([`PointFeed`], mm/s), checks that the plan is
 //! buildable, and returns a [`Program`]: one bead per layer, every point
 //! carrying its arc flag, with an approach point before and a retract point
 //! after each bead. Emitters turn a [`Program`] into controller files; every
@@ -69,7 +69,7 @@ pub(crate) use model::render;
 pub use model::{
     check_name, check_vendor, joint_move_target, joints_move, move_start, opens_bead,
     positioner_moves, segment_length_mm, write_files, ArcFlag, BeadSetup, EmittedFile, Payload,
-    Program, ProgramPoint, TravelSpeed, JOINT_STILL_RAD, POSITIONER_STILL_DEG,
+    PlannedPoint, PointFeed, Program, ProgramPoint, JOINT_STILL_RAD, POSITIONER_STILL_DEG,
 };
 pub use options::{HomePosition, ProcessControl, ProgramOptions};
 pub use registry::ProgramSettings;

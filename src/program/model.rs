@@ -77,6 +77,10 @@ pub struct ProgramPoint {
     /// of the moves into and out of the bead (approach point → first point,
     /// last point → retract point), [`ProgramOptions::approach_speed_mm_s`].
     pub speed_mm_s: f64,
+    /// Wire feed speed on the way to this point with the arc on (mm/s);
+    /// on a bead's first point the wire feed of its first segment (what
+    /// the arc starts with); 0 on approach and retract points (arc off).
+    pub wire_feed_mm_s: f64,
     /// Arc flag.
     pub arc: ArcFlag,
     /// This bead point is the via (circle) point of a circular move (FANUC
@@ -129,15 +133,16 @@ pub struct Program {
     /// What happens before each bead, one per bead in order (empty: nothing).
     pub bead_setup: Vec<BeadSetup>,
     /// The planned deposition points of every bead in order (part frame,
-    /// mm), before the beads were thinned into moves
+    /// mm) with their travel speeds and wire feeds (mm/s), before the beads
+    /// were thinned into moves
     /// ([`moves::thin_beads`](crate::program::moves::thin_beads)): what a checker compares the moves with.
-    pub planned: Vec<Point3>,
+    pub planned: Vec<PlannedPoint>,
 }
 
 impl Program {
     /// Checks that every number an emitter writes is finite (positions,
-    /// tool axes, `R_Z`, joints, positioner joints, speeds > 0): a
-    /// hand-built program must not put `NaN` or `inf` into a controller file.
+    /// tool axes, `R_Z`, joints, positioner joints, speeds > 0, wire feeds
+    /// at least 0): a hand-built program must not put `NaN` or `inf` into a controller file.
     ///
     /// # Errors
     /// [`ProgramError::Mismatch`] naming the first bad point and field.
@@ -169,6 +174,9 @@ impl Program {
             }
             if !(p.speed_mm_s.is_finite() && p.speed_mm_s > 0.0) {
                 return Err(bad("speed_mm_s (must be finite and > 0)"));
+            }
+            if !(p.wire_feed_mm_s.is_finite() && p.wire_feed_mm_s >= 0.0) {
+                return Err(bad("wire_feed_mm_s (must be finite and >= 0)"));
             }
         }
         Ok(())
@@ -280,14 +288,47 @@ impl Program {
     }
 }
 
-/// Travel speeds of a program (mm/s).
-#[derive(Debug, Clone, PartialEq)]
-pub enum TravelSpeed {
-    /// The same speed everywhere (mm/s).
-    Constant(f64),
-    /// One speed per point, the speed on the way to it (modulated travel
-    /// speed, SPEC §5) (mm/s).
-    PerPoint(Vec<f64>),
+/// The travel speed and the wire feed of one path point (mm/s): what the
+/// move into the point runs at (SPEC §5: the bead's cross-section is
+/// `A = pi d^2/4 * wire_feed / travel_speed`, eq. 1.1). The program builder
+/// takes one per trajectory point ([`build_program`](crate::program::build_program)).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PointFeed {
+    /// Travel speed of the deposition point over the part on the way to
+    /// the point (mm/s, > 0).
+    pub travel_speed_mm_s: f64,
+    /// Wire feed speed on the way to the point (mm/s, > 0).
+    pub wire_feed_mm_s: f64,
+}
+
+impl PointFeed {
+    /// The same travel speed and wire feed (mm/s) at each of `n` points.
+    pub fn constant(travel_speed_mm_s: f64, wire_feed_mm_s: f64, n: usize) -> Vec<PointFeed> {
+        vec![
+            PointFeed {
+                travel_speed_mm_s,
+                wire_feed_mm_s,
+            };
+            n
+        ]
+    }
+
+    /// `wire_feed / travel_speed`, the ratio that sets the bead's
+    /// cross-section (SPEC §5, eq. 1.1; dimensionless).
+    pub fn ratio(&self) -> f64 {
+        self.wire_feed_mm_s / self.travel_speed_mm_s
+    }
+}
+
+/// A planned deposition point of a bead, before the beads were thinned
+/// into moves: what a checker compares the moves with.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PlannedPoint {
+    /// Deposition point, part frame (mm).
+    pub position_mm: Point3,
+    /// Travel speed and wire feed on the way to it (mm/s); on a bead's
+    /// first point those of its first segment.
+    pub feed: PointFeed,
 }
 
 /// The payload carried on the flange (part-carried cell): substrate,

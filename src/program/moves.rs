@@ -20,7 +20,7 @@
 //! the part-carried cell, coordinated motion in the torch-carried one),
 //! else the robot base frame with the positioner turning the part under it.
 //! The deviation is measured over the part in both cases. Bead ends, speed
-//! changes and every point outside beads are kept.
+//! and wire feed changes and every point outside beads are kept.
 
 use crate::math::Isometry3;
 use crate::program::compress::{compress, CompressOptions, Move};
@@ -64,23 +64,28 @@ const MAX_JOINT_TURN_PER_MOVE_RAD: f64 = std::f64::consts::FRAC_PI_4;
 /// orientation turns half a turn each (see [`thin_beads`]).
 pub const MAX_ARC_SWEEP_DEG: f64 = 120.0;
 
-/// The bead points every thinned move must stop at: where the speed
-/// changes (a move carries one), and where the joints have turned
-/// [`MAX_JOINT_TURN_PER_MOVE_RAD`] since the last such point.
+/// The bead points every thinned move must stop at: where the travel
+/// speed or the wire feed changes (a move carries one of each: the point
+/// between the last segment of one and the first of the other), and where
+/// the joints have turned [`MAX_JOINT_TURN_PER_MOVE_RAD`] since the last
+/// such point.
 fn must_keep(bead: &[ProgramPoint]) -> Vec<bool> {
     let mut keep = vec![false; bead.len()];
     let mut anchor = 0;
+    let changes = |a: f64, b: f64| (a - b).abs() > SPEED_CHANGE * a.abs();
     for k in 1..bead.len() {
-        let speed = (bead[k].speed_mm_s - bead[k - 1].speed_mm_s).abs()
-            > SPEED_CHANGE * bead[k].speed_mm_s.abs();
+        // point k carries the feed of the segment into it
+        let feed = changes(bead[k].speed_mm_s, bead[k - 1].speed_mm_s)
+            || changes(bead[k].wire_feed_mm_s, bead[k - 1].wire_feed_mm_s);
         let turned = bead[k]
             .joints
             .iter()
             .zip(&bead[anchor].joints)
             .any(|(a, b)| (a - b).abs() > MAX_JOINT_TURN_PER_MOVE_RAD);
-        if speed || turned {
-            // stop at the last point before the turn grows too large
-            let at = if turned && k - 1 > anchor { k - 1 } else { k };
+        if feed || turned {
+            // a feed change ends the move at the segment's start; a turn
+            // stops at the last point before it grows too large
+            let at = if k - 1 > anchor { k - 1 } else { k };
             keep[at] = true;
             anchor = at;
         }

@@ -13,12 +13,11 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
-use crate::math::Point3;
 use crate::program::contract::{validate_build, Controller};
 use crate::program::cycle::CycleOptions;
 use crate::program::split::parse_group_name;
 use crate::program::validate::ValidationReport;
-use crate::program::{EmittedFile, Program, ProgramError, ProgramOptions};
+use crate::program::{EmittedFile, PlannedPoint, Program, ProgramError, ProgramOptions};
 use crate::robot::{CellLayout, Vendor};
 
 pub use crate::program::abb::Abb;
@@ -171,13 +170,13 @@ pub fn check_files(
     files: &[EmittedFile],
     cell: &CellLayout,
     settings: &ProgramSettings,
-    planned: Option<&[Point3]>,
+    planned: Option<&[PlannedPoint]>,
 ) -> Result<ValidationReport, ProgramError> {
     struct Check<'a> {
         files: &'a [EmittedFile],
         cell: &'a CellLayout,
         settings: &'a ProgramSettings,
-        planned: Option<&'a [Point3]>,
+        planned: Option<&'a [PlannedPoint]>,
     }
     impl ControllerTask for Check<'_> {
         type Output = Result<ValidationReport, ProgramError>;

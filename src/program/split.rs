@@ -105,10 +105,10 @@ fn planned_ranges(program: &Program, blocks: &[Range<usize>]) -> Option<Vec<Rang
         let s = cursor
             + program.planned[cursor..]
                 .iter()
-                .position(|q| *q == first.position_mm)?;
+                .position(|q| q.position_mm == first.position_mm)?;
         let e = s + program.planned[s..]
             .iter()
-            .position(|q| *q == last.position_mm)?;
+            .position(|q| q.position_mm == last.position_mm)?;
         out.push(s..e + 1);
         cursor = e + 1;
     }

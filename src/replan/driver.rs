@@ -18,7 +18,7 @@ use crate::pipeline::{
 use crate::process::PointProcess;
 use crate::program::cell_check::{check_cell, CellClearance, CellScene};
 use crate::program::{
-    build_program_with, check_vendor, LayerRefusal, Program, ProgramError, TravelSpeed,
+    build_program_with, check_vendor, LayerRefusal, PointFeed, Program, ProgramError,
 };
 use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
 use crate::robot::{CellLayout, Vendor};
@@ -215,6 +215,9 @@ fn replan_core(
         &plan,
         &point_speeds,
         v_nom,
+        // the speed correction changes the height on purpose (SPEC §5: TS
+        // modulated at the process's wire feed): the nominal wire feed
+        process.wire_feed_speed_mm_s,
         resume_payload,
         &process_plan.layer_masses_kg(&rebuilt.path, process),
     );
@@ -625,7 +628,8 @@ fn resume_payload(cell: &Cell, sliced: &SlicedPart, k: usize) -> Option<(f64, Po
     Some((mass, cog))
 }
 
-/// The program of the remaining layers: per-point speeds, the payload of
+/// The program of the remaining layers: per-point speeds at the process's
+/// wire feed `wire_feed_mm_s` (mm/s), the payload of
 /// the deposited layers as its base, refused (as data) when a layer is
 /// infeasible.
 #[allow(clippy::too_many_arguments)]
@@ -636,6 +640,7 @@ fn resumed_program(
     plan: &Plan,
     speeds: &[Vec<f64>],
     v_nom: f64,
+    wire_feed_mm_s: f64,
     payload: Option<(f64, Point3)>,
     layer_masses_kg: &[f64],
 ) -> Result<(Program, CellClearance, f64), ProgramError> {
@@ -669,15 +674,15 @@ fn resumed_program(
         common.payload_base_kg = mass;
         common.payload_base_cog_mm = [cog.x, cog.y, cog.z];
     }
-    let flat: Vec<f64> = speeds.iter().flatten().copied().collect();
-    let mut program = build_program_with(
-        name,
-        &cell.layout,
-        &inputs,
-        &traj,
-        &TravelSpeed::PerPoint(flat),
-        &common,
-    )?;
+    let flat: Vec<PointFeed> = speeds
+        .iter()
+        .flatten()
+        .map(|&travel_speed_mm_s| PointFeed {
+            travel_speed_mm_s,
+            wire_feed_mm_s,
+        })
+        .collect();
+    let mut program = build_program_with(name, &cell.layout, &inputs, &traj, &flat, &common)?;
     if common.payload_every_layers > 0 {
         let masses: Vec<f64> = layers
             .iter()

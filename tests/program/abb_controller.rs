@@ -61,8 +61,8 @@ use waam_slicer::program::abb::validate_abb;
 use waam_slicer::program::abb::{abb_files, AbbLoad, AbbOptions};
 use waam_slicer::program::validate::{ProblemKind, ValidationReport};
 use waam_slicer::program::{
-    build_program, BeadSetup, EmittedFile, HomePosition, Payload, ProcessControl, Program,
-    ProgramError, TravelSpeed,
+    build_program, BeadSetup, EmittedFile, HomePosition, Payload, PlannedPoint, PointFeed,
+    ProcessControl, Program, ProgramError,
 };
 use waam_slicer::robot::CellLayout;
 
@@ -73,11 +73,11 @@ use crate::rapid_grammar::{check_module, check_task};
 const PART: &str = "abb_irb2600_part_carried.toml";
 const TORCH: &str = "abb_irb2600_torch_carried.toml";
 
-fn planned(prog: &Program) -> Vec<Point3> {
+fn planned(prog: &Program) -> Vec<PlannedPoint> {
     prog.planned.clone()
 }
 
-fn check(text: &str, c: &CellLayout, opts: &AbbOptions, plan: &[Point3]) -> ValidationReport {
+fn check(text: &str, c: &CellLayout, opts: &AbbOptions, plan: &[PlannedPoint]) -> ValidationReport {
     let m = parse_mod(text, "HEMI.mod").unwrap_or_else(|e| panic!("{e}\n{text}"));
     validate_abb(&m, c, opts, Some(plan))
 }
@@ -272,7 +272,20 @@ fn one_welddata_per_planned_speed_and_weld_speed_is_checked() {
     let speeds: Vec<f64> = (0..path.len())
         .map(|i| if i % 2 == 0 { 6.0 } else { 8.0 })
         .collect();
-    let prog = build_program("HEMI", &c, &path, &tr, &TravelSpeed::PerPoint(speeds)).unwrap();
+    let prog = build_program(
+        "HEMI",
+        &c,
+        &path,
+        &tr,
+        &speeds
+            .iter()
+            .map(|&v| PointFeed {
+                travel_speed_mm_s: v,
+                wire_feed_mm_s: crate::fixture::WFS_MM_S,
+            })
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
     let opts = AbbOptions::default();
     let text = &abb_files(&prog, &opts).unwrap()[0].text;
     let welds: Vec<&str> = text

@@ -44,7 +44,7 @@ fn build(
 ) -> (
     CellLayout,
     Program,
-    Vec<waam_slicer::math::Point3>,
+    Vec<waam_slicer::program::PlannedPoint>,
     ProgramSettings,
 ) {
     let cell = cell(file);
@@ -68,7 +68,15 @@ fn build(
     (
         cell,
         prog,
-        path.iter().map(|p| p.position_mm).collect(),
+        path.iter()
+            .map(|p| waam_slicer::program::PlannedPoint {
+                position_mm: p.position_mm,
+                feed: waam_slicer::program::PointFeed {
+                    travel_speed_mm_s: crate::fixture::TS_MM_S,
+                    wire_feed_mm_s: crate::fixture::WFS_MM_S,
+                },
+            })
+            .collect(),
         settings,
     )
 }

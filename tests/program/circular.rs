@@ -35,7 +35,7 @@ fn thinned_hemisphere(
         c,
         &path,
         &tr,
-        &waam_slicer::program::TravelSpeed::Constant(TS_MM_S),
+        &waam_slicer::program::PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
     )
     .unwrap_or_else(|e| panic!("{}: {e}", c.name()))
 }
@@ -97,7 +97,11 @@ fn a_cell_file_can_turn_circular_moves_off() {
             &c,
             &path,
             &tr,
-            &waam_slicer::program::TravelSpeed::Constant(TS_MM_S),
+            &waam_slicer::program::PointFeed::constant(
+                TS_MM_S,
+                crate::fixture::WFS_MM_S,
+                path.len(),
+            ),
             common,
         )
         .unwrap()

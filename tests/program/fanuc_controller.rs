@@ -80,7 +80,7 @@ fn home_deg(prog: &Program) -> [f64; 6] {
 /// Two layers of 8 points with a home position and a set-up before each
 /// bead: payload before both (2.5 kg at 40 mm, then 2.6 kg at 41.5 mm on
 /// the flange's z), before the second a 30 s dwell and a wait for DI[3].
-fn with_setup(cell: &CellLayout) -> (Program, Vec<Point3>) {
+fn with_setup(cell: &CellLayout) -> (Program, Vec<waam_slicer::program::PlannedPoint>) {
     let (mut prog, path) = program(cell, 0..2, 8);
     let last = *prog.points.last().unwrap();
     prog.home = Some(HomePosition {
@@ -107,7 +107,7 @@ fn with_setup(cell: &CellLayout) -> (Program, Vec<Point3>) {
             wait_input: Some(3),
         },
     ];
-    (prog, path.iter().map(|p| p.position_mm).collect())
+    (prog, crate::fixture::planned_of(&path))
 }
 
 /// The options the set-up programs are written and checked with.
@@ -379,7 +379,7 @@ fn check_text(
     text: &str,
     cell: &CellLayout,
     opts: &FanucOptions,
-    planned: &[Point3],
+    planned: &[waam_slicer::program::PlannedPoint],
 ) -> ValidationReport {
     let tp = parse_ls(text, "HEMI.ls").unwrap_or_else(|e| panic!("{e}"));
     validate_fanuc(&[tp], cell, opts, Some(planned))
@@ -492,12 +492,15 @@ fn missing_coord_arc_true_or_a_wrong_weld_schedule_are_caught() {
     let (bad, _) = edit(&text, "ARC : TRUE", 0, |_| String::new());
     let r = check_text(&bad, &cell, &opts, &planned);
     find(&r, ProblemKind::Options, "ARC : TRUE");
-    // Weld Start[2,3] where the options give schedule 1
+    // Weld Start[2,3] where the program defines schedule 1 only (its
+    // `WELD SCHED 1` remark): the wire feed of schedule 3 is not the
+    // program's (a feed problem; before the schedules carried the wire
+    // feed, an options problem naming `Weld Start[2,1]`)
     let (bad, line) = edit(&text, "Weld Start[2,1]", 0, |l| l.replace("[2,1]", "[2,3]"));
     let r = check_text(&bad, &cell, &opts, &planned);
-    let (l, msg) = find(&r, ProblemKind::Options, "Weld Start[2,3]");
+    let (l, msg) = find(&r, ProblemKind::Feed, "Weld Start[2,3]");
     assert_eq!(l, line, "{msg}");
-    assert!(msg.contains("Weld Start[2,1]"), "{msg}");
+    assert!(msg.contains("WELD SCHED 3"), "{msg}");
     // still counted as the bead's start: no knock-on bead problems
     assert_eq!(r.problems.len(), 1, "{r}");
     assert_eq!(r.beads, 2);
@@ -620,9 +623,16 @@ fn a_segment_at_a_joints_limit_is_timed_under_rtcp() {
         .unwrap();
     let r6 = joint_speed_ratio(&base, i, 6.0);
     assert!(r6 > 0.0 && r6 < 0.5, "{r6}");
+    // the planned point of that move, whose speed the plan changes with it
+    let j = planned
+        .iter()
+        .position(|q| q.position_mm == base.points[i].position_mm)
+        .unwrap();
     let line_of = |ratio: f64| {
         let mut prog = base.clone();
         prog.points[i].speed_mm_s = 6.0 * ratio / r6;
+        let mut planned = planned.clone();
+        planned[j].feed.travel_speed_mm_s = prog.points[i].speed_mm_s;
         let files = fanuc_files(&prog, &opts).unwrap();
         let r = validate_fanuc(&read_all(&files), &cell, &opts, Some(&planned));
         assert!(r.is_ok(), "{ratio}: {r}");

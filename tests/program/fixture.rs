@@ -3,7 +3,7 @@
 //! cells, with a law `R_Z(v)` feasible in each ([`law`]).
 
 use waam_slicer::io::cell_file::read_cell_file;
-use waam_slicer::program::{build_program, Program, TravelSpeed};
+use waam_slicer::program::{build_program, PointFeed, Program};
 use waam_slicer::robot::trajectory::{
     joint_trajectory, JointTrajectory, PathPointInput, TrajectoryOptions,
 };
@@ -11,6 +11,9 @@ use waam_slicer::robot::{CellLayout, Vendor};
 
 /// TS 36 cm/min = 6 mm/s [thesis table 3.1].
 pub const TS_MM_S: f64 = 6.0;
+
+/// WFS 10 mm/s with TS 6 mm/s [thesis table 3.1].
+pub const WFS_MM_S: f64 = 10.0;
 
 /// Layers `layers` of the hemisphere, `points` per layer, `R_Z = r_z(v)`.
 pub fn hemisphere(
@@ -84,8 +87,14 @@ pub fn program(
 ) -> (Program, Vec<PathPointInput>) {
     let path = hemisphere(layers, points, law(cell));
     let tr = trajectory(cell, &path);
-    let prog = build_program("HEMI", cell, &path, &tr, &TravelSpeed::Constant(TS_MM_S))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let prog = build_program(
+        "HEMI",
+        cell,
+        &path,
+        &tr,
+        &PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     (prog, path)
 }
 
@@ -97,6 +106,20 @@ fn the_test_layers_are_feasible_in_every_cell() {
         let tr = trajectory(&cell, &path);
         assert!(tr.report.is_clean(), "{file}: {}", tr.report);
     }
+}
+
+/// The plan of `path` at the fixture's constant speed and wire feed, as a
+/// checker takes it.
+pub fn planned_of(path: &[PathPointInput]) -> Vec<waam_slicer::program::PlannedPoint> {
+    path.iter()
+        .map(|p| waam_slicer::program::PlannedPoint {
+            position_mm: p.position_mm,
+            feed: PointFeed {
+                travel_speed_mm_s: TS_MM_S,
+                wire_feed_mm_s: WFS_MM_S,
+            },
+        })
+        .collect()
 }
 
 /// The positions of the beads of layers `0..layers` of `prog` (part frame,

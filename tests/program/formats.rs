@@ -2,7 +2,6 @@
 //! we corrupt (a joint pushed out of range, a dropped arc end, a truncated
 //! file, a configuration flip) are rejected with a message naming the line.
 
-use waam_slicer::math::Point3;
 use waam_slicer::program::abb::read::parse_mod;
 use waam_slicer::program::abb::validate_abb;
 use waam_slicer::program::abb::{abb_files, AbbOptions};
@@ -27,7 +26,7 @@ fn abb_part_carried() -> CellLayout {
     cell("abb_irb2600_part_carried.toml")
 }
 
-fn hemi(cell: &CellLayout) -> (Program, Vec<Point3>) {
+fn hemi(cell: &CellLayout) -> (Program, Vec<waam_slicer::program::PlannedPoint>) {
     let (prog, _) = program(cell, 0..4, 24);
     let planned = prog.planned.clone();
     (prog, planned)
@@ -57,13 +56,17 @@ fn kuka_check(
     dat: &str,
     cell: &CellLayout,
     opts: &KukaOptions,
-    planned: &[Point3],
+    planned: &[waam_slicer::program::PlannedPoint],
 ) -> ValidationReport {
     let p = parse_krl(src, &files[0].name, dat, &files[1].name).unwrap_or_else(|e| panic!("{e}"));
     validate_kuka(&p, cell, opts, Some(planned))
 }
 
-fn abb_check(text: &str, cell: &CellLayout, planned: &[Point3]) -> ValidationReport {
+fn abb_check(
+    text: &str,
+    cell: &CellLayout,
+    planned: &[waam_slicer::program::PlannedPoint],
+) -> ValidationReport {
     let m = parse_mod(text, "HEMI.mod").unwrap_or_else(|e| panic!("{e}"));
     validate_abb(&m, cell, &AbbOptions::default(), Some(planned))
 }
@@ -471,7 +474,7 @@ fn abb_corruptions_are_named_by_their_line() {
 /// no `\T` even where the positioner turned since the previous bead.
 #[test]
 fn abb_arc_start_after_moveabsj_is_not_timed() {
-    use waam_slicer::program::{build_program_with, ProgramOptions, TravelSpeed};
+    use waam_slicer::program::{build_program_with, PointFeed, ProgramOptions};
     let c = cell("abb_irb2600_torch_carried.toml");
     let path = crate::fixture::hemisphere(0..3, 24, crate::fixture::law(&c));
     let tr = crate::fixture::trajectory(&c, &path);
@@ -480,7 +483,11 @@ fn abb_arc_start_after_moveabsj_is_not_timed() {
         &c,
         &path,
         &tr,
-        &TravelSpeed::Constant(crate::fixture::TS_MM_S),
+        &PointFeed::constant(
+            crate::fixture::TS_MM_S,
+            crate::fixture::WFS_MM_S,
+            path.len(),
+        ),
         &ProgramOptions {
             clearance_mm: 0.0,
             ..Default::default()
@@ -501,7 +508,7 @@ fn abb_arc_start_after_moveabsj_is_not_timed() {
     for l in starts {
         assert!(!l.contains("\\T"), "{l}");
     }
-    let planned: Vec<Point3> = prog.planned.clone();
+    let planned = prog.planned.clone();
     let r = abb_check(text, &c, &planned);
     assert!(r.is_ok(), "{r}");
 }

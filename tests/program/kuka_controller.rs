@@ -206,8 +206,10 @@ fn the_arc_waits_for_ignition_and_ends_with_crater_and_burn_back() {
         ]
     );
     assert_eq!(lines[on + 12..on + 14], ["    HALT", "  ENDLOOP"]);
-    // the motion before the arc on reaches the bead's first point exactly
-    assert_eq!(lines[on - 4], "  LIN P2");
+    // the motion before the arc on reaches the bead's first point exactly;
+    // the wire feed's analog command (10 mm/s of 400 mm/s) is set before
+    assert_eq!(lines[on - 6], "  LIN P2");
+    assert_eq!(lines[on - 4], "  $ANOUT[1] = 0.0250");
     let off = line_eq(src, "  $OUT[1]=FALSE", 0);
     assert_eq!(
         lines[off - 6..off + 2],

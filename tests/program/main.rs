@@ -13,6 +13,7 @@ mod contract;
 mod corner_splits;
 mod cycle;
 mod fanuc_controller;
+mod feed;
 mod fixture;
 mod formats;
 mod golden;

@@ -9,7 +9,6 @@
 
 use std::time::Instant;
 
-use waam_slicer::math::Point3;
 use waam_slicer::optimise::{layer_points, optimise, OptimiseOptions};
 use waam_slicer::path::slice;
 use waam_slicer::program::abb::AbbOptions;
@@ -18,7 +17,7 @@ use waam_slicer::program::fanuc::FanucOptions;
 use waam_slicer::program::kuka::KukaOptions;
 use waam_slicer::program::registry::{Abb, Fanuc, Kuka};
 use waam_slicer::program::PositionMode;
-use waam_slicer::program::{build_program, Program, TravelSpeed};
+use waam_slicer::program::{build_program, PointFeed, Program};
 use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions};
 use waam_slicer::robot::{CellLayout, Vendor};
 use waam_slicer::toolaxis::local_frames;
@@ -65,15 +64,21 @@ fn plan_program(part: &str, cell: &CellLayout, layers_max: usize) -> Result<Prog
     let ts = opts.travel_speed_mm_s;
     let traj = joint_trajectory(cell, &inputs, ts, &TrajectoryOptions::default())
         .map_err(|e| e.to_string())?;
-    build_program("PART", cell, &inputs, &traj, &TravelSpeed::Constant(ts))
-        .map_err(|e| e.to_string())
+    build_program(
+        "PART",
+        cell,
+        &inputs,
+        &traj,
+        &PointFeed::constant(ts, crate::fixture::WFS_MM_S, inputs.len()),
+    )
+    .map_err(|e| e.to_string())
 }
 
 /// Emits `prog` with `C`'s emitter, reads it back with `C`'s reader and
 /// validates it against `cell` and the planned points: no problem, every
 /// motion and bead found. The one round trip of every vendor.
 fn round_trip<C: Controller>(what: &str, prog: &Program, cell: &CellLayout, opts: &C::Options) {
-    let planned: Vec<Point3> = prog.planned.clone();
+    let planned = prog.planned.clone();
     let files = C::emit(prog, opts).unwrap_or_else(|e| panic!("{what}: {e}"));
     let read = C::read(&files).unwrap_or_else(|e| panic!("{what}: {e}"));
     let r = C::validate(&read, cell, opts, Some(&planned));

@@ -17,9 +17,7 @@ use waam_slicer::program::validate::{
     check_steps, DecodedStep, Motion, MotionSpeed, ProblemKind, ValidationReport,
 };
 use waam_slicer::program::MoveKind;
-use waam_slicer::program::{
-    build_program_with, ArcFlag, ProgramError, ProgramOptions, TravelSpeed,
-};
+use waam_slicer::program::{build_program_with, ArcFlag, PointFeed, ProgramError, ProgramOptions};
 use waam_slicer::robot::CellLayout;
 use waam_slicer::toolaxis::collision::Torch;
 
@@ -43,7 +41,7 @@ fn the_torch_seen_from_the_part_is_the_planned_point_and_axis_in_every_cell() {
             &cell,
             &path,
             &tr,
-            &TravelSpeed::Constant(TS_MM_S),
+            &PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
             &opts,
         )
         .unwrap_or_else(|e| panic!("{file}: {e}"));
@@ -90,7 +88,7 @@ fn home_dwell_and_interpass_wait_are_set_before_every_bead_but_the_first() {
         &cell,
         &path,
         &tr,
-        &TravelSpeed::Constant(TS_MM_S),
+        &PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
         &opts,
     )
     .unwrap_or_else(|e| panic!("{e}"));
@@ -123,7 +121,7 @@ fn a_home_outside_the_travel_is_refused_naming_the_field_and_joint() {
         &cell,
         &path,
         &tr,
-        &TravelSpeed::Constant(TS_MM_S),
+        &PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
         &opts,
     )
     .expect_err("J5 at 400 degrees is outside every arm's travel");
@@ -225,7 +223,7 @@ fn a_move_into_the_wall_is_found_and_the_program_refused() {
         &cell,
         &path,
         &tr,
-        &TravelSpeed::Constant(TS_MM_S),
+        &PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
         &opts,
     )
     .expect_err("the last move ends inside the wall");
@@ -275,6 +273,7 @@ fn motion(line: usize, q: [f64; 6], kind: MoveKind) -> DecodedStep {
         value_lines: [line; 6],
         joints: Some(q),
         from_cartesian: false,
+        wire_feed: None,
         positioner: None,
         kind,
         speed: if kind == MoveKind::Joint {

@@ -49,7 +49,16 @@ fn flatten(files: &[TpProgram]) -> Vec<String> {
 fn groups_at_n_positions_concatenate_to_the_uncut_program() {
     let cell = part_carried();
     let (prog, path) = program(&cell, 0..3, 10);
-    let planned: Vec<_> = path.iter().map(|p| p.position_mm).collect();
+    let planned: Vec<_> = path
+        .iter()
+        .map(|p| waam_slicer::program::PlannedPoint {
+            position_mm: p.position_mm,
+            feed: waam_slicer::program::PointFeed {
+                travel_speed_mm_s: crate::fixture::TS_MM_S,
+                wire_feed_mm_s: crate::fixture::WFS_MM_S,
+            },
+        })
+        .collect();
     let read = |opts: &FanucOptions| -> (Vec<TpProgram>, Vec<_>) {
         let files = fanuc_files(&prog, opts).unwrap();
         let tps = files

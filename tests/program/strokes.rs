@@ -124,7 +124,11 @@ fn a_bead_wider_than_the_stroke_is_refused_naming_the_layer() {
         &c,
         &path,
         &tr,
-        &waam_slicer::program::TravelSpeed::Constant(crate::fixture::TS_MM_S),
+        &waam_slicer::program::PointFeed::constant(
+            crate::fixture::TS_MM_S,
+            crate::fixture::WFS_MM_S,
+            path.len(),
+        ),
     )
     .unwrap_err()
     .to_string();

@@ -28,7 +28,7 @@ fn thinned_hemisphere(
         c,
         &path,
         &tr,
-        &waam_slicer::program::TravelSpeed::Constant(TS_MM_S),
+        &waam_slicer::program::PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
     )
     .unwrap_or_else(|e| panic!("{}: {e}", c.name()));
     (prog, path)
@@ -80,9 +80,9 @@ fn a_move_off_the_planned_path_is_reported() {
     // a planned point that no move lands on
     let kept: Vec<_> = prog.bead_points().map(|p| p.position_mm).collect();
     let k = (1..plan.len())
-        .find(|&k| !kept.iter().any(|q| (q - plan[k]).norm() < 1e-6))
+        .find(|&k| !kept.iter().any(|q| (q - plan[k].position_mm).norm() < 1e-6))
         .expect("a skipped point");
-    plan[k].z += 0.2;
+    plan[k].position_mm.z += 0.2;
     let r = check_files(c.robot().vendor, &files, &c, &settings, Some(&plan)).unwrap();
     assert!(
         r.problems

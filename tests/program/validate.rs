@@ -8,7 +8,7 @@ use waam_slicer::program::fanuc::{
 };
 use waam_slicer::program::validate::{ProblemKind, ValidationReport};
 use waam_slicer::program::PositionMode;
-use waam_slicer::program::{build_program, ProgramError, TravelSpeed};
+use waam_slicer::program::{build_program, PointFeed, ProgramError};
 use waam_slicer::robot::CellLayout;
 
 use crate::fixture::{cell, hemisphere, part_carried, program, trajectory, TS_MM_S};
@@ -19,21 +19,21 @@ const CELLS: [&str; 3] = [
     "robowam_torch_carried.toml",
 ];
 
-fn emitted(cell: &CellLayout, opts: &FanucOptions) -> (String, Vec<waam_slicer::math::Point3>) {
+fn emitted(
+    cell: &CellLayout,
+    opts: &FanucOptions,
+) -> (String, Vec<waam_slicer::program::PlannedPoint>) {
     let (prog, path) = program(cell, 0..4, 24);
     let files = fanuc_files(&prog, opts).unwrap();
     assert_eq!(files.len(), 1);
-    (
-        files[0].text.clone(),
-        path.iter().map(|p| p.position_mm).collect(),
-    )
+    (files[0].text.clone(), crate::fixture::planned_of(&path))
 }
 
 fn check(
     text: &str,
     cell: &CellLayout,
     opts: &FanucOptions,
-    planned: &[waam_slicer::math::Point3],
+    planned: &[waam_slicer::program::PlannedPoint],
 ) -> ValidationReport {
     let tp = parse_ls(text, "HEMI.ls").unwrap_or_else(|e| panic!("{e}"));
     validate_fanuc(&[tp], cell, opts, Some(planned))
@@ -281,7 +281,14 @@ fn no_program_for_an_infeasible_plan() {
     let path = hemisphere(0..12, 24, |_| 0.0);
     let tr = trajectory(&cell, &path);
     assert!(!tr.report.is_clean());
-    let e = build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(TS_MM_S)).unwrap_err();
+    let e = build_program(
+        "HEMI",
+        &cell,
+        &path,
+        &tr,
+        &PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
+    )
+    .unwrap_err();
     let msg = e.to_string();
     assert!(
         matches!(e, ProgramError::Infeasible { .. })
@@ -292,10 +299,24 @@ fn no_program_for_an_infeasible_plan() {
     // a speed the joints cannot follow is refused too, naming the joint
     let path = hemisphere(8..9, 24, |v| -v);
     let tr = trajectory(&cell, &path);
-    let e = build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(5000.0)).unwrap_err();
+    let e = build_program(
+        "HEMI",
+        &cell,
+        &path,
+        &tr,
+        &PointFeed::constant(5000.0, crate::fixture::WFS_MM_S, path.len()),
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("J6 needs"), "{e}");
     // and bad names
-    let e = build_program("9LIVES", &cell, &path, &tr, &TravelSpeed::Constant(6.0)).unwrap_err();
+    let e = build_program(
+        "9LIVES",
+        &cell,
+        &path,
+        &tr,
+        &PointFeed::constant(6.0, crate::fixture::WFS_MM_S, path.len()),
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("`name`"), "{e}");
 }
 
@@ -317,8 +338,14 @@ fn a_cartesian_position_on_a_turn_edge_is_written_in_joints() {
     let plan = |c: f64| {
         let path = hemisphere(0..4, 24, move |v| c - v);
         let tr = trajectory(&cell, &path);
-        let prog = build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(TS_MM_S))
-            .unwrap_or_else(|e| panic!("{e}"));
+        let prog = build_program(
+            "HEMI",
+            &cell,
+            &path,
+            &tr,
+            &PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         (prog, path)
     };
     let j6_at = |prog: &waam_slicer::program::Program| {
@@ -361,7 +388,7 @@ fn a_cartesian_position_on_a_turn_edge_is_written_in_joints() {
         .position(|p| p.layer == 0 && p.point == 3 && p.arc.is_bead())
         .unwrap();
     assert_eq!(joint_records, vec![k + 1], "{text}");
-    let planned: Vec<_> = path.iter().map(|p| p.position_mm).collect();
+    let planned = crate::fixture::planned_of(&path);
     let r = validate_fanuc(&[tp], &cell, &opts, Some(&planned));
     assert!(r.is_ok(), "{r}");
 }
@@ -378,7 +405,13 @@ fn a_zero_length_segment_that_turns_the_joints_is_refused() {
     path[5].tool_axis = path[4].tool_axis;
     path[5].build_direction = path[4].build_direction;
     let tr = trajectory(&cell, &path);
-    match build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(TS_MM_S)) {
+    match build_program(
+        "HEMI",
+        &cell,
+        &path,
+        &tr,
+        &PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, path.len()),
+    ) {
         Err(ProgramError::Infeasible { first, .. }) => {
             assert!(first.contains("layer 0, point 5"), "{first}");
             assert!(first.contains("zero-length"), "{first}");
@@ -415,8 +448,14 @@ fn a_speed_below_the_units_step_is_written_as_a_time() {
     let cell = cell("robowam_torch_carried.toml");
     let path = hemisphere(0..1, 24, |_| 0.0);
     let tr = trajectory(&cell, &path);
-    let prog = build_program("HEMI", &cell, &path, &tr, &TravelSpeed::Constant(0.1))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let prog = build_program(
+        "HEMI",
+        &cell,
+        &path,
+        &tr,
+        &PointFeed::constant(0.1, crate::fixture::WFS_MM_S, path.len()),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     let opts = FanucOptions {
         timing: MotionTiming::TcpSpeed,
         ..Default::default()

@@ -19,13 +19,14 @@ use crate::math::{Isometry3, Point3};
 use crate::program::abb::read::{RapidModule, RapidOp, RapidTarget, RapidTargetValue};
 use crate::program::abb::AbbOptions;
 use crate::program::MoveKind;
+use crate::program::PlannedPoint;
 use crate::program::ProcessControl;
 use crate::robot::{CellLayout, Configuration, Joints};
 
 use crate::program::validate::ProblemKind;
 use crate::program::validate::{arm_of, wrist_of_j5};
 use crate::program::validate::{
-    decode_pose, push, DecodedStep, Motion, MotionSpeed, ValidationReport,
+    decode_pose, push, DecodedStep, Motion, MotionSpeed, ValidationReport, WireFeed,
 };
 
 mod declarations;
@@ -265,7 +266,7 @@ pub fn validate_abb(
     module: &RapidModule,
     cell: &CellLayout,
     opts: &AbbOptions,
-    planned: Option<&[Point3]>,
+    planned: Option<&[PlannedPoint]>,
 ) -> ValidationReport {
     use crate::program::abb::Abb;
     use crate::program::contract::Controller;
@@ -352,6 +353,8 @@ struct Decoder<'a> {
     conf_l: bool,
     /// The positioner joints (rad) of the last motion's end.
     prev_positioner: Option<[f64; 2]>,
+    /// The wire feed of the arc-on move being decoded (its `welddata`'s).
+    wire_feed: Option<WireFeed>,
     unit: UnitState,
 }
 
@@ -391,6 +394,7 @@ impl<'a> Decoder<'a> {
             steps: Vec::new(),
             conf_l: false,
             prev_positioner: None,
+            wire_feed: None,
             unit: UnitState::new(matches!(cell, CellLayout::TorchCarried(_))),
         }
     }
@@ -511,8 +515,9 @@ impl<'a> Decoder<'a> {
         check_motion_args(self.module, &self.decls, zone, tool, line, report);
         let arc = !instruction.starts_with("Move");
         let mut v = *speed_mm_s;
+        let mut wire_feed = None;
         if arc {
-            v = self.weld_speed(
+            let (weld_v, wirefeed_m_min) = self.weld_speed(
                 instruction,
                 seam.as_deref(),
                 weld.as_deref(),
@@ -520,6 +525,13 @@ impl<'a> Decoder<'a> {
                 line,
                 report,
             );
+            v = weld_v;
+            // the written steps: wirefeed 4 decimals (nearest), weld_speed
+            // 4 decimals or \T 3 decimals
+            wire_feed = wirefeed_m_min.map(|m| WireFeed {
+                mm_s: m * 1000.0 / 60.0,
+                tolerance: 0.5e-4 / m + time_s.map_or(1e-4 / v, |t| 1e-3 / t),
+            });
         }
         let event = match instruction.as_str() {
             "ArcLStart" => Some(true),
@@ -533,9 +545,11 @@ impl<'a> Decoder<'a> {
             None => vec![(target, MoveKind::Linear)],
         };
         let v_reax_time = time_s.map(|t| (t, *v_reax_deg_s));
+        self.wire_feed = wire_feed;
         for (target, kind) in moves_to {
             self.move_to(target, kind, line, speed, v_reax_time, report);
         }
+        self.wire_feed = None;
         let file = self.file();
         match event {
             Some(true) => self.steps.push(DecodedStep::ProcessOn {
@@ -552,7 +566,9 @@ impl<'a> Decoder<'a> {
 
     /// An ArcWare move's `seamdata` and `welddata` checked; the speed
     /// (mm/s) it runs at: the `welddata`'s weld speed, else `v` (the
-    /// speeddata's `v_tcp`).
+    /// speeddata's `v_tcp`); and the wire feed (m/min) of an arc-on move
+    /// (not `ArcLStart`, which moves with the arc off): the `welddata`'s
+    /// `main_arc.wirefeed`, `None` where there is none, a problem then.
     fn weld_speed(
         &self,
         instruction: &str,
@@ -561,7 +577,8 @@ impl<'a> Decoder<'a> {
         mut v: f64,
         line: usize,
         report: &mut ValidationReport,
-    ) -> f64 {
+    ) -> (f64, Option<f64>) {
+        let mut wirefeed = None;
         let (module, file, decls) = (self.module, self.file(), &self.decls);
         if self.start.is_some() {
             push(
@@ -607,9 +624,23 @@ impl<'a> Decoder<'a> {
                     );
                 }
                 v = d.weld_speed_mm_s;
+                if d.wirefeed_m_min > 0.0 {
+                    wirefeed = Some(d.wirefeed_m_min);
+                } else {
+                    push(
+                        report,
+                        ProblemKind::Feed,
+                        file,
+                        line,
+                        format!(
+                            "{instruction}: {wd}.main_arc.wirefeed is {} m/min (line {}): the wire feed is left to the power source, not the planned one",
+                            d.wirefeed_m_min, d.line
+                        ),
+                    );
+                }
             }
         }
-        v
+        (v, wirefeed)
     }
 
     /// The speed of a linear move at `v` mm/s (or in `time_s` s), its
@@ -739,6 +770,7 @@ impl<'a> Decoder<'a> {
             positioner,
             kind,
             speed,
+            wire_feed: self.wire_feed,
         })));
     }
 

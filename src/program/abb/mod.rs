@@ -60,10 +60,14 @@
 //! * Arc process (ArcWare, RobotWare 6 Arc data layouts): `ArcLStart`
 //!   (`fine`) / `ArcL` (`z<n>`) / `ArcLEnd` (`fine`) with `seamWaam` and
 //!   `weldWaam<k>`. ArcWare takes the speed of the arc-on moves (`ArcL`,
-//!   `ArcLEnd`) from `welddata.weld_speed` (mm/s), so there is one
-//!   `welddata` per planned travel speed (rounded down to its 4 written
-//!   decimals), and the inline `speeddata` of those moves carries the same
-//!   `v_tcp` (used when welding is blocked). `ArcLStart` moves with the arc
+//!   `ArcLEnd`) from `welddata.weld_speed` (mm/s) and the wire feed from
+//!   its `main_arc.wirefeed` ("Weld data describes data that is often
+//!   changed along a seam", RAPID reference, `welddata`), so there is one
+//!   `welddata` per planned travel speed and wire feed (`weld_speed`
+//!   rounded down to its 4 written decimals; `wirefeed` in m/min, RobotWare
+//!   Arc's SI unit, 4 decimals: a system set to US units takes in/min and
+//!   needs its own conversion), and the inline `speeddata` of those moves
+//!   carries the same `v_tcp` (used when welding is blocked). `ArcLStart` moves with the arc
 //!   off at its `speeddata` (the approach speed) and names the welddata of
 //!   the bead's first segment. `welddata` = `[weld_speed, org_weld_speed,
 //!   main_arc, org_arc]`, `seamdata` = `[purge_time, preflow_time, ign_arc,
@@ -73,7 +77,7 @@
 //!   wirefeed, control, current, voltage2, wirefeed2, control2]` with
 //!   `sched` = the process schedule (the power source's program or job)
 //!   and everything else 0 but the gas times (`purge_time`, `preflow_time`,
-//!   `postflow_time` from the options): ignition, heat, crater fill and
+//!   `postflow_time` from the options) and the welddata's wire feed: ignition, heat, crater fill and
 //!   burn-back are left to the power source's program (tune them on the
 //!   controller). The data are `LOCAL PERS` so that a program loaded after
 //!   another one does not inherit that one's persistent values.
@@ -711,13 +715,22 @@ fn speeddata(v_tcp_mm_s: f64, v_reax_deg_s: Option<f64>) -> String {
     format!("[{},500,5000,{v_reax}]", Mm(floor_to(v_tcp_mm_s, 4)))
 }
 
-/// The welddata speeds of `program` (mm/s, as written: rounded down to 4
-/// decimals), in order of first use: one per planned travel speed of an
-/// arc-on move (a bead's first point carries its first segment's speed).
-fn weld_speeds(program: &Program) -> Vec<f64> {
-    let mut out: Vec<f64> = Vec::new();
+/// Millimetres a second in one metre a minute.
+const MM_S_PER_M_MIN: f64 = 1000.0 / 60.0;
+
+/// A wire feed (mm/s) as `arcdata.wirefeed` writes it: m/min to 4 decimals.
+pub fn wirefeed_m_min(wire_feed_mm_s: f64) -> f64 {
+    (wire_feed_mm_s / MM_S_PER_M_MIN * 1e4).round() / 1e4
+}
+
+/// The welddata of `program`, in order of first use: one per planned
+/// travel speed and wire feed of an arc-on move (a bead's first point
+/// carries its first segment's), as written: `weld_speed` rounded down to
+/// 4 decimals (mm/s), `wirefeed` to 4 decimals (m/min).
+fn weld_feeds(program: &Program) -> Vec<(f64, f64)> {
+    let mut out: Vec<(f64, f64)> = Vec::new();
     for p in program.bead_points() {
-        let v = floor_to(p.speed_mm_s, 4);
+        let v = (floor_to(p.speed_mm_s, 4), wirefeed_m_min(p.wire_feed_mm_s));
         if !out.contains(&v) {
             out.push(v);
         }
@@ -860,18 +873,15 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             pose_line(&wobj)
         )?,
     }
-    let weld_speeds = weld_speeds(program);
-    let weld_of = |v: f64| {
-        let v = floor_to(v, 4);
-        weld_speeds
-            .iter()
-            .position(|s| *s == v)
-            .map_or(1, |k| k + 1)
+    let weld_feeds = weld_feeds(program);
+    let weld_of = |p: &crate::program::ProgramPoint| {
+        let v = (floor_to(p.speed_mm_s, 4), wirefeed_m_min(p.wire_feed_mm_s));
+        weld_feeds.iter().position(|s| *s == v).map_or(1, |k| k + 1)
     };
     if let ProcessControl::Arc { schedule } = &opts.process {
         writeln!(
             w,
-            "  ! ArcWare data (RobotWare 6 Arc): process schedule {schedule} (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s)"
+            "  ! ArcWare data (RobotWare 6 Arc): process schedule {schedule} (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s) and wire feed (main_arc.wirefeed, m/min)"
         )?;
         let zeros = "[0,0,0,0,0,0,0,0,0]";
         let arc = format!("[{schedule},0,0,0,0,0,0,0,0]");
@@ -888,12 +898,13 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             w,
             "  LOCAL PERS seamdata seamWaam := [{purge},{preflow},{arc},0,0,0,0,0,{zeros},0,0,{zeros},0,0,{zeros},{postflow}];"
         )?;
-        for (k, v) in weld_speeds.iter().enumerate() {
+        for (k, (v, wfs)) in weld_feeds.iter().enumerate() {
             writeln!(
                 w,
-                "  LOCAL PERS welddata weldWaam{} := [{},0,{arc},{zeros}];",
+                "  LOCAL PERS welddata weldWaam{} := [{},0,[{schedule},0,0,{},0,0,0,0,0],{zeros}];",
                 k + 1,
-                Mm(*v)
+                Mm(*v),
+                Fixed::new(*wfs, 4)
             )?;
         }
     }
@@ -1027,7 +1038,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
                 Fixed::new(t, 3)
             );
         }
-        let weld = |v: f64| format!("seamWaam, weldWaam{}", weld_of(v));
+        let weld = |p: &crate::program::ProgramPoint| format!("seamWaam, weldWaam{}", weld_of(p));
         // the circle point of a circular move into this point (`ArcC`,
         // `ArcCEnd`, `MoveC`: RAPID reference, "CirPoint, ToPoint"), written
         // just before it
@@ -1064,27 +1075,21 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
                     }
                 };
                 match &opts.process {
-                    ProcessControl::Arc { .. } => writeln!(
-                        w,
-                        "    ArcLStart p{k}, {v_in}, {}, fine, {tw};",
-                        weld(p.speed_mm_s)
-                    )?,
+                    ProcessControl::Arc { .. } => {
+                        writeln!(w, "    ArcLStart p{k}, {v_in}, {}, fine, {tw};", weld(p))?
+                    }
                     ProcessControl::Custom { start, .. } => {
                         writeln!(w, "    MoveL p{k}, {v_in}, fine, {tw};")?;
                         writeln!(w, "    {start};")?;
                     }
                 }
             }
-            (ProcessControl::Arc { .. }, ArcFlag::On) => writeln!(
-                w,
-                "    {arc_on} {c}p{k}, {v}, {}, {zone}, {tw};",
-                weld(p.speed_mm_s)
-            )?,
-            (ProcessControl::Arc { .. }, ArcFlag::End) => writeln!(
-                w,
-                "    {arc_end} {c}p{k}, {v}, {}, fine, {tw};",
-                weld(p.speed_mm_s)
-            )?,
+            (ProcessControl::Arc { .. }, ArcFlag::On) => {
+                writeln!(w, "    {arc_on} {c}p{k}, {v}, {}, {zone}, {tw};", weld(p))?
+            }
+            (ProcessControl::Arc { .. }, ArcFlag::End) => {
+                writeln!(w, "    {arc_end} {c}p{k}, {v}, {}, fine, {tw};", weld(p))?
+            }
             (ProcessControl::Custom { .. }, ArcFlag::On) => {
                 writeln!(w, "    {move_on} {c}p{k}, {v}, {zone}, {tw};")?
             }

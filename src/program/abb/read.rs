@@ -223,6 +223,9 @@ pub struct RapidWeld {
     pub weld_speed_mm_s: f64,
     /// `main_arc.sched`.
     pub sched: f64,
+    /// `main_arc.wirefeed` (m/min, RobotWare Arc's SI unit; module doc of
+    /// [`abb`](crate::program::abb)).
+    pub wirefeed_m_min: f64,
 }
 
 /// A `seamdata` declaration (RobotWare 6 Arc, 16 components): its gas
@@ -657,6 +660,7 @@ fn parse_declaration(
                 line,
                 weld_speed_mm_s,
                 sched: main[0],
+                wirefeed_m_min: main[3],
             });
         }
         "loaddata" => m.loads.push((name.to_string(), line, loaddata(&v)?)),

@@ -23,6 +23,7 @@ fn point(layer: usize, k: usize, x: f64, speed: f64, arc: ArcFlag, q: [f64; 6]) 
         joints: q,
         positioner: None,
         speed_mm_s: speed,
+        wire_feed_mm_s: if arc.is_bead() { 10.0 } else { 0.0 },
         arc,
         via: false,
     }

@@ -23,14 +23,16 @@ use std::f64::consts::TAU;
 
 use crate::math::{Isometry3, Point3};
 use crate::program::contract::validate_decoded;
+use crate::program::fanuc::emit::parse_schedule_remark;
 use crate::program::fanuc::Fanuc;
 use crate::program::fanuc::{
     parse_frame_remark, ArmPosition, FanucFrames, FanucOptions, FrameKind, MotionOptions, MoveKind,
     Op, PayloadField, Position, Speed, TpProgram,
 };
 use crate::program::validate::{
-    decode_pose, push, DecodedStep, Motion, MotionSpeed, ProblemKind, ValidationReport,
+    decode_pose, push, DecodedStep, Motion, MotionSpeed, ProblemKind, ValidationReport, WireFeed,
 };
+use crate::program::PlannedPoint;
 use crate::program::ProcessControl;
 use crate::robot::orientation::FanucPose;
 use crate::robot::{CellLayout, Configuration, Joints};
@@ -59,6 +61,9 @@ pub fn fanuc_steps(
             frames: opts.frames(cell),
             payloads: HashMap::new(),
             checked: Vec::new(),
+            schedules: HashMap::new(),
+            arc_on: false,
+            schedule: None,
         };
         state.steps(main, 0, &mut steps, report);
     }
@@ -80,6 +85,12 @@ struct Decoder<'a> {
     payloads: HashMap<u8, [Option<f64>; 4]>,
     /// Programs whose header (frames, `/APPL`) was checked.
     checked: Vec<String>,
+    /// The wire feed (mm/s) each weld schedule's remark states.
+    schedules: HashMap<u32, f64>,
+    /// The arc is on (an `Arc Start` ran, no `Arc End` since).
+    arc_on: bool,
+    /// The weld schedule of the last `Arc Start` (the one the arc runs with).
+    schedule: Option<u32>,
 }
 
 impl Decoder<'_> {
@@ -90,6 +101,13 @@ impl Decoder<'_> {
         }
         self.checked.push(tp.name.clone());
         let file = &tp.name;
+        for ins in &tp.instructions {
+            if let Op::Remark(r) = &ins.op {
+                if let Some((n, v)) = parse_schedule_remark(r) {
+                    self.schedules.insert(n, v);
+                }
+            }
+        }
         if matches!(self.opts.process, ProcessControl::Arc { .. }) && !tp.arc_enabled {
             push(
                 report,
@@ -191,41 +209,75 @@ impl Decoder<'_> {
             let file = &tp.name;
             match &ins.op {
                 Op::Call(name) => self.call(name, depth, file, line, steps, report),
-                op if *op == start => steps.push(DecodedStep::ProcessOn {
-                    file: file.clone(),
-                    line,
-                }),
-                op if *op == end => steps.push(DecodedStep::ProcessOff {
-                    file: file.clone(),
-                    line,
-                }),
-                op @ (Op::ArcStart(_) | Op::WeldStart(..) | Op::ArcEnd(_) | Op::WeldEnd(..))
-                    if arc =>
-                {
-                    // the controller's arc instruction, another schedule or
-                    // form than the options': named, and counted as the
-                    // start or end it is
-                    let is_start = matches!(op, Op::ArcStart(_) | Op::WeldStart(..));
-                    let want = if is_start { &start } else { &end };
+                op @ (Op::ArcStart(_) | Op::WeldStart(..)) if arc => {
+                    // a bead's start, or with the arc on a change of
+                    // schedule (module doc, "Wire feed")
+                    let (n, same_form) = match (op, &start) {
+                        (Op::ArcStart(n), Op::ArcStart(_)) => (*n, true),
+                        (Op::WeldStart(p, n), Op::WeldStart(q, _)) => (*n, p == q),
+                        (Op::ArcStart(n) | Op::WeldStart(_, n), _) => (*n, false),
+                        _ => unreachable!("matched above"),
+                    };
+                    if !same_form {
+                        push(
+                            report,
+                            ProblemKind::Options,
+                            file,
+                            line,
+                            format!("`{}`: the options give `{}`", op_text(op), op_text(&start)),
+                        );
+                    }
+                    if !self.schedules.contains_key(&n) {
+                        push(
+                            report,
+                            ProblemKind::Feed,
+                            file,
+                            line,
+                            format!(
+                                "`{}`: the program states no wire feed for weld schedule {n} (remark `WELD SCHED {n}: WFS ... MM/S`)",
+                                op_text(op)
+                            ),
+                        );
+                    }
+                    // the same schedule again is a second start (an `Arc
+                    // End` missing), not a change
+                    let change = self.arc_on && self.schedule != Some(n);
+                    self.schedule = Some(n);
+                    if !change {
+                        self.arc_on = true;
+                        steps.push(DecodedStep::ProcessOn {
+                            file: file.clone(),
+                            line,
+                        });
+                    }
+                }
+                op if *op == end => {
+                    self.arc_on = false;
+                    steps.push(DecodedStep::ProcessOff {
+                        file: file.clone(),
+                        line,
+                    })
+                }
+                op @ (Op::ArcEnd(_) | Op::WeldEnd(..)) if arc => {
+                    // another schedule or form than the options': named,
+                    // and counted as the end it is
                     push(
                         report,
                         ProblemKind::Options,
                         file,
                         line,
-                        format!("`{}`: the options give `{}`", op_text(op), op_text(want)),
+                        format!("`{}`: the options give `{}`", op_text(op), op_text(&end)),
                     );
-                    steps.push(if is_start {
-                        DecodedStep::ProcessOn {
-                            file: file.clone(),
-                            line,
-                        }
-                    } else {
-                        DecodedStep::ProcessOff {
-                            file: file.clone(),
-                            line,
-                        }
+                    self.arc_on = false;
+                    steps.push(DecodedStep::ProcessOff {
+                        file: file.clone(),
+                        line,
                     });
                 }
+                op if *op == start => steps.push(DecodedStep::ProcessOn {
+                    file: file.clone(),
+                    line,
+                }),
                 Op::Remark(_) => {}
                 Op::WaitTime(t) => steps.push(DecodedStep::Wait {
                     file: file.clone(),
@@ -381,6 +433,24 @@ impl Decoder<'_> {
         }
     }
 
+    /// The wire feed of a move at `speed` with the arc on: the current
+    /// schedule's (its remark, to 0.01 mm/s), with the relative steps of
+    /// that value and of the written speed or time as its tolerance.
+    fn wire_feed(&self, speed: &Speed) -> Option<WireFeed> {
+        if !self.arc_on {
+            return None;
+        }
+        let mm_s = *self.schedules.get(&self.schedule?)?;
+        let speed_step = match *speed {
+            Speed::MmPerSec(v) | Speed::CmPerMin(v) | Speed::Msec(v) => 1.0 / f64::from(v.max(1)),
+            Speed::Percent(_) => return None,
+        };
+        Some(WireFeed {
+            mm_s,
+            tolerance: 0.005 / mm_s + speed_step,
+        })
+    }
+
     /// The motion step of a move at `line` of `tp` to `pos` (`kind`, at
     /// `speed` with `options`): its options against the cell's, its
     /// position decoded.
@@ -460,6 +530,7 @@ impl Decoder<'_> {
                 (None, Some(t)) => MotionSpeed::Time(t),
                 _ => MotionSpeed::Joint,
             },
+            wire_feed: self.wire_feed(speed),
         }))
     }
 
@@ -586,7 +657,7 @@ pub fn validate_fanuc(
     programs: &[TpProgram],
     cell: &CellLayout,
     opts: &FanucOptions,
-    planned: Option<&[Point3]>,
+    planned: Option<&[PlannedPoint]>,
 ) -> ValidationReport {
     let main = programs.first().map_or("", |p| p.name.as_str());
     validate_decoded::<Fanuc>(cell, main, opts, planned, |report| {

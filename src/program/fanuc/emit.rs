@@ -427,6 +427,9 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
     // every program resident at once within the budget: one program, or
     // groups of whole beads the cell loads in turn (module doc)
     let home_positions = usize::from(program.home.is_some());
+    // one schedule table for every group: the controller's schedules are
+    // shared by the programs it runs in turn
+    let schedules = WeldSchedules::of(program, opts);
     let parts = split_to_budget(program, &Fanuc::budget(opts), |g| {
         Ok(g.points.len() + home_positions)
     })?;
@@ -441,9 +444,63 @@ pub fn tp_programs(program: &Program, opts: &FanucOptions) -> Result<Vec<TpProgr
             } else {
                 format!("waam: {} of {n}", k + 1)
             };
-            tp_program(part, opts, &comment)
+            tp_program(part, opts, &comment, &schedules)
         })
         .collect()
+}
+
+/// The weld schedules a program's beads use (module doc, "Wire feed"):
+/// the `k`-th distinct wire feed of its arc-on moves (mm/s, as written: to
+/// 0.01 mm/s) is schedule `base + k`, `base` the process's schedule; empty
+/// without the arc process.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct WeldSchedules {
+    /// `(schedule, wire feed mm/s as written)`, in order of first use.
+    pub rows: Vec<(u32, f64)>,
+}
+
+impl WeldSchedules {
+    /// The schedules of `program`'s bead points with `opts`' process.
+    pub fn of(program: &Program, opts: &FanucOptions) -> Self {
+        let ProcessControl::Arc { schedule } = opts.process else {
+            return Self::default();
+        };
+        let mut rows: Vec<(u32, f64)> = Vec::new();
+        for p in program.bead_points() {
+            let v = written_wire_feed(p.wire_feed_mm_s);
+            if !rows.iter().any(|r| r.1 == v) {
+                rows.push((schedule + rows.len() as u32, v));
+            }
+        }
+        Self { rows }
+    }
+
+    /// The schedule of wire feed `mm_s` (as [`written_wire_feed`] rounds
+    /// it); `None` when no row has it.
+    pub fn schedule_of(&self, mm_s: f64) -> Option<u32> {
+        let v = written_wire_feed(mm_s);
+        self.rows.iter().find(|r| r.1 == v).map(|r| r.0)
+    }
+}
+
+/// A wire feed (mm/s) as a schedule remark writes it: to 0.01 mm/s.
+pub fn written_wire_feed(mm_s: f64) -> f64 {
+    (mm_s * 100.0).round() / 100.0
+}
+
+/// The remark stating weld schedule `n`'s wire feed (mm/s, ≤ 32
+/// characters): `WELD SCHED 2: WFS 80.00 MM/S`.
+pub fn schedule_remark(n: u32, wire_feed_mm_s: f64) -> String {
+    format!("WELD SCHED {n}: WFS {} MM/S", Fixed::new(wire_feed_mm_s, 2))
+}
+
+/// A [`schedule_remark`] read back: the schedule and its wire feed (mm/s).
+pub fn parse_schedule_remark(s: &str) -> Option<(u32, f64)> {
+    let rest = s.trim().strip_prefix("WELD SCHED ")?;
+    let (n, rest) = rest.split_once(':')?;
+    let v = rest.trim().strip_prefix("WFS ")?.strip_suffix("MM/S")?;
+    let v: f64 = v.trim().parse().ok().filter(|x: &f64| x.is_finite())?;
+    Some((n.trim().parse().ok()?, v))
 }
 
 /// One TP program of [`tp_programs`]: `program` whole, named
@@ -452,6 +509,7 @@ fn tp_program(
     program: &Program,
     opts: &FanucOptions,
     comment: &str,
+    schedules: &WeldSchedules,
 ) -> Result<TpProgram, ProgramError> {
     let robot = program.cell.robot();
     let frames = opts.frames(&program.cell);
@@ -524,6 +582,18 @@ fn tp_program(
     };
     let range = 0..program.points.len();
     let mut ins = frame_header(program, opts, &frames);
+    for &(n, v) in &schedules.rows {
+        ins.push(Instruction {
+            line: 0,
+            op: Op::Remark(schedule_remark(n, v)),
+        });
+    }
+    // the schedule the arc runs with (module doc, "Wire feed")
+    let mut schedule_on: Option<u32> = None;
+    let schedule_op = |n: u32| match (&start_op, opts.weld_procedure) {
+        (Op::WeldStart(p, _), _) => Op::WeldStart(*p, n),
+        _ => Op::ArcStart(n),
+    };
     if range
         .clone()
         .any(|i| !joint_move_target(program, i) && opts.segment_time_based(program, i))
@@ -598,18 +668,47 @@ fn tp_program(
                     }
                     _ => joint_move(index),
                 });
+                schedule_on = schedules.schedule_of(p.wire_feed_mm_s);
                 ins.push(Instruction {
                     line: 0,
-                    op: start_op.clone(),
+                    op: schedule_on.map_or_else(|| start_op.clone(), schedule_op),
                 });
             }
             // a via is written with the move it is the via of
             ArcFlag::On if p.via => {}
+            ArcFlag::On | ArcFlag::End
+                if schedule_on.is_some()
+                    && schedules.schedule_of(p.wire_feed_mm_s) != schedule_on =>
+            {
+                // the wire feed changes: the next schedule, from the
+                // move's start on
+                schedule_on = schedules.schedule_of(p.wire_feed_mm_s);
+                ins.push(Instruction {
+                    line: 0,
+                    op: schedule_on.map_or_else(|| start_op.clone(), schedule_op),
+                });
+                ins.push(linear(
+                    linear_speed(global, p.speed_mm_s),
+                    if p.arc == ArcFlag::End {
+                        Termination::Fine
+                    } else {
+                        Termination::Cnt(opts.cnt)
+                    },
+                ));
+                if p.arc == ArcFlag::End {
+                    schedule_on = None;
+                    ins.push(Instruction {
+                        line: 0,
+                        op: end_op.clone(),
+                    });
+                }
+            }
             ArcFlag::On => ins.push(linear(
                 linear_speed(global, p.speed_mm_s),
                 Termination::Cnt(opts.cnt),
             )),
             ArcFlag::End => {
+                schedule_on = None;
                 ins.push(linear(
                     linear_speed(global, p.speed_mm_s),
                     Termination::Fine,

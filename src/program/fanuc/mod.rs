@@ -99,6 +99,26 @@
 //! overwrite what was taught on the controller); the validator checks the
 //! statements against the options and the cell.
 //!
+//! **Wire feed** (arc process). ArcTool takes the wire feed from the weld
+//! schedule an `Arc Start[n]` (or `Weld Start[p,n]`) names, and an `Arc
+//! Start` while the arc is on switches the running weld to schedule `n`;
+//! writing `$AWESCH[...]` during a weld does not change the running weld
+//! (a practitioner's note, industrialmonitordirect.com "FANUC weld
+//! parameter change during auto mode welding"; the ArcTool manual is not
+//! in our sources). So the program defines its schedules and says which
+//! it assumes: schedule `s + k` (`s` the process's schedule) is the `k`-th
+//! distinct wire feed of its arc-on moves, each stated in a header remark
+//! `! WELD SCHED 2: WFS 80.00 MM/S` (mm/s to 0.01; set the schedules on the
+//! controller to these values, in the unit its power source takes), the
+//! same table in every group of a build. A bead starts with its first
+//! segment's schedule, and before a move whose wire feed differs an `Arc
+//! Start[k]` line switches to its schedule (a stand-alone line after the
+//! move into the segment's start: with `CNT` the controller runs it as the
+//! robot passes that point). `Arc End[s]` keeps the process's schedule
+//! (crater fill). The travel speed stays on the motion lines. `waam check`
+//! reads the remarks back and checks each arc-on move's wire feed over its
+//! travel speed against the plan's. A custom process writes no wire feed.
+//!
 //! **Arc, home, set-up.** `/APPL` has `ARC : TRUE ;` and `ARC Welding
 //! Equipment` as an ArcTool program exported by a controller; beads start
 //! and stop with `Arc Start[s]`/`Arc End[s]` or, with

@@ -18,9 +18,10 @@ mod handshake;
 mod motion;
 mod supervision;
 
-use crate::math::{Isometry3, Point3};
+use crate::math::Isometry3;
 use crate::program::kuka::read::{KrlOp, KrlProgram, KrlStatement};
 use crate::program::kuka::KukaOptions;
+use crate::program::PlannedPoint;
 use crate::robot::{CellLayout, Joints};
 
 use crate::program::validate::ProblemKind;
@@ -42,7 +43,7 @@ pub fn validate_kuka(
     program: &KrlProgram,
     cell: &CellLayout,
     opts: &KukaOptions,
-    planned: Option<&[Point3]>,
+    planned: Option<&[PlannedPoint]>,
 ) -> ValidationReport {
     use crate::program::contract::Controller;
     use crate::program::kuka::Kuka;
@@ -70,9 +71,11 @@ pub(crate) fn kuka_steps(
         }
         match &st.op {
             KrlOp::Ptp(_) | KrlOp::Lin { .. } | KrlOp::Circ { .. } => d.motion(st, report_out),
-            KrlOp::VelCp(_) | KrlOp::VelExtax { .. } | KrlOp::VelPtp(_) | KrlOp::Trigger { .. } => {
-                d.speed_or_trigger(st)
-            }
+            KrlOp::VelCp(_)
+            | KrlOp::VelExtax { .. }
+            | KrlOp::VelPtp(_)
+            | KrlOp::Trigger { .. }
+            | KrlOp::Anout { .. } => d.speed_or_trigger(st),
             KrlOp::OriType(_)
             | KrlOp::CircType(_)
             | KrlOp::IpoTcp(_)
@@ -159,6 +162,9 @@ struct Decoder<'a> {
     mass: Option<(f64, usize)>,
     /// `$ORI_TYPE = #VAR`, `$CIRC_TYPE = #BASE` stated before a `CIRC`.
     circ_stated: [bool; 2],
+    /// The wire feed's analog command (`$ANOUT[wire_feed_anout]`, −1 to
+    /// 1) as last set, by a statement or a trigger at a move's start.
+    anout: Option<f64>,
 }
 
 impl<'a> Decoder<'a> {
@@ -207,6 +213,7 @@ impl<'a> Decoder<'a> {
             after_off: None,
             mass: None,
             circ_stated: [false; 2],
+            anout: None,
         }
     }
 
@@ -274,6 +281,16 @@ impl<'a> Decoder<'a> {
                 }
             }
             KrlOp::VelPtp(p) => self.vel_extax = [*p; 6],
+            KrlOp::Anout { channel, value } => {
+                if *channel == self.opts.wire_feed_anout && self.arc {
+                    self.anout = Some(*value);
+                } else {
+                    self.instruction(
+                        line,
+                        format!("`$ANOUT[{channel}] = {value}`: not the wire feed's command (the options give the arc process's $ANOUT[{}])", self.opts.wire_feed_anout),
+                    );
+                }
+            }
             KrlOp::Trigger {
                 distance,
                 action,
@@ -546,12 +563,12 @@ fn missing_burn_back(report: &mut ValidationReport, file: &str, l: usize, opts: 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::{UnitVector3, Vector3};
+    use crate::math::{Point3, UnitVector3, Vector3};
     use crate::program::kuka::read::parse_krl;
     use crate::program::kuka::{kuka_files, KukaOptions, HOME_NAME};
     use crate::program::validate::Motion;
     use crate::program::MoveKind;
-    use crate::program::{build_program, BeadSetup, HomePosition, Payload, TravelSpeed};
+    use crate::program::{build_program, BeadSetup, HomePosition, Payload, PointFeed};
     use crate::robot::trajectory::{joint_trajectory, PathPointInput, TrajectoryOptions};
 
     /// Two layers of the hemisphere (R_s 45 mm, Delta 5 mm, 8 points) in
@@ -589,7 +606,14 @@ mod tests {
             }
         }
         let tr = joint_trajectory(&cell, &pts, 6.0, &TrajectoryOptions::default()).unwrap();
-        let prog = build_program("HEMI", &cell, &pts, &tr, &TravelSpeed::Constant(6.0)).unwrap();
+        let prog = build_program(
+            "HEMI",
+            &cell,
+            &pts,
+            &tr,
+            &PointFeed::constant(6.0, 80.0, pts.len()),
+        )
+        .unwrap();
         (prog, cell)
     }
 

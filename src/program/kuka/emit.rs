@@ -141,6 +141,13 @@ pub const CIRC_ORI_TYPE: &str = "#VAR";
 /// the auxiliary point's orientation ignored.
 pub const CIRC_CIRC_TYPE: &str = "#BASE";
 
+/// `$ANOUT[wire_feed_anout]` commanding `wire_feed_mm_s` (module doc,
+/// "Wire feed"): the wire feed over the full scale, as written (4
+/// decimals, nearest).
+pub fn wire_feed_anout(opts: &KukaOptions, wire_feed_mm_s: f64) -> f64 {
+    (wire_feed_mm_s / opts.wire_feed_full_scale_mm_s * 1e4).round() / 1e4
+}
+
 /// Name of the home position in the `.dat` (an `E6AXIS`).
 pub const HOME_NAME: &str = "PHOME";
 
@@ -260,6 +267,9 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
         writeln!(w, "  PTP {HOME_NAME}")?;
     }
     let mut bead = 0usize;
+    // the wire feed command as last written (arc process)
+    let mut anout: Option<f64> = None;
+    let channel = opts.wire_feed_anout;
     for (i, p) in program.points.iter().enumerate() {
         let name = format!("P{}", i + 1);
         let prev = i.checked_sub(1).map(|k| &program.points[k]);
@@ -298,6 +308,15 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                     }
                 }
                 if arc {
+                    let a = wire_feed_anout(opts, p.wire_feed_mm_s);
+                    writeln!(
+                        w,
+                        "  ; wire feed {} mm/s (power source's analog command, full scale {} mm/s)",
+                        Fixed::new(p.wire_feed_mm_s, 2),
+                        Fixed::new(opts.wire_feed_full_scale_mm_s, 2)
+                    )?;
+                    writeln!(w, "  $ANOUT[{channel}] = {}", Fixed::new(a, 4))?;
+                    anout = Some(a);
                     write_ignition(w, opts, &on, &off, p.layer)?;
                 }
             }
@@ -330,6 +349,16 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                 let start = move_start(program, i).map(|k| &program.points[k]);
                 if !arc && start.is_some_and(|q| q.arc == ArcFlag::Start) {
                     writeln!(w, "  {}", trigger_line(0, &on))?;
+                }
+                // the wire feed changes from the move's start on
+                let a = wire_feed_anout(opts, p.wire_feed_mm_s);
+                if arc && anout != Some(a) {
+                    writeln!(
+                        w,
+                        "  {}",
+                        trigger_line(0, &format!("$ANOUT[{channel}]={}", Fixed::new(a, 4)))
+                    )?;
+                    anout = Some(a);
                 }
                 // `CIRC aux, end` through the via written just before
                 let mv = match prev {
@@ -710,6 +739,19 @@ fn kuka_pair(program: &Program, opts: &KukaOptions) -> Result<Vec<EmittedFile>, 
             field: "name",
             value: program.name.clone(),
             reason: "KRL names (DEF, DEFDAT, file name) have at most 24 characters",
+        });
+    }
+    if let Some(p) = program
+        .bead_points()
+        .find(|p| opts.arc_process() && p.wire_feed_mm_s > opts.wire_feed_full_scale_mm_s)
+    {
+        return Err(ProgramError::InvalidOptions {
+            field: "wire_feed_full_scale_mm_s",
+            value: format!(
+                "{} (layer {}, point {}: wire feed {} mm/s)",
+                opts.wire_feed_full_scale_mm_s, p.layer, p.point, p.wire_feed_mm_s
+            ),
+            reason: "a bead's wire feed is above the analog command's full scale ($ANOUT <= 1)",
         });
     }
     if opts.arc_process() && program.name.eq_ignore_ascii_case(ARC_LOST_HANDLER) {

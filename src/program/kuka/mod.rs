@@ -25,6 +25,19 @@
 //!   crater` with the arc on, arc off, `WAIT SEC burn-back`
 //!   ([`KukaOptions::arc_ok_input`], [`KukaOptions::ignition_timeout_s`],
 //!   [`KukaOptions::crater_fill_s`], [`KukaOptions::burn_back_s`]).
+//! * **Wire feed** (arc process). These programs switch the arc by I/O
+//!   with their own handshake, not through ArcTech's inline forms (whose
+//!   weld data live in package-version-specific `.dat` structures), so the
+//!   wire feed goes to the power source as its analog command, as
+//!   KUKA.ArcTech Analog does for "power sources with analog reference
+//!   voltage" (KR C2 manual, ArcTechAnalog R1.1) and a Fronius TPSi takes it
+//!   ("Wire feed speed command value", analog 0–10 V): `$ANOUT[n] = wire
+//!   feed / full scale` ([`KukaOptions::wire_feed_anout`],
+//!   [`KukaOptions::wire_feed_full_scale_mm_s`]) before each bead's arc on,
+//!   and where a move's wire feed differs from the one before, `TRIGGER WHEN
+//!   DISTANCE=0 DELAY=0 DO $ANOUT[n]=v` before it, switching at the move's
+//!   start point (in the middle of its blend). Written to 4 decimals; a
+//!   wire feed above the full scale is refused.
 //! * **Arc supervision** (arc process only: a custom process switches a
 //!   device through lines we cannot interpret and has no input to watch,
 //!   so it gets none). An arc lost during a bead stops the robot and

@@ -89,6 +89,18 @@ pub struct KukaOptions {
     /// 1, 2, 4–39 or 81–128 (1 the highest; 3 and 40–80 are the system's).
     /// Default 20 (our choice, inside 4–39 and clear of ArcTech's 3).
     pub arc_loss_interrupt: u8,
+    /// Analog output `$ANOUT[n]` commanding the power source's wire feed
+    /// (arc process only; 1–32): each bead sets it before its arc on, and
+    /// a `TRIGGER WHEN DISTANCE=0` at the start of each move whose wire
+    /// feed differs (module doc, "Wire feed"). Default 1.
+    pub wire_feed_anout: u8,
+    /// The wire feed (mm/s, > 0) commanded by `$ANOUT[wire_feed_anout] =
+    /// 1.0` (KRL's full scale, the power source's 10 V): `$ANOUT = wire
+    /// feed / this`. Default 400 mm/s (24 m/min; our choice, a usual
+    /// wire feeder's top speed: set it from the power source's analog
+    /// interface, e.g. Fronius TPSi "Wire feed speed command value", 0–10 V
+    /// over the feeder's range).
+    pub wire_feed_full_scale_mm_s: f64,
     /// Most bytes of one program (its `.src` and `.dat` together) the
     /// controller is given at once. A build with more is cut between
     /// layers into groups, each a complete program the cell selects and
@@ -125,6 +137,8 @@ impl Default for KukaOptions {
             ek_machine: 2,
             arc_loss: ArcLoss::Abort,
             arc_loss_interrupt: 20,
+            wire_feed_anout: 1,
+            wire_feed_full_scale_mm_s: 400.0,
             max_file_bytes: DEFAULT_MAX_FILE_BYTES,
             common: Default::default(),
         }
@@ -265,6 +279,20 @@ impl KukaOptions {
                 "arc_loss_interrupt",
                 self.arc_loss_interrupt.to_string(),
                 "KRL user interrupt priorities are 1, 2, 4..=39 and 81..=128 (3 and 40..=80 are reserved for the system)",
+            ));
+        }
+        if !(1..=32).contains(&self.wire_feed_anout) {
+            return Err(bad(
+                "wire_feed_anout",
+                self.wire_feed_anout.to_string(),
+                "must be in 1..=32 ($ANOUT[1..32])",
+            ));
+        }
+        if !(self.wire_feed_full_scale_mm_s.is_finite() && self.wire_feed_full_scale_mm_s > 0.0) {
+            return Err(bad(
+                "wire_feed_full_scale_mm_s",
+                self.wire_feed_full_scale_mm_s.to_string(),
+                "must be finite and > 0",
             ));
         }
         if !(2..=32).contains(&self.ek_machine) {

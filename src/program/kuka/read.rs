@@ -139,6 +139,14 @@ pub enum KrlOp {
         /// Percent.
         percent: f64,
     },
+    /// `$ANOUT[n] = v`: analog output `n` (1-based) at `v` (−1 to 1, KRL's
+    /// full scale).
+    Anout {
+        /// Output `n`, 1-based.
+        channel: u8,
+        /// Value (−1 to 1).
+        value: f64,
+    },
     /// `BAS (#VEL_PTP,n )`: PTP speeds (robot and external axes) at `n` %.
     VelPtp(f64),
     /// `BAS (#TOOL,n)` or `$TOOL = TOOL_DATA[n]`.
@@ -544,6 +552,25 @@ fn parse_trigger(l: &str) -> Result<KrlOp, String> {
     })
 }
 
+/// `$ANOUT[n]` = `v`: the output (1..=32) and the value (−1 to 1); `None`
+/// for anything else.
+pub fn parse_anout(k: &str, v: &str) -> Option<(u8, f64)> {
+    let channel = k
+        .trim()
+        .strip_prefix("$ANOUT[")?
+        .strip_suffix(']')?
+        .trim()
+        .parse::<u8>()
+        .ok()
+        .filter(|n| (1..=32).contains(n))?;
+    let value: f64 = v
+        .trim()
+        .parse()
+        .ok()
+        .filter(|x: &f64| x.is_finite() && (-1.0..=1.0).contains(x))?;
+    Some((channel, value))
+}
+
 /// `IF NOT $IN[n] THEN`, `IF $IN[n] THEN`; `None` for another `IF`.
 fn parse_if_input(l: &str) -> Result<Option<KrlOp>, String> {
     let input = |r: &str| {
@@ -632,6 +659,11 @@ fn parse_setting(k: &str, v: &str) -> Result<Option<KrlOp>, String> {
             KrlOp::LoadMass(m)
         }
         "$LOAD.CM" => KrlOp::LoadCm(frame_of(v)?),
+        _ if k.starts_with("$ANOUT[") => {
+            let (channel, value) = parse_anout(k, v)
+                .ok_or_else(|| format!("bad `{k} = {v}` (n 1..32, -1 <= v <= 1)"))?;
+            KrlOp::Anout { channel, value }
+        }
         "$LOAD.J" => {
             let f = aggregate(v)?;
             let get = |k: &str| field(&f, k, v);

@@ -8,7 +8,7 @@ use crate::math::Point3;
 use crate::program::pose::{arc_length, interpolate, ControllerPose};
 use crate::program::transit::{joint_move_clearance, WallBeads};
 use crate::program::MoveKind;
-use crate::program::ProgramOptions;
+use crate::program::{PlannedPoint, ProgramOptions};
 use crate::robot::{CellLayout, Joints};
 use crate::toolaxis::collision::Torch;
 use nalgebra::UnitQuaternion;
@@ -26,11 +26,15 @@ type Reached = (Joints, Option<[f64; 2]>, Option<Point3>);
 
 /// Checks decoded `steps` against `cell` (module doc), adding problems and
 /// counts to `report`. `planned`: the planned deposition points (part
-/// frame, mm), one per bead motion in execution order.
+/// frame, mm) with their travel speeds and wire feeds (mm/s), one per bead
+/// motion in execution order; with them, each arc-on move's wire feed over
+/// its travel speed (the bead's cross-section, SPEC §5) is checked against
+/// the planned points it reaches, within the rounding of the written
+/// numbers ([`WireFeed::tolerance`](super::WireFeed::tolerance)).
 pub fn check_steps(
     steps: &[DecodedStep],
     cell: &CellLayout,
-    planned: Option<&[Point3]>,
+    planned: Option<&[PlannedPoint]>,
     common: &crate::program::ProgramOptions,
     report: &mut ValidationReport,
 ) {
@@ -87,7 +91,7 @@ fn bead_points(steps: &[DecodedStep]) -> Vec<bool> {
 /// What [`check_steps`] carries from step to step.
 struct Checker<'a> {
     cell: &'a CellLayout,
-    planned: Option<&'a [Point3]>,
+    planned: Option<&'a [PlannedPoint]>,
     common: &'a ProgramOptions,
     /// `bead[i]`: step `i` is a bead motion.
     bead: &'a [bool],
@@ -283,8 +287,8 @@ impl Checker<'_> {
         let mut matched = None;
         let plan_cursor = self.plan_cursor;
         if let (true, Some(plan), Some(d)) = (self.bead[i], self.planned, dep) {
-            matched =
-                (plan_cursor..plan.len()).find(|&j| (d - plan[j]).norm() <= REACH_TOLERANCE_MM);
+            matched = (plan_cursor..plan.len())
+                .find(|&j| (d - plan[j].position_mm).norm() <= REACH_TOLERANCE_MM);
             match matched {
                 // a bead's first motion lands on the next planned point:
                 // no bead is skipped
@@ -305,7 +309,7 @@ impl Checker<'_> {
                 None => {
                     let e = plan
                         .get(plan_cursor.min(plan.len().saturating_sub(1)))
-                        .map_or(f64::INFINITY, |t| (d - t).norm());
+                        .map_or(f64::INFINITY, |t| (d - t.position_mm).norm());
                     push(
                         report,
                         ProblemKind::Deviation,
@@ -353,9 +357,12 @@ impl Checker<'_> {
                 // a move between neighbouring planned points is the
                 // plan's own discretisation: only moves that skip planned
                 // points are held to the planned polyline
-                (Some(plan), Some(j0), Some(j1)) if self.bead[i] && j1 > j0 + 1 => {
-                    Some(&plan[j0..=j1])
-                }
+                (Some(plan), Some(j0), Some(j1)) if self.bead[i] && j1 > j0 + 1 => Some(
+                    plan[j0..=j1]
+                        .iter()
+                        .map(|p| p.position_mm)
+                        .collect::<Vec<Point3>>(),
+                ),
                 _ => None,
             };
             msgs.extend(check_between(
@@ -366,14 +373,69 @@ impl Checker<'_> {
                     via: circle_via.map(|(qv, qvp, _)| (qv, *qvp)),
                     to: (&q, qp),
                     duration_s: *duration_s,
-                    planned: planned_between,
+                    planned: planned_between.as_deref(),
                 },
             ));
         }
-        if let Some((dt, how)) = dt {
-            msgs.extend(joint_speeds(cell, pq, *pqp, &q, qp, dt, &how));
+        if let Some((dt, how)) = &dt {
+            msgs.extend(joint_speeds(cell, pq, *pqp, &q, qp, *dt, how));
+        }
+        if let (Some((dt, _)), true) = (dt, self.arc_on.is_some()) {
+            msgs.extend(self.check_feed(m, prev, to, circle_via, dt, matched));
         }
         msgs
+    }
+
+    /// The wire feed over the travel speed of arc-on move `m` (from `prev`
+    /// to `to` through `circle_via`, taking `dt` s, landing on planned
+    /// point `matched`) against the plan's at every planned point it
+    /// reaches: equal within the rounding of the written numbers
+    /// ([`WireFeed::tolerance`](super::WireFeed::tolerance)). Nothing without the plan, a wire feed in
+    /// the file (a custom process) or a deposition point.
+    fn check_feed(
+        &self,
+        m: &Motion,
+        prev: &Reached,
+        to: &Reached,
+        circle_via: Option<&Reached>,
+        dt: f64,
+        matched: Option<usize>,
+    ) -> Option<(ProblemKind, String)> {
+        let (plan, feed, j0, j1) = (self.planned?, m.wire_feed?, self.prev_matched?, matched?);
+        let (a, b) = (prev.2?, to.2?);
+        let d = match circle_via.and_then(|v| v.2) {
+            Some(v) => arc_length(&a, &v, &b),
+            None => (b - a).norm(),
+        };
+        if !(dt > 0.0 && d > 0.0) {
+            return None;
+        }
+        let ts = d / dt;
+        let ratio = feed.mm_s / ts;
+        // the written numbers' steps, and the length measured between
+        // positions decoded within REACH_TOLERANCE_MM of the planned ones
+        let tolerance = feed.tolerance + 2.0 * REACH_TOLERANCE_MM / d;
+        plan.get(j0 + 1..=j1)?.iter().enumerate().find_map(|(n, p)| {
+            let want = p.feed.ratio();
+            ((ratio / want - 1.0).abs() > tolerance + 1e-9).then(|| {
+                (
+                    ProblemKind::Feed,
+                    format!(
+                        "{}: wire feed {:.3} mm/s at {:.3} mm/s travel speed (WFS/TS {:.4}) but the plan has {:.3} mm/s at {:.3} mm/s ({:.4}) at planned point {}: the bead's cross-section is {:+.2} % off (rounding allows {:.2} %)",
+                        m.label,
+                        feed.mm_s,
+                        ts,
+                        ratio,
+                        p.feed.wire_feed_mm_s,
+                        p.feed.travel_speed_mm_s,
+                        want,
+                        j0 + 1 + n,
+                        100.0 * (ratio / want - 1.0),
+                        100.0 * tolerance
+                    ),
+                )
+            })
+        })
     }
 
     /// The duration (s) of the move of motion `m` from `prev` to `to`

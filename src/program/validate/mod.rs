@@ -96,6 +96,10 @@ pub enum ProblemKind {
     /// A program (or a group of a build) larger than the controller's
     /// memory budget (`max_positions`, `max_file_bytes`).
     Budget,
+    /// An arc-on move whose wire feed over travel speed (the bead's
+    /// cross-section) is not the plan's, or whose wire feed the file does
+    /// not define.
+    Feed,
 }
 
 impl ProblemKind {
@@ -119,6 +123,7 @@ impl ProblemKind {
             Self::Setup => "setup",
             Self::Collision => "collision",
             Self::Budget => "budget",
+            Self::Feed => "feed",
         }
     }
 }
@@ -210,6 +215,22 @@ pub struct Motion {
     pub kind: MoveKind,
     /// The speed.
     pub speed: MotionSpeed,
+    /// The wire feed the file commands for this move with the arc on;
+    /// `None` with the arc off, or where the file carries none (a custom
+    /// process's user lines).
+    pub wire_feed: Option<WireFeed>,
+}
+
+/// The wire feed of an arc-on move as a file writes it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WireFeed {
+    /// Wire feed speed (mm/s).
+    pub mm_s: f64,
+    /// Largest relative difference between this move's wire feed over
+    /// travel speed and the plan's that the rounding of its written numbers
+    /// explains (the steps of the written wire feed and of the written
+    /// speed or time, each relative to its value; dimensionless).
+    pub tolerance: f64,
 }
 
 /// One step of a program as a controller's decoder reads it back from its

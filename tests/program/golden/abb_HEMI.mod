@@ -5,10 +5,10 @@ MODULE MOD_HEMI
   ! tWaam.tload: load0: set [program] payload_base_kg or payload_every_layers for the part the robot holds
   LOCAL PERS tooldata tWaam := [FALSE,[[1000.0000,0.0000,900.0000],[0.0000000,1.0000000,0.0000000,0.0000000]],[0.0010,[0.0000,0.0000,0.0010],[1,0,0,0],0.000000,0.000000,0.000000]];
   LOCAL PERS wobjdata wWaam := [TRUE,TRUE,"",[[0.0000,0.0000,0.0000],[0.7071068,0.0000000,-0.7071068,0.0000000]],[[0,0,0],[1,0,0,0]]];
-  ! ArcWare data (RobotWare 6 Arc): process schedule 1 (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s)
+  ! ArcWare data (RobotWare 6 Arc): process schedule 1 (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s) and wire feed (main_arc.wirefeed, m/min)
   ! gas (s): purge_time 0.500, preflow_time 0.300, postflow_time 1.500 ([program.abb] purge_time_s, preflow_time_s, postflow_time_s)
   LOCAL PERS seamdata seamWaam := [0.500,0.300,[1,0,0,0,0,0,0,0,0],0,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],1.500];
-  LOCAL PERS welddata weldWaam1 := [6.0000,0,[1,0,0,0,0,0,0,0,0],[0,0,0,0,0,0,0,0,0]];
+  LOCAL PERS welddata weldWaam1 := [6.0000,0,[1,0,0,0.6000,0,0,0,0,0],[0,0,0,0,0,0,0,0,0]];
   LOCAL CONST robtarget p1 := [[45.0000,0.0000,20.0000],[0.0000000,1.0000000,0.0000000,0.0000000],[0,0,0,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
   LOCAL CONST jointtarget j1 := [[0.00000,4.04064,39.36673,0.00000,-43.40737,0.00000],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
   LOCAL CONST robtarget p2 := [[45.0000,0.0000,0.0000],[0.0000000,1.0000000,0.0000000,0.0000000],[0,0,0,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];

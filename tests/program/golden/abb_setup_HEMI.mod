@@ -5,10 +5,10 @@ MODULE MOD_HEMI
   ! tWaam.tload: load0: the payload updates (GripLoad) carry the part, substrate and fixture
   LOCAL PERS tooldata tWaam := [FALSE,[[1000.0000,0.0000,900.0000],[0.0000000,1.0000000,0.0000000,0.0000000]],[0.0010,[0.0000,0.0000,0.0010],[1,0,0,0],0.000000,0.000000,0.000000]];
   LOCAL PERS wobjdata wWaam := [TRUE,TRUE,"",[[0.0000,0.0000,0.0000],[0.7071068,0.0000000,-0.7071068,0.0000000]],[[0,0,0],[1,0,0,0]]];
-  ! ArcWare data (RobotWare 6 Arc): process schedule 1 (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s)
+  ! ArcWare data (RobotWare 6 Arc): process schedule 1 (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s) and wire feed (main_arc.wirefeed, m/min)
   ! gas (s): purge_time 0.500, preflow_time 0.300, postflow_time 1.500 ([program.abb] purge_time_s, preflow_time_s, postflow_time_s)
   LOCAL PERS seamdata seamWaam := [0.500,0.300,[1,0,0,0,0,0,0,0,0],0,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],1.500];
-  LOCAL PERS welddata weldWaam1 := [6.0000,0,[1,0,0,0,0,0,0,0,0],[0,0,0,0,0,0,0,0,0]];
+  LOCAL PERS welddata weldWaam1 := [6.0000,0,[1,0,0,0.6000,0,0,0,0,0],[0,0,0,0,0,0,0,0,0]];
   LOCAL PERS loaddata loadWaam1 := [2.0000,[10.0000,0.0000,40.0000],[1,0,0,0],0.000000,0.000000,0.000000];
   LOCAL PERS loaddata loadWaam2 := [2.0123,[10.2500,0.5000,41.5000],[1,0,0,0],0.000000,0.000000,0.000000];
   LOCAL CONST jointtarget jHome := [[20.00000,-5.95936,39.36673,0.00000,-43.40737,0.00000],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];

@@ -5,10 +5,10 @@ MODULE MOD_HEMI
   LOCAL PERS tooldata tWaam := [TRUE,[[-86.0000,0.0000,406.0000],[0.9510565,0.0000000,-0.3090170,0.0000000]],[3.0000,[-43.0000,0.0000,203.0000],[1,0,0,0],0.000000,0.000000,0.000000]];
   ! wWaam moves with mechanical unit STN1: its user frame is the positioner's table frame (system parameters), oframe the part on the table; speeds are the torch's over the part
   LOCAL PERS wobjdata wWaam := [FALSE,FALSE,"STN1",[[0,0,0],[1,0,0,0]],[[0.0000,0.0000,0.0000],[1.0000000,0.0000000,0.0000000,0.0000000]]];
-  ! ArcWare data (RobotWare 6 Arc): process schedule 1 (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s)
+  ! ArcWare data (RobotWare 6 Arc): process schedule 1 (arcdata.sched); one welddata per planned travel speed (weld_speed, mm/s) and wire feed (main_arc.wirefeed, m/min)
   ! gas (s): purge_time 0.500, preflow_time 0.300, postflow_time 1.500 ([program.abb] purge_time_s, preflow_time_s, postflow_time_s)
   LOCAL PERS seamdata seamWaam := [0.500,0.300,[1,0,0,0,0,0,0,0,0],0,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],0,0,[0,0,0,0,0,0,0,0,0],1.500];
-  LOCAL PERS welddata weldWaam1 := [6.0000,0,[1,0,0,0,0,0,0,0,0],[0,0,0,0,0,0,0,0,0]];
+  LOCAL PERS welddata weldWaam1 := [6.0000,0,[1,0,0,0.6000,0,0,0,0,0],[0,0,0,0,0,0,0,0,0]];
   LOCAL CONST robtarget p1 := [[45.0000,0.0000,20.0000],[0.0000000,0.0000000,1.0000000,0.0000000],[0,0,0,0],[0.00000,0.00000,9E+09,9E+09,9E+09,9E+09]];
   LOCAL CONST jointtarget j1 := [[0.00000,35.53246,3.35910,0.00000,87.10844,0.00000],[0.00000,0.00000,9E+09,9E+09,9E+09,9E+09]];
   LOCAL CONST robtarget p2 := [[45.0000,0.0000,0.0000],[0.0000000,0.0000000,-1.0000000,0.0000000],[0,0,0,0],[0.00000,0.00000,9E+09,9E+09,9E+09,9E+09]];

@@ -9,7 +9,9 @@ use super::{same, Decoder};
 use crate::math::Isometry3;
 use crate::program::kuka::read::{KrlOp, KrlPosition, KrlStatement, KrlValue};
 use crate::program::validate::{arm_of, decode_pose, push, wrist_of_j5};
-use crate::program::validate::{DecodedStep, Motion, MotionSpeed, ProblemKind, ValidationReport};
+use crate::program::validate::{
+    DecodedStep, Motion, MotionSpeed, ProblemKind, ValidationReport, WireFeed,
+};
 use crate::program::MoveKind;
 use crate::robot::orientation::KukaAbc;
 use crate::robot::{CellLayout, Configuration, Joints};
@@ -75,6 +77,15 @@ impl Decoder<'_> {
         let src = self.src();
         let mut after = Vec::new();
         for (distance, action, l) in std::mem::take(&mut self.pending) {
+            // the wire feed's command switched at the move's start
+            let anout = action
+                .split_once('=')
+                .and_then(|(k, v)| crate::program::kuka::read::parse_anout(k, v))
+                .filter(|(n, _)| *n == self.opts.wire_feed_anout && self.arc);
+            if let (Some((_, v)), 0) = (anout, distance) {
+                self.anout = Some(v);
+                continue;
+            }
             let step = if same(&action, &self.on) {
                 DecodedStep::ProcessOn {
                     file: src.to_string(),
@@ -195,8 +206,28 @@ impl Decoder<'_> {
             from_cartesian,
             positioner,
             kind,
+            wire_feed: self.wire_feed(&speed),
             speed,
         }))
+    }
+
+    /// The wire feed of a move at `speed` with the arc on: the analog
+    /// command times its full scale, with the relative steps of the written
+    /// command (4 decimals) and `$VEL.CP` (6 decimals of m/s) as its
+    /// tolerance.
+    fn wire_feed(&self, speed: &MotionSpeed) -> Option<WireFeed> {
+        if !(self.arc && self.arc_is_on) {
+            return None;
+        }
+        let a = self.anout.filter(|a| *a > 0.0)?;
+        let v = match *speed {
+            MotionSpeed::Linear(v) | MotionSpeed::Tcp { mm_s: v, .. } => v,
+            MotionSpeed::Time(_) | MotionSpeed::Joint => return None,
+        };
+        Some(WireFeed {
+            mm_s: a * self.opts.wire_feed_full_scale_mm_s,
+            tolerance: 0.5e-4 / a + 1e-3 / v,
+        })
     }
 
     /// The arm joints (rad) of the `E6POS` `pos` (`xyzabc` in mm and deg
