@@ -653,8 +653,12 @@ fn validate_input(
     Ok(())
 }
 
-/// Arc-off moves between consecutive planned layers.
-pub(super) fn transitions(cell: &CellLayout, plans: &[LayerPlan]) -> Vec<Transition> {
+/// Arc-off moves between consecutive planned layers: the joint change
+/// (rad) from each layer's last point to the next one's first, whether the
+/// branch changes, and how far the next layer's first point is from a
+/// joint's limit (rad). What [`Plan::transitions`] holds; a plan assembled
+/// from layers planned apart (replan) takes it from here.
+pub fn transitions(cell: &CellLayout, plans: &[LayerPlan]) -> Vec<Transition> {
     let robot = cell.robot();
     plans
         .windows(2)

@@ -28,6 +28,7 @@ mod fitted;
 mod options;
 mod place;
 mod planned;
+pub(crate) mod program;
 mod sliced;
 pub mod summary;
 

@@ -15,13 +15,10 @@ use super::summary::{
 };
 use super::{slice_part_with, Cell, Control, Part, PlanOptions, RzLaw, SlicedPart};
 use crate::optimise::{
-    layer_points, optimise_with, split_refused_layers, trajectory_inputs, LayerPlan, LayerPoints,
-    OptimiseOptions, Plan, SplitPlan,
+    layer_points, optimise_with, split_refused_layers, LayerPlan, LayerPoints, OptimiseOptions,
+    Plan, SplitPlan,
 };
-use crate::program::{
-    build_program_with, check_vendor, write_files, LayerRefusal, PointFeed, Program, ProgramError,
-};
-use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
+use crate::program::{check_vendor, write_files, PointFeed, Program, ProgramError};
 use crate::robot::Vendor;
 use crate::Error;
 
@@ -263,12 +260,10 @@ fn split_at_corners(
     )?)
 }
 
-/// The program model of a plan, refused when a layer is infeasible or lost
-/// or a motion collides in the cell; with the closest approach per layer
-/// and the collision check's run time (s). `every_layer`: `layers` are the
-/// whole build; `false` for a subsample (a placement's screening), whose
-/// transits between beads the cell check leaves out
-/// ([`CellScene::transits`](crate::program::cell_check::CellScene::transits)).
+/// The program model of a plan ([`ProgramBuild`](super::program::ProgramBuild)):
+/// every point at the nominal travel speed with the process's wire feed.
+/// `every_layer`: `layers` are the whole build; `false` for a subsample (a
+/// placement's screening).
 pub(super) fn build(
     name: &str,
     cell: &Cell,
@@ -278,109 +273,24 @@ pub(super) fn build(
     opts: &OptimiseOptions,
     every_layer: bool,
 ) -> Result<(Program, crate::program::cell_check::CellClearance, f64), ProgramError> {
-    check_every_layer(layers, plan)?;
-    let inputs = trajectory_inputs(layers, plan);
     let speed = opts.travel_speed_mm_s;
-    // the program reads the joints, speeds and violations only: no
-    // dexterity (an SVD a point) nor dq/dR_Z
-    let traj = joint_trajectory_without_measures(
-        &cell.layout,
-        &inputs,
-        speed,
-        &TrajectoryOptions::default(),
-    )
-    .map_err(|source| ProgramError::Trajectory { source })?;
-    let common = &cell.program.common;
-    let mut program = build_program_with(
+    let points = layers.iter().map(|l| l.points.len()).sum();
+    // the nominal travel speed and the process's wire feed at every point
+    let feed = PointFeed::constant(speed, sliced.process.wire_feed_speed_mm_s, points);
+    super::program::ProgramBuild {
         name,
-        &cell.layout,
-        &inputs,
-        &traj,
-        // the nominal travel speed and the process's wire feed at every point
-        &PointFeed::constant(speed, sliced.process.wire_feed_speed_mm_s, inputs.len()),
-        common,
-    )?;
-    if common.payload_every_layers > 0 {
-        // the mass of each planned layer (bead), from the process model
-        let per_layer = sliced
+        cell,
+        layers,
+        plan,
+        feed: &feed,
+        trajectory_speed_mm_s: speed,
+        common: &cell.program.common,
+        layer_masses_kg: &sliced
             .process_plan
-            .layer_masses_kg(&sliced.path, &sliced.process);
-        // a split layer's beads share its mass by their lengths
-        let length = |l: &LayerPoints| -> f64 {
-            l.points
-                .windows(2)
-                .map(|w| (w[1].position_mm - w[0].position_mm).norm())
-                .sum()
-        };
-        let mut layer_length = std::collections::HashMap::new();
-        for l in layers {
-            *layer_length.entry(l.layer).or_insert(0.0) += length(l);
-        }
-        let masses: Vec<f64> = layers
-            .iter()
-            .map(|l| {
-                let mass = per_layer.get(l.layer).copied().unwrap_or(0.0);
-                let whole = layer_length.get(&l.layer).copied().unwrap_or(0.0);
-                // (a whole layer's length over itself: exactly 1)
-                if whole > 0.0 {
-                    mass * length(l) / whole
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        program.set_payloads(common, &masses)?;
+            .layer_masses_kg(&sliced.path, &sliced.process),
+        every_layer,
     }
-    let t = Instant::now();
-    let scene = crate::program::cell_check::CellScene {
-        keep_out: cell.keep_out.clone(),
-        clearance_mm: common.collision_clearance_mm,
-        transits: every_layer,
-    };
-    let clearance = crate::program::cell_check::check_cell(&program, &traj, layers, &scene)?;
-    Ok((program, clearance, t.elapsed().as_secs_f64()))
-}
-
-/// No layer may vanish between the plan and the program: each layer of the
-/// path has its plan, with a joint solution at each of its points, and is
-/// feasible.
-fn check_every_layer(layers: &[LayerPoints], plan: &Plan) -> Result<(), ProgramError> {
-    let infeasible: Vec<_> = plan.infeasible_layers().collect();
-    if let Some(first) = infeasible.first() {
-        return Err(ProgramError::InfeasibleLayer {
-            layer: first.layer,
-            count: infeasible.len(),
-            status: LayerRefusal::Infeasible(first.status.clone()),
-        });
-    }
-    for (i, lp) in layers.iter().enumerate() {
-        let Some(pl) = plan.layers.get(i) else {
-            return Err(ProgramError::InfeasibleLayer {
-                layer: lp.layer,
-                count: layers.len() - i,
-                status: LayerRefusal::NoPlan,
-            });
-        };
-        if pl.layer != lp.layer || pl.points.len() != lp.points.len() {
-            return Err(ProgramError::InfeasibleLayer {
-                layer: lp.layer,
-                count: 1,
-                status: LayerRefusal::PointCount {
-                    planned: pl.points.len(),
-                    path: lp.points.len(),
-                    plan_layer: pl.layer,
-                },
-            });
-        }
-        if let Some(m) = pl.points.iter().position(|p| p.joints.is_none()) {
-            return Err(ProgramError::InfeasibleLayer {
-                layer: lp.layer,
-                count: 1,
-                status: LayerRefusal::NoJointSolution { point: m },
-            });
-        }
-    }
-    Ok(())
+    .build()
 }
 
 impl PlannedPart {
@@ -459,7 +369,7 @@ impl PlannedPart {
     pub fn program_files(&self) -> Result<Vec<crate::program::EmittedFile>, Error> {
         let format = self.format;
         check_vendor(&self.cell.layout, format, format.emitter())?;
-        check_every_layer(&self.layers, &self.plan)?;
+        super::program::check_every_layer(&self.layers, &self.plan)?;
         let program = self.program.as_ref().map_err(Clone::clone)?;
         let settings = &self.cell.program;
         Ok(crate::program::registry::emit(program, settings)?)

@@ -9,18 +9,13 @@ use super::rebuild::{self, Window};
 use super::{program_name_for, Measured, ScanEstimate};
 use super::{scan, LayerCorrection, ReplanError, ReplanOptions, ReplanTimes, ReplannedPart};
 use crate::math::{Point3, Vector3};
-use crate::optimise::{
-    layer_points, optimise_with, trajectory_inputs, LayerPoints, OptimiseOptions, Plan, Transition,
-};
+use crate::optimise::{layer_points, optimise_with, LayerPoints, OptimiseOptions, Plan};
+use crate::pipeline::program::ProgramBuild;
 use crate::pipeline::{
     slice_part_with, Cell, Control, Part, PlanOptions, PlanTimes, PlannedPart, RzLaw, SlicedPart,
 };
 use crate::process::PointProcess;
-use crate::program::cell_check::{check_cell, CellClearance, CellScene};
-use crate::program::{
-    build_program_with, check_vendor, LayerRefusal, PointFeed, Program, ProgramError,
-};
-use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
+use crate::program::{check_vendor, PointFeed};
 use crate::robot::{CellLayout, Vendor};
 use crate::Error;
 
@@ -205,22 +200,37 @@ fn replan_core(
     // The program that resumes the build.
     let t = Instant::now();
     let corrections = rebuilt.corrections;
-    let point_speeds: Vec<Vec<f64>> = corrections.iter().map(|c| c.speed_mm_s.clone()).collect();
     let name = program_name_for(&part.name, k);
+    // the payload of the deposited layers is the one the build resumes with
     let resume_payload = resume_payload(cell, &sliced, k);
-    let checked = resumed_program(
-        &name,
+    let mut common = cell.program.common;
+    if let Some((mass, cog)) = resume_payload {
+        common.payload_base_kg = mass;
+        common.payload_base_cog_mm = [cog.x, cog.y, cog.z];
+    }
+    // the corrected speeds at the process's nominal wire feed: the speed
+    // correction changes the height on purpose (SPEC §5: TS modulated at
+    // the process's WFS)
+    let feed: Vec<PointFeed> = corrections
+        .iter()
+        .flat_map(|c| &c.speed_mm_s)
+        .map(|&travel_speed_mm_s| PointFeed {
+            travel_speed_mm_s,
+            wire_feed_mm_s: process.wire_feed_speed_mm_s,
+        })
+        .collect();
+    let checked = ProgramBuild {
+        name: &name,
         cell,
-        &remaining,
-        &plan,
-        &point_speeds,
-        v_nom,
-        // the speed correction changes the height on purpose (SPEC §5: TS
-        // modulated at the process's wire feed): the nominal wire feed
-        process.wire_feed_speed_mm_s,
-        resume_payload,
-        &process_plan.layer_masses_kg(&rebuilt.path, process),
-    );
+        layers: &remaining,
+        plan: &plan,
+        feed: &feed,
+        trajectory_speed_mm_s: v_nom,
+        common: &common,
+        layer_masses_kg: &process_plan.layer_masses_kg(&rebuilt.path, process),
+        every_layer: true,
+    }
+    .build();
     times.program = t.elapsed().as_secs_f64();
     let (program, clearance, cell_check_s) = match checked {
         Ok((p, c, s)) => (Ok(p), Some(c), s),
@@ -250,7 +260,7 @@ fn replan_core(
         format,
         plan,
         program,
-        point_speeds_mm_s: Some(point_speeds),
+        point_speeds_mm_s: Some(corrections.iter().map(|c| c.speed_mm_s.clone()).collect()),
         clearance,
         splits: Vec::new(),
     };
@@ -513,7 +523,7 @@ fn optimise_remaining(
         None => {}
     }
     Ok(Plan {
-        transitions: transitions(&cell.layout, &plan_layers),
+        transitions: crate::optimise::transitions(&cell.layout, &plan_layers),
         layers: plan_layers,
         time_s: t.elapsed().as_secs_f64(),
     })
@@ -568,33 +578,6 @@ fn renumbered(plan: &crate::optimise::LayerPlan, layer: usize) -> crate::optimis
     p
 }
 
-/// Arc-off moves between consecutive planned layers (as the optimiser
-/// reports them for a whole plan).
-fn transitions(cell: &CellLayout, plans: &[crate::optimise::LayerPlan]) -> Vec<Transition> {
-    let robot = cell.robot();
-    plans
-        .windows(2)
-        .filter_map(|w| {
-            let last = w[0].points.last()?.joints?;
-            let first = w[1].points.first()?.joints?;
-            let start_limit = robot
-                .limits
-                .iter()
-                .zip(&first)
-                .filter(|(l, _)| !l.is_unlimited())
-                .map(|(l, q)| (q - l.lower_rad).min(l.upper_rad - q))
-                .fold(f64::INFINITY, f64::min);
-            Some(Transition {
-                from_layer: w[0].layer,
-                to_layer: w[1].layer,
-                joint_change_rad: std::array::from_fn(|j| first[j] - last[j]),
-                branch_change: w[0].configuration.chosen != w[1].configuration.chosen,
-                start_limit_distance_rad: start_limit,
-            })
-        })
-        .collect()
-}
-
 /// The payload on the flange when layer `k` is done (part-carried cell with
 /// payload updates): the substrate and fixture plus the layers `0..=k`,
 /// each at the mean of its points (flange frame). Mass in kg, centre in mm.
@@ -626,78 +609,4 @@ fn resume_payload(cell: &Cell, sliced: &SlicedPart, k: usize) -> Option<(f64, Po
         Point3::from(common.payload_base_cog_mm)
     };
     Some((mass, cog))
-}
-
-/// The program of the remaining layers: per-point speeds at the process's
-/// wire feed `wire_feed_mm_s` (mm/s), the payload of
-/// the deposited layers as its base, refused (as data) when a layer is
-/// infeasible.
-#[allow(clippy::too_many_arguments)]
-fn resumed_program(
-    name: &str,
-    cell: &Cell,
-    layers: &[LayerPoints],
-    plan: &Plan,
-    speeds: &[Vec<f64>],
-    v_nom: f64,
-    wire_feed_mm_s: f64,
-    payload: Option<(f64, Point3)>,
-    layer_masses_kg: &[f64],
-) -> Result<(Program, CellClearance, f64), ProgramError> {
-    let infeasible: Vec<_> = plan.infeasible_layers().collect();
-    if let Some(first) = infeasible.first() {
-        return Err(ProgramError::InfeasibleLayer {
-            layer: first.layer,
-            count: infeasible.len(),
-            status: LayerRefusal::Infeasible(first.status.clone()),
-        });
-    }
-    for (lp, pl) in layers.iter().zip(&plan.layers) {
-        if let Some(m) = pl.points.iter().position(|p| p.joints.is_none()) {
-            return Err(ProgramError::InfeasibleLayer {
-                layer: lp.layer,
-                count: 1,
-                status: LayerRefusal::NoJointSolution { point: m },
-            });
-        }
-    }
-    let inputs = trajectory_inputs(layers, plan);
-    let traj = joint_trajectory_without_measures(
-        &cell.layout,
-        &inputs,
-        v_nom,
-        &TrajectoryOptions::default(),
-    )
-    .map_err(|source| ProgramError::Trajectory { source })?;
-    let mut common = cell.program.common;
-    if let Some((mass, cog)) = payload {
-        common.payload_base_kg = mass;
-        common.payload_base_cog_mm = [cog.x, cog.y, cog.z];
-    }
-    let flat: Vec<PointFeed> = speeds
-        .iter()
-        .flatten()
-        .map(|&travel_speed_mm_s| PointFeed {
-            travel_speed_mm_s,
-            wire_feed_mm_s,
-        })
-        .collect();
-    let mut program = build_program_with(name, &cell.layout, &inputs, &traj, &flat, &common)?;
-    if common.payload_every_layers > 0 {
-        let masses: Vec<f64> = layers
-            .iter()
-            .map(|l| layer_masses_kg.get(l.layer).copied().unwrap_or(0.0))
-            .collect();
-        program.set_payloads(&common, &masses)?;
-    }
-    // the whole cell along every motion; the part's model holds the
-    // remaining layers only (the wall below layer K+1 is not in the scene)
-    let t = Instant::now();
-    let scene = CellScene {
-        keep_out: cell.keep_out.clone(),
-        clearance_mm: common.collision_clearance_mm,
-        transits: true,
-    };
-    let clearance = check_cell(&program, &traj, layers, &scene)?;
-    Ok((program, clearance, t.elapsed().as_secs_f64()))
 }

@@ -1,0 +1,157 @@
+//! **Stage 7 from a plan — the program of planned layers.** Takes the
+//! layers a plan was made for (part frame, mm), their [`Plan`] (joints,
+//! rad), each point's travel speed and wire feed ([`PointFeed`], mm/s), the
+//! cell and its `[program]` options, and returns the program model
+//! ([`build_program_with`]) with its payloads set and the whole cell checked
+//! along every motion ([`check_cell`]). `plan` and `replan` both build their
+//! programs here; they differ only in the feed they pass and the payload the
+//! build starts with. SPEC §8.
+
+use std::time::Instant;
+
+use super::Cell;
+use crate::optimise::{trajectory_inputs, LayerPoints, Plan};
+use crate::program::cell_check::{check_cell, CellClearance, CellScene};
+use crate::program::{
+    build_program_with, LayerRefusal, PointFeed, Program, ProgramError, ProgramOptions,
+};
+use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
+
+/// What a plan's program is built from.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ProgramBuild<'a> {
+    /// Program name (controller-safe).
+    pub name: &'a str,
+    /// The cell (robot base frame).
+    pub cell: &'a Cell,
+    /// The layers planned, in order (part frame, mm): a layer split at its
+    /// corners is one entry a bead.
+    pub layers: &'a [LayerPoints],
+    /// Their plan, one layer plan per entry of `layers`.
+    pub plan: &'a Plan,
+    /// Travel speed and wire feed of every point of `layers` in order
+    /// (mm/s).
+    pub feed: &'a [PointFeed],
+    /// The travel speed the joint trajectory's speed check runs at (mm/s);
+    /// the builder re-checks every segment at its own speed.
+    pub trajectory_speed_mm_s: f64,
+    /// The cell's `[program]` options, the payload the build starts with
+    /// among them (kg, mm).
+    pub common: &'a ProgramOptions,
+    /// Mass deposited in each layer of the path (kg), indexed by layer:
+    /// the payload updates' (a split layer's beads share it by their
+    /// lengths).
+    pub layer_masses_kg: &'a [f64],
+    /// `layers` are the whole build; `false` for a subsample (a
+    /// placement's screening), whose transits between beads the cell check
+    /// leaves out ([`CellScene::transits`]).
+    pub every_layer: bool,
+}
+
+impl ProgramBuild<'_> {
+    /// The program model, refused when a layer is infeasible or lost or a
+    /// motion collides in the cell; with the closest approach per layer and
+    /// the collision check's run time (s).
+    ///
+    /// # Errors
+    /// [`ProgramError::InfeasibleLayer`] naming the first layer without a
+    /// plan, a joint solution or its point count; the builder's and the
+    /// cell check's errors.
+    pub fn build(&self) -> Result<(Program, CellClearance, f64), ProgramError> {
+        let (cell, layers, common) = (self.cell, self.layers, self.common);
+        check_every_layer(layers, self.plan)?;
+        let inputs = trajectory_inputs(layers, self.plan);
+        // the program reads the joints, speeds and violations only: no
+        // dexterity (an SVD a point) nor dq/dR_Z
+        let traj = joint_trajectory_without_measures(
+            &cell.layout,
+            &inputs,
+            self.trajectory_speed_mm_s,
+            &TrajectoryOptions::default(),
+        )
+        .map_err(|source| ProgramError::Trajectory { source })?;
+        let mut program =
+            build_program_with(self.name, &cell.layout, &inputs, &traj, self.feed, common)?;
+        if common.payload_every_layers > 0 {
+            program.set_payloads(common, &self.bead_masses_kg())?;
+        }
+        let t = Instant::now();
+        let scene = CellScene {
+            keep_out: cell.keep_out.clone(),
+            clearance_mm: common.collision_clearance_mm,
+            transits: self.every_layer,
+        };
+        let clearance = check_cell(&program, &traj, layers, &scene)?;
+        Ok((program, clearance, t.elapsed().as_secs_f64()))
+    }
+
+    /// The mass of each bead (kg): its layer's, shared among a split
+    /// layer's beads by their lengths.
+    fn bead_masses_kg(&self) -> Vec<f64> {
+        let length = |l: &LayerPoints| -> f64 {
+            l.points
+                .windows(2)
+                .map(|w| (w[1].position_mm - w[0].position_mm).norm())
+                .sum()
+        };
+        let mut layer_length = std::collections::HashMap::new();
+        for l in self.layers {
+            *layer_length.entry(l.layer).or_insert(0.0) += length(l);
+        }
+        self.layers
+            .iter()
+            .map(|l| {
+                let mass = self.layer_masses_kg.get(l.layer).copied().unwrap_or(0.0);
+                let whole = layer_length.get(&l.layer).copied().unwrap_or(0.0);
+                // (a whole layer's length over itself: exactly 1)
+                if whole > 0.0 {
+                    mass * length(l) / whole
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+}
+
+/// No layer may vanish between the plan and the program: each layer of the
+/// path has its plan, with a joint solution at each of its points, and is
+/// feasible.
+pub(super) fn check_every_layer(layers: &[LayerPoints], plan: &Plan) -> Result<(), ProgramError> {
+    let infeasible: Vec<_> = plan.infeasible_layers().collect();
+    if let Some(first) = infeasible.first() {
+        return Err(ProgramError::InfeasibleLayer {
+            layer: first.layer,
+            count: infeasible.len(),
+            status: LayerRefusal::Infeasible(first.status.clone()),
+        });
+    }
+    for (i, lp) in layers.iter().enumerate() {
+        let Some(pl) = plan.layers.get(i) else {
+            return Err(ProgramError::InfeasibleLayer {
+                layer: lp.layer,
+                count: layers.len() - i,
+                status: LayerRefusal::NoPlan,
+            });
+        };
+        if pl.layer != lp.layer || pl.points.len() != lp.points.len() {
+            return Err(ProgramError::InfeasibleLayer {
+                layer: lp.layer,
+                count: 1,
+                status: LayerRefusal::PointCount {
+                    planned: pl.points.len(),
+                    path: lp.points.len(),
+                    plan_layer: pl.layer,
+                },
+            });
+        }
+        if let Some(m) = pl.points.iter().position(|p| p.joints.is_none()) {
+            return Err(ProgramError::InfeasibleLayer {
+                layer: lp.layer,
+                count: 1,
+                status: LayerRefusal::NoJointSolution { point: m },
+            });
+        }
+    }
+    Ok(())
+}
