@@ -324,6 +324,10 @@ pub struct FitArgs {
     /// Refuse a start end further than this from the --substrate mesh (mm).
     #[arg(long, value_name = "MM", default_value_t = 1.0)]
     pub substrate_tolerance: f64,
+    /// A mesh with features that are not tube (collars, flanges, blocks, tabs): fit its
+    /// longest tubular stretch and name the features in fit.json, instead of refusing it.
+    #[arg(long)]
+    pub trim: bool,
 }
 
 fn parse_units(s: &str) -> Result<waam_slicer::fit::Units, String> {

@@ -12,6 +12,7 @@ pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
         name: a.name.clone(),
         substrate: a.substrate.clone(),
         substrate_tolerance_mm: a.substrate_tolerance,
+        trim: a.trim,
         ..FitOptions::default()
     };
     let fitted = Part::from_mesh(&a.mesh, &opts).map_err(|e| e.to_string())?;
@@ -54,6 +55,17 @@ pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
                 e.station,
                 e.t_mm,
                 e.radius_mm
+            );
+        }
+        for f in &r.features {
+            println!(
+                "left out    a {} from {:.2} to {:.2} mm along the guide (stations {} to {} before trimming): {}",
+                f.kind.name(),
+                f.t_from_mm,
+                f.t_to_mm,
+                f.first_station,
+                f.last_station,
+                f.size()
             );
         }
         println!(

@@ -3,7 +3,9 @@
 //! a smooth refit of the guide, until the guide stops moving; a final pass
 //! fits the radius law (and wall thickness) and measures the residuals.
 
+use super::features;
 use super::options::units_warning;
+use super::outcome::FeatureReport;
 use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
 use super::section::{fit_circle, fit_plane, plane_basis, CircleFit, SectionPoint};
@@ -103,7 +105,7 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
             reason: "no triangle left after welding and dropping zero-area triangles".into(),
         });
     }
-    match fit_in_mm(&repaired.mesh, opts) {
+    match fit_in_mm(&repaired.mesh, opts, false) {
         Ok(mut fit) => {
             fit.vertex_distance_mm = repaired
                 .vertex_of
@@ -130,8 +132,9 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
     }
 }
 
-/// [`fit_tube`] on a mesh already in mm.
-fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
+/// [`fit_tube`] on a mesh already in mm; `trimmed`: the mesh was already
+/// cut to a tubular stretch (features are not looked for again).
+fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFit, FitError> {
     let surf = topology::surfaces(mesh, opts)?;
     let ends = end_rings(mesh, &surf)?;
     let [mut start, mut finish] = choose_start(mesh, ends, opts)?;
@@ -193,7 +196,18 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
         }
         let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
         if iterations > 1 {
-            check_sections(mesh, &stations, opts)?;
+            if let Err(e) = check_sections(mesh, &stations, opts) {
+                let cx = (
+                    mesh,
+                    &surf,
+                    &spline,
+                    &stations[..],
+                    &samples,
+                    &t[..],
+                    2.0 * r0,
+                );
+                return not_tube(cx, opts, trimmed, e);
+            }
         }
         let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
         slope = fit_law(mesh, &stations, &knots, &|s| s.radius)
@@ -215,16 +229,7 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
         // Converged, or stalled at the level of the mesh's noise (a quarter
         // of the sections' typical scatter: vertices changing station make
         // the last moves go back and forth).
-        let mut scatter: Vec<f64> = stations
-            .iter()
-            .flat_map(|s| s.fits.iter().flatten().map(|f| f.rms))
-            .collect();
-        let noise = if scatter.is_empty() {
-            0.0
-        } else {
-            let k = scatter.len() / 2;
-            *scatter.select_nth_unstable_by(k, f64::total_cmp).1
-        };
+        let noise = median_section_rms(&stations);
         let stall_level = (STALL_TOLERANCES * opts.tolerance_mm).max(STALL_NOISE_FRACTION * noise);
         let stalled = last_move < stall_level && last_move > STALL_SHRINK_RATIO * previous;
         if last_move < opts.tolerance_mm || stalled {
@@ -243,7 +248,19 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
         PROJECT_PAST_END_RADII * r0,
     );
     let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
-    check_sections(mesh, &stations, opts)?;
+    if let Err(e) = check_sections(mesh, &stations, opts) {
+        let cx = (
+            mesh,
+            &surf,
+            &spline,
+            &stations[..],
+            &samples,
+            &t[..],
+            2.0 * r0,
+        );
+        return not_tube(cx, opts, trimmed, e);
+    }
+    let pieces = separate_pieces(mesh, &surf, &stations, &spline, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick);
     let mut radius_mm = law(&|s| s.radius)?;
     let spread = radius_mm
@@ -279,23 +296,14 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
         vertex_distance_mm: Vec::new(),
         report: FitReport::default(),
     };
-    let last = stations.len() - 1;
-    for (first, ring, t_end, station) in [
-        (true, &mut start, range.0, 0),
-        (false, &mut finish, range.1, last),
-    ] {
-        let shape = ends::classify(
-            mesh,
-            &surf,
-            ring,
-            first,
-            &spline.d1(t_end),
-            station,
-            t_end,
-            opts,
-        )?;
-        ring.shape = Some((shape, station, t_end));
-    }
+    classify_ends(
+        mesh,
+        &surf,
+        [&mut start, &mut finish],
+        &spline,
+        &stations,
+        opts,
+    )?;
     let ctx = report::Context {
         mesh,
         surfaces: &surf,
@@ -312,23 +320,43 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError> {
         check_surface: opts.check_surface,
     };
     (fit.report, fit.vertex_distance_mm) = report::build(&ctx, &fit);
-    if fit.report.rms_mm > opts.max_rms_mm {
-        let worst = fit
-            .report
-            .stations
-            .iter()
-            .max_by(|a, b| a.vertex_rms_mm.total_cmp(&b.vertex_rms_mm))
-            .expect("stations");
-        return Err(FitError::Residual {
-            file: mesh.file.clone(),
-            rms_mm: fit.report.rms_mm,
-            max_rms_mm: opts.max_rms_mm,
-            station: worst.index,
-            t_mm: worst.t_mm,
-            station_rms_mm: worst.vertex_rms_mm,
-        });
+    fit.report.features = pieces;
+    check_residual(mesh, fit, opts)
+}
+
+/// The median RMS of the stations' circle fits (mm; 0 with none): the
+/// level of the mesh's noise.
+fn median_section_rms(stations: &[Station]) -> f64 {
+    let mut scatter: Vec<f64> = stations
+        .iter()
+        .flat_map(|s| s.fits.iter().flatten().map(|f| f.rms))
+        .collect();
+    if scatter.is_empty() {
+        return 0.0;
     }
-    Ok(fit)
+    let k = scatter.len() / 2;
+    *scatter.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
+/// `fit`, unless its residual is over [`FitOptions::max_rms_mm`].
+fn check_residual(mesh: &TubeMesh, fit: TubeFit, opts: &FitOptions) -> Result<TubeFit, FitError> {
+    if fit.report.rms_mm <= opts.max_rms_mm {
+        return Ok(fit);
+    }
+    let worst = fit
+        .report
+        .stations
+        .iter()
+        .max_by(|a, b| a.vertex_rms_mm.total_cmp(&b.vertex_rms_mm))
+        .expect("stations");
+    Err(FitError::Residual {
+        file: mesh.file.clone(),
+        rms_mm: fit.report.rms_mm,
+        max_rms_mm: opts.max_rms_mm,
+        station: worst.index,
+        t_mm: worst.t_mm,
+        station_rms_mm: worst.vertex_rms_mm,
+    })
 }
 
 fn spline_of(mesh: &TubeMesh, points: &[Point3]) -> Result<CubicSpline, FitError> {
@@ -976,4 +1004,139 @@ fn check_sections(
         }
     }
     Ok(())
+}
+
+/// Classifies both ends ([`ends::classify`]) at the first and last stations.
+fn classify_ends(
+    mesh: &TubeMesh,
+    surf: &Surfaces,
+    rings: [&mut EndRing; 2],
+    spline: &CubicSpline,
+    stations: &[Station],
+    opts: &FitOptions,
+) -> Result<(), FitError> {
+    let last = stations.len() - 1;
+    for (ring, station) in rings.into_iter().zip([0, last]) {
+        let t_end = stations[station].t;
+        let first = station == 0;
+        let tangent = spline.d1(t_end);
+        let shape = ends::classify(mesh, surf, ring, first, &tangent, station, t_end, opts)?;
+        ring.shape = Some((shape, station, t_end));
+    }
+    Ok(())
+}
+
+/// The separate pieces beside the tube as tabs: refused unless
+/// [`FitOptions::trim`].
+fn separate_pieces(
+    mesh: &TubeMesh,
+    surf: &Surfaces,
+    stations: &[Station],
+    spline: &CubicSpline,
+    opts: &FitOptions,
+) -> Result<Vec<FeatureReport>, FitError> {
+    let pieces: Vec<FeatureReport> = surf
+        .pieces
+        .iter()
+        .map(|p| features::piece(mesh, p, stations, spline))
+        .collect();
+    match (pieces.first(), opts.trim) {
+        (Some(f), false) => Err(feature_error(mesh, f, pieces.len())),
+        _ => Ok(pieces),
+    }
+}
+
+/// What [`not_tube`] looks at: the pass whose sections failed (the mesh,
+/// its surfaces, the guide, its stations, the samples and their guide
+/// parameters) and how far from a cut plane a vertex is sided by its
+/// distance to the plane rather than its guide parameter (mm).
+type NotTube<'a> = (
+    &'a TubeMesh,
+    &'a Surfaces,
+    &'a CubicSpline,
+    &'a [Station],
+    &'a Samples,
+    &'a [f64],
+    f64,
+);
+
+/// The refusal of a feature that is not tube.
+fn feature_error(mesh: &TubeMesh, f: &FeatureReport, count: usize) -> FitError {
+    let c = f.centre_mm;
+    FitError::Feature {
+        file: mesh.file.clone(),
+        kind: f.kind.name(),
+        station: f.first_station,
+        last_station: f.last_station,
+        t_mm: f.t_from_mm,
+        t_end_mm: f.t_to_mm,
+        size: format!(
+            "{}, near ({:.1}, {:.1}, {:.1}) mm{}",
+            f.size(),
+            c[0],
+            c[1],
+            c[2],
+            match count {
+                1 => String::new(),
+                n => format!(" (and {} more)", n - 1),
+            }
+        ),
+    }
+}
+
+/// Sections that failed `error`: features that are not tube refused by
+/// name, or with [`FitOptions::trim`] the longest tubular stretch cut out
+/// and fitted (once: `trimmed`); `error` itself when no feature is found.
+fn not_tube(
+    cx: NotTube<'_>,
+    opts: &FitOptions,
+    trimmed: bool,
+    error: FitError,
+) -> Result<TubeFit, FitError> {
+    let (mesh, surf, spline, stations, samples, t, reach) = cx;
+    let (tube, found) = features::detect(spline, stations, &samples.pos, &samples.skin, t, opts);
+    let Some(first) = found.first() else {
+        return Err(error);
+    };
+    if !opts.trim || trimmed {
+        return Err(feature_error(mesh, first, found.len()));
+    }
+    // Tubular runs that touch make one stretch; the longest is fitted.
+    let mut stretches: Vec<(usize, usize)> = Vec::new();
+    for r in tube {
+        match stretches.last_mut() {
+            Some(s) if s.1 + 1 == r.0 => s.1 = r.1,
+            _ => stretches.push(r),
+        }
+    }
+    let n = stations.len();
+    let Some(&(a, b)) = stretches.iter().max_by(|x, y| {
+        let len = |s: &(usize, usize)| stations[s.1].t - stations[s.0].t;
+        len(x).total_cmp(&len(y))
+    }) else {
+        return Err(feature_error(mesh, first, found.len()));
+    };
+    let t_lo = (a > 0).then(|| stations[a].t);
+    let t_hi = (b + 1 < n).then(|| stations[b].t);
+    let mut t_of = vec![None; mesh.vertices.len()];
+    let skin_vertices = surf.skins.iter().flat_map(|s| s.vertices.iter());
+    for (&v, &tv) in skin_vertices.zip(t) {
+        t_of[v as usize] = Some(tv);
+    }
+    let sub = features::clip(mesh, spline, &t_of, t_lo, t_hi, reach);
+    let mut fit = fit_in_mm(&sub, opts, true)?;
+    fit.vertex_distance_mm.truncate(mesh.vertices.len());
+    let rep = &mut fit.report;
+    for cut in [t_lo, t_hi].into_iter().flatten() {
+        let c = spline.point(cut);
+        let from = |e: &super::EndReport| (Point3::from(e.centre_mm) - c).norm();
+        let end = if from(&rep.start) <= from(&rep.end) {
+            &mut rep.start
+        } else {
+            &mut rep.end
+        };
+        end.kind = super::EndKind::Trimmed;
+    }
+    rep.features.splice(0..0, found);
+    Ok(fit)
 }

@@ -4,12 +4,11 @@
 //! is not flat, not round seen along the guide, a flat face covering part
 //! of it). Mesh frame, mm.
 
-use super::outcome::EndRing;
+use super::outcome::{which, EndKind, EndRing, EndShape};
 use super::section::{fit_circle, fit_plane, plane_basis, SectionPoint};
 use super::topology::Surfaces;
 use super::{FitError, FitOptions, TubeMesh};
 use crate::math::{Point3, UnitVector3, Vector3};
-use serde::Serialize;
 
 /// An end plane tilted from the guide's normal plane by more than this
 /// (degrees) is cut obliquely: below it, the tilt of a CAD tool's square
@@ -20,50 +19,6 @@ pub const OBLIQUE_TILT_DEG: f64 = 5.0;
 /// (dimensionless) closes that end; a face covering less is a partial cap,
 /// none of the ends the fit knows.
 pub const CAP_COVER_FRACTION: f64 = 0.9;
-
-/// How an end of the tube is closed, as found in the mesh.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum EndKind {
-    /// Open: the surface's rim (one skin, or both skins of a wall left open).
-    #[default]
-    Open,
-    /// Closed by a flat face (a disc) on a single skin: a solid end or a
-    /// plate.
-    FlatCapped,
-    /// The two skins of a wall joined by a flat ring.
-    RingCapped,
-}
-
-impl EndKind {
-    /// The kind's name as written in `fit.json` and printed.
-    pub fn name(self) -> &'static str {
-        match self {
-            EndKind::Open => "open",
-            EndKind::FlatCapped => "flat-capped",
-            EndKind::RingCapped => "ring-capped",
-        }
-    }
-}
-
-/// What [`classify`] finds of one end.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct EndShape {
-    pub kind: EndKind,
-    /// Angle between the end's plane and the guide's normal plane there (rad).
-    pub tilt: f64,
-    /// Radius of the rim seen along the guide (mm; the mean of the skins).
-    pub radius: f64,
-}
-
-/// Which end, for the messages: `start` or `end`.
-pub(super) fn which(first: bool) -> &'static str {
-    if first {
-        "start"
-    } else {
-        "end"
-    }
-}
 
 /// Points of a vertex set (mm).
 fn points(mesh: &TubeMesh, vs: &[u32]) -> Vec<Point3> {

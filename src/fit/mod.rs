@@ -29,6 +29,7 @@
 
 mod driver;
 pub mod ends;
+pub mod features;
 mod mesh;
 mod options;
 mod outcome;
@@ -40,11 +41,11 @@ pub mod smooth;
 pub mod topology;
 
 pub use driver::fit_tube;
-pub use ends::EndKind;
 pub use mesh::{TubeMesh, MAX_MESH_BYTES};
 pub use options::{FitOptions, StartEnd, Units};
 pub use outcome::{
-    EndReport, FitReport, LeftOut, RepairReport, StationReport, TubeFit, WallReport,
+    EndKind, EndReport, FeatureKind, FeatureReport, FitReport, LeftOut, RepairReport,
+    StationReport, TubeFit, WallReport,
 };
 
 /// Errors of the fit stage; each names the mesh file, and the station
@@ -185,6 +186,26 @@ pub enum FitError {
         t_mm: f64,
         /// What was found.
         found: String,
+    },
+    /// A feature that is not tube (a collar, a flange, a block, a tab) on
+    /// the mesh ([`features`]); [`FitOptions::trim`] fits the longest
+    /// tubular stretch instead.
+    #[error("{file}: not a tube: a {kind} at stations {station} to {last_station} ({t_mm:.2} to {t_end_mm:.2} mm from the start end along the guide): {size}; with --trim (FitOptions::trim) the longest tubular stretch is fitted and the rest named in fit.json")]
+    Feature {
+        /// The mesh file.
+        file: String,
+        /// What it looks like: collar, flange, block, tab.
+        kind: &'static str,
+        /// Its first station.
+        station: usize,
+        /// Its last station.
+        last_station: usize,
+        /// Where it begins (mm from the start end along the guide).
+        t_mm: f64,
+        /// Where it ends (mm from the start end along the guide).
+        t_end_mm: f64,
+        /// Its size (mm), where it is, and how many others were found.
+        size: String,
     },
     /// The fit could not be computed (too few points at a station, a
     /// singular system, no convergence to a usable guide).

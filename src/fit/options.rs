@@ -208,6 +208,11 @@ pub struct FitOptions {
     /// the [`substrate`](Self::substrate) mesh; a start end further away is
     /// refused ([`FitError::SubstrateFar`]).
     pub substrate_tolerance_mm: f64,
+    /// Fit the longest tubular stretch of a mesh that carries features that
+    /// are not tube (collars, flanges, blocks, tabs), cut at the guide's
+    /// normal planes next to them, and name the features in the report;
+    /// `false` (the default): such a mesh is refused, naming the feature.
+    pub trim: bool,
 }
 
 impl Default for FitOptions {
@@ -229,6 +234,7 @@ impl Default for FitOptions {
             name: None,
             substrate: None,
             substrate_tolerance_mm: 1.0,
+            trim: false,
         }
     }
 }

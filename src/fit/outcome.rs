@@ -3,7 +3,6 @@
 //! values the driver hands to the report builder (an open end's ring, a
 //! station's sections). Mesh frame = part frame, mm.
 
-use super::ends::{EndKind, EndShape};
 use super::section::CircleFit;
 use super::{smooth, Units};
 use crate::geometry::guide::CubicSpline;
@@ -221,6 +220,9 @@ pub struct FitReport {
     /// What the fit noticed but did not refuse (a size suggesting another
     /// unit).
     pub warnings: Vec<String>,
+    /// Features that are not tube, left out of a trimmed fit
+    /// ([`FitOptions::trim`](super::FitOptions::trim)).
+    pub features: Vec<FeatureReport>,
 }
 
 /// A separate piece of the mesh left out of the fit (mesh frame, mm).
@@ -248,4 +250,136 @@ pub struct RepairReport {
     pub degenerate_triangles: usize,
     /// Separate pieces holding under 1 % of the area, left out.
     pub left_out: Vec<LeftOut>,
+}
+
+/// How an end of the tube is closed, as found in the mesh.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EndKind {
+    /// Open: the surface's rim (one skin, or both skins of a wall left open).
+    #[default]
+    Open,
+    /// Closed by a flat face (a disc) on a single skin: a solid end or a
+    /// plate.
+    FlatCapped,
+    /// The two skins of a wall joined by a flat ring.
+    RingCapped,
+    /// Not an end of the mesh: the fit was trimmed there, by the guide's
+    /// normal plane, next to a feature that is not tube
+    /// ([`FitOptions::trim`](super::FitOptions::trim)).
+    Trimmed,
+}
+
+impl EndKind {
+    /// The kind's name as written in `fit.json` and printed.
+    pub fn name(self) -> &'static str {
+        match self {
+            EndKind::Open => "open",
+            EndKind::FlatCapped => "flat-capped",
+            EndKind::RingCapped => "ring-capped",
+            EndKind::Trimmed => "trimmed",
+        }
+    }
+}
+
+/// What [`classify`](super::ends::classify) finds of one end.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct EndShape {
+    pub kind: EndKind,
+    /// Angle between the end's plane and the guide's normal plane there (rad).
+    pub tilt: f64,
+    /// Radius of the rim seen along the guide (mm; the mean of the skins).
+    pub radius: f64,
+}
+
+/// Which end, for the messages: `start` or `end`.
+pub(super) fn which(first: bool) -> &'static str {
+    if first {
+        "start"
+    } else {
+        "end"
+    }
+}
+
+/// What a feature that is not tube looks like.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FeatureKind {
+    /// A round sleeve all around the tube, at least as long as it is high.
+    Collar,
+    /// A round disc all around the tube, higher than it is long.
+    Flange,
+    /// An outline all around the tube that is not round (a square block).
+    Block,
+    /// Something on one side of the tube only, or a separate piece.
+    Tab,
+}
+
+impl FeatureKind {
+    /// The kind's name as printed.
+    pub fn name(self) -> &'static str {
+        match self {
+            FeatureKind::Collar => "collar",
+            FeatureKind::Flange => "flange",
+            FeatureKind::Block => "block",
+            FeatureKind::Tab => "tab",
+        }
+    }
+}
+
+/// A feature that is not tube (mesh frame, mm; stations and `t` of the
+/// guide fitted before trimming).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FeatureReport {
+    /// What it looks like.
+    pub kind: FeatureKind,
+    /// Its first station along the guide.
+    pub first_station: usize,
+    /// Its last station.
+    pub last_station: usize,
+    /// Where it begins: its nearest point to the start end, as the
+    /// distance along the guide from the start end (mm).
+    pub t_from_mm: f64,
+    /// Where it ends: its farthest point from the start end along the
+    /// guide (mm from the start end).
+    pub t_to_mm: f64,
+    /// Its length along the guide (mm): `t_to_mm - t_from_mm`.
+    pub length_mm: f64,
+    /// How far it reaches out from the tube's wall (mm): its outline's
+    /// largest distance from the guide minus the tube's radius.
+    pub height_mm: f64,
+    /// Its outline's narrowest and widest size across the guide (mm): twice
+    /// its smallest and largest distance from the guide over the directions
+    /// it covers.
+    pub across_mm: [f64; 2],
+    /// The guide's point at its middle (mm).
+    pub centre_mm: [f64; 3],
+    /// For a separate piece: its triangles (0 otherwise).
+    pub triangles: usize,
+    /// For a separate piece: its bounding box's sides (mm; zeros otherwise).
+    pub box_mm: [f64; 3],
+}
+
+impl FeatureReport {
+    /// Its size in words (mm).
+    pub fn size(&self) -> String {
+        if self.triangles > 0 {
+            return format!(
+                "a separate piece of {} triangles, {:.1} x {:.1} x {:.1} mm",
+                self.triangles, self.box_mm[0], self.box_mm[1], self.box_mm[2]
+            );
+        }
+        let across = if (self.across_mm[1] - self.across_mm[0]) < 0.05 * self.across_mm[1] {
+            format!("{:.1} mm across", self.across_mm[1])
+        } else {
+            format!(
+                "{:.1} to {:.1} mm across",
+                self.across_mm[0], self.across_mm[1]
+            )
+        };
+        format!(
+            "{:.1} mm long, reaching {:.1} mm out from the tube's wall, {across}",
+            self.length_mm, self.height_mm
+        )
+    }
 }

@@ -3,7 +3,8 @@
 //! [`FitReport`] (the `fit.json` that `waam fit` writes; every number is
 //! finite).
 
-use super::ends::{EndKind, OBLIQUE_TILT_DEG};
+use super::ends::OBLIQUE_TILT_DEG;
+use super::outcome::EndKind;
 use super::outcome::{EndReport, EndRing, FitReport, Station, StationReport, TubeFit, WallReport};
 use super::section::plane_basis;
 use super::smooth;
@@ -173,6 +174,7 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> (FitReport, Vec<Option<f
         repair: Default::default(),
         units: Default::default(),
         warnings: Vec::new(),
+        features: Vec::new(),
     };
     (report, per_vertex)
 }

@@ -41,6 +41,8 @@ pub struct Surfaces {
     pub caps: Vec<Cap>,
     /// Triangles of small stray pieces left out of the fit.
     pub ignored_triangles: usize,
+    /// Separate closed pieces beside the tube (tabs): their triangles.
+    pub pieces: Vec<Vec<u32>>,
 }
 
 struct UnionFind(Vec<u32>);
@@ -175,13 +177,20 @@ pub fn surfaces(mesh: &TubeMesh, opts: &FitOptions) -> Result<Surfaces, FitError
         skins: Vec::new(),
         caps: Vec::new(),
         ignored_triangles: 0,
+        pieces: Vec::new(),
     };
-    for comp in components {
+    for (ci, comp) in components.into_iter().enumerate() {
+        let loops = boundary_loops(mesh, &comp);
+        if ci > 0 && loops.is_empty() {
+            // A closed piece beside the tube (the repair left out those under
+            // 1 % of the area): a tab, not an end face.
+            out.pieces.push(comp);
+            continue;
+        }
         if comp.len() < small {
             out.ignored_triangles += comp.len();
             continue;
         }
-        let loops = boundary_loops(mesh, &comp);
         if loops.len() >= 3 {
             return Err(branch_error(mesh, &comp, &loops));
         }
@@ -369,7 +378,7 @@ fn closed_end_error(mesh: &TubeMesh, tris: &[u32], rim: &[u32], opts: &FitOption
     };
     FitError::UnknownEnd {
         file: mesh.file.clone(),
-        end: super::ends::which(dome_first).into(),
+        end: super::outcome::which(dome_first).into(),
         station,
         t_mm,
         found: format!("{found} (stations are level sets of the distance from the open end, {width:.2} mm apart)"),

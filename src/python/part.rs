@@ -49,11 +49,14 @@ impl PyPart {
     /// the mesh holds both skins), a flat substrate at the start end
     /// (`start`: `"lowest"`, `"highest"`, `"capped"` or a point `(x, y, z)`);
     /// `units`: the mesh's length unit, `"mm"` (default), `"cm"`, `"m"` or
-    /// `"in"`; every other length, and the fit, is in mm. The other keywords
-    /// are `FitOptions`' fields. Releases the GIL.
+    /// `"in"`; every other length, and the fit, is in mm. `trim=True` fits
+    /// the longest tubular stretch of a mesh with features that are not
+    /// tube (collars, flanges, blocks, tabs) and names them in the report's
+    /// `features`. The other keywords are `FitOptions`' fields. Releases the
+    /// GIL.
     #[staticmethod]
     #[pyo3(signature = (path, *, units = None, start = None, max_rms_mm = None, template = None, name = None,
-        station_spacing_mm = None, knot_spacing_mm = None, check_surface = None))]
+        station_spacing_mm = None, knot_spacing_mm = None, check_surface = None, trim = None))]
     #[allow(clippy::too_many_arguments)]
     fn from_mesh(
         py: Python<'_>,
@@ -66,6 +69,7 @@ impl PyPart {
         station_spacing_mm: Option<f64>,
         knot_spacing_mm: Option<f64>,
         check_surface: Option<bool>,
+        trim: Option<bool>,
     ) -> PyResult<Self> {
         let mut opts = crate::FitOptions::default();
         if let Some(u) = units {
@@ -95,6 +99,9 @@ impl PyPart {
         opts.knot_spacing_mm = knot_spacing_mm;
         if let Some(c) = check_surface {
             opts.check_surface = c;
+        }
+        if let Some(t) = trim {
+            opts.trim = t;
         }
         let fitted = py
             .detach(|| Part::from_mesh(&path, &opts))

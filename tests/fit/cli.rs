@@ -116,3 +116,45 @@ fn fit_refuses_a_blob_naming_the_file() {
     );
     assert!(!dir.path().join("o").join("part.toml").exists());
 }
+
+/// `--trim` fits the pipe beside a flange and names it; without it the
+/// flange is refused (exit 1).
+#[test]
+fn fit_trim_names_the_feature_left_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let (v, f) = gen::collared_pipe(10.0, 80.0, 25.0, 38.0, 41.0, 64, 1.0);
+    let stl = dir.path().join("flange.stl");
+    std::fs::write(&stl, gen::binary_stl(&v, &f)).unwrap();
+    let run = |trim: bool| {
+        let mut c = waam();
+        c.arg("fit")
+            .arg(&stl)
+            .arg("--out")
+            .arg(dir.path().join("o"));
+        if trim {
+            c.arg("--trim");
+        }
+        c.output().unwrap()
+    };
+    let refused = run(false);
+    assert_eq!(refused.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("not a tube: a flange at stations"), "{err}");
+    let done = run(true);
+    let out = String::from_utf8_lossy(&done.stdout);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(
+        out.contains("left out    a flange from 38.00 to 41.00 mm"),
+        "{out}"
+    );
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("o").join("fit.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(report["features"][0]["kind"], "flange", "{report}");
+    assert_eq!(report["start"]["kind"], "trimmed", "{report}");
+}

@@ -600,3 +600,85 @@ pub fn domed_pipe(r: f64, len: f64, around: usize, h: f64) -> (Vec<Point3>, Vec<
     );
     (v, f)
 }
+
+/// A straight pipe of radius `r` about the z axis from z = 0 to `len`
+/// (rings about `h` apart, `around` points each) with a collar of outer
+/// radius `outer` from z = `z0` to `z1`: flat rings at z0 and z1 join the
+/// pipe to the collar's cylinder (a flange when short and wide).
+pub fn collared_pipe(
+    r: f64,
+    len: f64,
+    outer: f64,
+    z0: f64,
+    z1: f64,
+    around: usize,
+    h: f64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let mut rings = pipe_rings(around, r, 0.0, z0, h);
+    rings.extend(pipe_rings(around, outer, z0, z1, h));
+    rings.extend(pipe_rings(around, r, z1, len, h));
+    lofted(&rings)
+}
+
+/// A straight pipe of radius `r` about the z axis from z = 0 to `len` whose
+/// first `height` mm are a square block of side `side` (its open bottom a
+/// square, a flat step at z = `height` from the square to the pipe).
+pub fn blocked_pipe(
+    r: f64,
+    len: f64,
+    side: f64,
+    height: f64,
+    around: usize,
+    h: f64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let a = 0.5 * side;
+    let n = (height / h).ceil() as usize;
+    let mut rings: Vec<Vec<Point3>> = (0..=n)
+        .map(|i| {
+            let z = height * i as f64 / n as f64;
+            ring_of(around, |t| {
+                let s = a / t.cos().abs().max(t.sin().abs());
+                Point3::new(s * t.cos(), s * t.sin(), z)
+            })
+        })
+        .collect();
+    rings.extend(pipe_rings(around, r, height, len, h));
+    lofted(&rings)
+}
+
+/// A closed box from `lo` to `hi` (12 triangles): a printing tab.
+pub fn block(lo: Point3, hi: Point3) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let v: Vec<Point3> = (0..8)
+        .map(|k| {
+            Point3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect();
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let f = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    (v, f)
+}
+
+/// `(v, f)` with `(v2, f2)` added as another piece.
+pub fn join(
+    (mut v, mut f): (Vec<Point3>, Vec<[u32; 3]>),
+    (v2, f2): (Vec<Point3>, Vec<[u32; 3]>),
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let base = v.len() as u32;
+    v.extend(v2);
+    f.extend(f2.into_iter().map(|t| t.map(|i| i + base)));
+    (v, f)
+}

@@ -7,6 +7,7 @@ mod cli;
 #[path = "../common/mod.rs"]
 mod common;
 mod ends;
+mod features;
 mod gen;
 mod page;
 mod real;

@@ -1,0 +1,184 @@
+//! Features that are not tube (issue 47, deliverable 5): a collar, a
+//! flange, a block at one end and a separate tab on generated pipes,
+//! refused naming the feature, where it is and its size, each checked
+//! against the generator's dimensions; with `trim` the longest tubular
+//! stretch is fitted and the feature named in the report.
+
+use crate::gen;
+use waam_slicer::fit::{EndKind, FeatureKind, FeatureReport, FitError, TubeMesh};
+use waam_slicer::math::Point3;
+use waam_slicer::{Error, FitOptions, FittedPart, Part};
+
+type Mesh = (Vec<Point3>, Vec<[u32; 3]>);
+
+fn fit(mesh: &Mesh, name: &str, trim: bool) -> Result<FittedPart, Error> {
+    let opts = FitOptions {
+        trim,
+        ..FitOptions::default()
+    };
+    Part::from_tube_mesh(
+        &TubeMesh::new(mesh.0.clone(), mesh.1.clone(), name).unwrap(),
+        &opts,
+    )
+}
+
+/// Station spacing of a fit (mm).
+fn spacing(p: &FittedPart) -> f64 {
+    let s = &p.report().stations;
+    s[1].t_mm - s[0].t_mm
+}
+
+/// Refused without `trim`, naming the kind and the place; fitted with it,
+/// the feature in the report (checked by `check`) and the fitted stretch
+/// from `keep.0` to `keep.1` (mm along the pipe's axis, z) with one end
+/// trimmed.
+fn refused_then_trimmed(
+    mesh: &Mesh,
+    name: &str,
+    kind: FeatureKind,
+    keep: (f64, f64),
+    check: impl Fn(&FeatureReport, f64),
+) {
+    let e = fit(mesh, name, false).unwrap_err();
+    let msg = e.to_string();
+    let Error::Fit(FitError::Feature { kind: named, .. }) = e else {
+        panic!("{msg}")
+    };
+    assert_eq!(named, kind.name(), "{msg}");
+    assert!(
+        msg.starts_with(&format!("{name}: not a tube: a {}", kind.name()))
+            && msg.contains("--trim"),
+        "{msg}"
+    );
+    let p = fit(mesh, name, true).unwrap_or_else(|e| panic!("{name} trimmed: {e}"));
+    let r = p.report();
+    assert_eq!(r.features.len(), 1, "{:?}", r.features);
+    let f = &r.features[0];
+    assert_eq!(f.kind, kind, "{f:?}");
+    // The whole pipe's station spacing, as the refusal's.
+    let h = 2.0 * spacing(&p);
+    check(f, h);
+    let z: Vec<f64> = [&r.start, &r.end].iter().map(|e| e.centre_mm[2]).collect();
+    let (lo, hi) = (z[0].min(z[1]), z[0].max(z[1]));
+    assert!(
+        (lo - keep.0).abs() <= 2.0 * h && (hi - keep.1).abs() <= 2.0 * h,
+        "{name}: fitted from z = {lo} to {hi}, want {keep:?}"
+    );
+    let trimmed = [&r.start, &r.end]
+        .iter()
+        .filter(|e| e.kind == EndKind::Trimmed)
+        .count();
+    assert_eq!(trimmed, 1, "{:?} {:?}", r.start, r.end);
+    assert!(r.rms_mm < 0.05, "{}", r.rms_mm);
+}
+
+/// A pipe of radius 10 from z = 0 to 80 with a collar of radius 14 from
+/// z = 36 to 46: 10 mm long, 4 mm high, 28 mm across. The longest tubular
+/// stretch is 0 to 36 (46 to 80 is 2 mm shorter).
+#[test]
+fn a_collar_is_named_with_its_place_and_size() {
+    let mesh = gen::collared_pipe(10.0, 80.0, 14.0, 36.0, 46.0, 64, 1.0);
+    refused_then_trimmed(
+        &mesh,
+        "collar.stl",
+        FeatureKind::Collar,
+        (0.0, 36.0),
+        |f, h| {
+            assert!(
+                (f.t_from_mm - 36.0).abs() <= h && (f.t_to_mm - 46.0).abs() <= h,
+                "{f:?}"
+            );
+            assert!((f.length_mm - 10.0).abs() <= h, "{f:?}");
+            assert!((f.height_mm - 4.0).abs() <= 0.2, "{f:?}");
+            assert!((f.across_mm[1] - 28.0).abs() <= 0.4, "{f:?}");
+        },
+    );
+}
+
+/// A flange of radius 25, 3 mm thick, from z = 38 to 41 on the same pipe:
+/// 15 mm high, 50 mm across. The longest tubular stretch is 41 to 80.
+#[test]
+fn a_flange_is_named_with_its_place_and_size() {
+    let mesh = gen::collared_pipe(10.0, 80.0, 25.0, 38.0, 41.0, 64, 1.0);
+    refused_then_trimmed(
+        &mesh,
+        "flange.stl",
+        FeatureKind::Flange,
+        (41.0, 80.0),
+        |f, h| {
+            assert!(
+                (f.t_from_mm - 38.0).abs() <= h && (f.t_to_mm - 41.0).abs() <= h,
+                "{f:?}"
+            );
+            assert!((f.height_mm - 15.0).abs() <= 0.2, "{f:?}");
+            assert!((f.across_mm[1] - 50.0).abs() <= 0.4, "{f:?}");
+        },
+    );
+}
+
+/// A square block of side 40 from z = 0 to 15 at the start of the pipe:
+/// 40 mm across its sides, 56.6 across its corners (28.3 - 10 = 18.3 mm
+/// out from the wall). The longest tubular stretch is 15 to 80.
+#[test]
+fn a_block_at_one_end_is_named_with_its_place_and_size() {
+    let mesh = gen::blocked_pipe(10.0, 80.0, 40.0, 15.0, 64, 1.0);
+    refused_then_trimmed(
+        &mesh,
+        "block.stl",
+        FeatureKind::Block,
+        (15.0, 80.0),
+        |f, h| {
+            assert_eq!(f.first_station, 0, "{f:?}");
+            assert!(
+                f.t_from_mm.abs() <= h && (f.t_to_mm - 15.0).abs() <= h,
+                "{f:?}"
+            );
+            assert!((f.across_mm[0] - 40.0).abs() <= 0.5, "{f:?}");
+            assert!((f.across_mm[1] - 40.0 * 2f64.sqrt()).abs() <= 0.5, "{f:?}");
+            assert!(
+                (f.height_mm - (20.0 * 2f64.sqrt() - 10.0)).abs() <= 0.5,
+                "{f:?}"
+            );
+        },
+    );
+}
+
+/// A separate printing tab, a box 20 x 20 x 2 mm at z = 30 to 32 beside the
+/// straight pipe (z = 0 to 80): named by its box and the stations beside it;
+/// with `trim` the whole pipe is fitted and the tab named.
+#[test]
+fn a_separate_tab_is_named_with_its_place_and_size() {
+    let mesh = gen::join(
+        gen::mesh(&gen::straight(), 1.0, 0.0, 0.0, 0),
+        gen::block(Point3::new(40.0, 0.0, 30.0), Point3::new(60.0, 20.0, 32.0)),
+    );
+    let msg = fit(&mesh, "tab.stl", false).unwrap_err().to_string();
+    assert!(
+        msg.starts_with("tab.stl: not a tube: a tab at stations")
+            && msg.contains("20.0 x 20.0 x 2.0 mm"),
+        "{msg}"
+    );
+    let p = fit(&mesh, "tab.stl", true).unwrap();
+    let r = p.report();
+    let f = &r.features[0];
+    let h = spacing(&p);
+    assert_eq!(
+        (f.kind, f.triangles, f.box_mm),
+        (FeatureKind::Tab, 12, [20.0, 20.0, 2.0])
+    );
+    assert!(f.t_from_mm >= 30.0 - h && f.t_to_mm <= 32.0 + h, "{f:?}");
+    assert!((r.length_mm - 80.0).abs() < 0.1, "{}", r.length_mm);
+    assert!(r.start.kind == EndKind::Open && r.end.kind == EndKind::Open);
+}
+
+/// A tube that fits is the same with `trim`.
+#[test]
+fn trim_leaves_a_tube_without_features_as_it_is() {
+    let mesh = gen::mesh(&gen::elbow(), 1.0, 0.0, 0.0, 0);
+    let (a, b) = (
+        fit(&mesh, "e.stl", false).unwrap(),
+        fit(&mesh, "e.stl", true).unwrap(),
+    );
+    assert_eq!(a.toml, b.toml);
+    assert!(b.report().features.is_empty());
+}
