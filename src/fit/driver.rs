@@ -1071,7 +1071,7 @@ fn feature_error(mesh: &TubeMesh, f: &FeatureReport, count: usize) -> FitError {
         t_mm: f.t_from_mm,
         t_end_mm: f.t_to_mm,
         size: format!(
-            "{}, near ({:.1}, {:.1}, {:.1}) mm{}",
+            "{}, near ({:.1}, {:.1}, {:.1}) mm{}; with --trim (FitOptions::trim) the longest tubular stretch is fitted and the rest named in fit.json",
             f.size(),
             c[0],
             c[1],

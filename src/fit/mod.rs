@@ -190,7 +190,7 @@ pub enum FitError {
     /// A feature that is not tube (a collar, a flange, a block, a tab) on
     /// the mesh ([`features`]); [`FitOptions::trim`] fits the longest
     /// tubular stretch instead.
-    #[error("{file}: not a tube: a {kind} at stations {station} to {last_station} ({t_mm:.2} to {t_end_mm:.2} mm from the start end along the guide): {size}; with --trim (FitOptions::trim) the longest tubular stretch is fitted and the rest named in fit.json")]
+    #[error("{file}: not a tube: a {kind} at stations {station} to {last_station} ({t_mm:.2} to {t_end_mm:.2} mm from the start end along the guide): {size}")]
     Feature {
         /// The mesh file.
         file: String,
@@ -204,7 +204,8 @@ pub enum FitError {
         t_mm: f64,
         /// Where it ends (mm from the start end along the guide).
         t_end_mm: f64,
-        /// Its size (mm), where it is, and how many others were found.
+        /// Its size (mm), where it is, how many others were found, and
+        /// whether `trim` can cut it out.
         size: String,
     },
     /// The fit could not be computed (too few points at a station, a

@@ -3,6 +3,7 @@
 //! geodesic distance from an open end (a first guide, and where a tube
 //! branches). Mesh frame, mm.
 
+use super::outcome::FeatureKind;
 use super::section::fit_plane;
 use super::{FitError, FitOptions, TubeMesh};
 use crate::math::{Point3, UnitVector3};
@@ -281,6 +282,9 @@ fn branch_error(mesh: &TubeMesh, tris: &[u32], loops: &[Vec<u32>]) -> FitError {
     let found = format!("{} open ends: a branched tube", loops.len());
     match sets.bands.iter().position(|b| b.pieces >= 2) {
         Some(k) => {
+            if let Some(e) = extra_loop_feature(mesh, loops, lowest, &sets, k, width) {
+                return e;
+            }
             let c = sets.bands[k].centroid;
             FitError::Branch {
                 file: mesh.file.clone(),
@@ -384,6 +388,85 @@ fn closed_end_error(mesh: &TubeMesh, tris: &[u32], rim: &[u32], opts: &FitOption
         found: format!("{found} (stations are level sets of the distance from the open end, {width:.2} mm apart)"),
     }
 }
+
+/// An extra open end whose surface ends soon after the level sets split
+/// (within [`FEATURE_LOOP_RADII`] of its own radius: a sleeve, a block open
+/// at one side) beside one that continues as the tube: a feature that is
+/// not tube, not a branch (whose open ends all lie further on). Named by its
+/// open end's outline (round: a collar; else a block), its distance from
+/// the split and its size across.
+fn extra_loop_feature(
+    mesh: &TubeMesh,
+    loops: &[Vec<u32>],
+    lowest: &[u32],
+    sets: &LevelSets,
+    k: usize,
+    width: f64,
+) -> Option<FitError> {
+    let d_split = k as f64 * width;
+    let mut ending = Vec::new();
+    let mut continuing = 0;
+    for l in loops.iter().filter(|l| l.as_slice() != lowest) {
+        let pts: Vec<Point3> = l.iter().map(|&v| mesh.vertices[v as usize]).collect();
+        let c = pts
+            .iter()
+            .fold(crate::math::Vector3::zeros(), |a, p| a + p.coords)
+            / pts.len() as f64;
+        let rho: Vec<f64> = pts.iter().map(|p| (p.coords - c).norm()).collect();
+        let r = rho.iter().sum::<f64>() / rho.len() as f64;
+        let d = l
+            .iter()
+            .map(|&v| sets.distance[v as usize])
+            .fold(f64::INFINITY, f64::min);
+        if d - d_split < FEATURE_LOOP_RADII * r {
+            let (lo, hi) = rho
+                .iter()
+                .fold((f64::INFINITY, 0.0_f64), |a, &x| (a.0.min(x), a.1.max(x)));
+            ending.push((d, lo, hi, Point3::from(c)));
+        } else {
+            continuing += 1;
+        }
+    }
+    if continuing != 1 || ending.is_empty() {
+        return None;
+    }
+    let (d, lo, hi, c) = ending[0];
+    let kind = if hi - lo > 0.1 * hi {
+        FeatureKind::Block
+    } else {
+        FeatureKind::Collar
+    };
+    let across = if hi - lo > 0.05 * hi {
+        format!("{:.1} to {:.1} mm across", 2.0 * lo, 2.0 * hi)
+    } else {
+        format!("{:.1} mm across", 2.0 * hi)
+    };
+    Some(FitError::Feature {
+        file: mesh.file.clone(),
+        kind: kind.name(),
+        station: k,
+        last_station: (d / width) as usize,
+        t_mm: d_split,
+        t_end_mm: d,
+        size: format!(
+            "an open surface beside the tube that ends {:.1} mm further on, its open end {across} near ({:.1}, {:.1}, {:.1}) mm{}; not a branch: no tube continues past it (stations are level sets of the distance along the surface from the lowest open end, {width:.2} mm apart; --trim cannot cut it out: it holds an open end of the mesh)",
+            d - d_split,
+            c.x,
+            c.y,
+            c.z,
+            match ending.len() {
+                1 => String::new(),
+                n => format!(" (and {} more)", n - 1),
+            }
+        ),
+    })
+}
+
+/// An extra open end reached within this many of its own radii (mean
+/// distance of its vertices from their centroid) past the split of the
+/// level sets ends a feature, not a branch (dimensionless): a branch is a
+/// tube, longer than it is wide.
+const FEATURE_LOOP_RADII: f64 = 2.0;
 
 fn mean_z(mesh: &TubeMesh, vs: &[u32]) -> f64 {
     vs.iter().map(|&v| mesh.vertices[v as usize].z).sum::<f64>() / vs.len().max(1) as f64

@@ -182,3 +182,31 @@ fn trim_leaves_a_tube_without_features_as_it_is() {
     assert_eq!(a.toml, b.toml);
     assert!(b.report().features.is_empty());
 }
+
+/// A stop block around a bore (as the ear tube of issue 47): a pipe of
+/// radius 10 from z = 0 to 80 in an open square sleeve of side 40 from
+/// z = 0 to 15, joined to the pipe at z = 15. Three open ends, but only the
+/// pipe's top continues as a tube: a block, not a branch, named where the
+/// level sets of the distance along the surface from the lowest open end
+/// (the bore's bottom) fall apart: once across the step, 15 mm up the bore
+/// and 10 to 18.3 mm across the step (within a level set's width of 3 mm),
+/// with its open end's size across (40 to 56.6 mm).
+#[test]
+fn a_block_around_a_bore_is_a_feature_not_a_branch() {
+    let mesh = gen::sleeved_pipe(10.0, 80.0, 40.0, 15.0, 64);
+    let e = fit(&mesh, "ear.stl", false).unwrap_err();
+    let msg = e.to_string();
+    let Error::Fit(FitError::Feature { kind, t_mm, .. }) = e else {
+        panic!("{msg}")
+    };
+    assert_eq!(kind, "block", "{msg}");
+    assert!(
+        msg.contains("40.0 to 56.6 mm across") && msg.contains("not a branch"),
+        "{msg}"
+    );
+    assert!((25.0 - 3.0..=33.3 + 3.0).contains(&t_mm), "{msg}");
+    // The Y of the branch test stays a branch.
+    let (v, f) = gen::y_branch(10.0, 30.0, 16);
+    let msg = fit(&(v, f), "y.stl", false).unwrap_err().to_string();
+    assert!(msg.contains("not one tube: a branch"), "{msg}");
+}

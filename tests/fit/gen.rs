@@ -682,3 +682,40 @@ pub fn join(
     f.extend(f2.into_iter().map(|t| t.map(|i| i + base)));
     (v, f)
 }
+
+/// A straight pipe of radius `r` about the z axis from z = 0 to `len`
+/// (rings 1 mm apart: `height` a whole number) inside a square sleeve of
+/// side `side` from z = 0 to `height`, open at the bottom and joined to the
+/// pipe at z = `height` by a flat step: a stop block around a bore, with
+/// three open ends (the bore's two and the sleeve's).
+pub fn sleeved_pipe(
+    r: f64,
+    len: f64,
+    side: f64,
+    height: f64,
+    around: usize,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let (v, mut f) = lofted(&pipe_rings(around, r, 0.0, len, 1.0));
+    let a = 0.5 * side;
+    let sleeve: Vec<Vec<Point3>> = (0..=height as usize)
+        .map(|i| {
+            ring_of(around, |t| {
+                let s = a / t.cos().abs().max(t.sin().abs());
+                Point3::new(s * t.cos(), s * t.sin(), i as f64)
+            })
+        })
+        .collect();
+    let top = (v.len() + (sleeve.len() - 1) * around) as u32;
+    let pipe_ring = (height as usize * around) as u32;
+    let (mut v, f2) = join((v, Vec::new()), lofted(&sleeve));
+    f.extend(f2);
+    let n = around as u32;
+    for j in 0..n {
+        let (o0, o1) = (top + j, top + (j + 1) % n);
+        let (i0, i1) = (pipe_ring + j, pipe_ring + (j + 1) % n);
+        f.push([o0, o1, i0]);
+        f.push([o1, i1, i0]);
+    }
+    v.shrink_to_fit();
+    (v, f)
+}
