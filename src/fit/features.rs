@@ -4,8 +4,9 @@
 //! tubular stretches; the stations between them make features, each named
 //! by its shape: a round outline all around is a collar (longer than it is
 //! high) or a flange (higher than long), an outline all around that is not
-//! round a block, an outline on one side only a tab; a separate piece of
-//! the mesh that is not a skin is a tab too. A cut of the mesh by the guide's normal planes to one
+//! round a block; a separate piece of the mesh that is not a skin is a tab.
+//! An outline on one side only is not named (a guide off the axis of a
+//! coarse bend gives one too): the sections' failure stands. A cut of the mesh by the guide's normal planes to one
 //! tubular stretch (for [`FitOptions::trim`](super::FitOptions::trim)).
 
 use super::outcome::{FeatureKind, FeatureReport, Station};
@@ -175,26 +176,23 @@ pub(super) fn detect(
             .iter()
             .fold((f64::INFINITY, 0.0_f64), |a, &o| (a.0.min(o), a.1.max(o)));
         let cover = out.len() as f64 / SECTORS as f64;
-        if out.is_empty() {
-            // Not round, yet nothing beyond the wall: not a feature.
-            (t_lo, t_hi) = (stations[first].t, stations[last].t);
-        }
         // Points past an end project beyond it along the guide.
         (t_lo, t_hi) = (t_lo.max(t0), t_hi.min(stations[n - 1].t).max(t_lo.max(t0)));
         let length = t_hi - t_lo;
         let height = (hi - r_tube).max(0.0);
-        let kind = if out.is_empty() || cover < ALL_AROUND_FRACTION {
-            FeatureKind::Tab
-        } else if hi - lo > ROUND_OUTLINE_FRACTION * hi {
+        // An outline on one side only is what a guide off the tube's axis
+        // gives as well (a coarse bend): not named a feature, the failure
+        // stands.
+        if out.is_empty() || cover < ALL_AROUND_FRACTION {
+            continue;
+        }
+        let kind = if hi - lo > ROUND_OUTLINE_FRACTION * hi {
             FeatureKind::Block
         } else if length >= height {
             FeatureKind::Collar
         } else {
             FeatureKind::Flange
         };
-        if out.is_empty() {
-            continue;
-        }
         let mid = spline.point(0.5 * (t_lo + t_hi));
         features.push(FeatureReport {
             kind,

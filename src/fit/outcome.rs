@@ -311,7 +311,7 @@ pub enum FeatureKind {
     Flange,
     /// An outline all around the tube that is not round (a square block).
     Block,
-    /// Something on one side of the tube only, or a separate piece.
+    /// A separate piece beside the tube (a printing tab).
     Tab,
 }
 

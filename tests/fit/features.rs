@@ -210,3 +210,20 @@ fn a_block_around_a_bore_is_a_feature_not_a_branch() {
     let msg = fit(&(v, f), "y.stl", false).unwrap_err().to_string();
     assert!(msg.contains("not one tube: a branch"), "{msg}");
 }
+
+/// A coarse export of a bend (R/r 3, five stretches along 90 degrees, a
+/// straight leg of 20 mm in one stretch each side) is not named a feature:
+/// a guide off the axis gives sections with an outline on one side. (It
+/// does not fit yet either: issue 47, deliverable 2.)
+#[test]
+fn a_coarse_bend_is_not_named_a_feature() {
+    for around in [16, 32] {
+        let (_, v, f) = gen::coarse_bend(10.0, 30.0, 20.0, 5, around);
+        if let Err(e) = fit(&(v, f), "bend.stl", false) {
+            assert!(
+                !matches!(e, Error::Fit(FitError::Feature { .. })),
+                "{around}: {e}"
+            );
+        }
+    }
+}

@@ -719,3 +719,43 @@ pub fn sleeved_pipe(
     v.shrink_to_fit();
     (v, f)
 }
+
+/// A coarse export of a bend: straight legs of `leg` mm (one stretch each),
+/// a 90° bend of centre-line radius `bend_r` toward +x in `segments`
+/// stretches, tube radius `r`, `around` points per ring (rings on the true
+/// surface, normal to the centre line).
+pub fn coarse_bend(
+    r: f64,
+    bend_r: f64,
+    leg: f64,
+    segments: usize,
+    around: usize,
+) -> (Truth, Vec<Point3>, Vec<[u32; 3]>) {
+    let truth = Truth {
+        name: "coarse bend",
+        length: 2.0 * leg + bend_r * FRAC_PI_2,
+        centre: Box::new(elbow_centre(leg, bend_r)),
+        radius: Box::new(move |_| r),
+    };
+    let bend = bend_r * FRAC_PI_2;
+    let mut at: Vec<f64> = vec![0.0];
+    at.extend((0..=segments).map(|i| leg + bend * i as f64 / segments as f64));
+    at.push(2.0 * leg + bend);
+    let m = (truth.length / 0.05).ceil() as usize;
+    let fr = frames(&truth, m);
+    let rings: Vec<Vec<Point3>> = at
+        .iter()
+        .map(|&s| {
+            let (_, x, ti, n) = fr[((s / truth.length) * m as f64).round() as usize];
+            let b = ti.cross(&n);
+            (0..around)
+                .map(|j| {
+                    let a = TAU * j as f64 / around as f64;
+                    x + (n * a.cos() + b * a.sin()) * r
+                })
+                .collect()
+        })
+        .collect();
+    let (v, f) = lofted(&rings);
+    (truth, v, f)
+}
