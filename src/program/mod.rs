@@ -67,9 +67,9 @@ pub use error::{LayerRefusal, ProgramError};
 pub use kinds::{MoveKind, PositionMode};
 pub(crate) use model::render;
 pub use model::{
-    check_name, check_vendor, joint_move_target, joints_move, move_start, opens_bead,
-    positioner_moves, segment_length_mm, write_files, ArcFlag, BeadSetup, EmittedFile, Payload,
-    PlannedPoint, PointFeed, Program, ProgramPoint, JOINT_STILL_RAD, POSITIONER_STILL_DEG,
+    check_name, check_vendor, deposited_length_mm, joint_move_target, joints_move, move_start,
+    opens_bead, positioner_moves, segment_length_mm, write_files, ArcFlag, BeadSetup, EmittedFile,
+    Payload, PlannedPoint, PointFeed, Program, ProgramPoint, JOINT_STILL_RAD, POSITIONER_STILL_DEG,
 };
 pub use options::{HomePosition, ProcessControl, ProgramOptions};
 pub use registry::ProgramSettings;

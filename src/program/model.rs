@@ -432,6 +432,32 @@ pub fn segment_length_mm(program: &Program, i: usize) -> f64 {
     }
 }
 
+/// Length of the path the deposition point travels over the part during
+/// the move into point `i` of `program` as the controller interpolates it
+/// (mm; [`pose::deposited_length_mm`](crate::program::pose::deposited_length_mm)),
+/// in the part frame when `in_part` ([`pose::moves_in_part_frame`](crate::program::pose::moves_in_part_frame):
+/// then [`segment_length_mm`]) else in the robot base frame; 0 for `i = 0`.
+/// The length a timed move's time is the planned speed over.
+pub fn deposited_length_mm(program: &Program, i: usize, in_part: bool) -> f64 {
+    let Some(k) = move_start(program, i) else {
+        return 0.0;
+    };
+    if in_part {
+        return segment_length_mm(program, i);
+    }
+    fn at(p: &ProgramPoint) -> (&Joints, Option<PositionerJoints>) {
+        (&p.joints, p.positioner)
+    }
+    let points = &program.points;
+    crate::program::pose::deposited_length_mm(
+        &program.cell,
+        at(&points[k]),
+        (k + 2 == i).then(|| at(&points[k + 1])),
+        at(&points[i]),
+        false,
+    )
+}
+
 /// Where the move into point `i` of `program` starts: the point before it,
 /// or the one before the via when point `i` ends a circular move
 /// ([`ProgramPoint::via`]); `None` for `i = 0`.

@@ -219,6 +219,70 @@ pub fn flange_of(cell: &CellLayout, pose: &ControllerPose, in_part: bool) -> Iso
     }
 }
 
+/// Samples of a move's interpolation over which
+/// [`deposited_length_mm`] measures the deposited path: a 45° turn of the
+/// part is then measured within 3e-5 of its arc (the polyline of `n`
+/// chords falls short of an arc of angle `a` by about `(a/n)^2/24`).
+pub const DEPOSITED_SAMPLES: usize = 32;
+
+/// Length (mm) of the path the deposition point travels over the part
+/// while the controller runs the move from the arm's joints `a.0` (rad) and
+/// positioner `a.1` (rad) to `b`, circular through `via` when given: the
+/// controller interpolates its tool in the part frame (`in_part`; the path
+/// is then the chord, or the arc through the via, over the part) or in the
+/// robot base frame, where the part turns under a straight flange path (a
+/// part-carried cell without remote TCP, a torch-carried cell without
+/// coordination) and the deposited path bows away from the chord: a pure
+/// turn of the part by `theta` about the axis of a circle of radius `r`
+/// deposits its arc `r theta`, not the chord `2 r sin(theta/2)`. Measured as
+/// the polyline through [`DEPOSITED_SAMPLES`] + 1 poses of [`interpolate`].
+pub fn deposited_length_mm(
+    cell: &CellLayout,
+    a: (&crate::robot::Joints, Option<[f64; 2]>),
+    via: Option<(&crate::robot::Joints, Option<[f64; 2]>)>,
+    b: (&crate::robot::Joints, Option<[f64; 2]>),
+    in_part: bool,
+) -> f64 {
+    let pose = |(q, qp): (&crate::robot::Joints, Option<[f64; 2]>)| {
+        controller_pose_at(cell, q, qp, in_part)
+    };
+    let (pa, pb) = (pose(a), pose(b));
+    let via = via.map(|v| pose(v).p);
+    if in_part {
+        // the controller's tool is the deposition point over the part
+        return match via {
+            Some(v) => arc_length(&pa.p, &v, &pb.p),
+            None => (pb.p - pa.p).norm(),
+        };
+    }
+    let path = MovePath::new(&pa, via.as_ref(), &pb);
+    let mut at = pa.clone();
+    let mut prev: Option<Point3<f64>> = None;
+    let mut length = 0.0;
+    for n in 0..=DEPOSITED_SAMPLES {
+        path.pose_into(n as f64 / DEPOSITED_SAMPLES as f64, &mut at);
+        let flange = flange_of(cell, &at, false);
+        let d: Point3<f64> = match cell {
+            CellLayout::PartCarried(c) => {
+                (flange * c.flange_from_part).inverse() * c.deposition_point_mm
+            }
+            CellLayout::TorchCarried(c) => {
+                let tcp = flange * c.flange_from_tcp;
+                let qp = [
+                    at.ext.first().copied().unwrap_or(0.0),
+                    at.ext.get(1).copied().unwrap_or(0.0),
+                ];
+                c.base_from_part(&qp).inverse() * Point3::from(tcp.translation.vector)
+            }
+        };
+        if let Some(p) = prev {
+            length += (d - p).norm();
+        }
+        prev = Some(d);
+    }
+    length
+}
+
 /// `true` when `cell`'s linear moves are interpolated in the part frame
 /// (the part is the moving frame: a fixed tool about which the part-carried
 /// robot moves, or coordinated motion with the positioner); `false` when

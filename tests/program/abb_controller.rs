@@ -380,7 +380,7 @@ fn coordinated_work_object_and_v_reax() {
     let free_text = &abb_files(&prog, &off).unwrap()[0].text;
     assert!(check(free_text, &c, &off, &plan).is_ok());
     let l = line_of(free_text, "ArcL p13,");
-    let fast = free_text.replacen(",7.8878]\\T:=5.705", ",1000]\\T:=5.705", 1);
+    let fast = free_text.replacen(",7.6857]\\T:=5.855", ",1000]\\T:=5.855", 1);
     let r = check(&fast, &c, &off, &plan);
     assert!(has(&r, ProblemKind::Timing, l, "v_reax 1000"), "{r}");
 }

@@ -222,3 +222,62 @@ fn abb_writes_each_moves_welddata_speed_and_wire_feed() {
         l.trim_start().starts_with("Arc") && !l.contains("ArcLStart")
     });
 }
+
+/// A timed move takes the time of the path it deposits (issue 45): in the
+/// ROBOWAM part-carried cell the FANUC controller interpolates the flange
+/// (no remote TCP), and with `R_Z = -v` only J6 turns, so each move of a
+/// hemisphere layer of radius `r = 45 cos(l 5/45)` mm (SPEC §2.1) turns the
+/// part by `theta = 45 deg` about the layer's axis and the fixed torch
+/// deposits the arc `r theta`, not the chord `2 r sin(theta/2)` (2.62 %
+/// shorter). Each arc-on move is written `ceil(1000 r theta / 6)` ms at 6
+/// mm/s (layer 0: 5891 ms where the chord gave 5741), and the checker,
+/// which measures the deposited path the same way, finds the chord's time
+/// 2.6 % too fast.
+#[test]
+fn fanuc_timed_moves_take_the_time_of_the_deposited_arc() {
+    let c = cell("robowam_part_carried.toml");
+    let path = hemisphere(0..2, 8, law(&c));
+    let tr = trajectory(&c, &path);
+    let ts = crate::fixture::TS_MM_S;
+    let feed = PointFeed::constant(ts, crate::fixture::WFS_MM_S, path.len());
+    let prog = build_program("HEMI", &c, &path, &tr, &feed).unwrap();
+    let files = emit(&prog, &ProgramSettings::default()).unwrap();
+    let tp = parse_ls(&files[0].text, &files[0].name).unwrap();
+    let theta = std::f64::consts::FRAC_PI_4;
+    let (mut on, mut moves) = (false, 0);
+    for ins in &tp.instructions {
+        match &ins.op {
+            Op::ArcStart(_) => on = true,
+            Op::ArcEnd(_) => on = false,
+            Op::Move {
+                kind: MoveKind::Linear,
+                position,
+                speed,
+                ..
+            } if on => {
+                let p = &prog.points[position - 1];
+                let r = 45.0 * (p.layer as f64 * 5.0 / 45.0).cos();
+                let want = (1000.0 * r * theta / ts).ceil() as u32;
+                assert_eq!(*speed, Speed::Msec(want), "P[{position}] layer {}", p.layer);
+                let chord = (1000.0 * 2.0 * r * (theta / 2.0).sin() / ts).ceil() as u32;
+                assert!(want as f64 > 1.026 * chord as f64, "{want} {chord}");
+                moves += 1;
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(moves, 2 * 7);
+    let settings = ProgramSettings::default();
+    let r = check_files(c.robot().vendor, &files, &c, &settings, Some(&prog.planned)).unwrap();
+    assert!(r.is_ok(), "{r}");
+    // the chord's time, as written before: 2.6 % too fast over the arc
+    let mut bad = files.clone();
+    bad[0].text = bad[0].text.replace("5891msec", "5741msec");
+    let r = check_files(c.robot().vendor, &bad, &c, &settings, Some(&prog.planned)).unwrap();
+    let p = r
+        .problems
+        .iter()
+        .find(|p| p.kind == ProblemKind::Feed)
+        .unwrap_or_else(|| panic!("{r}"));
+    assert!(p.message.contains("-2.5"), "{p}");
+}

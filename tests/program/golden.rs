@@ -170,13 +170,14 @@ fn fanuc_torch_carried_golden_has_group_2() {
     assert!(files[0].text.contains("L P[3] 36cm/min CNT100 COORD"));
     assert!(files[0].text.contains("L P[13] 36cm/min CNT100 COORD"));
     check_all("fanuc_torch_", &files);
-    // not coordinated: layer 0 at TCP speed, layer 1 time-based (34.2 mm /
-    // 6 mm/s)
+    // not coordinated: layer 0 at TCP speed, layer 1 time-based over the
+    // arc the still torch deposits on the turning part (r 44.72 mm, 45 deg:
+    // 35.12 mm / 6 mm/s = 5.8542 s; the chord's 34.2 mm gave 5705 ms)
     let mut opts = FanucOptions::default();
     opts.common.coordinated = false;
     let text = &fanuc_files(&prog, &opts).unwrap()[0].text;
     assert!(text.contains("L P[3] 36cm/min CNT100    ;"), "{text}");
-    assert!(text.contains("L P[13] 5705msec CNT100    ;"), "{text}");
+    assert!(text.contains("L P[13] 5855msec CNT100    ;"), "{text}");
 }
 
 /// Two layers in a KUKA or ABB example cell.
@@ -198,8 +199,9 @@ fn kuka_golden() {
     // layer 1: the positioner turns 45° per segment under a still torch.
     // Coordinated (default): the base is math-coupled, $VEL.CP is the
     // planned speed over the part; not coordinated: $VEL.CP and
-    // $VEL_EXTAX[2] make each LIN take the planned 5.705 s (4.9177 % of
-    // the D500B's 160.4°/s turn; 4.3822 % of the 180°/s assumed before)
+    // $VEL_EXTAX[2] make each LIN take the planned 5.8542 s over the
+    // deposited arc (45°/5.8542 s = 4.7924 % of the D500B's 160.4°/s turn;
+    // 4.9177 % over the chord's 5.705 s before)
     let torch = small_in("kuka_kr16_2_torch_carried.toml");
     let src = &kuka_files(&torch, &KukaOptions::default()).unwrap()[0].text;
     assert!(src.contains("  $BASE = EK (MACHINE_DEF[2].ROOT, MACHINE_DEF[2].MECH_TYPE, {X 0.0000,Y 0.0000,Z 0.0000,A 0.00000,B 0.00000,C 0.00000})\n"), "{src}");
@@ -207,7 +209,7 @@ fn kuka_golden() {
     let mut uncoupled = KukaOptions::default();
     uncoupled.common.coordinated = false;
     let src = &kuka_files(&torch, &uncoupled).unwrap()[0].text;
-    assert!(src.contains("  $VEL_EXTAX[2] = 4.9177\n"), "{src}");
+    assert!(src.contains("  $VEL_EXTAX[2] = 4.7924\n"), "{src}");
     assert!(src.contains("  $BASE = {X 0.0000,"), "{src}");
     // part carried: fixed-tool mode, E6POS of the part in the torch frame
     let opts = KukaOptions {
@@ -241,13 +243,14 @@ fn abb_golden() {
         .contains("ArcL p13, [6.0000,500,5000,1000], seamWaam, weldWaam1, z1"));
     check_all("abb_torch_", &torch);
     // not coordinated: timed moves where the positioner turns (layer 1),
-    // v_reax bounded to the planned 45 deg / 5.705 s, not in layer 0
+    // v_reax bounded to the planned 45 deg / 5.855 s (the deposited arc's
+    // time, rounded up), not in layer 0
     let mut opts = AbbOptions::default();
     opts.common.coordinated = false;
     let free = abb_files(&small_in("abb_irb2600_torch_carried.toml"), &opts).unwrap();
     assert!(free[0]
         .text
-        .contains("ArcL p13, [6.0000,500,5000,7.8878]\\T:=5.705, seamWaam, weldWaam1"));
+        .contains("ArcL p13, [6.0000,500,5000,7.6857]\\T:=5.855, seamWaam, weldWaam1"));
     assert!(free[0]
         .text
         .contains("ArcL p3, [6.0000,500,5000,1000], seamWaam, weldWaam1"));

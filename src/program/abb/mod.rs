@@ -124,8 +124,10 @@
 //! * **Torch-carried cell, not coordinated.** Where the positioner moves
 //!   within a bead ([`positioner_moves`]) the TCP's speed in the world
 //!   frame is not the torch's over the part: such moves carry the optional
-//!   argument `\T` (`ArcL p13, [6,500,5000,7.8869]\T:=5.705, ...`), the
-//!   segment time in seconds = the segment's length in the part frame / the
+//!   argument `\T` (`ArcL p13, [6,500,5000,7.6857]\T:=5.855, ...`), the
+//!   segment time in seconds = the length of the path the move deposits
+//!   over the part as the controller interpolates it (an arc where the part
+//!   turns under the torch, [`deposited_length_mm`](crate::program::deposited_length_mm)) / the
 //!   planned speed, which RAPID uses instead of the `speeddata` (`Speed
 //!   [\V] | [\T]` of `MoveL`/`MoveC`/`MoveAbsJ`; uncoordinated external
 //!   axes reach their targets with the robot). ArcWare may take the arc-on
@@ -159,8 +161,8 @@ use crate::math::Isometry3;
 use crate::program::fmt::{ascii_comment, ceil_to, floor_to, Deg, Fixed, Mm, Unitless};
 use crate::program::frames::ToolFrames;
 use crate::program::{
-    check_name, check_vendor, move_start, opens_bead, positioner_moves, render, segment_length_mm,
-    ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, move_start, opens_bead, positioner_moves, render, ArcFlag,
+    EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::abb_quaternion;
 use crate::robot::{CellLayout, Joints, RobotModel, Vendor};
@@ -1020,7 +1022,9 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         let mut v = speeddata(p.speed_mm_s, None);
         if coordinated.is_none() && positioner_moves(program, i) {
             // the part turns under the torch: time the move (s)
-            let t = segment_length_mm(program, i) / p.speed_mm_s;
+            // over the path it deposits (interpolated in the robot base
+            // frame, the part turning under the TCP)
+            let t = crate::program::deposited_length_mm(program, i, false) / p.speed_mm_s;
             // rounded up to the ms: never faster than planned
             let t = ceil_to(t, 3).max(0.001);
             // and bound the positioner to its planned rate (°/s), for a

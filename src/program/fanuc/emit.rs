@@ -12,10 +12,11 @@ use crate::program::fanuc::options::{is_identity, FanucFrames, FanucOptions, Spe
 use crate::program::fanuc::{Fanuc, EMITTER};
 use crate::program::fmt::{ascii_comment, ceil_to, floor_to, FanucDeg, FanucMm, Fixed};
 use crate::program::kinds::{MoveKind, PositionMode};
+use crate::program::pose::moves_in_part_frame;
 use crate::program::split::split_to_budget;
 use crate::program::{
-    check_name, check_vendor, joint_move_target, move_start, render, segment_length_mm, ArcFlag,
-    EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, deposited_length_mm, joint_move_target, move_start, render,
+    segment_length_mm, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::FanucPose;
 use crate::robot::{CellLayout, Joints, Vendor};
@@ -527,11 +528,13 @@ fn tp_program(
     };
     let bead_of = bead_openings(program)?;
     let home = home_position(program, groups)?;
-    // the segment time of the linear move into point `i` at `v` mm/s,
-    // rounded up: never faster than planned (a joint at its maximum speed
-    // stays within it)
+    // the segment time of the linear move into point `i` at `v` mm/s over
+    // the path it deposits (in the robot base frame the part turns under a
+    // straight flange path: longer than the chord), rounded up: never
+    // faster than planned (a joint at its maximum speed stays within it)
+    let in_part = moves_in_part_frame(&program.cell, &opts.common);
     let timed = |i: usize, v: f64| {
-        let ms = 1000.0 * segment_length_mm(program, i) / v;
+        let ms = 1000.0 * deposited_length_mm(program, i, in_part) / v;
         Speed::Msec((ceil_to(ms, 0) as u32).max(1))
     };
     // the speed of the linear move into point `i` at `v` mm/s: rounded down

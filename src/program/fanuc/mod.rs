@@ -58,14 +58,17 @@
 //!   linear and circular moves).
 //! * **Part-carried cell without remote TCP** (default) and the
 //!   torch-carried cell without coordination: linear moves are
-//!   **time-based** ([`MotionTiming::Auto`]): `L P[n] 5741msec CNT100`,
-//!   the segment's length in the part frame divided by the planned speed,
-//!   rounded up to the millisecond (in the torch-carried cell only where
-//!   the positioner turns). This needs no option and makes every segment
-//!   take exactly the planned time; between the points the controller
-//!   interpolates the flange pose, which for the short segments of a bead
-//!   keeps the deposition point within a fraction of a millimetre of the
-//!   chord.
+//!   **time-based** ([`MotionTiming::Auto`]): `L P[n] 5891msec CNT100`,
+//!   the length of the path the move deposits divided by the planned
+//!   speed, rounded up to the millisecond (in the torch-carried cell only
+//!   where the positioner turns). This needs no option and makes every
+//!   segment take the planned time over what it deposits: the controller
+//!   interpolates the flange pose, so where the part turns under the fixed
+//!   torch the deposition point travels an arc, not the chord (a 45° turn
+//!   of a 45 mm circle: 35.34 mm, the chord 34.44 mm, 2.6 % shorter); the
+//!   length is measured along that interpolation
+//!   ([`deposited_length_mm`](crate::program::deposited_length_mm); before
+//!   issue 45 the chord's time made such moves 2.6 % too fast).
 //! * **Part-carried cell with remote TCP** (`common.remote_tcp`, off in
 //!   [`FanucOptions::default`]): every linear move carries `RTCP`, the user
 //!   frame being the remote TCP frame at the fixed torch

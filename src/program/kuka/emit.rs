@@ -14,8 +14,8 @@ use crate::program::kuka::{Kuka, EMITTER};
 use crate::program::split::split_to_budget;
 use crate::program::PositionMode;
 use crate::program::{
-    check_name, check_vendor, joint_move_target, move_start, positioner_moves, render,
-    segment_length_mm, ArcFlag, BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, joint_move_target, move_start, positioner_moves, render, ArcFlag,
+    BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::KukaAbc;
 use crate::robot::{ArmSide, CellLayout, Joints, RobotModel, Vendor};
@@ -78,7 +78,8 @@ pub(crate) fn switch_statements(opts: &KukaOptions) -> (String, String) {
 /// positioner turning").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TimedSegment {
-    /// The segment's planned time (s): its length over the part (part frame)
+    /// The segment's planned time (s): the length of the path it deposits
+    /// over the part ([`deposited_length_mm`](crate::program::deposited_length_mm))
     /// / the planned speed.
     pub time_s: f64,
     /// `$VEL.CP` (mm/s; written in m/s) making the TCP's travel in the robot
@@ -106,7 +107,9 @@ pub fn timed_segment(program: &Program, opts: &KukaOptions, i: usize) -> Option<
     }
     let start = move_start(program, i)?;
     let (p, a) = (&program.points[i], &program.points[start]);
-    let time_s = segment_length_mm(program, i) / p.speed_mm_s;
+    // over the path it deposits: the controller interpolates in the robot
+    // base frame here, the part turning under the TCP
+    let time_s = crate::program::deposited_length_mm(program, i, false) / p.speed_mm_s;
     let robot = &c.robot;
     let tool = held_tool(&program.cell, opts.flange_from_tool);
     let tcp =

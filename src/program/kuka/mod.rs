@@ -120,7 +120,9 @@
 //!   speed in the robot frame; where the positioner turns within a bead the
 //!   part moves under a nearly still torch, and the planned speed (over the
 //!   part) is not the TCP's. KRL's `LIN` has no time argument: such a `LIN`
-//!   gets `$VEL.CP` = the TCP's travel / the planned segment time and
+//!   gets `$VEL.CP` = the TCP's travel / the planned segment time (the
+//!   length of the path it deposits over the part / the planned speed,
+//!   [`deposited_length_mm`](crate::program::deposited_length_mm)) and
 //!   `$VEL_EXTAX[n]` = the positioner axis's turn / that time, in % of its
 //!   maximum speed ([`timed_segment`]), so that the TCP and each external
 //!   axis take the planned time; the next `PTP` re-issues `BAS

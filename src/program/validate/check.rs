@@ -403,9 +403,21 @@ impl Checker<'_> {
     ) -> Option<(ProblemKind, String)> {
         let (plan, feed, j0, j1) = (self.planned?, m.wire_feed?, self.prev_matched?, matched?);
         let (a, b) = (prev.2?, to.2?);
-        let d = match circle_via.and_then(|v| v.2) {
-            Some(v) => arc_length(&a, &v, &b),
-            None => (b - a).norm(),
+        // the path the move deposits as the controller interpolates it
+        // (in the robot base frame it bows away from the chord)
+        let d = if crate::program::pose::moves_in_part_frame(self.cell, self.common) {
+            match circle_via.and_then(|v| v.2) {
+                Some(v) => arc_length(&a, &v, &b),
+                None => (b - a).norm(),
+            }
+        } else {
+            crate::program::pose::deposited_length_mm(
+                self.cell,
+                (&prev.0, prev.1),
+                circle_via.map(|v| (&v.0, v.1)),
+                (&to.0, to.1),
+                false,
+            )
         };
         if !(dt > 0.0 && d > 0.0) {
             return None;

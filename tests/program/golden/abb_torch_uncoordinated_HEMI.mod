@@ -48,13 +48,13 @@ MODULE MOD_HEMI
     ! bead 1 (layer 1): approach
     MoveAbsJ j11, [100.0000,500,5000,1000], fine, tWaam\WObj:=wWaam;
     ArcLStart p12, [20.0000,500,5000,1000], seamWaam, weldWaam1, fine, tWaam\WObj:=wWaam;
-    ArcL p13, [6.0000,500,5000,7.8878]\T:=5.705, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
-    ArcL p14, [6.0000,500,5000,7.8878]\T:=5.705, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
-    ArcL p15, [6.0000,500,5000,7.8878]\T:=5.705, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
-    ArcL p16, [6.0000,500,5000,7.8878]\T:=5.705, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
-    ArcL p17, [6.0000,500,5000,7.8878]\T:=5.705, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
-    ArcL p18, [6.0000,500,5000,7.8878]\T:=5.705, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
-    ArcLEnd p19, [6.0000,500,5000,7.8878]\T:=5.705, seamWaam, weldWaam1, fine, tWaam\WObj:=wWaam;
+    ArcL p13, [6.0000,500,5000,7.6857]\T:=5.855, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p14, [6.0000,500,5000,7.6857]\T:=5.855, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p15, [6.0000,500,5000,7.6857]\T:=5.855, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p16, [6.0000,500,5000,7.6857]\T:=5.855, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p17, [6.0000,500,5000,7.6857]\T:=5.855, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcL p18, [6.0000,500,5000,7.6857]\T:=5.855, seamWaam, weldWaam1, z1, tWaam\WObj:=wWaam;
+    ArcLEnd p19, [6.0000,500,5000,7.6857]\T:=5.855, seamWaam, weldWaam1, fine, tWaam\WObj:=wWaam;
     MoveL p20, [20.0000,500,5000,1000], fine, tWaam\WObj:=wWaam;
     DeactUnit STN1;
   ENDPROC
