@@ -302,6 +302,7 @@ pub(crate) fn abb_steps(
         }
         match &ins.op {
             RapidOp::ConfL(on) => d.conf_l = *on,
+            RapidOp::CirPathMode(mode) => d.cir_path_mode = Some(mode.clone()),
             RapidOp::WaitTime(t) => d.steps.push(DecodedStep::Wait {
                 file: file.clone(),
                 line,
@@ -351,6 +352,9 @@ struct Decoder<'a> {
     steps: Vec<DecodedStep>,
     /// `ConfL \On` in force.
     conf_l: bool,
+    /// The `CirPathMode` switch in force (`None`: RobotWare's default,
+    /// `\PathFrame`).
+    cir_path_mode: Option<String>,
     /// The positioner joints (rad) of the last motion's end.
     prev_positioner: Option<[f64; 2]>,
     /// The wire feed of the arc-on move being decoded (its `welddata`'s).
@@ -393,6 +397,7 @@ impl<'a> Decoder<'a> {
             schedule,
             steps: Vec::new(),
             conf_l: false,
+            cir_path_mode: None,
             prev_positioner: None,
             wire_feed: None,
             unit: UnitState::new(matches!(cell, CellLayout::TorchCarried(_))),
@@ -539,6 +544,24 @@ impl<'a> Decoder<'a> {
             _ => None,
         };
         let speed = self.linear_speed(*time_s, v, *v_reax_deg_s);
+        if via.is_some()
+            && self.cir_path_mode.as_deref() != Some(crate::program::abb::CIR_PATH_MODE)
+        {
+            let mode = self
+                .cir_path_mode
+                .as_deref()
+                .unwrap_or("PathFrame (the default)");
+            push(
+                report,
+                ProblemKind::Frame,
+                self.file(),
+                line,
+                format!(
+                    "{instruction} under CirPathMode \\{mode}: the controller reorients the tool otherwise than the checker's start-to-end slerp in the work object's frame (write `CirPathMode \\{}` before the circular moves)",
+                    crate::program::abb::CIR_PATH_MODE
+                ),
+            );
+        }
         // a circular move's circle point first, as its own step
         let moves_to = match via {
             Some(c) => vec![(c, MoveKind::Via), (target, MoveKind::Circular)],

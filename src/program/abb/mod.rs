@@ -39,7 +39,9 @@
 //!   to every bead start; the torch-carried cell's positioner as external
 //!   axes `eax_a`, `eax_b` (deg; [`AbbOptions::positioner_axes`]), the
 //!   others `9E+09`.
-//! * `ConfL \On` so that the controller keeps our branch on linear moves.
+//! * `ConfL \On` so that the controller keeps our branch on linear moves;
+//!   with circular moves, `CirPathMode \ObjectFrame` so that it reorients
+//!   the tool as the checker models it ([`CIR_PATH_MODE`]).
 //! * **Memory budget** ([`AbbOptions::max_file_bytes`], default 2 MB): a
 //!   build whose module is larger is cut between layers into part modules
 //!   `<name>_P01.mod`, `<name>_P02.mod`, … (each a complete module as
@@ -208,6 +210,22 @@ pub const DEFAULT_POSTFLOW_TIME_S: f64 = 1.5;
 /// (tests/program/golden/abb_*.mod). ABB publishes no module size limit.
 pub const DEFAULT_MAX_FILE_BYTES: usize = 2_000_000;
 
+/// The `CirPathMode` switch written before a module's circular moves
+/// (`CirPathMode \ObjectFrame;`): the tool reorients from the start to the
+/// end orientation in the work object's frame, the slerp of
+/// [`interpolate`](crate::program::pose::interpolate) that the thinner and
+/// the checker model. RobotWare's default, `\PathFrame`, reorients
+/// relative to the circular path ("The reorientation is performed relative
+/// to the circular path. Thus, if the orientation relative to the path is
+/// the same at the start and the destination points, the relative
+/// orientation remains unchanged during the movement": RAPID reference,
+/// MoveC, Basic Characteristics RAPID); on our thinned beads the two part
+/// by about 0.5° mid-arc (issue 45). The switch names of RAPID's
+/// `CirPathMode`: `\PathFrame`, `\ObjectFrame`, `\CirPointOri`,
+/// `\Wrist45`, `\Wrist46`, `\Wrist56` (as RPI's abb_motion_program_exec
+/// writes them).
+pub const CIR_PATH_MODE: &str = "ObjectFrame";
+
 /// The prefix of the module's name: `MODULE MOD_<name>` holds `PROC
 /// <name>()`, since a routine and its module may not share a name (RAPID
 /// routine and module names are one name space; RoboDK's ABB post writes
@@ -298,6 +316,7 @@ const USED_NAMES: &[&str] = &[
     "speeddata",
     "zonedata",
     "ConfL",
+    "CirPathMode",
     "MoveAbsJ",
     "MoveL",
     "ArcLStart",
@@ -983,6 +1002,16 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         writeln!(w, "    ActUnit {u};")?;
     }
     writeln!(w, "    ConfL \\On;")?;
+    if program.points.iter().any(|p| p.via) {
+        // the reorientation of circular moves the checker models: from the
+        // start to the end orientation in the work object's frame (slerp),
+        // not RobotWare's default relative to the path
+        writeln!(
+            w,
+            "    ! circular moves reorient the tool in the work object's frame, start to end orientation"
+        )?;
+        writeln!(w, "    CirPathMode \\{CIR_PATH_MODE};")?;
+    }
     let tw = "tWaam\\WObj:=wWaam";
     let zone = format!("z{}", opts.zone_mm);
     let joint_speed = speeddata(opts.approach_speed_mm_s, None);

@@ -346,6 +346,9 @@ pub enum RapidOp {
     },
     /// `ConfL \On` (`true`) or `\Off`.
     ConfL(bool),
+    /// `CirPathMode \Mode`: how circular moves reorient the tool (the
+    /// switch's name without its `\`).
+    CirPathMode(String),
     /// `WaitTime s` (s).
     WaitTime(f64),
     /// `WaitDI signal, value`.
@@ -721,6 +724,14 @@ fn tool_arg(a: &str) -> Result<ToolArg, String> {
 }
 
 fn parse_instruction(stmt: &str) -> Result<RapidOp, String> {
+    if let Some(v) = stmt.strip_prefix("CirPathMode") {
+        let mode = v.trim().strip_prefix('\\').unwrap_or("");
+        return if !mode.is_empty() && mode.chars().all(|c| c.is_ascii_alphanumeric()) {
+            Ok(RapidOp::CirPathMode(mode.to_string()))
+        } else {
+            Err(format!("bad `{stmt}`: expected `CirPathMode \\<switch>`"))
+        };
+    }
     if let Some(v) = stmt.strip_prefix("ConfL") {
         return match v.trim() {
             "\\On" => Ok(RapidOp::ConfL(true)),
