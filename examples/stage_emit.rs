@@ -28,6 +28,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = slice(&part.tube, &part.substrate, &opts)?;
     let frames = local_frames(&path, &part.tube);
 
+    // TS = 36 cm/min [thesis table 3.1]
+    let speed = 6.0;
     // R_Z = −v, v the point's angle about the part's axis, unwrapped
     let mut points = Vec::new();
     for (l, (layer, frames)) in path.layers.iter().zip(&frames).enumerate() {
@@ -48,12 +50,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 r_z: -v,
                 positioner: None,
                 bead: 0,
+                travel_speed_mm_s: speed,
             });
         }
     }
-    // TS = 36 cm/min [thesis table 3.1]
-    let speed = 6.0;
-    let traj = joint_trajectory(&cell.layout, &points, speed, &TrajectoryOptions::default())?;
+    let traj = joint_trajectory(&cell.layout, &points, &TrajectoryOptions::default())?;
     assert!(
         traj.report.is_clean(),
         "the thesis's law is feasible: {}",

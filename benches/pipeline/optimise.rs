@@ -31,7 +31,8 @@ fn layers(part: &str, delta: f64) -> Vec<LayerPoints> {
     so.delta_mm = delta;
     let path = slice(&part.tube, &part.substrate, &so).unwrap();
     let frames = local_frames(&path, &part.tube);
-    layer_points(&path, &frames)
+    // 6 mm/s: 36 cm/min, the thesis's table 3.1
+    layer_points(&path, &frames, 6.0)
 }
 
 /// Whole-part optimisation (default options: branch choice, degrees raised
@@ -76,11 +77,14 @@ pub fn plan_at_scale(c: &mut Criterion) {
     let cell = waam_slicer::Cell::read(&cell_file).unwrap();
     // the layers, travel speed and branch rule `plan_part` optimises with
     let sliced = waam_slicer::slice_part(&part).unwrap();
-    let l = layer_points(&sliced.path, &sliced.axes.frames);
+    let l = layer_points(
+        &sliced.path,
+        &sliced.axes.frames,
+        sliced.process.travel_speed_mm_s,
+    );
     let points: usize = l.iter().map(|x| x.points.len()).sum();
     assert!(points > 100_000, "{points} points");
     let opts = OptimiseOptions {
-        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
         configuration: waam_slicer::optimise::ConfigurationChoice::Cell,
         ..OptimiseOptions::default()
     };

@@ -100,6 +100,7 @@ pub fn hemisphere_trajectory(c: &mut Criterion) {
                 positioner: None,
                 r_z: -v,
                 bead: 0,
+                travel_speed_mm_s: 6.0,
             });
         }
     }
@@ -107,7 +108,7 @@ pub fn hemisphere_trajectory(c: &mut Criterion) {
     let mut g = c.benchmark_group("robot");
     g.throughput(Throughput::Elements(pts.len() as u64));
     g.bench_function("hemisphere_joint_trajectory_1500_points", |b| {
-        b.iter(|| black_box(joint_trajectory(&cell, black_box(&pts), 6.0, &opts).unwrap()))
+        b.iter(|| black_box(joint_trajectory(&cell, black_box(&pts), &opts).unwrap()))
     });
     g.finish();
 }

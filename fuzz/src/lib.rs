@@ -220,6 +220,7 @@ pub fn cell_file(text: &str) {
             tool_axis: UnitVector3::new_normalize(*a),
             build_direction: None,
             positioner: None,
+            travel_speed_mm_s: 6.0,
         };
         for r_z in [0.0, 1.0, -2.5] {
             if let Ok((q, pose)) = cell.joints(&p, r_z, near.as_ref(), 0.0) {

@@ -101,6 +101,7 @@
 //!             tool_axis: UnitVector3::new_normalize(Vector3::z()),
 //!             build_direction: None,
 //!             positioner: None,
+//!             travel_speed_mm_s: 6.0,
 //!         }
 //!     })
 //!     .collect();
@@ -247,8 +248,13 @@ impl LayerPoints {
 }
 
 /// Layers of `path` with the tool axes and build directions of `frames`
-/// (from [`toolaxis::local_frames`](crate::toolaxis::local_frames)).
-pub fn layer_points(path: &Path, frames: &[Vec<LocalFrame>]) -> Vec<LayerPoints> {
+/// (from [`toolaxis::local_frames`](crate::toolaxis::local_frames)), every
+/// point reached at `travel_speed_mm_s` (mm/s).
+pub fn layer_points(
+    path: &Path,
+    frames: &[Vec<LocalFrame>],
+    travel_speed_mm_s: f64,
+) -> Vec<LayerPoints> {
     path.layers
         .iter()
         .zip(frames)
@@ -266,6 +272,7 @@ pub fn layer_points(path: &Path, frames: &[Vec<LocalFrame>]) -> Vec<LayerPoints>
                     tool_axis: UnitVector3::new_normalize(f.tool),
                     build_direction: Some(UnitVector3::new_normalize(f.build)),
                     positioner: None,
+                    travel_speed_mm_s,
                 })
                 .collect(),
         })
@@ -306,6 +313,7 @@ fn path_point(layer: usize, point: usize, cp: &CellPoint, r_z: f64) -> PathPoint
         r_z,
         positioner: cp.positioner,
         bead: 0,
+        travel_speed_mm_s: cp.travel_speed_mm_s,
     }
 }
 
@@ -445,7 +453,6 @@ fn arm_coupled(
         let law = positioner::positioner_law_for_arm(
             c,
             &layer.points,
-            opts.travel_speed_mm_s,
             opts.joint_limit_margin_rad,
             &opts.positioner,
             &rows,
@@ -565,7 +572,6 @@ fn schedule_positioner(
         positioner::positioner_law(
             c,
             &l.points,
-            opts.travel_speed_mm_s,
             opts.joint_limit_margin_rad,
             0.0,
             &opts.positioner,
@@ -646,6 +652,13 @@ fn validate_input(
                     layer: l.layer,
                     point: i,
                     reason: "non-finite position, tool axis or build direction",
+                });
+            }
+            if !(p.travel_speed_mm_s > 0.0 && p.travel_speed_mm_s.is_finite()) {
+                return Err(OptimiseError::BadPoint {
+                    layer: l.layer,
+                    point: i,
+                    reason: "travel_speed_mm_s not finite and > 0",
                 });
             }
         }

@@ -182,9 +182,6 @@ pub struct OptimiseOptions {
     pub parameterisation: Parameterisation,
     /// What is minimised.
     pub objective: Objective,
-    /// Programmed travel speed TS (mm/s) for the joint-speed constraints and
-    /// the quality figures. Default 6 mm/s (36 cm/min, thesis table 3.1).
-    pub travel_speed_mm_s: f64,
     /// The dexterity floor (eq. 4.6).
     pub dexterity_floor: DexterityFloor,
     /// IK branch per layer.
@@ -230,7 +227,6 @@ impl Default for OptimiseOptions {
         Self {
             parameterisation: Parameterisation::default(),
             objective: Objective::default(),
-            travel_speed_mm_s: 6.0,
             dexterity_floor: DexterityFloor::default(),
             configuration: ConfigurationChoice::default(),
             joint_limit_margin_rad: 0.5f64.to_radians(),
@@ -296,13 +292,6 @@ impl OptimiseOptions {
                 )
             }
             _ => {}
-        }
-        if !(self.travel_speed_mm_s > 0.0 && self.travel_speed_mm_s.is_finite()) {
-            return bad(
-                "travel_speed_mm_s",
-                self.travel_speed_mm_s,
-                "must be finite and > 0",
-            );
         }
         match self.dexterity_floor {
             DexterityFloor::FractionOfUnoptimised { fraction }

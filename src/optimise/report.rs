@@ -68,7 +68,7 @@ pub(super) fn finish(
         .collect();
     let mut topts = opts.trajectory;
     topts.with_derivatives = false;
-    let violations = match joint_trajectory(&cell, &inputs, opts.travel_speed_mm_s, &topts) {
+    let violations = match joint_trajectory(&cell, &inputs, &topts) {
         Ok(t) => {
             // its dexterity is the exact value the plan reports, wherever
             // it solved the same joints (it does everywhere: same IK, same
@@ -107,7 +107,7 @@ pub(super) fn finish(
                     });
                     (
                         Constraint::JointSpeed { joint },
-                        (speed_rad_s - max_rad_s) * step_mm / opts.travel_speed_mm_s,
+                        (speed_rad_s - max_rad_s) * step_mm / inputs[v.point].travel_speed_mm_s,
                     )
                 }
                 ViolationKind::HoseTorsion {

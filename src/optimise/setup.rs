@@ -31,7 +31,7 @@ pub(super) struct LayerSetup<'a> {
 
 impl<'a> LayerSetup<'a> {
     /// The setup of `points` (a layer, or a spiral turn continuing from
-    /// `anchor`): times between points at the travel speed, cylindrical
+    /// `anchor`): times between points at their travel speeds, cylindrical
     /// angles, whether the layer turns about the part Z axis, and the
     /// polynomial abscissa the options ask for.
     pub(super) fn new(
@@ -43,8 +43,8 @@ impl<'a> LayerSetup<'a> {
         let p = points.len();
         let mut dt = vec![0.0; p];
         for m in 1..p {
-            dt[m] =
-                (points[m].position_mm - points[m - 1].position_mm).norm() / opts.travel_speed_mm_s;
+            dt[m] = (points[m].position_mm - points[m - 1].position_mm).norm()
+                / points[m].travel_speed_mm_s;
         }
         let theta = cylindrical_angles(&points.iter().map(|c| c.position_mm).collect::<Vec<_>>());
         let turning = turns_about_z(&theta);

@@ -44,7 +44,7 @@ fn hemisphere_layers() -> Vec<LayerPoints> {
         normal: Vector3::z_axis(),
     };
     let path = slice(&tube, &plate, &SliceOptions::new(Strategy::Constant, 5.0)).unwrap();
-    layer_points(&path, &local_frames(&path, &tube))
+    layer_points(&path, &local_frames(&path, &tube), 6.0)
 }
 
 /// The cell of `parts/cells/robowam_part_carried.toml`.

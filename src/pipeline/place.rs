@@ -135,9 +135,12 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
     };
     let bounds = placement_bounds(cell, half)?;
     let sliced = slice_part_with(part, &req.slice.for_cell(part, cell), &Default::default())?;
-    let layers = layer_points(&sliced.path, &sliced.axes.frames);
+    let layers = layer_points(
+        &sliced.path,
+        &sliced.axes.frames,
+        sliced.process.travel_speed_mm_s,
+    );
     let optimise = OptimiseOptions {
-        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
         configuration: ConfigurationChoice::Cell,
         ..OptimiseOptions::default()
     };
@@ -156,7 +159,7 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
             ..cell.clone()
         };
         let whole_build = layers.len() == every_layer;
-        super::planned::build(&name, &c, &sliced, layers, plan, &optimise, whole_build).map(|_| ())
+        super::planned::build(&name, &c, &sliced, layers, plan, whole_build).map(|_| ())
     };
     let placement = place_with(
         &cell.layout,

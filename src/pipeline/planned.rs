@@ -18,7 +18,7 @@ use crate::optimise::{
     layer_points, optimise_with, split_refused_layers, LayerPlan, LayerPoints, OptimiseOptions,
     Plan, SplitPlan,
 };
-use crate::program::{check_vendor, write_files, PointFeed, Program, ProgramError};
+use crate::program::{check_vendor, write_files, Program, ProgramError};
 use crate::robot::Vendor;
 use crate::Error;
 
@@ -161,12 +161,13 @@ pub fn plan_part_with(
         source: Box::new(e.into()),
     })?;
     let t = Instant::now();
-    let layers = layer_points(&sliced.path, &sliced.axes.frames);
+    let layers = layer_points(
+        &sliced.path,
+        &sliced.axes.frames,
+        sliced.process.travel_speed_mm_s,
+    );
     let t_axes = sliced.times.tool_axes + t.elapsed().as_secs_f64();
-    let optimise_opts = OptimiseOptions {
-        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
-        ..opts.optimise
-    };
+    let optimise_opts = opts.optimise;
     optimise_opts.validate()?;
     control.check("optimising")?;
     control.report("optimising", 0.1);
@@ -187,7 +188,7 @@ pub fn plan_part_with(
     control.report("program", 0.95);
     let t = Instant::now();
     let name = program_name(&part.name);
-    let built = build(&name, cell, &sliced, &layers, &plan, &optimise_opts, true);
+    let built = build(&name, cell, &sliced, &layers, &plan, true);
     let t_program = t.elapsed().as_secs_f64();
     let (program, clearance, t_check) = match built {
         Ok((p, c, t)) => (Ok(p), Some(c), t),
@@ -261,7 +262,7 @@ fn split_at_corners(
 }
 
 /// The program model of a plan ([`ProgramBuild`](super::program::ProgramBuild)):
-/// every point at the nominal travel speed with the process's wire feed.
+/// every point at its own travel speed with the process's wire feed.
 /// `every_layer`: `layers` are the whole build; `false` for a subsample (a
 /// placement's screening).
 pub(super) fn build(
@@ -270,20 +271,16 @@ pub(super) fn build(
     sliced: &SlicedPart,
     layers: &[LayerPoints],
     plan: &Plan,
-    opts: &OptimiseOptions,
     every_layer: bool,
 ) -> Result<(Program, crate::program::cell_check::CellClearance, f64), ProgramError> {
-    let speed = opts.travel_speed_mm_s;
     let points = layers.iter().map(|l| l.points.len()).sum();
-    // the nominal travel speed and the process's wire feed at every point
-    let feed = PointFeed::constant(speed, sliced.process.wire_feed_speed_mm_s, points);
+    let wire = vec![sliced.process.wire_feed_speed_mm_s; points];
     super::program::ProgramBuild {
         name,
         cell,
         layers,
         plan,
-        feed: &feed,
-        trajectory_speed_mm_s: speed,
+        wire_feed_mm_s: &wire,
         common: &cell.program.common,
         layer_masses_kg: &sliced
             .process_plan
@@ -305,9 +302,10 @@ impl PlannedPart {
         self.program.as_ref().err()
     }
 
-    /// The travel speed planned (mm/s).
+    /// The nominal travel speed (mm/s): the process's, which every point
+    /// runs at unless the plan slowed it ([`PlannedPart::point_process`]).
     pub fn travel_speed_mm_s(&self) -> f64 {
-        self.optimise.travel_speed_mm_s
+        self.sliced.process.travel_speed_mm_s
     }
 
     /// `true` when the cell has a positioner (torch carried): the joints
@@ -531,7 +529,7 @@ impl PlannedPart {
             part_file: self.sliced.part_file.clone(),
             cell_file: self.cell.file.clone(),
             rz: self.rz.to_string(),
-            travel_speed_mm_s: self.optimise.travel_speed_mm_s,
+            travel_speed_mm_s: self.travel_speed_mm_s(),
             feasible: plan.is_feasible(),
             infeasible_layers: plan.infeasible_layers().map(|l| l.layer).collect(),
             unbuildable_layers: plan.layers.iter().filter_map(unbuildable).collect(),

@@ -1,6 +1,6 @@
 //! **Stage 7 from a plan — the program of planned layers.** Takes the
-//! layers a plan was made for (part frame, mm), their [`Plan`] (joints,
-//! rad), each point's travel speed and wire feed ([`PointFeed`], mm/s), the
+//! layers a plan was made for (part frame, mm, each point at its own travel
+//! speed), their [`Plan`] (joints, rad), each point's wire feed (mm/s), the
 //! cell and its `[program]` options, and returns the program model
 //! ([`build_program_with`]) with its payloads set and the whole cell checked
 //! along every motion ([`check_cell`]). `plan` and `replan` both build their
@@ -29,12 +29,9 @@ pub(crate) struct ProgramBuild<'a> {
     pub layers: &'a [LayerPoints],
     /// Their plan, one layer plan per entry of `layers`.
     pub plan: &'a Plan,
-    /// Travel speed and wire feed of every point of `layers` in order
-    /// (mm/s).
-    pub feed: &'a [PointFeed],
-    /// The travel speed the joint trajectory's speed check runs at (mm/s);
-    /// the builder re-checks every segment at its own speed.
-    pub trajectory_speed_mm_s: f64,
+    /// Wire feed of every point of `layers` in order (mm/s); each point's
+    /// travel speed is its own ([`crate::robot::CellPoint::travel_speed_mm_s`]).
+    pub wire_feed_mm_s: &'a [f64],
     /// The cell's `[program]` options, the payload the build starts with
     /// among them (kg, mm).
     pub common: &'a ProgramOptions,
@@ -63,15 +60,26 @@ impl ProgramBuild<'_> {
         let inputs = trajectory_inputs(layers, self.plan);
         // the program reads the joints, speeds and violations only: no
         // dexterity (an SVD a point) nor dq/dR_Z
-        let traj = joint_trajectory_without_measures(
-            &cell.layout,
-            &inputs,
-            self.trajectory_speed_mm_s,
-            &TrajectoryOptions::default(),
-        )
-        .map_err(|source| ProgramError::Trajectory { source })?;
+        let traj =
+            joint_trajectory_without_measures(&cell.layout, &inputs, &TrajectoryOptions::default())
+                .map_err(|source| ProgramError::Trajectory { source })?;
+        if self.wire_feed_mm_s.len() != inputs.len() {
+            return Err(ProgramError::InvalidOptions {
+                field: "wire_feed_mm_s",
+                value: format!("{} values", self.wire_feed_mm_s.len()),
+                reason: "one wire feed per planned point",
+            });
+        }
+        let feed: Vec<PointFeed> = inputs
+            .iter()
+            .zip(self.wire_feed_mm_s)
+            .map(|(p, &w)| PointFeed {
+                travel_speed_mm_s: p.travel_speed_mm_s,
+                wire_feed_mm_s: w,
+            })
+            .collect();
         let mut program =
-            build_program_with(self.name, &cell.layout, &inputs, &traj, self.feed, common)?;
+            build_program_with(self.name, &cell.layout, &inputs, &traj, &feed, common)?;
         if common.payload_every_layers > 0 {
             program.set_payloads(common, &self.bead_masses_kg())?;
         }

@@ -626,6 +626,7 @@ fn clearance_point(
         // the planned positioner as the program writes it (its turn
         // unwound by whole turns, `unwind_turns`)
         positioner: input.positioner.and(p.positioner),
+        travel_speed_mm_s: input.travel_speed_mm_s,
     };
     let q8 = p.positioner.map_or(0.0, |q| q[1]);
     let (q, pose) = cell

@@ -15,7 +15,7 @@ use crate::pipeline::{
     slice_part_with, Cell, Control, Part, PlanOptions, PlanTimes, PlannedPart, RzLaw, SlicedPart,
 };
 use crate::process::PointProcess;
-use crate::program::{check_vendor, PointFeed};
+use crate::program::check_vendor;
 use crate::robot::{CellLayout, Vendor};
 use crate::Error;
 
@@ -77,10 +77,7 @@ pub fn replan_part_with(
         file: cell.file.clone(),
         source: Box::new(e.into()),
     })?;
-    let optimise = OptimiseOptions {
-        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
-        ..opts.optimise
-    };
+    let optimise = opts.optimise;
     optimise.validate()?;
     let t_slice = t0.elapsed().as_secs_f64();
     let mut r = replan_core(
@@ -166,7 +163,7 @@ fn replan_core(
     times.scan = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let v_nom = optimise.travel_speed_mm_s;
+    let v_nom = sliced.process.travel_speed_mm_s;
     let process = &sliced.process.clone();
     let law = process.bead_height_law.anchored(v_nom, path.delta_mm);
     let window = Window {
@@ -190,8 +187,14 @@ fn replan_core(
         source: Box::new(e.into()),
     })?;
     let process_plan = rebuilt_process(&sliced, &rebuilt, k);
-    let all_layers = layer_points(&rebuilt.path, &axes.frames);
-    let remaining: Vec<LayerPoints> = all_layers[k + 1..].to_vec();
+    let all_layers = layer_points(&rebuilt.path, &axes.frames, v_nom);
+    let mut remaining: Vec<LayerPoints> = all_layers[k + 1..].to_vec();
+    // every remaining point at its corrected speed (nominal where none)
+    for (lp, c) in remaining.iter_mut().zip(&rebuilt.corrections) {
+        for (p, v) in lp.points.iter_mut().zip(&c.speed_mm_s) {
+            p.travel_speed_mm_s = *v;
+        }
+    }
     times.tool_axes = t.elapsed().as_secs_f64();
 
     let plan = optimise_remaining(cell, &remaining, &rebuilt, nominal, optimise)?;
@@ -208,24 +211,17 @@ fn replan_core(
         common.payload_base_kg = mass;
         common.payload_base_cog_mm = [cog.x, cog.y, cog.z];
     }
-    // the corrected speeds at the process's nominal wire feed: the speed
-    // correction changes the height on purpose (SPEC §5: TS modulated at
-    // the process's WFS)
-    let feed: Vec<PointFeed> = corrections
-        .iter()
-        .flat_map(|c| &c.speed_mm_s)
-        .map(|&travel_speed_mm_s| PointFeed {
-            travel_speed_mm_s,
-            wire_feed_mm_s: process.wire_feed_speed_mm_s,
-        })
-        .collect();
+    // the corrected speeds (the points') at the process's nominal wire
+    // feed: the speed correction changes the height on purpose (SPEC §5:
+    // TS modulated at the process's WFS)
+    let points = remaining.iter().map(|l| l.points.len()).sum();
+    let wire = vec![process.wire_feed_speed_mm_s; points];
     let checked = ProgramBuild {
         name: &name,
         cell,
         layers: &remaining,
         plan: &plan,
-        feed: &feed,
-        trajectory_speed_mm_s: v_nom,
+        wire_feed_mm_s: &wire,
         common: &common,
         layer_masses_kg: &process_plan.layer_masses_kg(&rebuilt.path, process),
         every_layer: true,
@@ -473,10 +469,9 @@ fn rebuilt_process(
     process_plan
 }
 
-/// Optimises the remaining layers: the corrected layers at their fastest
-/// speed (the joint-speed bound holds at every slower one), the others at
-/// the nominal speed or as the nominal plan has them when their points are
-/// unchanged. The plan's `time_s` is this step's run time (s).
+/// Optimises the remaining layers: the corrected layers at their points'
+/// corrected speeds, the others at the nominal speed or as the nominal plan
+/// has them when their points are unchanged. The plan's `time_s` is this step's run time (s).
 fn optimise_remaining(
     cell: &Cell,
     remaining: &[LayerPoints],
@@ -487,18 +482,9 @@ fn optimise_remaining(
     let t = Instant::now();
     let s = rebuilt.skip;
     let r_count = rebuilt.layers.len();
-    let fastest = rebuilt
-        .layers
-        .iter()
-        .flat_map(|r| r.speed_mm_s.iter().copied())
-        .fold(optimise.travel_speed_mm_s, f64::max);
     let never = |_: usize, _: usize| true;
-    let corrected_opts = OptimiseOptions {
-        travel_speed_mm_s: fastest,
-        ..optimise
-    };
     let mut plan_layers =
-        optimise_with(&cell.layout, &remaining[..r_count], &corrected_opts, &never)?.layers;
+        optimise_with(&cell.layout, &remaining[..r_count], &optimise, &never)?.layers;
     let rest = &remaining[r_count..];
     let reused: Option<Vec<_>> = nominal.and_then(|(layers, plan)| {
         rest.iter()

@@ -143,6 +143,7 @@ fn the_drawn_cell_puts_the_torch_tip_on_the_path_point() {
         tool_axis: UnitVector3::new_normalize(Vector3::new(0.2, 0.1, 1.0)),
         build_direction: Some(UnitVector3::new_normalize(Vector3::new(0.2, 0.1, 1.0))),
         positioner: None,
+        travel_speed_mm_s: 6.0,
     };
     for name in [
         "robowam_part_carried.toml",

@@ -47,6 +47,10 @@ pub struct CellPoint {
     /// cell, [`crate::optimise::positioner`]); `None`: the positioner turns
     /// `b` exactly vertical ([`TorchCarriedCell::positioner_angles`]).
     pub positioner: Option<PositionerJoints>,
+    /// Travel speed of the deposition point on the way into this point
+    /// from the previous point of its bead (mm/s, along the chord); unused
+    /// at a bead's first point. What the joint speeds are measured at.
+    pub travel_speed_mm_s: f64,
 }
 
 /// Where one path point puts the cell.

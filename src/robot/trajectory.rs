@@ -50,6 +50,10 @@ pub struct PathPointInput {
     /// share the split point, one in each bead).
     #[serde(default)]
     pub bead: usize,
+    /// Travel speed of the deposition point on the way into this point
+    /// from the previous point of its bead (mm/s, along the chord); unused
+    /// at a bead's first point.
+    pub travel_speed_mm_s: f64,
 }
 
 impl PathPointInput {
@@ -339,14 +343,15 @@ impl JointTrajectory {
     }
 }
 
-/// Joint trajectory of `points` in `cell` at `travel_speed_mm_s`.
+/// Joint trajectory of `points` in `cell`, each point reached at its own
+/// travel speed ([`PathPointInput::travel_speed_mm_s`]).
 ///
 /// The cell's configuration is used for every point; each point's joints
 /// are unwrapped towards the previous point's (so J6, unlimited, turns
 /// continuously within a layer); the first point of a layer takes the
 /// representation inside each joint's travel (see
 /// [`TrajectoryOptions::rewind_between_layers`]). Joint speeds are `Δq / Δt` with
-/// `Δt = |M_m − M_{m−1}| / TS` (part frame, consecutive points of a layer).
+/// `Δt = |M_m − M_{m−1}| / TS_m` (part frame, consecutive points of a layer).
 ///
 /// # Errors
 /// Only for bad input: [`RobotError::InvalidOptions`] (options, travel speed),
@@ -355,10 +360,9 @@ impl JointTrajectory {
 pub fn joint_trajectory(
     cell: &CellLayout,
     points: &[PathPointInput],
-    travel_speed_mm_s: f64,
     opts: &TrajectoryOptions,
 ) -> Result<JointTrajectory, RobotError> {
-    trajectory(cell, points, travel_speed_mm_s, opts, true)
+    trajectory(cell, points, opts, true)
 }
 
 /// [`joint_trajectory`] without the dexterity (0 at every point) and
@@ -370,20 +374,18 @@ pub fn joint_trajectory(
 pub(crate) fn joint_trajectory_without_measures(
     cell: &CellLayout,
     points: &[PathPointInput],
-    travel_speed_mm_s: f64,
     opts: &TrajectoryOptions,
 ) -> Result<JointTrajectory, RobotError> {
-    trajectory(cell, points, travel_speed_mm_s, opts, false)
+    trajectory(cell, points, opts, false)
 }
 
 fn trajectory(
     cell: &CellLayout,
     points: &[PathPointInput],
-    travel_speed_mm_s: f64,
     opts: &TrajectoryOptions,
     measures: bool,
 ) -> Result<JointTrajectory, RobotError> {
-    check_inputs(points, travel_speed_mm_s, opts)?;
+    check_inputs(points, opts)?;
     let robot = cell.robot();
     let hose_limit = match cell {
         CellLayout::TorchCarried(c) => Some(c.max_hose_torsion_rad),
@@ -401,6 +403,7 @@ fn trajectory(
             tool_axis: p.tool_axis,
             build_direction: p.build_direction,
             positioner: p.positioner,
+            travel_speed_mm_s: p.travel_speed_mm_s,
         };
         let mut violation = |kind| {
             report.violations.push(Violation {
@@ -448,16 +451,8 @@ fn trajectory(
             });
         }
         // speeds, within a layer
-        let (speed, dt) = joint_speeds(
-            cell,
-            points,
-            &out,
-            idx,
-            &q,
-            pose.positioner,
-            travel_speed_mm_s,
-            &mut violation,
-        );
+        let (speed, dt) =
+            joint_speeds(cell, points, &out, idx, &q, pose.positioner, &mut violation);
         if let (CellLayout::TorchCarried(c), Some(qp)) = (cell, pose.positioner) {
             positioner_checks(c, &cp, &qp, &mut violation);
         }
@@ -498,22 +493,18 @@ fn trajectory(
     })
 }
 
-/// Refuses a travel speed that is not finite and positive, and a path
-/// point whose position, `R_Z` or tool axis is not finite.
-fn check_inputs(
-    points: &[PathPointInput],
-    travel_speed_mm_s: f64,
-    opts: &TrajectoryOptions,
-) -> Result<(), RobotError> {
+/// Refuses a path point whose position, `R_Z`, tool axis or travel speed
+/// is not finite (the speed also not positive).
+fn check_inputs(points: &[PathPointInput], opts: &TrajectoryOptions) -> Result<(), RobotError> {
     opts.validate()?;
-    if !(travel_speed_mm_s > 0.0 && travel_speed_mm_s.is_finite()) {
-        return Err(RobotError::InvalidOptions {
-            field: "travel_speed_mm_s",
-            value: travel_speed_mm_s,
-            reason: "must be finite and > 0",
-        });
-    }
     for p in points {
+        if !(p.travel_speed_mm_s > 0.0 && p.travel_speed_mm_s.is_finite()) {
+            return Err(RobotError::BadPathPoint {
+                layer: p.layer,
+                point: p.point,
+                reason: "travel_speed_mm_s not finite and > 0",
+            });
+        }
         if !(p.position_mm.iter().all(|v| v.is_finite()) && p.r_z.is_finite()) {
             return Err(RobotError::BadPathPoint {
                 layer: p.layer,
@@ -534,7 +525,7 @@ fn check_inputs(
 
 /// Joint speeds (rad/s) from the previous point of the same layer to point
 /// `idx` at joints `q` (positioner joints `positioner`), and the time
-/// between them (s) at `travel_speed_mm_s`; zeros at a layer's first point.
+/// between them (s) at the point's travel speed; zeros at a layer's first point.
 /// Reports every arm and positioner joint over its maximum speed.
 #[allow(clippy::too_many_arguments)]
 fn joint_speeds(
@@ -544,7 +535,6 @@ fn joint_speeds(
     idx: usize,
     q: &Joints,
     positioner: Option<PositionerJoints>,
-    travel_speed_mm_s: f64,
     violation: &mut dyn FnMut(ViolationKind),
 ) -> ([f64; 6], f64) {
     let p = &points[idx];
@@ -557,7 +547,7 @@ fn joint_speeds(
             if let (Some(qprev), d) = (out[idx - 1].joints, (p.position_mm - pp.position_mm).norm())
             {
                 if d > 0.0 {
-                    dt = d / travel_speed_mm_s;
+                    dt = d / p.travel_speed_mm_s;
                     for j in 0..6 {
                         speed[j] = (q[j] - qprev[j]) / dt;
                         if speed[j].abs() > robot.max_speed_rad_s[j] {

@@ -111,6 +111,7 @@ pub fn hemisphere_cell_points(
                 positioner: None,
                 r_z: r_z(layer, v),
                 bead: 0,
+                travel_speed_mm_s: 6.0,
             });
         }
     }

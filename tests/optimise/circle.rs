@@ -18,6 +18,7 @@ fn circle() -> Vec<CellPoint> {
                 tool_axis: UnitVector3::new_normalize(Vector3::z()),
                 build_direction: Some(UnitVector3::new_normalize(Vector3::z())),
                 positioner: None,
+                travel_speed_mm_s: 6.0,
             }
         })
         .collect()
@@ -62,10 +63,11 @@ fn circle_is_feasible_within_the_hose_limit_and_beats_the_thesis_cubic() {
                 positioner: None,
                 r_z: rz.to_radians(),
                 bead: 0,
+                travel_speed_mm_s: 6.0,
             }
         })
         .collect();
-    let tr = joint_trajectory(&cell, &inputs, 6.0, &TrajectoryOptions::default()).unwrap();
+    let tr = joint_trajectory(&cell, &inputs, &TrajectoryOptions::default()).unwrap();
     let robot = cell.robot();
     let mut phi = 0.0;
     for w in tr.points.windows(2) {

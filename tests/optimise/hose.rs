@@ -35,9 +35,8 @@ fn kuka_torch_layer(
         &part.tool_axis,
     )
     .unwrap();
-    let all = layer_points(&path, &axes.frames);
+    let all = layer_points(&path, &axes.frames, part.process.travel_speed_mm_s);
     let opts = OptimiseOptions {
-        travel_speed_mm_s: part.process.travel_speed_mm_s,
         configuration: ConfigurationChoice::Cell,
         ..OptimiseOptions::default()
     };
@@ -85,7 +84,6 @@ fn a_layer_held_on_the_hose_bound_passes_the_trajectory_recheck() {
     let tr = joint_trajectory(
         &cell,
         &trajectory_inputs(&layers, &plan),
-        opts.travel_speed_mm_s,
         &TrajectoryOptions::default(),
     )
     .unwrap();

@@ -23,7 +23,7 @@ fn hemisphere_spiral_is_optimised_turn_by_turn_continuously() {
     let path = slice(&part.tube, &part.substrate, &so).unwrap();
     let per_turn = path.spiral.unwrap().per_turn;
     let frames = local_frames(&path, &part.tube);
-    let layers = layer_points(&path, &frames);
+    let layers = layer_points(&path, &frames, 6.0);
     assert_eq!(layers.len(), 1);
     let cell = cell("robowam_part_carried.toml");
     let plan = optimise_spiral(&cell, &layers[0], per_turn, &OptimiseOptions::default()).unwrap();

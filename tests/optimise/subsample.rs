@@ -33,18 +33,21 @@ fn objective(l: &LayerPlan, opts: &OptimiseOptions) -> f64 {
     l.objective.joint_displacement + opts.centring_weight * l.objective.centring
 }
 
-/// Every `every`-th layer of `part` at `points` points a layer, with the
-/// travel speed of its process (mm/s).
-fn layers(part: &str, points: usize, every: usize) -> (Vec<LayerPoints>, f64) {
+/// Every `every`-th layer of `part` at `points` points a layer, each point
+/// at the travel speed of its process.
+fn layers(part: &str, points: usize, every: usize) -> Vec<LayerPoints> {
     let part = load_part(part);
     let over = SliceOverrides {
         discretisation: Some(Discretisation::Points(points)),
         ..SliceOverrides::default()
     };
     let sliced = slice_part_with(&part, &over, &Control::default()).unwrap();
-    let all = layer_points(&sliced.path, &sliced.axes.frames);
-    let picked = all.into_iter().step_by(every).collect();
-    (picked, sliced.process.travel_speed_mm_s)
+    let all = layer_points(
+        &sliced.path,
+        &sliced.axes.frames,
+        sliced.process.travel_speed_mm_s,
+    );
+    all.into_iter().step_by(every).collect()
 }
 
 /// What [`compare`] found.
@@ -67,12 +70,10 @@ fn compare(
     what: &str,
     cell: &CellLayout,
     layers: &[LayerPoints],
-    speed: f64,
     samples: usize,
     strict_objective: bool,
 ) -> Compared {
     let opts = OptimiseOptions {
-        travel_speed_mm_s: speed,
         configuration: ConfigurationChoice::Cell,
         subsample_points: samples,
         ..OptimiseOptions::default()
@@ -169,18 +170,11 @@ fn subsampled_and_whole_layer_optimisation_agree_on_every_part_and_cell() {
     let samples = OptimiseOptions::default().subsample_points;
     let (mut layers_seen, mut certified, mut worst) = (0, 0, 0.0f64);
     for part in SAMPLE_PARTS {
-        let (all, speed) = layers(part, 200, 1);
+        let all = layers(part, 200, 1);
         let every = all.len().div_ceil(5).max(1);
         let picked: Vec<LayerPoints> = all.into_iter().step_by(every).collect();
         for (name, c) in &cells {
-            let r = compare(
-                &format!("{part} in {name}"),
-                c,
-                &picked,
-                speed,
-                samples,
-                true,
-            );
+            let r = compare(&format!("{part} in {name}"), c, &picked, samples, true);
             layers_seen += r.layers;
             certified += r.certified;
             worst = worst.max(r.worst_gap);
@@ -217,12 +211,15 @@ fn full_size_subsampled_and_whole_layer_verdicts_agree() {
         }
         let p = load_part(part);
         let sliced = slice_part_with(&p, &SliceOverrides::default(), &Control::default()).unwrap();
-        let layers = layer_points(&sliced.path, &sliced.axes.frames);
-        let speed = sliced.process.travel_speed_mm_s;
+        let layers = layer_points(
+            &sliced.path,
+            &sliced.axes.frames,
+            sliced.process.travel_speed_mm_s,
+        );
         for (name, c) in &cells {
             let what = format!("{part} in {name}");
             let t = std::time::Instant::now();
-            let r = compare(&what, c, &layers, speed, samples, false);
+            let r = compare(&what, c, &layers, samples, false);
             println!(
                 "{what}: {} ({} layers, {} certified on a subsample, largest objective gap {:.3} %; {:.1} s)",
                 if r.feasible { "feasible" } else { "infeasible" },

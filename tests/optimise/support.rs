@@ -31,7 +31,7 @@ pub fn part_layers(part: &str, delta: f64, every: usize) -> Vec<LayerPoints> {
     so.delta_mm = delta;
     let path = slice(&part.tube, &part.substrate, &so).unwrap();
     let frames = local_frames(&path, &part.tube);
-    layer_points(&path, &frames)
+    layer_points(&path, &frames, 6.0)
         .into_iter()
         .step_by(every)
         .collect()

@@ -199,7 +199,6 @@ fn cell_data(file: &str) -> CellData {
 /// Checks every point of every feasible layer; returns the points checked.
 #[allow(clippy::needless_range_loop)] // joints, limits and speeds side by side
 fn fk_check(d: &CellData, planned: &waam_slicer::pipeline::PlannedPart, what: &str) -> usize {
-    let ts = planned.optimise.travel_speed_mm_s;
     let mut checked = 0;
     for (lp, pl) in planned.layers.iter().zip(&planned.plan.layers) {
         if !pl.status.is_feasible() {
@@ -259,7 +258,16 @@ fn fk_check(d: &CellData, planned: &waam_slicer::pipeline::PlannedPart, what: &s
                 );
             }
             if let Some((qp, ep, pp_)) = prev {
-                let dt = (cp.position_mm.coords - pp_).norm() / ts;
+                // at the point's own speed, within the process window
+                let v = cp.travel_speed_mm_s;
+                let process = &planned.sliced.process;
+                assert!(
+                    v >= process.travel_speed_min_mm_s * (1.0 - 1e-9)
+                        && v <= planned.travel_speed_mm_s() * (1.0 + 1e-9),
+                    "{}: travel speed {v} mm/s",
+                    at()
+                );
+                let dt = (cp.position_mm.coords - pp_).norm() / v;
                 if dt > 0.0 {
                     for j in 0..6 {
                         let v = (q[j] - qp[j]).abs() / dt;
@@ -474,12 +482,14 @@ fn sample_layer(
     };
     let sliced =
         waam_slicer::slice_part_with(&part, &today, &waam_slicer::Control::default()).unwrap();
-    let layer = layer_points(&sliced.path, &sliced.axes.frames).swap_remove(n);
+    let layer = layer_points(
+        &sliced.path,
+        &sliced.axes.frames,
+        sliced.process.travel_speed_mm_s,
+    )
+    .swap_remove(n);
     let cell = Cell::read(part_path(&format!("cells/{cell_file}"))).unwrap();
-    let opts = OptimiseOptions {
-        travel_speed_mm_s: sliced.process.travel_speed_mm_s,
-        ..OptimiseOptions::default()
-    };
+    let opts = OptimiseOptions::default();
     (cell, layer, opts)
 }
 
@@ -551,7 +561,7 @@ fn a_corner_off_the_pole_plans_on_the_grids_path_in_every_torch_carried_cell() {
                 }
                 if m > 0 {
                     let dt = (p.position_mm - layer.points[m - 1].position_mm).norm()
-                        / opts.travel_speed_mm_s;
+                        / p.travel_speed_mm_s;
                     let before = law.joints[m - 1];
                     for (a, max) in tc.positioner.max_speed_rad_s.iter().enumerate() {
                         let speed = (q[a] - before[a]).abs() / dt;
@@ -616,7 +626,6 @@ fn law_of(
     waam_slicer::optimise::positioner::positioner_law(
         tc,
         &layer.points,
-        opts.travel_speed_mm_s,
         opts.joint_limit_margin_rad,
         0.0,
         &opts.positioner,
@@ -778,7 +787,7 @@ fn a_one_degree_grid_proves_an_s_bend_layer_the_two_degree_grid_cannot() {
             layer
                 .points
                 .windows(2)
-                .map(|w| (w[1].position_mm - w[0].position_mm).norm() / opts.travel_speed_mm_s),
+                .map(|w| (w[1].position_mm - w[0].position_mm).norm() / w[1].travel_speed_mm_s),
         )
         .collect();
     let r0 = *tc

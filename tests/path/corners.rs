@@ -149,7 +149,7 @@ fn a_layer_with_two_corners_has_one_inside_its_bead() {
         .filter(|&li| layers[li].corners(SEAM_CORNER_RAD).len() >= 2)
         .collect();
     assert_eq!(two, (168..=175).collect::<Vec<_>>());
-    let whole = layer_points(&sliced.path, &sliced.axes.frames);
+    let whole = layer_points(&sliced.path, &sliced.axes.frames, 6.0);
     for li in two {
         let l = &layers[li];
         let n = l.points.len();

@@ -32,13 +32,7 @@ fn planned(cell: &str) -> PlannedPart {
 /// The plan's joints at every bead point, as the check reads them.
 fn trajectory(p: &PlannedPart) -> waam_slicer::robot::trajectory::JointTrajectory {
     let inputs = waam_slicer::optimise::trajectory_inputs(&p.layers, &p.plan);
-    joint_trajectory(
-        &p.cell.layout,
-        &inputs,
-        p.travel_speed_mm_s(),
-        &TrajectoryOptions::default(),
-    )
-    .unwrap()
+    joint_trajectory(&p.cell.layout, &inputs, &TrajectoryOptions::default()).unwrap()
 }
 
 fn scene(keep_out: Vec<KeepOut>) -> CellScene {

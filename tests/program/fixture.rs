@@ -40,7 +40,7 @@ pub fn part_carried() -> CellLayout {
 }
 
 pub fn trajectory(cell: &CellLayout, path: &[PathPointInput]) -> JointTrajectory {
-    joint_trajectory(cell, path, TS_MM_S, &TrajectoryOptions::default()).unwrap()
+    joint_trajectory(cell, path, &TrajectoryOptions::default()).unwrap()
 }
 
 /// The law of each cell. ROBOWAM (FANUC): `R_Z = −v` where the robot holds

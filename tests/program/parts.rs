@@ -25,6 +25,9 @@ use waam_slicer::toolaxis::local_frames;
 use crate::fixture::cell;
 use crate::shared::{load_part, SAMPLE_CELLS, SAMPLE_PARTS};
 
+/// The travel speed the parts are planned at (mm/s; 36 cm/min, thesis table 3.1).
+const TS_MM_S: f64 = 6.0;
+
 /// Layers planned (the first ones) of `part` in `cell`: every layer in the
 /// ROBOWAM cells (about a minute for the seven parts in the three cells,
 /// dev profile on 2 loaded cores), the first 3 for the helix (a whole
@@ -48,7 +51,7 @@ fn plan_program(part: &str, cell: &CellLayout, layers_max: usize) -> Result<Prog
     so.seams_on_corners = matches!(cell, CellLayout::TorchCarried(_));
     let path = slice(&p.tube, &p.substrate, &so).map_err(|e| e.to_string())?;
     let frames = local_frames(&path, &p.tube);
-    let mut layers = layer_points(&path, &frames);
+    let mut layers = layer_points(&path, &frames, TS_MM_S);
     // dev-profile CI budget (layers_planned)
     layers.truncate(layers_max);
     let opts = OptimiseOptions::default();
@@ -61,15 +64,14 @@ fn plan_program(part: &str, cell: &CellLayout, layers_max: usize) -> Result<Prog
         return Err(format!("layer {}: {}", l.layer, l.status));
     }
     let inputs = waam_slicer::optimise::trajectory_inputs(&layers, &plan);
-    let ts = opts.travel_speed_mm_s;
-    let traj = joint_trajectory(cell, &inputs, ts, &TrajectoryOptions::default())
+    let traj = joint_trajectory(cell, &inputs, &TrajectoryOptions::default())
         .map_err(|e| e.to_string())?;
     build_program(
         "PART",
         cell,
         &inputs,
         &traj,
-        &PointFeed::constant(ts, crate::fixture::WFS_MM_S, inputs.len()),
+        &PointFeed::constant(TS_MM_S, crate::fixture::WFS_MM_S, inputs.len()),
     )
     .map_err(|e| e.to_string())
 }

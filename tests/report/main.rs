@@ -283,9 +283,8 @@ fn planned_report(
     )
     .unwrap();
     let map = distance_map(&path);
-    let layers = layer_points(&path, &axes.frames);
+    let layers = layer_points(&path, &axes.frames, part.process.travel_speed_mm_s);
     let opts = OptimiseOptions {
-        travel_speed_mm_s: part.process.travel_speed_mm_s,
         configuration: waam_slicer::optimise::ConfigurationChoice::Cell,
         ..OptimiseOptions::default()
     };
@@ -296,7 +295,7 @@ fn planned_report(
             cell: &cell,
             layers: &layers,
             plan: &plan,
-            travel_speed_mm_s: opts.travel_speed_mm_s,
+            travel_speed_mm_s: part.process.travel_speed_mm_s,
             cycle: None,
             keep_out: &[],
             clearance: None,
@@ -545,13 +544,7 @@ fn refused_part() -> waam_slicer::PlannedPart {
     use waam_slicer::robot::trajectory::{joint_trajectory, TrajectoryOptions};
     let mut p = planned_part("robowam_part_carried");
     let inputs = waam_slicer::optimise::trajectory_inputs(&p.layers, &p.plan);
-    let traj = joint_trajectory(
-        &p.cell.layout,
-        &inputs,
-        p.travel_speed_mm_s(),
-        &TrajectoryOptions::default(),
-    )
-    .unwrap();
+    let traj = joint_trajectory(&p.cell.layout, &inputs, &TrajectoryOptions::default()).unwrap();
     let program = p.program.clone().unwrap();
     let last = traj
         .points

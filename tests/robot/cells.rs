@@ -99,6 +99,7 @@ fn torch_carried_pose_puts_the_torch_on_the_point_with_b_vertical() {
             tool_axis: t,
             build_direction: Some(b),
             positioner: None,
+            travel_speed_mm_s: 6.0,
         };
         let pose = cell.pose(&p, rng.range(-3.0, 3.0), 0.0).unwrap();
         let qp = pose.positioner.unwrap();
@@ -158,6 +159,7 @@ fn dq_drz_matches_finite_differences_part_carried() {
                     tool_axis: t,
                     build_direction: None,
                     positioner: None,
+                    travel_speed_mm_s: 6.0,
                 },
                 rng.range(-3.0, 3.0),
             )
@@ -184,6 +186,7 @@ fn dq_drz_matches_finite_differences_torch_carried() {
                     tool_axis: t,
                     build_direction: Some(t),
                     positioner: None,
+                    travel_speed_mm_s: 6.0,
                 },
                 rng.range(-3.0, 3.0),
             )
@@ -202,7 +205,7 @@ fn check_trajectory_dq_drz(cell: &CellLayout, points: &[PathPointInput]) {
             dexterity_length_scale_mm: scale,
             ..TrajectoryOptions::default()
         };
-        let tr = joint_trajectory(cell, points, 6.0, &opts).unwrap();
+        let tr = joint_trajectory(cell, points, &opts).unwrap();
         let mut q8 = 0.0;
         let mut some = 0;
         for (p, jp) in points.iter().zip(&tr.points) {
@@ -214,6 +217,7 @@ fn check_trajectory_dq_drz(cell: &CellLayout, points: &[PathPointInput]) {
                 tool_axis: p.tool_axis,
                 build_direction: p.build_direction,
                 positioner: None,
+                travel_speed_mm_s: 6.0,
             };
             let pose = cell.pose(&cp, p.r_z, q8).unwrap();
             if let Some(qp) = jp.positioner {
@@ -246,6 +250,7 @@ fn trajectory_dq_drz_is_the_cells() {
                     positioner: None,
                     r_z: -v,
                     bead: 0,
+                    travel_speed_mm_s: 6.0,
                 }
             })
         })
@@ -277,6 +282,7 @@ fn part_carried_rz_rate_is_not_one_for_tilted_tool_axes() {
         tool_axis: t,
         build_direction: None,
         positioner: None,
+        travel_speed_mm_s: 6.0,
     };
     let w = cell.pose(&p, 0.0, 0.0).unwrap().flange_twist_per_rz;
     assert!((w[5] - 0.6 / (0.36 + 0.64)).abs() < 1e-12 && w[3] == 0.0 && w[4] == 0.0);
@@ -306,10 +312,11 @@ fn torch_carried_circle_is_reachable_and_reports_hose_torsion() {
                 positioner: None,
                 r_z: 0.0,
                 bead: 0,
+                travel_speed_mm_s: 12.0,
             }
         })
         .collect();
-    let tr = joint_trajectory(&cell, &path, 12.0, &TrajectoryOptions::default()).unwrap();
+    let tr = joint_trajectory(&cell, &path, &TrajectoryOptions::default()).unwrap();
     assert!(
         tr.points.iter().all(|p| p.joints.is_some()),
         "{}",
@@ -355,10 +362,11 @@ fn torch_carried_circle_uncertainty_matches_thesis() {
                 positioner: None,
                 r_z: 0.0,
                 bead: 0,
+                travel_speed_mm_s: 12.0,
             }
         })
         .collect();
-    let tr = joint_trajectory(&cell, &path, 12.0, &TrajectoryOptions::default()).unwrap();
+    let tr = joint_trajectory(&cell, &path, &TrajectoryOptions::default()).unwrap();
     let tcp = tc.flange_from_tcp.translation.vector;
     let sigma = [1e-4f64.to_radians(); 6];
     let mean = |f| {

@@ -16,6 +16,7 @@ fn point(layer: usize, point: usize, x: f64) -> PathPointInput {
         positioner: None,
         r_z: 0.0,
         bead: 0,
+        travel_speed_mm_s: 6.0,
     }
 }
 
@@ -23,7 +24,7 @@ fn point(layer: usize, point: usize, x: f64) -> PathPointInput {
 fn bad_path_point_names_layer_and_point() {
     let cell = robowam_part_carried(thesis_configuration());
     let pts = [point(0, 0, 0.0), point(3, 7, f64::NAN)];
-    let e = joint_trajectory(&cell, &pts, 6.0, &TrajectoryOptions::default()).unwrap_err();
+    let e = joint_trajectory(&cell, &pts, &TrajectoryOptions::default()).unwrap_err();
     assert!(matches!(
         e,
         RobotError::BadPathPoint {
@@ -39,13 +40,18 @@ fn bad_path_point_names_layer_and_point() {
 fn invalid_options_name_the_field() {
     let cell = robowam_part_carried(thesis_configuration());
     let pts = [point(0, 0, 0.0)];
-    let e = joint_trajectory(&cell, &pts, 0.0, &TrajectoryOptions::default()).unwrap_err();
+    let stopped = [PathPointInput {
+        travel_speed_mm_s: 0.0,
+        ..point(2, 5, 0.0)
+    }];
+    let e = joint_trajectory(&cell, &stopped, &TrajectoryOptions::default()).unwrap_err();
     assert!(e.to_string().contains("travel_speed_mm_s"), "{e}");
+    assert!(e.to_string().contains("layer 2, point 5"), "{e}");
     let opts = TrajectoryOptions {
         dexterity_length_scale_mm: -1.0,
         ..Default::default()
     };
-    let e = joint_trajectory(&cell, &pts, 6.0, &opts).unwrap_err();
+    let e = joint_trajectory(&cell, &pts, &opts).unwrap_err();
     assert!(e.to_string().contains("dexterity_length_scale_mm"), "{e}");
 }
 
@@ -58,6 +64,7 @@ fn degenerate_tool_axis_is_reported() {
         tool_axis: Vector3::y_axis(),
         build_direction: None,
         positioner: None,
+        travel_speed_mm_s: 6.0,
     };
     let e = cell.pose(&p, 0.0, 0.0).unwrap_err();
     assert!(matches!(e, RobotError::DegenerateToolAxis { .. }), "{e}");
@@ -67,7 +74,7 @@ fn degenerate_tool_axis_is_reported() {
         tool_axis: Vector3::y_axis(),
         ..point(2, 5, 0.0)
     }];
-    let tr = joint_trajectory(&cell, &pts, 6.0, &TrajectoryOptions::default()).unwrap();
+    let tr = joint_trajectory(&cell, &pts, &TrajectoryOptions::default()).unwrap();
     assert!(tr.points[0].joints.is_none());
     assert!(
         tr.report
@@ -90,6 +97,7 @@ fn singular_jacobian_is_reported_by_dq_drz() {
         tool_axis: Vector3::z_axis(),
         build_direction: None,
         positioner: None,
+        travel_speed_mm_s: 6.0,
     };
     let pose = pc.pose(&p, 0.0).unwrap();
     let e = cell.dq_drz(&pose, &q).unwrap_err();

@@ -47,7 +47,7 @@ fn constant_rz_zero_makes_j5_leave_its_travel_and_the_report_says_so() {
     let path = hemisphere(|_, _| 0.0);
     assert_eq!(path.len(), 15 * POINTS);
     // TS 36 cm/min = 6 mm/s [table 3.1]
-    let tr = joint_trajectory(&cell, &path, 6.0, &TrajectoryOptions::default()).unwrap();
+    let tr = joint_trajectory(&cell, &path, &TrajectoryOptions::default()).unwrap();
     assert!(tr.points.iter().all(|p| p.joints.is_some()));
     let j5_max = tr
         .points
@@ -79,7 +79,7 @@ fn constant_rz_zero_makes_j5_leave_its_travel_and_the_report_says_so() {
     // the other constant values of fig. 3.22 fail too
     for c in [90.0f64, 180.0, 270.0] {
         let path = hemisphere(|_, _| c.to_radians());
-        let tr = joint_trajectory(&cell, &path, 6.0, &TrajectoryOptions::default()).unwrap();
+        let tr = joint_trajectory(&cell, &path, &TrajectoryOptions::default()).unwrap();
         assert!(tr.report.limit_violations_of(5).count() > 0, "R_Z = {c}");
     }
 }
@@ -89,7 +89,7 @@ fn rz_turning_opposite_to_the_layer_angle_keeps_j1_to_j5_still() {
     let cell = robowam_part_carried(thesis_configuration());
     for c in [0.0f64, 1.0, 3.0] {
         let path = hemisphere(|_, v| c - v);
-        let tr = joint_trajectory(&cell, &path, 6.0, &TrajectoryOptions::default()).unwrap();
+        let tr = joint_trajectory(&cell, &path, &TrajectoryOptions::default()).unwrap();
         for layer in 0..15 {
             let pts: Vec<_> = tr.layer(layer).map(|p| p.joints.unwrap()).collect();
             assert_eq!(pts.len(), POINTS);
@@ -125,8 +125,13 @@ fn rz_turning_opposite_to_the_layer_angle_keeps_j1_to_j5_still() {
 fn joint_speeds_follow_the_travel_speed() {
     let cell = robowam_part_carried(thesis_configuration());
     let path = hemisphere(|_, v| -v);
-    let slow = joint_trajectory(&cell, &path, 6.0, &TrajectoryOptions::default()).unwrap();
-    let fast = joint_trajectory(&cell, &path, 600.0, &TrajectoryOptions::default()).unwrap();
+    let slow = joint_trajectory(&cell, &path, &TrajectoryOptions::default()).unwrap();
+    let fast = joint_trajectory(
+        &cell,
+        &at_speed(&path, 600.0),
+        &TrajectoryOptions::default(),
+    )
+    .unwrap();
     for (a, b) in slow.points.iter().zip(&fast.points) {
         assert!((b.joint_speed_rad_s[5] - 100.0 * a.joint_speed_rad_s[5]).abs() < 1e-9);
     }
@@ -140,7 +145,60 @@ fn joint_speeds_follow_the_travel_speed() {
         0
     );
     // ... at 6000 mm/s the small top layers are too fast for J6, and reported
-    let crazy = joint_trajectory(&cell, &path, 6000.0, &TrajectoryOptions::default()).unwrap();
+    let crazy = joint_trajectory(
+        &cell,
+        &at_speed(&path, 6000.0),
+        &TrajectoryOptions::default(),
+    )
+    .unwrap();
     let text = crazy.report.to_string();
     assert!(text.contains("J6 needs"), "{text}");
+}
+
+/// `path` with every point reached at `v` (mm/s).
+fn at_speed(path: &[PathPointInput], v: f64) -> Vec<PathPointInput> {
+    path.iter()
+        .map(|p| PathPointInput {
+            travel_speed_mm_s: v,
+            ..*p
+        })
+        .collect()
+}
+
+#[test]
+fn each_point_is_reached_at_its_own_speed() {
+    // layer 3's odd points at a third of the speed: their joint speeds are a
+    // third and their times three times the uniform run's; every other
+    // point's are unchanged (dt_m = |M_m - M_{m-1}| / TS_m)
+    let cell = robowam_part_carried(thesis_configuration());
+    let path = hemisphere(|_, v| -v);
+    let uniform = joint_trajectory(&cell, &path, &TrajectoryOptions::default()).unwrap();
+    let slowed: Vec<PathPointInput> = path
+        .iter()
+        .map(|p| PathPointInput {
+            travel_speed_mm_s: if p.layer == 3 && p.point % 2 == 1 {
+                p.travel_speed_mm_s / 3.0
+            } else {
+                p.travel_speed_mm_s
+            },
+            ..*p
+        })
+        .collect();
+    let tr = joint_trajectory(&cell, &slowed, &TrajectoryOptions::default()).unwrap();
+    let mut seen = 0;
+    for ((a, b), p) in uniform.points.iter().zip(&tr.points).zip(&slowed) {
+        assert_eq!(a.joints, b.joints);
+        let k = if p.layer == 3 && p.point % 2 == 1 {
+            3.0
+        } else {
+            1.0
+        };
+        assert!((b.dt_s - k * a.dt_s).abs() <= 1e-12 * a.dt_s.max(1.0));
+        for j in 0..6 {
+            let want = a.joint_speed_rad_s[j] / k;
+            assert!((b.joint_speed_rad_s[j] - want).abs() <= 1e-9 * want.abs().max(1.0));
+        }
+        seen += usize::from(k > 1.0 && a.dt_s > 0.0);
+    }
+    assert!(seen > 10, "{seen} slowed points");
 }

@@ -260,7 +260,7 @@ fn unreachable_cell_names_the_layer_point_and_reach() {
     so.discretisation = waam_slicer::path::Discretisation::Points(24);
     let path = slice(&part.tube, &part.substrate, &so).unwrap();
     let frames = local_frames(&path, &part.tube);
-    let layers = layer_points(&path, &frames);
+    let layers = layer_points(&path, &frames, 6.0);
     let plan = optimise(&cell, &layers, &OptimiseOptions::default()).unwrap();
     assert!(!plan.layers.is_empty());
     for l in &plan.layers {

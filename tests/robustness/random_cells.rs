@@ -38,7 +38,7 @@ pub(crate) fn hemisphere_layers() -> &'static [LayerPoints] {
             &part.tool_axis,
         )
         .expect("hemisphere tool axes");
-        layer_points(&path, &axes.frames)
+        layer_points(&path, &axes.frames, 6.0)
     })
 }
 

@@ -649,12 +649,13 @@ mod tests {
                     tool_axis: b,
                     build_direction: Some(b),
                     positioner: None,
+                    travel_speed_mm_s: 10.0,
                 }
             })
             .collect();
         let opts = PositionerOptions::default();
         c.positioner.max_speed_rad_s = [25f64.to_radians(), 1000f64.to_radians()];
-        let pb = LawProblem::new(&c, &points, 10.0, 0.0, &opts, &[]);
+        let pb = LawProblem::new(&c, &points, 0.0, &opts, &[]);
         let path = grid_path(&pb).expect("a path at 25°/s");
         assert_eq!(path.len(), n);
         assert!(
@@ -663,7 +664,7 @@ mod tests {
             check(&pb, &path).binding
         );
         c.positioner.max_speed_rad_s = [15f64.to_radians(), 1000f64.to_radians()];
-        let pb = LawProblem::new(&c, &points, 10.0, 0.0, &opts, &[]);
+        let pb = LawProblem::new(&c, &points, 0.0, &opts, &[]);
         assert!(grid_path(&pb).is_none());
         let r0 = Matrix3::identity();
         let at = unreachable_point(
@@ -692,9 +693,10 @@ mod tests {
                 tool_axis: Vector3::z_axis(),
                 build_direction: Some(Vector3::z_axis()),
                 positioner: None,
+                travel_speed_mm_s: 10.0,
             })
             .collect();
-        let pb = LawProblem::new(&c, &points, 10.0, 0.0, &PositionerOptions::default(), &[]);
+        let pb = LawProblem::new(&c, &points, 0.0, &PositionerOptions::default(), &[]);
         // tilt 0 → 8° in one step at the middle (within 90°/s · 0.1 s)
         let mut q: Vec<PositionerJoints> = (0..n)
             .map(|m| [if m < n / 2 { 0.0 } else { 8f64.to_radians() }, 0.0])

@@ -80,28 +80,18 @@ use grid::GRID_CELLS_DEG;
 use problem::{check, LawProblem};
 use starts::solve_bases;
 
-/// Positioner laws of one layer [module doc]. `travel_speed_mm_s`: the
-/// programmed speed of the torch over the part (mm/s); `margin_rad`: how far
+/// Positioner laws of one layer [module doc], each point reached at its
+/// own travel speed ([`CellPoint::travel_speed_mm_s`]); `margin_rad`: how far
 /// inside its travel each axis stays (rad); `q8_hint`: the turn the layer
 /// should start near (rad; the previous layer's last).
 pub fn positioner_law(
     cell: &TorchCarriedCell,
     points: &[CellPoint],
-    travel_speed_mm_s: f64,
     margin_rad: f64,
     q8_hint: f64,
     opts: &PositionerOptions,
 ) -> PositionerLaw {
-    solve_law(
-        cell,
-        points,
-        travel_speed_mm_s,
-        margin_rad,
-        q8_hint,
-        opts,
-        &[],
-        None,
-    )
+    solve_law(cell, points, margin_rad, q8_hint, opts, &[], None)
 }
 
 /// [`positioner_law`] under the arm's linearised constraints `arm`, with
@@ -113,7 +103,6 @@ pub fn positioner_law(
 pub fn positioner_law_for_arm(
     cell: &TorchCarriedCell,
     points: &[CellPoint],
-    travel_speed_mm_s: f64,
     margin_rad: f64,
     opts: &PositionerOptions,
     arm: &[ArmRow],
@@ -123,7 +112,6 @@ pub fn positioner_law_for_arm(
     solve_law(
         cell,
         points,
-        travel_speed_mm_s,
         margin_rad,
         hint,
         opts,
@@ -136,14 +124,13 @@ pub fn positioner_law_for_arm(
 fn solve_law(
     cell: &TorchCarriedCell,
     points: &[CellPoint],
-    travel_speed_mm_s: f64,
     margin_rad: f64,
     q8_hint: f64,
     opts: &PositionerOptions,
     arm: &[ArmRow],
     start: Option<&[PositionerJoints]>,
 ) -> PositionerLaw {
-    let mut pb = LawProblem::new(cell, points, travel_speed_mm_s, margin_rad, opts, arm);
+    let mut pb = LawProblem::new(cell, points, margin_rad, opts, arm);
     let n = points.len();
     let follow = vertical_joints(cell, points, q8_hint);
     if opts.mode == PositionerMode::Vertical {

@@ -71,13 +71,12 @@ pub(super) struct LawProblem<'a> {
 }
 
 impl<'a> LawProblem<'a> {
-    /// The layer `points` (part frame) in `cell`'s table frame, at
-    /// `travel_speed_mm_s`, each travel narrowed by `margin_rad`, with the
+    /// The layer `points` (part frame) in `cell`'s table frame, each at its
+    /// travel speed, each travel narrowed by `margin_rad`, with the
     /// arm's rows `arm`.
     pub(super) fn new(
         cell: &'a TorchCarriedCell,
         points: &[CellPoint],
-        travel_speed_mm_s: f64,
         margin_rad: f64,
         opts: &PositionerOptions,
         arm: &[ArmRow],
@@ -105,9 +104,9 @@ impl<'a> LawProblem<'a> {
                 .matrix(),
             dt: std::iter::once(0.0)
                 .chain(
-                    points
-                        .windows(2)
-                        .map(|w| (w[1].position_mm - w[0].position_mm).norm() / travel_speed_mm_s),
+                    points.windows(2).map(|w| {
+                        (w[1].position_mm - w[0].position_mm).norm() / w[1].travel_speed_mm_s
+                    }),
                 )
                 .collect(),
             cos_cone: (0.99 * cell.max_vertical_error_rad.min(std::f64::consts::PI)).cos(),

@@ -46,6 +46,7 @@ fn the_turn_holds_still_at_the_pole() {
                 tool_axis: UnitVector3::new_normalize(b),
                 build_direction: Some(UnitVector3::new_normalize(b)),
                 positioner: None,
+                travel_speed_mm_s: 6.0,
             }
         })
         .collect();
@@ -63,7 +64,7 @@ fn the_turn_holds_still_at_the_pole() {
         spin > 3.0,
         "the exact vertical turns the table by {spin} rad"
     );
-    let law = positioner_law(&c, &points, 6.0, 0.0, 0.0, &PositionerOptions::default());
+    let law = positioner_law(&c, &points, 0.0, 0.0, &PositionerOptions::default());
     assert!(law.feasible, "{:?}", law.binding);
     // the turn only trims the tilt (±5° here), it does not follow b round
     let turn = range(&law.joints);
@@ -88,6 +89,7 @@ fn the_turn_stays_within_the_controllers_stroke() {
                 tool_axis: Vector3::z_axis(),
                 build_direction: Some(Vector3::z_axis()),
                 positioner: None,
+                travel_speed_mm_s: 6.0,
             }
         })
         .collect();
@@ -100,7 +102,7 @@ fn the_turn_stays_within_the_controllers_stroke() {
             });
         (lo, hi)
     };
-    let free = positioner_law(&c, &points, 6.0, 0.0, 0.0, &PositionerOptions::default());
+    let free = positioner_law(&c, &points, 0.0, 0.0, &PositionerOptions::default());
     let (lo, hi) = span(&free);
     assert!(free.feasible, "{:?}", free.binding);
     assert!(
@@ -113,7 +115,7 @@ fn the_turn_stays_within_the_controllers_stroke() {
         lower_rad: -stroke,
         upper_rad: stroke,
     });
-    let law = positioner_law(&c, &points, 6.0, 0.0, 0.0, &PositionerOptions::default());
+    let law = positioner_law(&c, &points, 0.0, 0.0, &PositionerOptions::default());
     let (lo, hi) = span(&law);
     assert!(law.feasible, "{:?}", law.binding);
     let shifts = c.turn_stroke().whole_turn_shifts(lo, hi);

@@ -602,10 +602,11 @@ mod tests {
                     positioner: None,
                     r_z: 0.0,
                     bead: 0,
+                    travel_speed_mm_s: 6.0,
                 });
             }
         }
-        let tr = joint_trajectory(&cell, &pts, 6.0, &TrajectoryOptions::default()).unwrap();
+        let tr = joint_trajectory(&cell, &pts, &TrajectoryOptions::default()).unwrap();
         let prog = build_program(
             "HEMI",
             &cell,
