@@ -1,6 +1,6 @@
 //! `joints.csv`: one row per planned point, header
 //! `layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6` (+ `e1,e2` with a
-//! positioner) `,travel_speed_mm_s,bead_height_mm,bead`. Position (mm) and tool
+//! positioner) `,travel_speed_mm_s,bead_height_mm,bead,wire_feed_mm_s`. Position (mm) and tool
 //! axis in the part frame, `R_Z` and joints in degrees, joints in the
 //! robot's controller convention (FANUC J2/J3 for FANUC arms); a point
 //! without a joint solution has empty joint cells. The last two columns are
@@ -10,9 +10,13 @@
 //! replanned one ([`crate::replan`]) with its corrected values. The `bead`
 //! column numbers the beads of a layer: 0 for its first (or only) one, one
 //! more at each split at a corner, whose point is written once in each of
-//! the two beads ([`crate::optimise::split`]). Also reads such a file back
-//! (files without the `bead` column, or without the process columns and
-//! it, too).
+//! the two beads ([`crate::optimise::split`]). The last column is the wire
+//! feed speed the program runs on the way to the point (mm/s): the
+//! process's, but where the plan slowed the torch down
+//! ([`crate::optimise::slow`]), where it follows the speed so that the bead's
+//! cross-section stays. Also reads such a file back (files without the wire
+//! feed column, without it and the `bead` column, or without those and the
+//! process columns, too).
 
 use std::io::Write;
 
@@ -25,12 +29,15 @@ pub const HEADER: &str = "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6";
 /// The process columns, last on every line (after `e1,e2` when present).
 pub const PROCESS_COLUMNS: &str = "travel_speed_mm_s,bead_height_mm";
 
-/// The bead column, last on every line written (after the process columns).
+/// The bead column, after the process columns.
 pub const BEAD_COLUMN: &str = "bead";
 
+/// The wire feed column, last on every line written (after the bead column).
+pub const WIRE_FEED_COLUMN: &str = "wire_feed_mm_s";
+
 /// Writes `plan`'s points (made from `layers`); `positioner` adds `e1,e2`;
-/// `process[i][m]` is `[travel speed (mm/s), bead height (mm)]` of point `m`
-/// of `layers[i]` (a missing entry writes empty cells).
+/// `process[i][m]` is `[travel speed (mm/s), bead height (mm), wire feed
+/// (mm/s)]` of point `m` of `layers[i]` (a missing entry writes empty cells).
 /// Numbers with 6 decimals by the fixed-point formatter of
 /// [`decimal`](crate::util::decimal) (within half a unit of the last digit of
 /// the standard formatting), one row at a time into a reused buffer.
@@ -42,11 +49,11 @@ pub fn write_joints_csv(
     layers: &[LayerPoints],
     plan: &Plan,
     positioner: bool,
-    process: &[Vec<[f64; 2]>],
+    process: &[Vec<[f64; 3]>],
 ) -> std::io::Result<()> {
     write!(w, "{HEADER}")?;
     write!(w, "{}", if positioner { ",e1,e2" } else { "" })?;
-    writeln!(w, ",{PROCESS_COLUMNS},{BEAD_COLUMN}")?;
+    writeln!(w, ",{PROCESS_COLUMNS},{BEAD_COLUMN},{WIRE_FEED_COLUMN}")?;
     let mut row: Vec<u8> = Vec::with_capacity(256);
     for (i, (lp, l)) in layers.iter().zip(&plan.layers).enumerate() {
         for (m, (cp, pp)) in lp.points.iter().zip(&l.points).enumerate() {
@@ -87,8 +94,9 @@ struct Row {
     joints_rad: Option<[f64; 6]>,
     /// `None`: no positioner columns; `Some(None)`: empty ones.
     positioner_rad: Option<Option<[f64; 2]>>,
-    /// Travel speed (mm/s) and bead height (mm); `None`: empty cells.
-    process: Option<[f64; 2]>,
+    /// Travel speed (mm/s), bead height (mm) and wire feed (mm/s); `None`:
+    /// empty cells.
+    process: Option<[f64; 3]>,
     /// The bead within the layer.
     bead: usize,
 }
@@ -123,17 +131,22 @@ fn push_row(out: &mut Vec<u8>, r: &Row) {
         Some(None) => out.extend_from_slice(b",,"),
         None => {}
     }
-    match r.process {
-        Some(v) if v.iter().all(|x| x.is_finite()) => {
-            for x in v {
+    let process = r.process.filter(|v| v.iter().all(|x| x.is_finite()));
+    match process {
+        Some(v) => {
+            for x in &v[..2] {
                 out.push(b',');
-                push_fixed(out, x, 6);
+                push_fixed(out, *x, 6);
             }
         }
-        _ => out.extend_from_slice(b",,"),
+        None => out.extend_from_slice(b",,"),
     }
     out.push(b',');
     push_u64(out, r.bead as u64);
+    out.push(b',');
+    if let Some(v) = process {
+        push_fixed(out, v[2], 6);
+    }
     out.push(b'\n');
 }
 
@@ -159,6 +172,9 @@ pub struct JointsRow {
     pub travel_speed_mm_s: Option<f64>,
     /// Bead height asked for at the point (mm); `None` as above.
     pub bead_height_mm: Option<f64>,
+    /// Wire feed speed on the way to the point (mm/s); `None` when the cell
+    /// is empty or the file has no wire feed column.
+    pub wire_feed_mm_s: Option<f64>,
     /// The bead within the layer (0 for its first, one more at each split
     /// at a corner; 0 when the file has no `bead` column).
     pub bead: usize,
@@ -188,8 +204,15 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
         reason,
     };
     let mut lines = text.lines().enumerate();
-    let (header, with_bead) = match lines.next() {
-        Some((_, h)) => match h.strip_suffix(&format!(",{BEAD_COLUMN}")) {
+    let (header, with_wire) = match lines.next() {
+        Some((_, h)) => match h.strip_suffix(&format!(",{WIRE_FEED_COLUMN}")) {
+            Some(rest) => (Some(rest), true),
+            None => (Some(h), false),
+        },
+        None => (None, false),
+    };
+    let (header, with_bead) = match header {
+        Some(h) => match h.strip_suffix(&format!(",{BEAD_COLUMN}")) {
             Some(rest) => (Some(rest), true),
             None => (Some(h), false),
         },
@@ -208,7 +231,7 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
         _ => {
             return Err(err(
                 1,
-                format!("expected the header `{HEADER}` (with `,e1,e2` for a positioner), then `,{PROCESS_COLUMNS},{BEAD_COLUMN}`"),
+                format!("expected the header `{HEADER}` (with `,e1,e2` for a positioner), then `,{PROCESS_COLUMNS},{BEAD_COLUMN},{WIRE_FEED_COLUMN}`"),
             ))
         }
     };
@@ -229,6 +252,7 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
             Vec::new()
         })
         .chain(with_bead.then_some(BEAD_COLUMN))
+        .chain(with_wire.then_some(WIRE_FEED_COLUMN))
         .collect();
     let process_at = 15 + if positioner { 2 } else { 0 };
     let mut rows = Vec::new();
@@ -296,9 +320,14 @@ pub fn read_joints_csv(text: &str, file: &str) -> Result<Vec<JointsRow>, JointsC
             joints_deg,
             positioner_deg,
             bead: if with_bead {
-                index(names.len() - 1)?
+                index(names.len() - 1 - usize::from(with_wire))?
             } else {
                 0
+            },
+            wire_feed_mm_s: if with_wire {
+                num(names.len() - 1)?
+            } else {
+                None
             },
             travel_speed_mm_s: if with_process { num(process_at)? } else { None },
             bead_height_mm: if with_process {
@@ -337,10 +366,14 @@ mod tests {
             None => {}
         }
         match r.process {
-            Some(v) => v.iter().for_each(|x| s += &format!(",{x:.6}")),
+            Some(v) => v[..2].iter().for_each(|x| s += &format!(",{x:.6}")),
             None => s += ",,",
         }
         s += &format!(",{}", r.bead);
+        match r.process {
+            Some(v) => s += &format!(",{:.6}", v[2]),
+            None => s += ",",
+        }
         s
     }
 
@@ -367,7 +400,8 @@ mod tests {
                     1 => Some(None),
                     _ => Some(Some([next(3.2), next(6.4)])),
                 },
-                process: (i % 5 != 2).then(|| [next(20.0).abs(), next(3.0).abs()]),
+                process: (i % 5 != 2)
+                    .then(|| [next(20.0).abs(), next(3.0).abs(), next(90.0).abs()]),
                 bead: i % 3,
             };
             let mut ours = Vec::new();
@@ -422,17 +456,19 @@ mod tests {
                 rz_rad: 0.25,
                 joints_rad: Some([0.1, -0.2, 0.3, -0.4, 0.5, -3.0]),
                 positioner_rad: Some(Some([-0.5, 1.5])),
-                process: Some([8.5, 1.75]),
+                process: Some([8.5, 1.75, 61.25]),
                 bead: 1,
             },
         ];
-        let mut text = format!("{HEADER},e1,e2,{PROCESS_COLUMNS},{BEAD_COLUMN}\n").into_bytes();
+        let mut text =
+            format!("{HEADER},e1,e2,{PROCESS_COLUMNS},{BEAD_COLUMN},{WIRE_FEED_COLUMN}\n")
+                .into_bytes();
         for r in &rows {
             push_row(&mut text, r);
         }
         let text = String::from_utf8(text).unwrap();
         assert!(
-            text.contains("\n2,7,1045.747000,-630.155000,0.500000,0.000000,0.000000,1.000000,-90.000000,,,,,,,,,,,0\n"),
+            text.contains("\n2,7,1045.747000,-630.155000,0.500000,0.000000,0.000000,1.000000,-90.000000,,,,,,,,,,,0,\n"),
             "{text}"
         );
         let back = read_joints_csv(&text, "joints.csv").unwrap();
@@ -446,8 +482,10 @@ mod tests {
         assert_eq!(back[1].travel_speed_mm_s, Some(8.5));
         assert_eq!(back[1].bead_height_mm, Some(1.75));
         assert_eq!((back[0].bead, back[1].bead), (0, 1));
-        // files written before the bead column, and before the process
-        // columns, still read
+        assert_eq!(back[0].wire_feed_mm_s, None);
+        assert_eq!(back[1].wire_feed_mm_s, Some(61.25));
+        // files written before the wire feed column, before the bead column,
+        // and before the process columns, still read
         let without = |columns: usize| -> String {
             text.lines()
                 .map(|l| {
@@ -458,8 +496,12 @@ mod tests {
         };
         let back = read_joints_csv(&without(1), "joints.csv").unwrap();
         assert_eq!(back[1].bead_height_mm, Some(1.75));
+        assert_eq!(back[1].bead, 1);
+        assert_eq!(back[1].wire_feed_mm_s, None);
+        let back = read_joints_csv(&without(2), "joints.csv").unwrap();
+        assert_eq!(back[1].bead_height_mm, Some(1.75));
         assert_eq!(back[1].bead, 0);
-        let old = without(3);
+        let old = without(4);
         let back = read_joints_csv(&old, "joints.csv").unwrap();
         assert_eq!(back[1].bead_height_mm, None);
         assert!((back[1].positioner_deg.unwrap()[1] - 1.5f64.to_degrees()).abs() < 1e-6);

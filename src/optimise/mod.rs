@@ -122,6 +122,7 @@ mod qp;
 mod report;
 mod seed;
 mod setup;
+pub mod slow;
 mod spiral;
 pub mod split;
 mod sqp;
@@ -138,6 +139,7 @@ pub use outcome::{
     ObjectiveReport, OptimiseError, Plan, PlannedPoint, SolvedRzLaw, SolverReport, Transition,
 };
 
+pub use slow::{slow_refused_layers, SlowPlan, SlowedBead};
 pub use spiral::optimise_spiral;
 pub use split::{split_refused_layers, BeadSplit, SplitPlan};
 

@@ -107,7 +107,10 @@ pub fn split_refused_layers(
         out_layers.extend(beads[range.clone()].iter().cloned());
         out_plans.extend(solved.layers[range].iter().cloned());
     }
-    shift_turns(cell, &out_layers, &mut out_plans);
+    // every split bead (bead > 0, and the first bead of a split layer)
+    let split =
+        |k: usize| out_layers[k].bead > 0 || out_layers.get(k + 1).is_some_and(|l| l.bead > 0);
+    shift_turns(cell, &mut out_plans, &split);
     let plan = Plan {
         transitions: transitions(cell, &out_plans),
         layers: out_plans,
@@ -120,18 +123,21 @@ pub fn split_refused_layers(
     })
 }
 
-/// Shifts the positioner's turn of every split bead (bead > 0, and the
-/// first bead of a split layer) by whole turns to start nearest the end of
-/// the entry before it, where the bead stays within the turn's travel.
-fn shift_turns(cell: &CellLayout, layers: &[LayerPoints], plans: &mut [super::LayerPlan]) {
+/// Shifts the positioner's turn of every entry `k > 0` that `which(k)`
+/// names by whole turns to start nearest the end of the entry before it,
+/// where the entry stays within the turn's travel.
+pub(super) fn shift_turns(
+    cell: &CellLayout,
+    plans: &mut [super::LayerPlan],
+    which: &dyn Fn(usize) -> bool,
+) {
     use std::f64::consts::TAU;
     let CellLayout::TorchCarried(c) = cell else {
         return;
     };
     let turn = c.positioner.limits[1];
     for k in 1..plans.len() {
-        let split = layers[k].bead > 0 || layers.get(k + 1).is_some_and(|l| l.bead > 0);
-        if !split {
+        if !which(k) {
             continue;
         }
         let prev = plans[k - 1].points.last().and_then(|p| p.positioner);

@@ -159,7 +159,7 @@ pub fn place_part(part: &Part, cell: &Cell, req: &PlaceRequest) -> Result<Placed
             ..cell.clone()
         };
         let whole_build = layers.len() == every_layer;
-        super::planned::build(&name, &c, &sliced, layers, plan, whole_build).map(|_| ())
+        super::planned::build(&name, &c, &sliced, layers, plan, &[], whole_build).map(|_| ())
     };
     let placement = place_with(
         &cell.layout,

@@ -10,13 +10,13 @@ use serde::Serialize;
 
 use super::summary::{
     deg6, finite, CellCheckSummary, CollisionSummary, CycleSummary, LayerSummary, ObjectiveSummary,
-    PlanSummary, PositionerSummary, QualitySummary, SolverSummary, SplitSummary, TransitionSummary,
-    UnbuildableLayer, UnbuildableProof,
+    PlanSummary, PositionerSummary, QualitySummary, SlowSummary, SolverSummary, SplitSummary,
+    TransitionSummary, UnbuildableLayer, UnbuildableProof,
 };
 use super::{slice_part_with, Cell, Control, Part, PlanOptions, RzLaw, SlicedPart};
 use crate::optimise::{
-    layer_points, optimise_with, split_refused_layers, LayerPlan, LayerPoints, OptimiseOptions,
-    Plan, SplitPlan,
+    layer_points, optimise_with, slow_refused_layers, split_refused_layers, LayerPlan, LayerPoints,
+    OptimiseOptions, Plan, SplitPlan,
 };
 use crate::program::{check_vendor, write_files, Program, ProgramError};
 use crate::robot::Vendor;
@@ -76,16 +76,16 @@ pub struct PlannedPart {
     pub clearance: Option<crate::program::cell_check::CellClearance>,
     /// Run times.
     pub times: PlanTimes,
-    /// The travel speed of every point of `layers` (mm/s, on the way to the
-    /// point) when the program modulates it (a replanned part,
-    /// [`crate::replan`]); `None`: the constant
-    /// [`PlannedPart::travel_speed_mm_s`] everywhere.
-    pub point_speeds_mm_s: Option<Vec<Vec<f64>>>,
     /// The beads split at corners: where a layer could not be built as one
     /// bead in a torch-carried cell with seams on corners, it is split at
     /// its corners inside the bead, each split here (in path order), and
     /// `layers` and `plan` hold its beads ([`crate::optimise::split`]).
     pub splits: Vec<crate::optimise::BeadSplit>,
+    /// The beads slowed down: where a layer (or bead) could not be built at
+    /// the process's speed, the torch slows where an axis binds, down to the
+    /// process's `travel_speed_min_mm_s`, and the wire feed follows
+    /// ([`crate::optimise::slow`]); `layers` hold their points' speeds.
+    pub slowed: Vec<crate::optimise::SlowedBead>,
 }
 
 /// The program name for a part: its name in upper case, letters, digits and
@@ -183,12 +183,20 @@ pub fn plan_part_with(
     })?;
     control.check("optimising")?;
     let split = split_at_corners(cell, &sliced, layers, plan, &optimise_opts)?;
-    let (layers, plan) = (split.layers, split.plan);
+    control.check("optimising")?;
+    let slow = slow_refused_layers(
+        &cell.layout,
+        split.layers,
+        split.plan,
+        sliced.process.travel_speed_min_mm_s,
+        &optimise_opts,
+    )?;
+    let (layers, plan) = (slow.layers, slow.plan);
     control.check("optimising")?;
     control.report("program", 0.95);
     let t = Instant::now();
     let name = program_name(&part.name);
-    let built = build(&name, cell, &sliced, &layers, &plan, true);
+    let built = build(&name, cell, &sliced, &layers, &plan, &slow.slowed, true);
     let t_program = t.elapsed().as_secs_f64();
     let (program, clearance, t_check) = match built {
         Ok((p, c, t)) => (Ok(p), Some(c), t),
@@ -211,9 +219,9 @@ pub fn plan_part_with(
         format,
         plan,
         program,
-        point_speeds_mm_s: None,
         clearance,
         splits: split.splits,
+        slowed: slow.slowed,
     })
 }
 
@@ -262,7 +270,8 @@ fn split_at_corners(
 }
 
 /// The program model of a plan ([`ProgramBuild`](super::program::ProgramBuild)):
-/// every point at its own travel speed with the process's wire feed.
+/// every point at its own travel speed with its wire feed ([`wire_feeds`]:
+/// the process's, following the speed on the beads `slowed`).
 /// `every_layer`: `layers` are the whole build; `false` for a subsample (a
 /// placement's screening).
 pub(super) fn build(
@@ -271,10 +280,13 @@ pub(super) fn build(
     sliced: &SlicedPart,
     layers: &[LayerPoints],
     plan: &Plan,
+    slowed: &[crate::optimise::SlowedBead],
     every_layer: bool,
 ) -> Result<(Program, crate::program::cell_check::CellClearance, f64), ProgramError> {
-    let points = layers.iter().map(|l| l.points.len()).sum();
-    let wire = vec![sliced.process.wire_feed_speed_mm_s; points];
+    let wire: Vec<f64> = wire_feeds(layers, &sliced.process, slowed)
+        .into_iter()
+        .flatten()
+        .collect();
     super::program::ProgramBuild {
         name,
         cell,
@@ -288,6 +300,36 @@ pub(super) fn build(
         every_layer,
     }
     .build()
+}
+
+/// The wire feed of every point of `layers` (mm/s): the process's
+/// `wire_feed_speed_mm_s`, scaled on the beads `slowed` by the point's speed
+/// over the process's, so that `WFS/TS` — the bead's cross-section
+/// `pi d^2/4 · WFS/TS` (SPEC §5) — stays the process's where the torch slows.
+pub(super) fn wire_feeds(
+    layers: &[LayerPoints],
+    process: &crate::process::ProcessParameters,
+    slowed: &[crate::optimise::SlowedBead],
+) -> Vec<Vec<f64>> {
+    let (wfs, nominal) = (process.wire_feed_speed_mm_s, process.travel_speed_mm_s);
+    layers
+        .iter()
+        .map(|lp| {
+            let slow = slowed
+                .iter()
+                .any(|s| s.layer == lp.layer && s.bead == lp.bead);
+            lp.points
+                .iter()
+                .map(|p| {
+                    if slow {
+                        wfs * p.travel_speed_mm_s / nominal
+                    } else {
+                        wfs
+                    }
+                })
+                .collect()
+        })
+        .collect()
 }
 
 impl PlannedPart {
@@ -328,29 +370,33 @@ impl PlannedPart {
         )
     }
 
-    /// Per point of `layers`: `[travel speed (mm/s), bead height (mm)]` — the
-    /// speed the program runs on the way to the point and the height the
-    /// plan asks for there (the point's local distance to the layer below,
-    /// `Delta` on the first layer).
-    pub fn point_process(&self) -> Vec<Vec<[f64; 2]>> {
+    /// Per point of `layers`: `[travel speed (mm/s), bead height (mm), wire
+    /// feed (mm/s)]` — the speed the program runs on the way to the point,
+    /// the height the plan asks for there (the point's local distance to
+    /// the layer below, `Delta` on the first layer) and the wire feed: the
+    /// process's, scaled by the slowdown on a slowed bead
+    /// ([`PlannedPart::slowed`]) so that `WFS/TS`, the bead's cross-section
+    /// (SPEC §5), stays that of the process's speed.
+    pub fn point_process(&self) -> Vec<Vec<[f64; 3]>> {
         let path = &self.sliced.path;
+        let wire = wire_feeds(&self.layers, &self.sliced.process, &self.slowed);
         self.layers
             .iter()
-            .enumerate()
-            .map(|(i, lp)| {
-                let speeds = self.point_speeds_mm_s.as_ref().and_then(|s| s.get(i));
-                (0..lp.points.len())
-                    .map(|m| {
-                        let v = speeds
-                            .and_then(|s| s.get(m).copied())
-                            .unwrap_or_else(|| self.travel_speed_mm_s());
+            .zip(wire)
+            .map(|(lp, wire)| {
+                lp.points
+                    .iter()
+                    .zip(wire)
+                    .enumerate()
+                    .map(|(m, (p, w))| {
+                        let v = p.travel_speed_mm_s;
                         let h = path
                             .layers
                             .get(lp.layer)
                             .and_then(|l| l.points.get(lp.first_point + m))
                             .and_then(|p| p.delta)
                             .unwrap_or(path.delta_mm);
-                        [v, h]
+                        [v, h, w]
                     })
                     .collect()
             })
@@ -595,6 +641,20 @@ impl PlannedPart {
                 layers: c.layers,
             }),
             splits: self.split_summaries(),
+            slowed: self
+                .slowed
+                .iter()
+                .map(|s| SlowSummary {
+                    layer: s.layer,
+                    bead: s.bead,
+                    points_slowed: s.points_slowed,
+                    slowest_mm_s: s.slowest_mm_s,
+                    slowest_point: s.slowest_point,
+                    wire_feed_min_mm_s: self.sliced.process.wire_feed_speed_mm_s * s.slowest_mm_s
+                        / self.travel_speed_mm_s(),
+                    why: s.why.clone(),
+                })
+                .collect(),
             run_time_s: self.times,
             path: {
                 let mut path = self.sliced.path_summary();

@@ -214,6 +214,9 @@ pub struct PlanSummary {
     /// Where a layer's bead was split at a corner (torch-carried cells), in
     /// path order; each split is one more arc start (`arc_starts`).
     pub splits: Vec<SplitSummary>,
+    /// Where the torch slows down because an axis cannot keep up at the
+    /// process's speed, per bead, in path order.
+    pub slowed: Vec<SlowSummary>,
     /// Filled by the writer of the program files (`null` here).
     pub program: Option<()>,
     /// The program stage's refusal of a plan whose layers are all feasible
@@ -253,6 +256,25 @@ pub struct SplitSummary {
     /// Turning angle of the layer's polyline across the corner (deg).
     pub turning_deg: f64,
     /// Why the layer was split: how its plan as one bead failed.
+    pub why: String,
+}
+
+/// A bead slowed down ([`SlowedBead`](crate::optimise::SlowedBead)).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SlowSummary {
+    /// The layer.
+    pub layer: usize,
+    /// The bead within the layer (0 for a whole layer).
+    pub bead: usize,
+    /// Points reached slower than the process's speed.
+    pub points_slowed: usize,
+    /// The slowest travel speed of the bead (mm/s).
+    pub slowest_mm_s: f64,
+    /// The layer's point reached at that speed.
+    pub slowest_point: usize,
+    /// The wire feed there (mm/s): the process's, scaled as the speed.
+    pub wire_feed_min_mm_s: f64,
+    /// Why: how the plan at the process's speed failed.
     pub why: String,
 }
 

@@ -256,9 +256,9 @@ fn replan_core(
         format,
         plan,
         program,
-        point_speeds_mm_s: Some(corrections.iter().map(|c| c.speed_mm_s.clone()).collect()),
         clearance,
         splits: Vec::new(),
+        slowed: Vec::new(),
     };
     Ok(ReplannedPart {
         planned,

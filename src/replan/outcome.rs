@@ -105,7 +105,7 @@ pub struct ReplannedPart {
     /// path with the corrected layers (part frame, mm; each corrected point's
     /// `delta` is its bead height), `planned.layers` and `planned.plan` the
     /// layers after `after_layer` only, `planned.program` the program that
-    /// resumes the build, `planned.point_speeds_mm_s` every point's speed.
+    /// resumes the build, each point of `planned.layers` at its corrected speed.
     pub planned: PlannedPart,
     /// The measured layer `K`.
     pub after_layer: usize,
