@@ -17,9 +17,12 @@ use crate::robot::cell::{CellLayout, CellPoint};
 use super::split::shift_turns;
 use super::{optimise, transitions, LayerPlan, LayerPoints, OptimiseError, OptimiseOptions, Plan};
 
-/// Speeds are set this far (relative) under the one at which a joint reaches
-/// its bound, so that the joint speed measured again stays under it.
-const SPEED_SAFETY: f64 = 1e-6;
+/// A slowed step's joints turn at most this fraction of their maximum speed
+/// on average from point to point: the controller interpolates the tool
+/// between the points (a straight line, the orientation by slerp), and the
+/// joints' speed peaks within a step above their average there, most near
+/// the wrist singularity where the steps slow down.
+const SPEED_FRACTION: f64 = 0.8;
 
 /// One entry of a plan slowed down by [`slow_refused_layers`].
 #[derive(Debug, Clone, PartialEq)]
@@ -192,7 +195,7 @@ fn with_joint_speeds(
         let d = (layer.points[m].position_mm - layer.points[m - 1].position_mm).norm();
         let own = layer.points[m].travel_speed_mm_s;
         let v = if need > 0.0 {
-            (d / (need * (1.0 + SPEED_SAFETY))).min(own)
+            (SPEED_FRACTION * d / need).min(own)
         } else {
             own
         };

@@ -42,7 +42,7 @@ fn plan_refuses_fixed_zero_and_succeeds_with_a_linear_law() {
     let text = std::fs::read_to_string(good.join("joints.csv")).unwrap();
     assert_eq!(
         text.lines().next().unwrap(),
-        "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6,travel_speed_mm_s,bead_height_mm,bead"
+        "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6,travel_speed_mm_s,bead_height_mm,bead,wire_feed_mm_s"
     );
     assert!(text.lines().count() > 14 * 120);
     let summary: serde_json::Value =
@@ -110,9 +110,9 @@ fn plan_names_the_bad_file_and_field() {
 /// sample parts, sliced at Delta = 5 mm with their own `[tool_axis]` and
 /// `[process]` tables, plan in the ROBOWAM part-carried cell (the cell the
 /// thesis built its tubes in) and get a FANUC program that `check` accepts.
-/// Without the tool-axis rate bound (`--plain-axes`) the quarter torus is
-/// refused (exit 2): at the cusps of its upper layers the wrist would have
-/// to turn faster than J4/J6 can.
+/// Without the tool-axis rate bound (`--plain-axes`) the wrist would have to
+/// turn faster than J4/J6 can at the cusps of the quarter torus's upper
+/// layers: the torch slows there (issue 45; before, exit 2).
 #[test]
 fn every_sample_part_plans_in_the_part_carried_cell() {
     let dir = tempfile::tempdir().unwrap();
@@ -163,11 +163,41 @@ fn every_sample_part_plans_in_the_part_carried_cell() {
         .arg(&out)
         .status()
         .unwrap();
-    assert_eq!(status.code(), Some(2));
+    // with the tool axis along the build direction, the wrist cannot turn
+    // through the quarter torus's corners at the process's speed: the torch
+    // slows there (before the slowdown, exit 2 on "J4 needs"/"J6 needs"),
+    // within the PLA window (3–12 mm/s), and the checker reads the program's
+    // slower moves back clean
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    let v = summary["violations"].to_string();
-    assert!(v.contains("J4 needs") || v.contains("J6 needs"), "{v}");
+    assert_eq!(status.code(), Some(0), "{summary}");
+    let slowed = summary["slowed"].as_array().expect("slowed beads");
+    assert!(!slowed.is_empty(), "{summary}");
+    for s in slowed {
+        let why = s["why"].as_str().unwrap();
+        assert!(why.contains("J4 speed") || why.contains("J6 speed"), "{s}");
+        let v = s["slowest_mm_s"].as_f64().unwrap();
+        assert!((3.0..6.0).contains(&v), "{s}");
+    }
+    let program = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ls"))
+        .min_by_key(|p| p.as_os_str().len())
+        .expect("a program");
+    let check = waam()
+        .args(["--quiet", "check"])
+        .arg(&program)
+        .arg("--cell")
+        .arg(&cell)
+        .output()
+        .unwrap();
+    assert_eq!(
+        check.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&check.stderr)
+    );
 }
 
 /// A layer without any joint solution is an answer, not an error (issue 33):

@@ -64,7 +64,7 @@ fn replan_writes_the_remaining_layers_and_refuses_a_scan_of_another_layer() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6,travel_speed_mm_s,bead_height_mm,bead"
+        "layer,point,x,y,z,tx,ty,tz,rz_deg,j1,j2,j3,j4,j5,j6,travel_speed_mm_s,bead_height_mm,bead,wire_feed_mm_s"
     );
     assert!(lines.next().unwrap().starts_with("11,0,"));
     assert_eq!(csv.lines().count(), 1 + 3 * 96);
