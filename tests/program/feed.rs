@@ -232,7 +232,7 @@ fn abb_writes_each_moves_welddata_speed_and_wire_feed() {
 /// shorter). Each arc-on move is written `ceil(1000 r theta / 6)` ms at 6
 /// mm/s (layer 0: 5891 ms where the chord gave 5741), and the checker,
 /// which measures the deposited path the same way, finds the chord's time
-/// 2.6 % too fast.
+/// 2.6 % too fast; the cycle time's bead is the arcs' time.
 #[test]
 fn fanuc_timed_moves_take_the_time_of_the_deposited_arc() {
     let c = cell("robowam_part_carried.toml");
@@ -280,4 +280,15 @@ fn fanuc_timed_moves_take_the_time_of_the_deposited_arc() {
         .find(|p| p.kind == ProblemKind::Feed)
         .unwrap_or_else(|| panic!("{r}"));
     assert!(p.message.contains("-2.5"), "{p}");
+    // the cycle time runs the same moves: layer 0's bead is 7 arcs of
+    // 35.34 mm at 6 mm/s (41.23 s; the chords' 40.18 s before), the
+    // acceleration ramps adding milliseconds
+    let cycle =
+        waam_slicer::program::cycle::cycle_time(&prog, &c.robot().vendor.cycle_options(&settings));
+    let arcs = 7.0 * 45.0 * theta / ts;
+    let bead = cycle.layers[0].bead_s;
+    assert!(
+        bead >= arcs && bead < arcs + 0.05,
+        "{bead} s, arcs {arcs} s"
+    );
 }

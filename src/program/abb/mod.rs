@@ -1261,6 +1261,12 @@ impl Controller for Abb {
         CycleOptions {
             joint_speed_fraction: 1.0,
             joint_move_tcp_speed_mm_s: Some(opts.approach_speed_mm_s),
+            // a stationary tool (part carried by default) or a work object
+            // moving with the positioner: the part frame
+            beads_in_part_frame: [
+                opts.stationary_tool.unwrap_or(true),
+                opts.common.coordinated && !opts.stationary_tool.unwrap_or(false),
+            ],
             ..CycleOptions::default()
         }
     }

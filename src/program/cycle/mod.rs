@@ -83,6 +83,15 @@ pub struct CycleOptions {
     /// Acceleration of the torch along its path over the part (mm/s², > 0),
     /// for the linear and circular moves.
     pub path_acceleration_mm_s2: f64,
+    /// Whether the controller interpolates a bead's moves in the part frame,
+    /// `[part-carried cell, torch-carried cell]`: then the deposited path is
+    /// the chord or arc between the positions; else it runs in the robot
+    /// base frame, the part turns under the tool and the deposited path, the
+    /// one a move's speed or time is planned over, bows away from the chord
+    /// ([`deposited_length_mm`](crate::program::pose::deposited_length_mm);
+    /// FANUC without remote TCP, torch-carried cells without coordination).
+    /// Default `[true, true]`.
+    pub beads_in_part_frame: [bool; 2],
 }
 
 impl Default for CycleOptions {
@@ -91,6 +100,7 @@ impl Default for CycleOptions {
             joint_speed_fraction: 0.1,
             joint_move_tcp_speed_mm_s: None,
             path_acceleration_mm_s2: ASSUMED_PATH_ACCELERATION_MM_S2,
+            beads_in_part_frame: [true, true],
         }
     }
 }
@@ -287,6 +297,11 @@ pub fn cycle_time(program: &Program, opts: &CycleOptions) -> CycleTime {
     let cell = &program.cell;
     let axes = Axes::of(cell);
     let defaults = CycleOptions::default();
+    let in_part = match cell {
+        crate::robot::CellLayout::PartCarried(_) => opts.beads_in_part_frame[0],
+        crate::robot::CellLayout::TorchCarried(_) => opts.beads_in_part_frame[1],
+    };
+    let deposited = (!in_part).then_some(cell);
     let fraction = if opts.joint_speed_fraction > 0.0 && opts.joint_speed_fraction <= 1.0 {
         opts.joint_speed_fraction
     } else {
@@ -366,7 +381,7 @@ pub fn cycle_time(program: &Program, opts: &CycleOptions) -> CycleTime {
             if s > 0 {
                 lc.approach_s = linear_move(&block[s - 1], &block[s], block[s - 1].speed_mm_s);
             }
-            lc.bead_s = bead_time(&axes, &block[s..=e], accel);
+            lc.bead_s = bead_time(&axes, &block[s..=e], accel, deposited);
             if e + 1 < block.len() {
                 lc.retract_s = linear_move(&block[e], &block[e + 1], block[e + 1].speed_mm_s);
             }
@@ -388,8 +403,26 @@ pub fn cycle_time(program: &Program, opts: &CycleOptions) -> CycleTime {
 }
 
 /// The blended moves of one bead (its first point to its last) as
-/// [`Segment`]s, and their [`profile_time`] (s).
-fn bead_time(axes: &Axes, bead: &[ProgramPoint], accel: f64) -> f64 {
+/// [`Segment`]s, and their [`profile_time`] (s); with `deposited` (the cell,
+/// interpolating in the robot base frame) each move's length is the path it
+/// deposits, not the chord.
+fn bead_time(
+    axes: &Axes,
+    bead: &[ProgramPoint],
+    accel: f64,
+    deposited: Option<&crate::robot::CellLayout>,
+) -> f64 {
+    let over_part = |a: &ProgramPoint, via: Option<&ProgramPoint>, b: &ProgramPoint| {
+        deposited.map(|cell| {
+            crate::program::pose::deposited_length_mm(
+                cell,
+                (&a.joints, a.positioner),
+                via.map(|v| (&v.joints, v.positioner)),
+                (&b.joints, b.positioner),
+                false,
+            )
+        })
+    };
     let mut segments = Vec::with_capacity(bead.len());
     let mut k = 1;
     while k < bead.len() {
@@ -402,7 +435,9 @@ fn bead_time(axes: &Axes, bead: &[ProgramPoint], accel: f64) -> f64 {
             k += 2;
             (
                 b,
-                arc_length(&a.position_mm, &via.position_mm, &b.position_mm),
+                over_part(a, Some(via), b).unwrap_or_else(|| {
+                    arc_length(&a.position_mm, &via.position_mm, &b.position_mm)
+                }),
                 d,
             )
         } else {
@@ -410,7 +445,7 @@ fn bead_time(axes: &Axes, bead: &[ProgramPoint], accel: f64) -> f64 {
             k += 1;
             (
                 b,
-                distance(&a.position_mm, &b.position_mm),
+                over_part(a, None, b).unwrap_or_else(|| distance(&a.position_mm, &b.position_mm)),
                 Axes::changes(&a.joints, a.positioner, &b.joints, b.positioner),
             )
         };

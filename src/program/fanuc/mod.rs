@@ -191,6 +191,9 @@ impl Controller for Fanuc {
     fn cycle_options(opts: &FanucOptions) -> CycleOptions {
         CycleOptions {
             joint_speed_fraction: f64::from(opts.approach_percent) / 100.0,
+            // the flange interpolated unless remote TCP (part carried) or
+            // COORD (torch carried)
+            beads_in_part_frame: [opts.common.remote_tcp, opts.common.coordinated],
             ..CycleOptions::default()
         }
     }

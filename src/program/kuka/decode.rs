@@ -393,6 +393,18 @@ impl<'a> Decoder<'a> {
                 });
                 self.arc_is_on = true;
                 self.sup.bead_start(h.on_line, true);
+                if self.anout.is_none() {
+                    push(
+                        &mut self.report,
+                        ProblemKind::Feed,
+                        src,
+                        h.on_line,
+                        format!(
+                            "arc on without the wire feed's command: no `$ANOUT[{}] = ...` before it",
+                            self.opts.wire_feed_anout
+                        ),
+                    );
+                }
             }
             _ => {
                 let form = handshake_form(self.opts);

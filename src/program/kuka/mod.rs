@@ -192,6 +192,12 @@ impl Controller for Kuka {
     fn cycle_options(opts: &KukaOptions) -> CycleOptions {
         CycleOptions {
             joint_speed_fraction: f64::from(opts.ptp_percent) / 100.0,
+            // fixed-tool mode (part carried by default) or a base coupled
+            // to the positioner: the part frame
+            beads_in_part_frame: [
+                opts.external_tcp.unwrap_or(true),
+                opts.common.coordinated && !opts.external_tcp.unwrap_or(false),
+            ],
             ..CycleOptions::default()
         }
     }
