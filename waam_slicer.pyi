@@ -268,7 +268,16 @@ class PlannedPart:
         positioner (its two joints last); NaN where a point has no solution."""
     @property
     def travel_speed_mm_s(self) -> float:
-        """The travel speed planned (mm/s)."""
+        """The process's travel speed (mm/s): every point's, but where the
+        plan slowed the torch down (point_speed_mm_s)."""
+    @property
+    def point_speed_mm_s(self) -> npt.NDArray[np.float64]:
+        """Travel speed on the way to each point (N,), mm/s: the process's,
+        or slower where an axis could not keep up (the summary's slowed)."""
+    @property
+    def wire_feed_mm_s(self) -> npt.NDArray[np.float64]:
+        """Wire feed on the way to each point (N,), mm/s: the process's,
+        scaled with the speed where the torch slows (WFS/TS stays)."""
     @property
     def format(self) -> str:
         """The program format written by default (the cell vendor's)."""

@@ -20,6 +20,10 @@ pub(crate) struct PyPlannedPart {
     layer: Py<PyArray1<i64>>,
     rz_deg: Py<PyArray1<f64>>,
     joints: Py<PyArray2<f64>>,
+    /// Travel speed on the way to each point (N,), mm/s.
+    speed: Py<PyArray1<f64>>,
+    /// Wire feed on the way to each point (N,), mm/s.
+    wire_feed: Py<PyArray1<f64>>,
     /// A replan's whole summary (with its `replan` object), when this is
     /// the plan of the remaining layers of a replan.
     replan_summary: Option<crate::replan::summary::ReplanSummary>,
@@ -59,7 +63,10 @@ impl PyPlannedPart {
                 }
             }
         }
+        let process: Vec<[f64; 3]> = planned.point_process().into_iter().flatten().collect();
         Ok(Self {
+            speed: arrays::floats(py, process.iter().map(|p| p[0]).collect())?,
+            wire_feed: arrays::floats(py, process.iter().map(|p| p[2]).collect())?,
             points: arrays::matrix(py, points, 3)?,
             tool_axis: arrays::matrix(py, axes, 3)?,
             layer: arrays::ints(py, layer)?,
@@ -196,10 +203,26 @@ impl PyPlannedPart {
         self.joints.bind(py).clone()
     }
 
-    /// The travel speed planned (mm/s).
+    /// The process's travel speed (mm/s): every point's, but where the
+    /// plan slowed the torch down (`point_speed_mm_s`).
     #[getter]
     fn travel_speed_mm_s(&self) -> f64 {
         self.planned.travel_speed_mm_s()
+    }
+
+    /// Travel speed on the way to each point (N,), mm/s: the process's, or
+    /// slower where an axis could not keep up (the summary's `slowed`).
+    #[getter]
+    fn point_speed_mm_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.speed.bind(py).clone()
+    }
+
+    /// Wire feed on the way to each point (N,), mm/s: the process's, scaled
+    /// with the speed where the torch slows (WFS/TS, the bead's
+    /// cross-section, stays).
+    #[getter]
+    fn wire_feed_mm_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.wire_feed.bind(py).clone()
     }
 
     /// The program format written by default: the cell robot's vendor's.

@@ -63,6 +63,15 @@ def test_joints_are_the_clis(hemisphere, waam_cli, tmp_path, cell_file, width):
     np.testing.assert_allclose(plan.tool_axis, axes, atol=2e-6)
     np.testing.assert_allclose(plan.rz_deg, [float(row["rz_deg"]) for row in rows], atol=2e-6)
     assert plan.layer.tolist() == [int(row["layer"]) for row in rows]
+    for key, got in (
+        ("travel_speed_mm_s", plan.point_speed_mm_s),
+        ("wire_feed_mm_s", plan.wire_feed_mm_s),
+    ):
+        np.testing.assert_allclose(got, [float(row[key]) for row in rows], atol=2e-6)
+    # nothing slowed on the hemisphere: the process's speed and wire feed
+    # at every point (PLA, table 3.1: 6 mm/s, 10 mm/s)
+    np.testing.assert_allclose(plan.point_speed_mm_s, plan.travel_speed_mm_s)
+    np.testing.assert_allclose(plan.wire_feed_mm_s / plan.point_speed_mm_s, 10.0 / 6.0)
 
 
 def test_infeasible_plan_refuses_to_write(hemisphere, part_carried, tmp_path):
