@@ -491,10 +491,9 @@ fn safe_transits(
         let refuse = |r: transit::TransitClearance, why: String| ProgramError::Infeasible {
             count: 1,
             first: format!(
-                "layer {layer}: the arc-off joint move to {to_what} passes {:.1} mm into the \
-                 deposited wall at {:.0}% of the move (torch tip at [{:.1}, {:.1}, {:.1}] mm, \
-                 part frame){why}",
-                -r.min_clearance_mm,
+                "layer {layer}: the arc-off joint move to {to_what} passes {} at {:.0}% of the \
+                 move (torch tip at [{:.1}, {:.1}, {:.1}] mm, part frame){why}",
+                transit::intrusion(r.min_clearance_mm, opts.bead_radius_mm),
                 100.0 * r.at_fraction,
                 r.tip_mm.x,
                 r.tip_mm.y,

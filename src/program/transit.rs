@@ -77,6 +77,20 @@ pub struct TransitClearance {
     pub tip_mm: Point3,
 }
 
+/// How deep a transit's deepest sample goes into the wall, in words:
+/// `min_clearance_mm` (negative, mm) below the capsules' surface, or, where
+/// it reaches `bead_radius_mm` (the capsules' radius, mm), through the
+/// bead: the distance measured is to the bead's centreline, so a torch
+/// across it reads the radius whatever the crossing.
+pub fn intrusion(min_clearance_mm: f64, bead_radius_mm: f64) -> String {
+    let depth = -min_clearance_mm;
+    if bead_radius_mm > 0.0 && depth >= bead_radius_mm - 1e-6 {
+        "through the deposited wall (the torch crosses a bead's centreline)".to_string()
+    } else {
+        format!("{depth:.1} mm into the deposited wall")
+    }
+}
+
 /// Where the torch touches `wall` along the joint move from `(qa, pa)` to
 /// `(qb, pb)` (robot joints, positioner joints; rad), sampled every
 /// [`TRANSIT_STEP_RAD`] of the joint that moves most, both ends included:

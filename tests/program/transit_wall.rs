@@ -207,3 +207,45 @@ fn the_arc_off_moves_of_a_program_meet_the_wall_alike() {
     }
     assert!(colliding >= 3, "{colliding} colliding moves");
 }
+
+/// The transit's depth in words (`transit::intrusion`): the clearance is
+/// measured from the torch to the bead's centreline, less the bead's
+/// radius, so a torch pushed 1 mm into a bead (tip 1 mm inside the capsule,
+/// axis across it) reads 1 mm, and a torch through the bead (its tip below
+/// the centreline) reads the radius itself however deep it goes: that is
+/// said as "through the deposited wall", not as a depth (before, the elbow's
+/// and the S-bend's refused transits read "2.0 mm into the deposited wall").
+#[test]
+fn a_torch_through_the_bead_is_said_so_not_given_the_radius_as_its_depth() {
+    use waam_slicer::program::transit::intrusion;
+    let radius = 2.0;
+    // one straight bead along X at the origin
+    let bead: Vec<Point3> = (0..=20).map(|i| Point3::new(i as f64, 0.0, 0.0)).collect();
+    let wall = wall_of([bead.as_slice()], radius);
+    let torch = Torch::new(&Default::default()).unwrap();
+    let up = Vector3::z();
+    // the torch's lowest point lies `stand` above the wire's tip (its
+    // point): measured with the tip on the centreline
+    let stand = wall
+        .clearance(&torch, &Point3::new(10.0, 0.0, 0.0), &up)
+        .unwrap()
+        + radius;
+    assert!(stand > 0.0, "{stand}");
+    // lowest point 1 mm inside the capsule's top: 1 mm deep
+    let c = wall
+        .clearance(&torch, &Point3::new(10.0, 0.0, 1.0 - stand), &up)
+        .unwrap();
+    assert!((c + 1.0).abs() < 1e-9, "{c}");
+    assert_eq!(intrusion(c, radius), "1.0 mm into the deposited wall");
+    // lowest point 5 and 10 mm below the centreline: the same -radius
+    for z in [-5.0, -10.0] {
+        let c = wall
+            .clearance(&torch, &Point3::new(10.0, 0.0, z - stand), &up)
+            .unwrap();
+        assert!((c + radius).abs() < 1e-9, "{z}: {c}");
+        assert_eq!(
+            intrusion(c, radius),
+            "through the deposited wall (the torch crosses a bead's centreline)"
+        );
+    }
+}

@@ -912,9 +912,9 @@ fn check_transits(
                                 &m.file,
                                 m.line,
                                 format!(
-                                    "the joint move to {} sweeps the torch {:.1} mm into the deposited wall at {:.0}% of the move (torch tip at [{:.1}, {:.1}, {:.1}] mm, part frame)",
+                                    "the joint move to {} sweeps the torch {} at {:.0}% of the move (torch tip at [{:.1}, {:.1}, {:.1}] mm, part frame)",
                                     m.label,
-                                    -c.min_clearance_mm,
+                                    crate::program::transit::intrusion(c.min_clearance_mm, common.bead_radius_mm),
                                     100.0 * c.at_fraction,
                                     c.tip_mm.x,
                                     c.tip_mm.y,
