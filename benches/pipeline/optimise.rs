@@ -111,52 +111,65 @@ pub fn plan_at_scale(c: &mut Criterion) {
 }
 
 /// The torch-carried cell against the part-carried cell for the same part
-/// [issue 33]: the whole optimisation (the positioner's laws, then `R_Z`)
-/// of the hemisphere (Delta 5 mm) and of the elbow (its own grid: Delta 2 mm,
-/// 400 points a layer) in the ROBOWAM and KUKA KR 16-2 cells. Goal: the
-/// torch-carried planning time per layer within 2× of the part-carried one.
-/// The layers are the same in both cells, so the ratio of the medians is the
-/// ratio per layer.
+/// [issue 33; issue 45, deliverable 7]: `plan`'s whole optimising stage
+/// (the positioner's laws, `R_Z`, then the corner splits and the slow-down
+/// of refused layers; `PlanTimes::optimise`) of the hemisphere and the elbow
+/// at their part files' own grids, in the ROBOWAM and the KUKA KR 16-2
+/// cells. Goal: the torch-carried planning time per layer within 2× of the
+/// part-carried one. Both cells' plans are timed in the same run,
+/// alternately, and the ratio of their mean times per layer is printed.
 pub fn torch_vs_part_carried(c: &mut Criterion) {
-    let cell = |f: &str| -> CellLayout {
-        read_cell_file(parts_dir().join("cells").join(f))
-            .unwrap()
-            .cell
-            .unwrap()
-    };
+    use std::time::Duration;
     let mut g = c.benchmark_group("torch_vs_part_carried");
-    g.sample_size(10);
-    for (part, delta, pair) in [
-        (
-            "hemisphere.toml",
-            5.0,
-            ["robowam_part_carried.toml", "robowam_torch_carried.toml"],
-        ),
-        (
-            "elbow.toml",
-            2.0,
-            [
-                "kuka_kr16_2_part_carried.toml",
-                "kuka_kr16_2_torch_carried.toml",
-            ],
-        ),
-    ] {
-        let l = layers(part, delta);
-        for file in pair {
-            let cl = cell(file);
-            let opts = OptimiseOptions {
-                configuration: waam_slicer::optimise::ConfigurationChoice::Cell,
-                ..OptimiseOptions::default()
-            };
-            let name = format!(
-                "{}_{}_{}_layers",
-                part.trim_end_matches(".toml"),
-                file.trim_end_matches(".toml"),
-                l.len()
-            );
-            g.bench_function(name, |b| {
-                b.iter(|| optimise(black_box(&cl), black_box(&l), &opts).unwrap())
+    g.sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(10));
+    for part in ["hemisphere", "elbow"] {
+        let p = waam_slicer::Part::read(parts_dir().join(format!("{part}.toml"))).unwrap();
+        for robot in ["robowam", "kuka_kr16_2"] {
+            let cells = ["part_carried", "torch_carried"].map(|kind| {
+                waam_slicer::Cell::read(
+                    parts_dir()
+                        .join("cells")
+                        .join(format!("{robot}_{kind}.toml")),
+                )
+                .unwrap()
             });
+            // mean optimising time per layer (s) of each cell, over every plan
+            let per_layer = std::cell::RefCell::new([(0.0, 0usize); 2]);
+            for (k, (cell, kind)) in cells.iter().zip(["part", "torch"]).enumerate() {
+                g.bench_function(format!("{part}_{robot}_{kind}_carried"), |b| {
+                    b.iter_custom(|iters| {
+                        let mut total = Duration::ZERO;
+                        for _ in 0..iters {
+                            let planned = waam_slicer::plan_part(
+                                black_box(&p),
+                                cell,
+                                &waam_slicer::PlanOptions::default(),
+                            )
+                            .unwrap();
+                            let t = planned.times.optimise;
+                            let layers = planned.sliced.path.layers.len().max(1);
+                            let mut m = per_layer.borrow_mut();
+                            m[k].0 += t / layers as f64;
+                            m[k].1 += 1;
+                            total += Duration::from_secs_f64(t);
+                        }
+                        total
+                    })
+                });
+            }
+            let m = per_layer.borrow();
+            let mean = |k: usize| m[k].0 / m[k].1.max(1) as f64;
+            eprintln!(
+                "torch_vs_part_carried {part} in {robot}: {:.2} ms a layer torch carried, \
+                 {:.2} ms part carried, ratio {:.2} ({} and {} plans)",
+                1e3 * mean(1),
+                1e3 * mean(0),
+                mean(1) / mean(0),
+                m[1].1,
+                m[0].1
+            );
         }
     }
     g.finish();
