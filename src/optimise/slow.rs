@@ -24,6 +24,13 @@ use super::{optimise, transitions, LayerPlan, LayerPoints, OptimiseError, Optimi
 /// the wrist singularity where the steps slow down.
 const SPEED_FRACTION: f64 = 0.8;
 
+/// Slowed speeds are rounded down to whole steps of this fraction of the
+/// point's own speed: a slowed bead runs at a few speeds (at most
+/// `1 / SPEED_STEP`) rather than one a point, so its program changes speed
+/// and wire feed (a FANUC weld schedule, a KUKA analog command, an ABB
+/// welddata) a few times, not at every move. Rounding down keeps the bound.
+const SPEED_STEP: f64 = 0.05;
+
 /// One entry of a plan slowed down by [`slow_refused_layers`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct SlowedBead {
@@ -195,7 +202,8 @@ fn with_joint_speeds(
         let d = (layer.points[m].position_mm - layer.points[m - 1].position_mm).norm();
         let own = layer.points[m].travel_speed_mm_s;
         let v = if need > 0.0 {
-            (SPEED_FRACTION * d / need).min(own)
+            let step = SPEED_STEP * own;
+            ((SPEED_FRACTION * d / need / step).floor() * step).min(own)
         } else {
             own
         };

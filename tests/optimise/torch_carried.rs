@@ -932,4 +932,21 @@ fn a_layer_the_positioner_cannot_follow_plans_slowed_with_the_wire_feed_followin
     }
     assert!(slow_rows >= s.points_slowed, "{slow_rows} rows");
     assert!((min_speed - s.slowest_mm_s).abs() < 1e-5);
+    // a few speeds, not one a point: whole 5 % steps of the nominal, or the
+    // window's floor
+    let mut speeds: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.layer == 6)
+        .filter_map(|r| r.travel_speed_mm_s)
+        .collect();
+    speeds.sort_by(f64::total_cmp);
+    speeds.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+    for v in &speeds {
+        let k = v / (0.05 * nominal);
+        assert!(
+            (k - k.round()).abs() < 1e-4 || (v - 1.0).abs() < 1e-6,
+            "{v}"
+        );
+    }
+    assert!(speeds.len() <= 21, "{speeds:?}");
 }
