@@ -116,8 +116,9 @@ pub fn plan_at_scale(c: &mut Criterion) {
 /// of refused layers; `PlanTimes::optimise`) of the hemisphere and the elbow
 /// at their part files' own grids, in the ROBOWAM and the KUKA KR 16-2
 /// cells. Goal: the torch-carried planning time per layer within 2× of the
-/// part-carried one. Both cells' plans are timed in the same run,
-/// alternately, and the ratio of their mean times per layer is printed.
+/// part-carried one. Both cells' plans are timed in the same run, one
+/// cell after the other, and the ratio of their mean times per layer is
+/// printed.
 pub fn torch_vs_part_carried(c: &mut Criterion) {
     use std::time::Duration;
     let mut g = c.benchmark_group("torch_vs_part_carried");
