@@ -130,28 +130,7 @@ fn every_sample_part_plans_in_the_part_carried_cell() {
             .unwrap();
         let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
         assert_eq!(status.code(), Some(0), "{part}: {summary}");
-        // The program: the shortest .ls name (NAME.ls; a build cut to the
-        // memory budget is NAME_P01.ls, NAME_P02.ls, …, any of which brings
-        // the others to `check`).
-        let program = std::fs::read_dir(&out)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "ls"))
-            .min_by_key(|p| p.as_os_str().len())
-            .unwrap_or_else(|| panic!("{part}: no program"));
-        let check = waam()
-            .args(["--quiet", "check"])
-            .arg(&program)
-            .arg("--cell")
-            .arg(&cell)
-            .output()
-            .unwrap();
-        assert_eq!(
-            check.status.code(),
-            Some(0),
-            "{part}: {}",
-            String::from_utf8_lossy(&check.stderr)
-        );
+        checks_clean(&out, &cell, part);
     }
     let out = dir.path().join("plain");
     let status = waam()
@@ -179,23 +158,31 @@ fn every_sample_part_plans_in_the_part_carried_cell() {
         let v = s["slowest_mm_s"].as_f64().unwrap();
         assert!((3.0..6.0).contains(&v), "{s}");
     }
-    let program = std::fs::read_dir(&out)
+    checks_clean(&out, &cell, "quarter torus, --plain-axes");
+}
+
+/// `waam check` reads the FANUC program `plan` wrote in `out` back clean
+/// against `cell` (exit 0): the shortest `.ls` name (NAME.ls; a build cut
+/// to the memory budget is NAME_P01.ls, NAME_P02.ls, …, any of which brings
+/// the others to `check`).
+fn checks_clean(out: &std::path::Path, cell: &std::path::Path, what: &str) {
+    let program = std::fs::read_dir(out)
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "ls"))
         .min_by_key(|p| p.as_os_str().len())
-        .expect("a program");
+        .unwrap_or_else(|| panic!("{what}: no program"));
     let check = waam()
         .args(["--quiet", "check"])
         .arg(&program)
         .arg("--cell")
-        .arg(&cell)
+        .arg(cell)
         .output()
         .unwrap();
     assert_eq!(
         check.status.code(),
         Some(0),
-        "{}",
+        "{what}: {}",
         String::from_utf8_lossy(&check.stderr)
     );
 }
