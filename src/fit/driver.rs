@@ -24,6 +24,21 @@ struct Samples {
     pos: Vec<Point3>,
     skin: Vec<u8>,
     skins: usize,
+    /// The first `vertices` samples are the skins' vertices; the others
+    /// lie along the skins' long edges.
+    vertices: usize,
+}
+
+impl Samples {
+    /// The skins' vertices only.
+    fn vertex_only(&self) -> Samples {
+        Samples {
+            pos: self.pos[..self.vertices].to_vec(),
+            skin: self.skin[..self.vertices].to_vec(),
+            skins: self.skins,
+            vertices: self.vertices,
+        }
+    }
 }
 
 /// Default station spacing, in median mesh edges: two edges between
@@ -82,6 +97,23 @@ const MAX_KNOTS: f64 = 1000.0;
 /// around, as rings of a coarse mesh between its stations give.
 const WIDEN_GAP_DEG: f64 = 60.0;
 
+/// Sections are checked from this refit on (dimensionless count) when the
+/// samples hold points along a coarse bend's edges ([`with_bend_edges`]):
+/// the first guides of a coarse export (level sets a few edges wide) leave
+/// sections that are not yet circles. Otherwise from the second.
+const CHECK_SECTIONS_AFTER: usize = 6;
+/// Most refits with the points along a coarse bend's edges (dimensionless
+/// count); then the vertices alone.
+const EDGE_REFITS: usize = 8;
+/// An edge spans a bend when the first guide turns by more than this
+/// between its ends (degrees): a coarse export's bend in eight stretches
+/// along 90 degrees turns by 11 degrees a stretch.
+const BEND_EDGE_MIN_TURN_DEG: f64 = 3.0;
+/// An edge runs along the tube when within this of the first guide's
+/// tangent (degrees): the long thin triangles of a coarse export do, the
+/// flat rings of a flange and the rings of vertices do not.
+const BEND_EDGE_MAX_ANGLE_DEG: f64 = 45.0;
+
 /// Fits a tube to `mesh`.
 ///
 /// # Errors
@@ -134,11 +166,32 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
 
 /// [`fit_tube`] on a mesh already in mm; `trimmed`: the mesh was already
 /// cut to a tubular stretch (features are not looked for again).
+///
+/// The fit runs on the skins' vertices; when their sections fail (not near
+/// a circle, too few), it runs again with points along the edges of a
+/// coarse bend too ([`with_bend_edges`]), and the first failure stands when
+/// that fails as well: a mesh that fits on its vertices is fitted as before.
 fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFit, FitError> {
+    match fit_pass(mesh, opts, trimmed, false) {
+        Err(e @ (FitError::SectionNotCircle { .. } | FitError::Degenerate { .. })) => {
+            fit_pass(mesh, opts, trimmed, true).map_err(|_| e)
+        }
+        fitted => fitted,
+    }
+}
+
+/// One fit of [`fit_in_mm`]: on the skins' vertices, or with `bend_edges`
+/// on points along a coarse bend's edges first (an error when the mesh has
+/// no such edges: nothing new to try).
+fn fit_pass(
+    mesh: &TubeMesh,
+    opts: &FitOptions,
+    trimmed: bool,
+    bend_edges: bool,
+) -> Result<TubeFit, FitError> {
     let surf = topology::surfaces(mesh, opts)?;
     let ends = end_rings(mesh, &surf)?;
     let [mut start, mut finish] = choose_start(mesh, ends, opts)?;
-    let samples = samples(mesh, &surf);
     let edge = median_edge(mesh, &surf.skins[0].triangles);
     let r0 = start.radius.min(finish.radius);
     let spacing = opts.station_spacing_mm.unwrap_or_else(|| {
@@ -154,6 +207,27 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFi
         })
         .max(MIN_KNOT_STATIONS * spacing);
     let mut guide = initial_guide(mesh, &surf, &start, &finish, edge, knot_h)?;
+    let mut samples = samples(mesh, &surf);
+    let mut check_after = 1;
+    if bend_edges {
+        samples = with_bend_edges(
+            mesh,
+            &surf,
+            samples,
+            &spline_of(mesh, &guide)?,
+            tube_range(&guide),
+            spacing,
+            PROJECT_PAST_END_RADII * r0,
+        );
+        if samples.vertices == samples.pos.len() {
+            return Err(FitError::Degenerate {
+                file: mesh.file.clone(),
+                station: 0,
+                reason: "no edge spans a bend".into(),
+            });
+        }
+        check_after = CHECK_SECTIONS_AFTER;
+    }
     let mut hints: Option<Vec<f64>> = None;
     // The radius law's slope from the previous pass (none at first).
     let mut slope: Option<(Vec<f64>, Vec<f64>)> = None;
@@ -195,8 +269,11 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFi
             });
         }
         let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
-        if iterations > 1 {
+        if iterations > check_after {
             if let Err(e) = check_sections(mesh, &stations, opts) {
+                if bend_edges {
+                    return Err(e);
+                }
                 let cx = (
                     mesh,
                     &surf,
@@ -232,7 +309,21 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFi
         let noise = median_section_rms(&stations);
         let stall_level = (STALL_TOLERANCES * opts.tolerance_mm).max(STALL_NOISE_FRACTION * noise);
         let stalled = last_move < stall_level && last_move > STALL_SHRINK_RATIO * previous;
-        if last_move < opts.tolerance_mm || stalled {
+        let settled = last_move < opts.tolerance_mm || stalled;
+        if (settled || iterations >= EDGE_REFITS) && samples.vertices < samples.pos.len() {
+            // Settled on the edges' points too, or they had their refits:
+            // on to the vertices alone (the points along a coarse export's
+            // edges lie on its chords, inside the true surface, more on a
+            // bend's outer side than on its inner).
+            samples = samples.vertex_only();
+            hints = hints.map(|mut h| {
+                h.truncate(samples.vertices);
+                h
+            });
+            last_move = f64::INFINITY;
+            continue;
+        }
+        if settled {
             converged = true;
             break;
         }
@@ -240,15 +331,21 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFi
     let spline = spline_of(mesh, &guide)?;
     let knots = chord_knots(&guide);
     let range = tube_range(&guide);
+    let samples = samples.vertex_only();
     let t = project_all(
         &spline,
         range,
         &samples,
-        hints.as_deref(),
+        hints
+            .as_deref()
+            .map(|h| &h[..samples.vertices.min(h.len())]),
         PROJECT_PAST_END_RADII * r0,
     );
     let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
     if let Err(e) = check_sections(mesh, &stations, opts) {
+        if bend_edges {
+            return Err(e);
+        }
         let cx = (
             mesh,
             &surf,
@@ -532,6 +629,7 @@ fn choose_start(
     Ok(if swap { [b, a] } else { [a, b] })
 }
 
+/// The skins' vertices, with their skins.
 fn samples(mesh: &TubeMesh, surf: &Surfaces) -> Samples {
     let mut pos = Vec::new();
     let mut skin = Vec::new();
@@ -539,10 +637,86 @@ fn samples(mesh: &TubeMesh, surf: &Surfaces) -> Samples {
         pos.extend(s.vertices.iter().map(|&v| mesh.vertices[v as usize]));
         skin.extend(std::iter::repeat_n(k as u8, s.vertices.len()));
     }
+    let vertices = pos.len();
     Samples {
         pos,
         skin,
         skins: surf.skins.len(),
+        vertices,
+    }
+}
+
+/// `vertices` with points along the skins' edges that span a bend: edges
+/// longer than a station `spacing` (mm), running along the first `guide`
+/// (within [`BEND_EDGE_MAX_ANGLE_DEG`] of its tangent) while the guide turns
+/// by more than [`BEND_EDGE_MIN_TURN_DEG`] between their ends. A coarse
+/// export's bend (a few long stretches) then gives each station a ring of
+/// points of the surface, not only those near the exporter's vertex rings,
+/// which lie askew to the stations there. Straight stretches and the faces
+/// of features across the tube (a flange's flat rings) keep their vertices
+/// alone: their chords' points lie inside the surface. The edges' points
+/// come after the vertices (the report pairs the first samples with them).
+fn with_bend_edges(
+    mesh: &TubeMesh,
+    surf: &Surfaces,
+    vertices: Samples,
+    guide: &CubicSpline,
+    range: (f64, f64),
+    spacing: f64,
+    past_end: f64,
+) -> Samples {
+    let t = project_all(guide, range, &vertices, None, past_end);
+    let mut t_of = vec![f64::NAN; mesh.vertices.len()];
+    let skin_vertices = surf.skins.iter().flat_map(|s| s.vertices.iter());
+    for (&v, &tv) in skin_vertices.zip(&t) {
+        t_of[v as usize] = tv;
+    }
+    let (min_turn, max_angle) = (
+        BEND_EDGE_MIN_TURN_DEG.to_radians(),
+        BEND_EDGE_MAX_ANGLE_DEG.to_radians(),
+    );
+    let Samples {
+        mut pos, mut skin, ..
+    } = vertices;
+    let (count, mut bend) = (pos.len(), false);
+    for (k, s) in surf.skins.iter().enumerate() {
+        let mut edges: Vec<(u32, u32)> = s
+            .triangles
+            .iter()
+            .flat_map(|&t| {
+                let v = mesh.triangles[t as usize];
+                [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])].map(|(a, b)| (a.min(b), a.max(b)))
+            })
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        for (a, b) in edges {
+            let (p, q) = (mesh.vertices[a as usize], mesh.vertices[b as usize]);
+            let m = ((q - p).norm() / spacing).floor() as usize;
+            if m < 2 {
+                continue;
+            }
+            let (ta, tb) = (t_of[a as usize], t_of[b as usize]);
+            let along = guide.d1(0.5 * (ta + tb));
+            if (q - p).angle(&along).min((p - q).angle(&along)) >= max_angle {
+                continue;
+            }
+            bend |= guide.d1(ta).angle(&guide.d1(tb)) > min_turn;
+            for i in 1..m {
+                pos.push(p + (q - p) * (i as f64 / m as f64));
+                skin.push(k as u8);
+            }
+        }
+    }
+    if !bend {
+        pos.truncate(count);
+        skin.truncate(count);
+    }
+    Samples {
+        pos,
+        skin,
+        skins: surf.skins.len(),
+        vertices: count,
     }
 }
 
@@ -1094,7 +1268,15 @@ fn not_tube(
     error: FitError,
 ) -> Result<TubeFit, FitError> {
     let (mesh, surf, spline, stations, samples, t, reach) = cx;
-    let (tube, found) = features::detect(spline, stations, &samples.pos, &samples.skin, t, opts);
+    let nv = samples.vertices;
+    let (tube, found) = features::detect(
+        spline,
+        stations,
+        &samples.pos[..nv],
+        &samples.skin[..nv],
+        &t[..nv],
+        opts,
+    );
     let Some(first) = found.first() else {
         return Err(error);
     };

@@ -214,7 +214,7 @@ fn a_block_around_a_bore_is_a_feature_not_a_branch() {
 /// A coarse export of a bend (R/r 3, five stretches along 90 degrees, a
 /// straight leg of 20 mm in one stretch each side) is not named a feature:
 /// a guide off the axis gives sections with an outline on one side. (It
-/// does not fit yet either: issue 47, deliverable 2.)
+/// fits now: `coarse_bends_fit_against_the_generators_tube`.)
 #[test]
 fn a_coarse_bend_is_not_named_a_feature() {
     for around in [16, 32] {
