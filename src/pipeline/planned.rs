@@ -18,7 +18,7 @@ use crate::optimise::{
     layer_points, optimise_with, slow_refused_layers, split_refused_layers, LayerPlan, LayerPoints,
     OptimiseOptions, Plan, SplitPlan,
 };
-use crate::program::{check_vendor, write_files, Program, ProgramError};
+use crate::program::{check_vendor, write_files, ArcFlag, Program, ProgramError};
 use crate::robot::Vendor;
 use crate::Error;
 
@@ -606,6 +606,15 @@ impl PlannedPart {
                         summary.closest_approach_mm = finite(lc.closest_approach_mm);
                         summary.closest_pair = lc.closest_pair.clone().map(|(a, b)| [a, b]);
                     }
+                    if let Ok(p) = &self.program {
+                        summary.transit_vias = p
+                            .points
+                            .iter()
+                            .filter(|q| {
+                                q.arc == ArcFlag::Transit && q.layer == l.layer && q.bead == lp.bead
+                            })
+                            .count();
+                    }
                     summary
                 })
                 .collect(),
@@ -716,6 +725,7 @@ fn layer_summary(l: &LayerPlan) -> LayerSummary {
         cycle_time_s: None,
         closest_approach_mm: None,
         closest_pair: None,
+        transit_vias: 0,
         solver: SolverSummary {
             iterations: l.solver.iterations,
             qp_solves: l.solver.qp_solves,

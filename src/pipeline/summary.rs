@@ -368,6 +368,14 @@ pub struct LayerSummary {
     pub closest_approach_mm: Option<f64>,
     /// The two bodies at that approach.
     pub closest_pair: Option<[String; 2]>,
+    /// Via points of the arc-off transit after this bead
+    /// ([`ArcFlag::Transit`](crate::program::ArcFlag::Transit)): where the
+    /// direct joint move to the next bead (or home) would take the torch
+    /// through the deposited wall, the program goes through these (the
+    /// torch lifted along the tool axis, the positioner turning alone, or
+    /// home); absent when none.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub transit_vias: usize,
     /// The solver's counts.
     pub solver: SolverSummary,
 }

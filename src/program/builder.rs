@@ -402,7 +402,9 @@ fn blocks(points: &[ProgramPoint]) -> Vec<Block> {
 /// home) against the wall deposited so far ([`transit`](crate::program::transit)); where one
 /// collides, moves that transition's retract and approach points further
 /// along the tool axis (2, 4, 8… times `clearance_mm`, up to
-/// `transit_max_clearance_mm`) until it clears.
+/// `transit_max_clearance_mm`) until it clears, and where none of these
+/// clears, leaves the retract and approach points as they were and goes
+/// through [`ArcFlag::Transit`] via points instead ([`via_points`]).
 fn safe_transits(
     program: &mut Program,
     inputs: &[PathPointInput],
@@ -471,6 +473,8 @@ fn safe_transits(
         transit::joint_move_touches(&program.cell, &wall, &torch, a, (&qb, pb))
             .map_err(|e| failed(from.layer, e))
     };
+    // via points to insert after a block's last point, in block order
+    let mut inserts: Vec<(usize, Vec<ProgramPoint>)> = Vec::new();
     let first: Vec<Result<bool, ProgramError>> = (0..n)
         .into_par_iter()
         .map(|k| touches(program, k))
@@ -555,18 +559,153 @@ fn safe_transits(
             }
         }
         if !fixed {
-            // the program is as it was: the deepest sample of the transit
-            return Err(refuse(
-                check(program, k)?,
-                format!(
-                ", even with the retract and approach points raised up to {} mm along the tool \
-                 axis (transit_max_clearance_mm)",
-                opts.transit_max_clearance_mm
-            ),
-            ));
+            // the program is as it was: through via points, or the
+            // deepest sample of the direct transit
+            let wall = decimated.wall(k + 1, opts.bead_radius_mm);
+            let transit = Transit {
+                from: blocks[k],
+                to: next_approach,
+                target: target(program, k),
+            };
+            match via_points(program, inputs, opts, &transit, &wall, &torch)? {
+                Some(vias) => inserts.push((blocks[k].last, vias)),
+                None => {
+                    return Err(refuse(
+                        check(program, k)?,
+                        format!(
+                            ", even with the retract and approach points raised up to {} mm \
+                             along the tool axis (transit_max_clearance_mm) or through via \
+                             points (the torch lifted that far, the positioner turning alone, \
+                             home)",
+                            opts.transit_max_clearance_mm
+                        ),
+                    ))
+                }
+            }
         }
     }
+    for (after, vias) in inserts.into_iter().rev() {
+        program.points.splice(after + 1..after + 1, vias);
+    }
     Ok(())
+}
+
+/// An arc-off transit between two beads' blocks ([`via_points`]): the
+/// block it leaves, the next one's block when it has an approach point,
+/// and the joints it goes to (the next block's first point, or home).
+struct Transit {
+    from: Block,
+    to: Option<Block>,
+    target: Option<(Joints, Option<PositionerJoints>)>,
+}
+
+/// Via points ([`ArcFlag::Transit`]) for an arc-off transit whose direct
+/// joint move touches `wall`, tried at lift heights of 2, 4, 8… times
+/// `clearance_mm` up to `transit_max_clearance_mm`, each in this order:
+/// 1. the torch lifted that far along the tool axis from the bead's last
+///    point; the positioner turning alone to the next bead's joints with the
+///    arm still; the torch lowered along the tool axis to the next bead's
+///    first point that far (torch-carried cell);
+/// 2. the same without the positioner's own move;
+/// 3. the first lifted point, the home position, the second.
+///
+/// The first sequence whose every joint move (from the retract point
+/// through the vias to the next approach point, or home) clears `wall` is
+/// kept; `None` when none does.
+fn via_points(
+    program: &Program,
+    inputs: &[PathPointInput],
+    opts: &ProgramOptions,
+    transit: &Transit,
+    wall: &(impl transit::TransitWall + ?Sized),
+    torch: &crate::toolaxis::collision::Torch,
+) -> Result<Option<Vec<ProgramPoint>>, ProgramError> {
+    let Some(target) = transit.target else {
+        return Ok(None);
+    };
+    let cell = &program.cell;
+    let retract = program.points[transit.from.last];
+    let end = program.points[transit.from.end];
+    let end_input = &inputs[transit.from.start_input + (transit.from.end - transit.from.start)];
+    let failed = |e: String| ProgramError::Infeasible {
+        count: 1,
+        first: format!("layer {}: transit check: {e}", end.layer),
+        layers: vec![end.layer],
+    };
+    // a via point at joints `q`, `qp`: the torch tip and axis seen from the
+    // part, labelled as the bead it leaves
+    let via_at = |q: Joints, qp: Option<PositionerJoints>| -> Option<ProgramPoint> {
+        let (tip, axis) = transit::torch_in_part(cell, &q, qp)?;
+        Some(ProgramPoint {
+            position_mm: tip,
+            tool_axis: crate::math::UnitVector3::new_normalize(axis),
+            joints: q,
+            positioner: qp,
+            speed_mm_s: opts.approach_speed_mm_s,
+            wire_feed_mm_s: 0.0,
+            arc: ArcFlag::Transit,
+            via: false,
+            ..end
+        })
+    };
+    let clears = |vias: &[ProgramPoint]| -> Result<bool, ProgramError> {
+        let mut from = (retract.joints, retract.positioner);
+        for to in vias
+            .iter()
+            .map(|v| (v.joints, v.positioner))
+            .chain(std::iter::once(target))
+        {
+            if transit::joint_move_touches(cell, wall, torch, (&from.0, from.1), (&to.0, to.1))
+                .map_err(failed)?
+            {
+                return Ok(false);
+            }
+            from = to;
+        }
+        Ok(true)
+    };
+    let mut lift = opts.clearance_mm;
+    while lift < opts.transit_max_clearance_mm {
+        lift = (2.0 * lift).min(opts.transit_max_clearance_mm);
+        let via = |p: &ProgramPoint, input: &PathPointInput| {
+            // labelled as the bead the transit leaves, in whose block it is
+            lifted(cell, p, input, ArcFlag::Transit, lift).map(|v| ProgramPoint {
+                speed_mm_s: opts.approach_speed_mm_s,
+                layer: end.layer,
+                bead: end.bead,
+                point: end.point,
+                ..v
+            })
+        };
+        // a point that leaves a joint's travel at this lift is left out:
+        // the transit then starts from the retract point, or ends at the
+        // approach point, themselves
+        let up = via(&end, end_input).ok();
+        let down = transit
+            .to
+            .and_then(|b| via(&program.points[b.start], &inputs[b.start_input]).ok());
+        let mut candidates: Vec<Vec<ProgramPoint>> = Vec::new();
+        // the positioner alone, with the torch lifted
+        let arm = up.map_or(retract.joints, |u| u.joints);
+        let positioner = up.map_or(retract.positioner, |u| u.positioner);
+        if target.1.is_some() && target.1 != positioner {
+            if let Some(turned) = via_at(arm, target.1) {
+                candidates.push([up, Some(turned), down].into_iter().flatten().collect());
+            }
+        }
+        if up.is_some() || down.is_some() {
+            candidates.push([up, down].into_iter().flatten().collect());
+        }
+        if let Some(h) = program.home.and_then(|h| via_at(h.joints, h.positioner)) {
+            candidates.push([up, Some(h), down].into_iter().flatten().collect());
+        }
+        for vias in candidates {
+            if clears(&vias)? {
+                return Ok(Some(vias));
+            }
+        }
+    }
+    Ok(None)
 }
 
 /// The approach or retract point of bead point `p` at `clearance_mm`, or,
@@ -594,8 +733,8 @@ fn clearance_point_within_travel(
 
 /// The approach or retract point of bead point `p`: `clearance_mm` along the
 /// tool axis, same orientation and positioner joints, joints unwrapped
-/// towards `p`'s; refused if a joint leaves its travel or the linear move
-/// between it and `p` outruns a joint at the approach speed.
+/// towards `p`'s ([`lifted`]); refused if a joint leaves its travel or the
+/// linear move between it and `p` outruns a joint at the approach speed.
 fn clearance_point(
     cell: &CellLayout,
     p: &ProgramPoint,
@@ -604,19 +743,63 @@ fn clearance_point(
     opts: &ProgramOptions,
     clearance_mm: f64,
 ) -> Result<ProgramPoint, ProgramError> {
-    let what = if flag == ArcFlag::Approach {
-        "approach"
-    } else {
-        "retract"
+    let lifted = lifted(cell, p, input, flag, clearance_mm)?;
+    let robot = cell.robot();
+    let dt = clearance_mm / opts.approach_speed_mm_s;
+    for (j, (qj, pj)) in lifted.joints.iter().zip(p.joints).enumerate() {
+        let s = (qj - pj).abs() / dt;
+        if s > robot.max_speed_rad_s[j] {
+            return Err(lifted_error(
+                p,
+                flag,
+                clearance_mm,
+                format!(
+                    "J{} needs {:.2}°/s at {} mm/s, maximum {:.1}°/s",
+                    j + 1,
+                    s.to_degrees(),
+                    opts.approach_speed_mm_s,
+                    robot.max_speed_rad_s[j].to_degrees()
+                ),
+            ));
+        }
+    }
+    Ok(ProgramPoint {
+        speed_mm_s: opts.approach_speed_mm_s,
+        ..lifted
+    })
+}
+
+/// A refusal of the point `clearance_mm` from bead point `p` along the tool
+/// axis, for `flag`'s purpose.
+fn lifted_error(p: &ProgramPoint, flag: ArcFlag, clearance_mm: f64, msg: String) -> ProgramError {
+    let what = match flag {
+        ArcFlag::Approach => "approach",
+        ArcFlag::Retract => "retract",
+        _ => "transit via",
     };
-    let infeasible = |msg: String| ProgramError::Infeasible {
+    ProgramError::Infeasible {
         count: 1,
         first: format!(
             "layer {}, {what} point ({} mm from point {} along the tool axis): {msg}",
             p.layer, clearance_mm, p.point
         ),
         layers: vec![p.layer],
-    };
+    }
+}
+
+/// Bead point `p` moved `clearance_mm` along the tool axis with `flag`,
+/// same orientation and positioner joints, the arm's joints from the IK
+/// unwrapped towards `p`'s, the arc off (speed: `p`'s, to be set by the
+/// caller); refused if the positioner would have to move or a joint leaves
+/// its travel.
+fn lifted(
+    cell: &CellLayout,
+    p: &ProgramPoint,
+    input: &PathPointInput,
+    flag: ArcFlag,
+    clearance_mm: f64,
+) -> Result<ProgramPoint, ProgramError> {
+    let infeasible = |msg: String| lifted_error(p, flag, clearance_mm, msg);
     let position_mm = p.position_mm + p.tool_axis.into_inner() * clearance_mm;
     let cp = CellPoint {
         position_mm,
@@ -644,24 +827,10 @@ fn clearance_point(
             v.to_degrees()
         )));
     }
-    let dt = clearance_mm / opts.approach_speed_mm_s;
-    for (j, (qj, pj)) in q.iter().zip(p.joints).enumerate() {
-        let s = (qj - pj).abs() / dt;
-        if s > robot.max_speed_rad_s[j] {
-            return Err(infeasible(format!(
-                "J{} needs {:.2}°/s at {} mm/s, maximum {:.1}°/s",
-                j + 1,
-                s.to_degrees(),
-                opts.approach_speed_mm_s,
-                robot.max_speed_rad_s[j].to_degrees()
-            )));
-        }
-    }
     Ok(ProgramPoint {
         position_mm,
         joints: q,
         positioner: pose.positioner,
-        speed_mm_s: opts.approach_speed_mm_s,
         wire_feed_mm_s: 0.0,
         arc: flag,
         via: false,

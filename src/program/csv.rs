@@ -25,6 +25,7 @@ pub fn write_csv(w: &mut dyn Write, program: &Program) -> std::io::Result<()> {
             ArcFlag::On => "on",
             ArcFlag::End => "end",
             ArcFlag::Retract => "retract",
+            ArcFlag::Transit => "transit",
         };
         write!(
             w,

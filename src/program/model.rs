@@ -38,11 +38,19 @@ pub enum ArcFlag {
     /// arc-off transition to the next layer goes from here to the next
     /// [`ArcFlag::Approach`] by a joint move. Not a bead point.
     Retract,
+    /// Via point of an arc-off transit that a single joint move from the
+    /// retract point to the next approach point would take through the
+    /// deposited wall: reached by a joint move with the arc off, after the
+    /// retract point of the bead it leaves (the torch lifted far along the
+    /// tool axis, the positioner turning alone with the torch clear, or the
+    /// home position; [`build_program_with`](crate::program::build_program_with)).
+    /// Its position is the torch tip's, part frame. Not a bead point.
+    Transit,
 }
 
 impl ArcFlag {
     /// `true` for the points of a bead (start, on, end), `false` for the
-    /// approach and retract points.
+    /// approach, retract and transit points.
     pub fn is_bead(&self) -> bool {
         matches!(self, ArcFlag::Start | ArcFlag::On | ArcFlag::End)
     }
@@ -357,13 +365,15 @@ pub struct BeadSetup {
 }
 
 /// `true` when point `i` of `program` is reached by a joint move (FANUC
-/// `J`, KUKA `PTP`, ABB `MoveAbsJ`): an approach point, or a bead's first
-/// point without one; every other point is reached by a linear move.
+/// `J`, KUKA `PTP`, ABB `MoveAbsJ`): an approach point, a bead's first
+/// point without one, or a transit's via point ([`ArcFlag::Transit`]);
+/// every other point is reached by a linear move.
 pub fn joint_move_target(program: &Program, i: usize) -> bool {
-    opens_bead(
-        i.checked_sub(1).map(|k| program.points[k].arc),
-        program.points[i].arc,
-    )
+    program.points[i].arc == ArcFlag::Transit
+        || opens_bead(
+            i.checked_sub(1).map(|k| program.points[k].arc),
+            program.points[i].arc,
+        )
 }
 
 /// `true` when a point with flag `arc`, after one with flag `prev` (`None`

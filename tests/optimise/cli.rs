@@ -161,15 +161,18 @@ fn every_sample_part_plans_in_the_part_carried_cell() {
     checks_clean(&out, &cell, "quarter torus, --plain-axes");
 }
 
-/// `waam check` reads the FANUC program `plan` wrote in `out` back clean
-/// against `cell` (exit 0): the shortest `.ls` name (NAME.ls; a build cut
-/// to the memory budget is NAME_P01.ls, NAME_P02.ls, …, any of which brings
-/// the others to `check`).
+/// `waam check` reads the program `plan` wrote in `out` back clean against
+/// `cell` (exit 0): the shortest FANUC `.ls`, KUKA `.src` or ABB `.mod`
+/// name (NAME.ls; a build cut to the memory budget is NAME_P01.ls,
+/// NAME_P02.ls, …, any of which brings the others to `check`).
 fn checks_clean(out: &std::path::Path, cell: &std::path::Path, what: &str) {
     let program = std::fs::read_dir(out)
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ls"))
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|e| e == "ls" || e == "src" || e == "mod")
+        })
         .min_by_key(|p| p.as_os_str().len())
         .unwrap_or_else(|| panic!("{what}: no program"));
     let check = waam()
@@ -270,5 +273,54 @@ fn a_layer_without_joints_exits_2_with_its_summary_and_report() {
             let tilt = plans[10]["positioner"]["max_tilt_deg"].as_f64().unwrap();
             assert!(tilt <= 15.0 + 1e-6, "{tilt}");
         }
+    }
+}
+
+/// Arc-off transits that one joint move would take through the deposited
+/// wall go through via points (issue 45): the elbow's layer 55 → 56 in the
+/// KUKA torch-carried cell and the S-bend's layer 111 → 112 in the ABB one
+/// exited 2 ("passes through the deposited wall ... even with the retract
+/// and approach points raised up to 160 mm"). Now both plan (exit 0),
+/// summary.json names the vias on the bead they leave, and `waam check`
+/// reads the programs (KUKA `PTP`, ABB `MoveAbsJ` to each via) back clean,
+/// its transit check included.
+#[test]
+fn transits_through_via_points_plan_and_check_clean() {
+    let dir = tempfile::tempdir().unwrap();
+    for (part, cell, layers, leaving) in [
+        ("elbow.toml", "kuka_kr16_2_torch_carried.toml", 57, 55),
+        ("s-bend.toml", "abb_irb2600_torch_carried.toml", 113, 111),
+    ] {
+        let out = dir.path().join(part);
+        let cell = part_path(&format!("cells/{cell}"));
+        let o = waam()
+            .args(["--quiet", "plan"])
+            .arg(part_path(part))
+            .arg("--cell")
+            .arg(&cell)
+            .args(["--max-layers", &layers.to_string(), "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{part}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let s: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let vias: Vec<(u64, u64)> = s["layer_plans"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|l| Some((l["layer"].as_u64()?, l["transit_vias"].as_u64()?)))
+            .collect();
+        assert!(
+            vias.iter().any(|&(l, n)| l == leaving && n > 0),
+            "{part}: {vias:?}"
+        );
+        checks_clean(&out, &cell, part);
     }
 }

@@ -103,7 +103,8 @@
 //! * With approach and retract points: `MoveAbsJ` to the approach point's
 //!   `jointtarget`, `ArcLStart` (or `MoveL`) into the bead's first point at
 //!   the approach speed (the arc is off while it moves and ignites there),
-//!   the bead, then `MoveL` out to the retract point.
+//!   the bead, then `MoveL` out to the retract point; a transit's via
+//!   points ([`ArcFlag::Transit`]) are `MoveAbsJ` to their `jointtarget`s.
 //! * **Part-carried cell: stationary tool.** RAPID speeds are TCP speeds
 //!   relative to the work object. In the part-carried cell the torch is
 //!   declared as a stationary tool (`tooldata` `robhold` FALSE, `tframe` the
@@ -982,7 +983,7 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
             extax(p.positioner, slots)
         )?;
         let prev = i.checked_sub(1).map(|k| program.points[k].arc);
-        if opens_bead(prev, p.arc) {
+        if opens_bead(prev, p.arc) || p.arc == ArcFlag::Transit {
             writeln!(
                 w,
                 "  LOCAL CONST jointtarget j{} := {};",
@@ -1094,6 +1095,15 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
                 abs_j(w, k)?;
             }
             (_, ArcFlag::Retract) => writeln!(w, "    MoveL p{k}, {v}, fine, {tw};")?,
+            (_, ArcFlag::Transit) => {
+                writeln!(
+                    w,
+                    "    ! bead {} (layer {}): arc-off transit via point",
+                    p.bead_label(),
+                    p.layer
+                )?;
+                abs_j(w, k)?;
+            }
             (_, ArcFlag::Start) => {
                 // into the bead: from the approach point at its speed, else
                 // a joint move to the first point

@@ -349,6 +349,9 @@ pub fn cycle_time(program: &Program, opts: &CycleOptions) -> CycleTime {
     let mut out = CycleTime::default();
     let mut prev: Option<Pose> = program.home.as_ref().map(|h| (&h.joints, h.positioner));
     let mut bead = 0usize;
+    // the joint moves through a transit's via points (after a bead's
+    // retract point), counted in the next transit
+    let mut via_legs_s = 0.0;
     let mut i = 0;
     while i < points.len() {
         let layer = points[i].layer;
@@ -362,8 +365,18 @@ pub fn cycle_time(program: &Program, opts: &CycleOptions) -> CycleTime {
             ..LayerCycle::default()
         };
         if let Some(from) = prev {
-            lc.transit_s = joint_move(from, (&block[0].joints, block[0].positioner));
+            lc.transit_s = via_legs_s + joint_move(from, (&block[0].joints, block[0].positioner));
         }
+        via_legs_s = block
+            .windows(2)
+            .filter(|w| w[1].arc == ArcFlag::Transit)
+            .map(|w| {
+                joint_move(
+                    (&w[0].joints, w[0].positioner),
+                    (&w[1].joints, w[1].positioner),
+                )
+            })
+            .sum();
         if let Some(s) = program.bead_setup.get(bead) {
             let BeadSetup {
                 dwell_s,
@@ -396,7 +409,7 @@ pub fn cycle_time(program: &Program, opts: &CycleOptions) -> CycleTime {
         i = end;
     }
     if let (Some(h), Some(from)) = (&program.home, prev) {
-        out.home_return_s = joint_move(from, (&h.joints, h.positioner));
+        out.home_return_s = via_legs_s + joint_move(from, (&h.joints, h.positioner));
         out.total_s += out.home_return_s;
     }
     out

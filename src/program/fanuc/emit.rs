@@ -15,8 +15,8 @@ use crate::program::kinds::{MoveKind, PositionMode};
 use crate::program::pose::moves_in_part_frame;
 use crate::program::split::split_to_budget;
 use crate::program::{
-    check_name, check_vendor, deposited_length_mm, joint_move_target, move_start, render,
-    segment_length_mm, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, deposited_length_mm, joint_move_target, move_start, opens_bead,
+    render, segment_length_mm, ArcFlag, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::FanucPose;
 use crate::robot::{CellLayout, Joints, Vendor};
@@ -663,7 +663,7 @@ fn tp_program(
             },
         };
         match p.arc {
-            ArcFlag::Approach => ins.push(joint_move(index)),
+            ArcFlag::Approach | ArcFlag::Transit => ins.push(joint_move(index)),
             ArcFlag::Start => {
                 ins.push(match prev {
                     Some(a) if a.arc == ArcFlag::Approach => {
@@ -834,7 +834,8 @@ fn bead_openings(program: &Program) -> Result<Vec<Option<usize>>, ProgramError> 
     let mut k = 0;
     let mut out = Vec::with_capacity(program.points.len());
     for i in 0..program.points.len() {
-        if joint_move_target(program, i) {
+        let prev = i.checked_sub(1).map(|k| program.points[k].arc);
+        if opens_bead(prev, program.points[i].arc) {
             if let Some(s) = program.bead_setup.get(k) {
                 let p = &program.points[i];
                 let bad = |reason: String| ProgramError::Mismatch { index: i, reason };

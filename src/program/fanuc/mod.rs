@@ -32,7 +32,8 @@
 //!   off), `L P[s] ... FINE` (into the bead), `Arc Start`, the bead, `Arc
 //!   End`, `L P[r] ... FINE` (retract); the joint move from one layer's
 //!   retract point to the next layer's approach point is the arc-off
-//!   transition.
+//!   transition, or `J P[v] 10% FINE` through each of its via points
+//!   ([`ArcFlag::Transit`](crate::program::ArcFlag::Transit)) where one joint move would cross the wall.
 //!
 //! Speeds are integers (mm/sec, cm/min or msec), the only form a TP motion
 //! line takes without a register; speeds are rounded down and times up to

@@ -14,8 +14,8 @@ use crate::program::kuka::{Kuka, EMITTER};
 use crate::program::split::split_to_budget;
 use crate::program::PositionMode;
 use crate::program::{
-    check_name, check_vendor, joint_move_target, move_start, positioner_moves, render, ArcFlag,
-    BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
+    check_name, check_vendor, joint_move_target, move_start, opens_bead, positioner_moves, render,
+    ArcFlag, BeadSetup, EmittedFile, ProcessControl, Program, ProgramError,
 };
 use crate::robot::orientation::KukaAbc;
 use crate::robot::{ArmSide, CellLayout, Joints, RobotModel, Vendor};
@@ -276,7 +276,7 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
     for (i, p) in program.points.iter().enumerate() {
         let name = format!("P{}", i + 1);
         let prev = i.checked_sub(1).map(|k| &program.points[k]);
-        if joint_move_target(program, i) {
+        if opens_bead(prev.map(|q| q.arc), p.arc) {
             if let Some(setup) = program.bead_setup.get(bead) {
                 write_bead_setup(w, setup)?;
             }
@@ -287,6 +287,16 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
                 writeln!(
                     w,
                     "  ; bead {} (layer {}): approach, arc off",
+                    p.bead_label(),
+                    p.layer
+                )?;
+                restore_ptp(w, &mut extax)?;
+                writeln!(w, "  PTP {name}")?;
+            }
+            ArcFlag::Transit => {
+                writeln!(
+                    w,
+                    "  ; bead {} (layer {}): arc-off transit via point",
                     p.bead_label(),
                     p.layer
                 )?;
@@ -347,7 +357,7 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
             ArcFlag::Retract => {}
         }
         match p.arc {
-            ArcFlag::Approach | ArcFlag::Start => {}
+            ArcFlag::Approach | ArcFlag::Start | ArcFlag::Transit => {}
             ArcFlag::On | ArcFlag::End => {
                 let start = move_start(program, i).map(|k| &program.points[k]);
                 if !arc && start.is_some_and(|q| q.arc == ArcFlag::Start) {

@@ -11,7 +11,8 @@
 //!   inline forms write, and may be refused).
 //! * Each bead: `PTP` to its first point (exact stop), then `LIN` moves at
 //!   `$VEL.CP` (m/s) blended with `C_DIS` inside the bead, the last one
-//!   exact.
+//!   exact. A transit's via points ([`ArcFlag::Transit`](crate::program::ArcFlag::Transit)), where one joint
+//!   move from a bead to the next would cross the wall, are `PTP`s.
 //! * **Arc process** (`$OUT[schedule]`): the arc is switched on at the
 //!   bead's first point, where the robot stands (exact stop), inside the
 //!   ignition handshake, a `LOOP` left only with the arc established: arc
