@@ -228,6 +228,10 @@ fn fit_pass(
         }
         check_after = CHECK_SECTIONS_AFTER;
     }
+    let failed = |spline: &CubicSpline, stations: &[Station], samples: &Samples, t: &[f64]| {
+        let cx = (mesh, &surf, spline, stations, samples, t, 2.0 * r0);
+        failed_sections(cx, opts, trimmed, bend_edges)
+    };
     let mut hints: Option<Vec<f64>> = None;
     // The radius law's slope from the previous pass (none at first).
     let mut slope: Option<(Vec<f64>, Vec<f64>)> = None;
@@ -270,20 +274,8 @@ fn fit_pass(
         }
         let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
         if iterations > check_after {
-            if let Err(e) = check_sections(mesh, &stations, opts) {
-                if bend_edges {
-                    return Err(e);
-                }
-                let cx = (
-                    mesh,
-                    &surf,
-                    &spline,
-                    &stations[..],
-                    &samples,
-                    &t[..],
-                    2.0 * r0,
-                );
-                return not_tube(cx, opts, trimmed, e);
+            if let Some(exit) = failed(&spline, &stations, &samples, &t) {
+                return exit;
             }
         }
         let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
@@ -342,20 +334,8 @@ fn fit_pass(
         PROJECT_PAST_END_RADII * r0,
     );
     let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
-    if let Err(e) = check_sections(mesh, &stations, opts) {
-        if bend_edges {
-            return Err(e);
-        }
-        let cx = (
-            mesh,
-            &surf,
-            &spline,
-            &stations[..],
-            &samples,
-            &t[..],
-            2.0 * r0,
-        );
-        return not_tube(cx, opts, trimmed, e);
+    if let Some(exit) = failed(&spline, &stations, &samples, &t) {
+        return exit;
     }
     let pieces = separate_pieces(mesh, &surf, &stations, &spline, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick);
@@ -1233,6 +1213,24 @@ type NotTube<'a> = (
     &'a [f64],
     f64,
 );
+
+/// The exit of a pass whose sections fail [`check_sections`] (`None` when
+/// they pass): [`not_tube`] on the vertices' pass, the sections' own error
+/// on the pass with points along a coarse bend's edges (`bend_edges`: its
+/// failure gives way to the vertices' pass's, features and all).
+fn failed_sections(
+    cx: NotTube<'_>,
+    opts: &FitOptions,
+    trimmed: bool,
+    bend_edges: bool,
+) -> Option<Result<TubeFit, FitError>> {
+    let error = check_sections(cx.0, cx.3, opts).err()?;
+    Some(if bend_edges {
+        Err(error)
+    } else {
+        not_tube(cx, opts, trimmed, error)
+    })
+}
 
 /// The refusal of a feature that is not tube.
 fn feature_error(mesh: &TubeMesh, f: &FeatureReport, count: usize) -> FitError {
