@@ -1108,3 +1108,45 @@ fn a_transit_the_wall_blocks_goes_through_via_points() {
     let named: usize = summary.layer_plans.iter().map(|l| l.transit_vias).sum();
     assert_eq!(named, vias.len());
 }
+
+/// Tubes nobody here designed: the 70° two-skin elbow and the helical coil
+/// other people exported (`tests/fit/data`, SOURCES there), fitted with the
+/// default options and planned at 80 points a layer (the first 20 layers)
+/// in each torch-carried sample cell: every layer plans, the program stage builds the program,
+/// and the independent kinematics check every point.
+#[test]
+fn fitted_meshes_made_elsewhere_plan_whole_in_every_torch_carried_cell() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fit/data");
+    for mesh in ["breakout-coin-elbow-70.stl", "cal-helical-coil.stl"] {
+        let fitted = Part::from_mesh(data.join(mesh), &waam_slicer::FitOptions::default())
+            .unwrap_or_else(|e| panic!("{mesh}: {e}"));
+        for cell_file in TORCH_CELLS {
+            let what = format!("{mesh} in {cell_file}");
+            let cell = Cell::read(part_path(&format!("cells/{cell_file}"))).unwrap();
+            let opts = PlanOptions {
+                slice: SliceOverrides {
+                    discretisation: Some(waam_slicer::path::Discretisation::Points(80)),
+                    // the elbow's 19 layers, the coil's first 20 of 38
+                    max_layers: Some(20),
+                    ..SliceOverrides::default()
+                },
+                ..PlanOptions::default()
+            };
+            let planned =
+                plan_part(&fitted.part, &cell, &opts).unwrap_or_else(|e| panic!("{what}: {e}"));
+            let refused: Vec<usize> = planned.plan.infeasible_layers().map(|l| l.layer).collect();
+            assert!(refused.is_empty(), "{what}: refused {refused:?}");
+            assert!(
+                planned.refusal().is_none(),
+                "{what}: {}",
+                planned.refusal().map(|e| e.to_string()).unwrap_or_default()
+            );
+            let layers = planned.sliced.path.layers.len();
+            let checked = fk_check(&cell_data(cell_file), &planned, &what);
+            assert!(
+                checked >= 80 * layers,
+                "{what}: {checked} points of {layers} layers"
+            );
+        }
+    }
+}
