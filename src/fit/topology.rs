@@ -509,6 +509,11 @@ pub struct LevelSets {
     pub bands: Vec<Band>,
 }
 
+/// Vertices whose distances differ by less than this many band widths
+/// (dimensionless) lie at one distance: rounding apart (single-precision
+/// coordinates give about 1e-6 of the band width).
+const ONE_DISTANCE_BANDS: f64 = 1e-3;
+
 /// Dijkstra over the edges of `tris` from `sources`, then bands of `width` mm.
 pub fn level_sets(mesh: &TubeMesh, tris: &[u32], sources: &[u32], width: f64) -> LevelSets {
     let n = mesh.vertices.len();
@@ -574,6 +579,20 @@ pub fn level_sets(mesh: &TubeMesh, tris: &[u32], sources: &[u32], width: f64) ->
         let k = band_of(dist[root as usize]).expect("on the surface");
         if size * 10 >= num[k] && size >= 3 {
             pieces[k] += 1;
+        }
+    }
+    // A band whose vertices all lie at one distance holds only a ring of
+    // vertices on its far boundary, split between two bands by rounding (a
+    // flat step joining two radii, written in single precision): one ring.
+    let mut spread = vec![(f64::INFINITY, f64::NEG_INFINITY); count];
+    for &d in &dist {
+        if let Some(k) = band_of(d) {
+            spread[k] = (spread[k].0.min(d), spread[k].1.max(d));
+        }
+    }
+    for (p, (lo, hi)) in pieces.iter_mut().zip(spread) {
+        if hi - lo < ONE_DISTANCE_BANDS * width {
+            *p = (*p).min(1);
         }
     }
     let bands = (0..count)

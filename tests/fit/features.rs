@@ -227,3 +227,39 @@ fn a_coarse_bend_is_not_named_a_feature() {
         }
     }
 }
+
+/// The collar, the flange and the block written as binary STL (single
+/// precision, as exporters write): the same feature is named. The flat
+/// step of the collar and the flange lies at one distance along the surface
+/// from the start end, on a boundary of the first guide's level sets;
+/// rounding once split it into fragments named "a branch".
+#[test]
+fn features_read_from_single_precision_stl_are_named_alike() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, (v, f), kind) in [
+        (
+            "collar",
+            gen::collared_pipe(10.0, 80.0, 14.0, 36.0, 46.0, 64, 1.0),
+            FeatureKind::Collar,
+        ),
+        (
+            "flange",
+            gen::collared_pipe(10.0, 80.0, 25.0, 38.0, 41.0, 64, 1.0),
+            FeatureKind::Flange,
+        ),
+        (
+            "block",
+            gen::blocked_pipe(10.0, 80.0, 40.0, 15.0, 64, 1.0),
+            FeatureKind::Block,
+        ),
+    ] {
+        let path = dir.path().join(format!("{name}.stl"));
+        std::fs::write(&path, gen::binary_stl(&v, &f)).unwrap();
+        let e = Part::from_mesh(&path, &FitOptions::default()).unwrap_err();
+        let msg = e.to_string();
+        let Error::Fit(FitError::Feature { kind: named, .. }) = e else {
+            panic!("{name}: {msg}")
+        };
+        assert_eq!(named, kind.name(), "{msg}");
+    }
+}
