@@ -102,3 +102,57 @@ def test_a_closed_blob_is_refused(tmp_path):
         ws.Part.from_mesh(stl)
     with pytest.raises(ws.InputError, match="start"):
         ws.Part.from_mesh(stl, start="sideways")
+
+
+def collared_pipe_stl(path, r=10.0, length=80.0, outer=14.0, z0=36.0, z1=46.0, around=64):
+    """A straight pipe of radius r about the z axis from z = 0 to length, rings
+    1 mm apart, with a collar of radius outer from z0 to z1: flat rings at z0
+    and z1 join the pipe to the collar (the generator of tests/fit/gen.rs)."""
+    heights = [(r, z) for z in np.arange(0.0, z0 + 0.5)]
+    heights += [(outer, z) for z in np.arange(z0, z1 + 0.5)]
+    heights += [(r, z) for z in np.arange(z1, length + 0.5)]
+    v = 2 * math.pi * np.arange(around) / around
+    pts = np.array([[rad * math.cos(a), rad * math.sin(a), z] for rad, z in heights for a in v])
+    tris = []
+    for i in range(len(heights) - 1):
+        for j in range(around):
+            a, b = i * around + j, i * around + (j + 1) % around
+            tris += [(a, b, a + around), (b, b + around, a + around)]
+    write_stl(path, pts, tris)
+
+
+def test_trim_fits_the_longest_tubular_stretch_and_names_the_collar(tmp_path):
+    # A pipe of radius 10 from z = 0 to 80 with a collar of radius 14 from
+    # z = 36 to 46: refused naming the collar; with trim=True the longest
+    # tubular stretch (0 to 36; 46 to 80 is 2 mm shorter) is fitted and the
+    # collar named in the report and in the fit.json written.
+    stl = tmp_path / "collar.stl"
+    collared_pipe_stl(stl)
+    with pytest.raises(ws.InputError, match=r"collar\.stl: not a tube: a collar .*--trim"):
+        ws.Part.from_mesh(stl)
+    part = ws.Part.from_mesh(stl, trim=True)
+    report = part.fit_report
+    stations = report["stations"]
+    h = 2 * (stations[1]["t_mm"] - stations[0]["t_mm"])
+    # The fitted stretch: from the open end at z = 0 to the cut at z = 36,
+    # the cut end named trimmed; the pipe's axis and radius.
+    ends = sorted([report["start"], report["end"]], key=lambda e: e["centre_mm"][2])
+    assert abs(ends[0]["centre_mm"][2]) <= 2 * h and abs(ends[1]["centre_mm"][2] - 36.0) <= 2 * h, ends
+    assert [e["kind"] for e in ends] == ["open", "trimmed"], ends
+    assert report["rms_mm"] < 0.05
+    for st in stations:
+        if st["centre_mm"] is not None:
+            assert math.hypot(st["centre_mm"][0], st["centre_mm"][1]) < 0.05, st
+            assert st["centre_mm"][2] < 36.0 + 2 * h, st
+            assert abs(st["law_radius_mm"] - 10.0) < 0.05, st
+    # The rest: the collar, 10 mm long, 4 mm high, 28 mm across.
+    [collar] = report["features"]
+    assert collar["kind"] == "collar", collar
+    assert abs(collar["t_from_mm"] - 36.0) <= h and abs(collar["t_to_mm"] - 46.0) <= h, collar
+    assert abs(collar["length_mm"] - 10.0) <= h, collar
+    assert abs(collar["height_mm"] - 4.0) <= 0.2, collar
+    assert abs(collar["across_mm"][1] - 28.0) <= 0.4, collar
+    files = part.write_fit(tmp_path / "module")
+    written = read_json(files[1])
+    assert written["features"] == report["features"]
+    assert [written["start"]["kind"], written["end"]["kind"]] == [report["start"]["kind"], report["end"]["kind"]]
