@@ -283,16 +283,41 @@ fn a_layer_without_joints_exits_2_with_its_summary_and_report() {
 /// and approach points raised up to 160 mm"). Now both plan (exit 0),
 /// summary.json names the vias on the bead they leave, and `waam check`
 /// reads the programs (KUKA `PTP`, ABB `MoveAbsJ` to each via) back clean,
-/// its transit check included.
+/// its transit check included. FANUC: no sample part needs a via in the
+/// ROBOWAM torch-carried cell, so the quarter torus is planned there with
+/// the retract and approach points at 10 mm, raised at most to 20: its
+/// transits after layer 10 then go through vias (`J P[..]`), read back
+/// clean too.
 #[test]
 fn transits_through_via_points_plan_and_check_clean() {
     let dir = tempfile::tempdir().unwrap();
+    let low = dir.path().join("robowam_torch_carried_low_clearance.toml");
+    let text = std::fs::read_to_string(part_path("cells/robowam_torch_carried.toml")).unwrap();
+    assert!(text.contains("\ntransit_max_clearance_mm = 160.0\n"));
+    std::fs::write(
+        &low,
+        text.replace(
+            "\ntransit_max_clearance_mm = 160.0\n",
+            "\nclearance_mm = 10.0\ntransit_max_clearance_mm = 20.0\n",
+        ),
+    )
+    .unwrap();
     for (part, cell, layers, leaving) in [
-        ("elbow.toml", "kuka_kr16_2_torch_carried.toml", 57, 55),
-        ("s-bend.toml", "abb_irb2600_torch_carried.toml", 113, 111),
+        (
+            "elbow.toml",
+            part_path("cells/kuka_kr16_2_torch_carried.toml"),
+            57,
+            55,
+        ),
+        (
+            "s-bend.toml",
+            part_path("cells/abb_irb2600_torch_carried.toml"),
+            113,
+            111,
+        ),
+        ("quarter-torus.toml", low.clone(), 17, 10),
     ] {
         let out = dir.path().join(part);
-        let cell = part_path(&format!("cells/{cell}"));
         let o = waam()
             .args(["--quiet", "plan"])
             .arg(part_path(part))
