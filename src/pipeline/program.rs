@@ -15,7 +15,10 @@ use crate::program::cell_check::{check_cell, CellClearance, CellScene};
 use crate::program::{
     build_program_with, LayerRefusal, PointFeed, Program, ProgramError, ProgramOptions,
 };
-use crate::robot::trajectory::{joint_trajectory_without_measures, TrajectoryOptions};
+use crate::robot::trajectory::{
+    joint_trajectory_without_measures, JointTrajectory, PathPointInput, TrajectoryOptions,
+};
+use crate::robot::{CellLayout, RobotError};
 
 /// What a plan's program is built from.
 #[derive(Debug, Clone, Copy)]
@@ -60,9 +63,8 @@ impl ProgramBuild<'_> {
         let inputs = trajectory_inputs(layers, self.plan);
         // the program reads the joints, speeds and violations only: no
         // dexterity (an SVD a point) nor dq/dR_Z
-        let traj =
-            joint_trajectory_without_measures(&cell.layout, &inputs, &TrajectoryOptions::default())
-                .map_err(|source| ProgramError::Trajectory { source })?;
+        let traj = trajectory_by_bead(&cell.layout, &inputs)
+            .map_err(|source| ProgramError::Trajectory { source })?;
         if self.wire_feed_mm_s.len() != inputs.len() {
             return Err(ProgramError::InvalidOptions {
                 field: "wire_feed_mm_s",
@@ -120,6 +122,54 @@ impl ProgramBuild<'_> {
             })
             .collect()
     }
+}
+
+/// The program's joint trajectory of `inputs` (default options: no
+/// measures), its beads solved in parallel: the same joints, speeds and
+/// violations as one walk along `inputs`. Each bead starts afresh in that
+/// walk (the options rewind between layers: no joints to stay near, no
+/// speed from the previous bead), and the positioner's turn hint it
+/// carries from bead to bead is read only for a point without planned
+/// positioner joints: where one has none in a torch-carried cell, the
+/// walk is one.
+///
+/// # Errors
+/// As [`joint_trajectory_without_measures`]: the first bad input point in
+/// order.
+fn trajectory_by_bead(
+    cell: &CellLayout,
+    inputs: &[PathPointInput],
+) -> Result<JointTrajectory, RobotError> {
+    use rayon::prelude::*;
+    let opts = TrajectoryOptions::default();
+    let independent = opts.rewind_between_layers
+        && (matches!(cell, CellLayout::PartCarried(_))
+            || inputs.iter().all(|p| p.positioner.is_some()));
+    if !independent {
+        return joint_trajectory_without_measures(cell, inputs, &opts);
+    }
+    let mut beads: Vec<std::ops::Range<usize>> = Vec::new();
+    for (i, p) in inputs.iter().enumerate() {
+        match beads.last_mut() {
+            Some(r) if inputs[r.start].same_bead(p) => r.end = i + 1,
+            _ => beads.push(i..i + 1),
+        }
+    }
+    let parts: Vec<Result<JointTrajectory, RobotError>> = beads
+        .par_iter()
+        .map(|r| joint_trajectory_without_measures(cell, &inputs[r.clone()], &opts))
+        .collect();
+    let mut whole = JointTrajectory {
+        configuration: cell.configuration(),
+        points: Vec::with_capacity(inputs.len()),
+        report: Default::default(),
+    };
+    for part in parts {
+        let part = part?;
+        whole.points.extend(part.points);
+        whole.report.violations.extend(part.report.violations);
+    }
+    Ok(whole)
 }
 
 /// No layer may vanish between the plan and the program: each layer of the
