@@ -62,7 +62,10 @@
 //! its radius, summed like an odometer), and skipped when that bound
 //! already exceeds the clearance and comes within [`REPORT_TOLERANCE_MM`]
 //! of the layer's closest approach so far; parry's exact distance (GJK)
-//! runs only on the pairs left. The part's hulls are built from at most
+//! runs only on the pairs left. A body whose bound with a sphere holding
+//! all the part's hulls (they share one pose) already passes that test is
+//! culled with every hull at once: each hull's own bound is no lower, so
+//! the pairs culled are the same. The part's hulls are built from at most
 //! [`HULL_POINTS_PER_LAYER`] points a layer, its distances lowered by the
 //! largest chord deviation of a dropped point (conservative). So
 //! `closest_approach_mm` is a distance measured at a sample, at most
@@ -304,6 +307,12 @@ struct Memory {
     places: Vec<(Point3, Point3, UnitQuaternion)>,
     odometer: Vec<f64>,
     pairs: Vec<Option<(f64, f64, f64)>>,
+    /// The sample's pairs (indices into its bodies): a buffer kept from
+    /// sample to sample, rebuilt at each.
+    pair_list: Vec<(usize, usize)>,
+    /// Per body before the part's hulls, whether the hulls' common sphere
+    /// culls its pairs with every hull (a buffer, as `pair_list`).
+    far_from_part: Vec<bool>,
 }
 
 impl Memory {
@@ -680,6 +689,64 @@ fn wall_bands(layers: &[LayerPoints]) -> (Vec<Local>, Vec<(usize, Option<Local>)
     (bands, per_layer)
 }
 
+/// The part's model a layer's motions are checked against: its hulls
+/// (part frame, one pose) and a sphere holding their bounding spheres.
+pub(super) struct PartModel<'c> {
+    hulls: Vec<&'c Local>,
+    /// `None` for fewer than two hulls (nothing to gain).
+    sphere: Option<HullsSphere>,
+}
+
+impl<'c> PartModel<'c> {
+    /// The model of `hulls` with their common sphere.
+    fn new(hulls: Vec<&'c Local>) -> Self {
+        let sphere = (hulls.len() >= 2).then(|| {
+            let n = hulls.len() as f64;
+            let centre = Point3::from(hulls.iter().map(|h| h.centre.coords).sum::<Vector3>() / n);
+            let radius = hulls
+                .iter()
+                .map(|h| (h.centre - centre).norm() + h.radius)
+                .fold(0.0, f64::max);
+            let margin = hulls.iter().map(|h| h.margin).fold(0.0, f64::max);
+            HullsSphere {
+                centre,
+                radius,
+                margin,
+            }
+        });
+        Self { hulls, sphere }
+    }
+}
+
+/// A sphere holding the bounding spheres of a layer's hulls (part frame,
+/// mm) and the largest of their margins (mm).
+#[derive(Clone, Copy)]
+struct HullsSphere {
+    centre: Point3,
+    radius: f64,
+    margin: f64,
+}
+
+/// What [`HullsSphere::lower_bound`] leaves below every hull's own sphere
+/// bound (mm): far above the rounding of either (some 1e-12 mm at
+/// metres), so that a pair culled by the common sphere is one its own
+/// bound culls as well.
+const HULLS_SPHERE_SLACK_MM: f64 = 1e-6;
+
+impl HullsSphere {
+    /// A lower bound of the sphere bound of `a` with each of the hulls
+    /// placed at `pose` (`|centre_a - centre_h| - r_a - r_h - margin_h`):
+    /// each hull's sphere lies in this one.
+    fn lower_bound(&self, a: &Body, pose: &Isometry3) -> f64 {
+        (a.centre - pose * self.centre).norm()
+            - a.radius
+            - self.radius
+            - a.margin
+            - self.margin
+            - HULLS_SPHERE_SLACK_MM
+    }
+}
+
 /// The refusal or the closest approach of one pair.
 struct Closest {
     distance_mm: f64,
@@ -823,7 +890,7 @@ impl<'a> Checker<'a> {
     fn check(
         &self,
         s: &Sample,
-        (layer, hull): (usize, &[&Local]),
+        (layer, part): (usize, &PartModel),
         best: &mut Closest,
         memory: &mut Memory,
         stats: &mut CellClearance,
@@ -831,10 +898,12 @@ impl<'a> Checker<'a> {
         stats.samples += 1;
         let robot = self.cell.robot();
         let capsules = links(robot, &self.radii, s.q);
-        let arm: Vec<Body> = capsules.iter().map(|(n, c)| capsule_body(n, c)).collect();
-        let mut others: Vec<Body> = Vec::new();
+        let mut all: Vec<Body> =
+            Vec::with_capacity(capsules.len() + self.keep_out.len() + 2 + part.hulls.len());
+        all.extend(capsules.iter().map(|(n, c)| capsule_body(n, c)));
+        let first_other = all.len();
         for (k, name) in self.keep_out.iter().zip(&self.keep_out_names) {
-            others.push(Body {
+            all.push(Body {
                 name,
                 shape: k.shape.as_ref(),
                 pose: Isometry3::from_parts(
@@ -849,8 +918,9 @@ impl<'a> Checker<'a> {
                 capsule: None,
             });
         }
-        let mut pairs: Vec<(usize, usize)> = Vec::new(); // indices into `all`
-        let mut all: Vec<Body> = arm;
+        // indices into `all` (the list kept from sample to sample)
+        let mut pairs = std::mem::take(&mut memory.pair_list);
+        pairs.clear();
         let (column, upper, fore, wrist, flange) = (0, 1, 2, 3, 4);
         pairs.extend([
             (column, fore),
@@ -859,14 +929,13 @@ impl<'a> Checker<'a> {
             (upper, wrist),
             (upper, flange),
         ]);
-        let first_other = all.len();
-        all.extend(others);
         for o in first_other..all.len() {
             for l in 0..5 {
                 pairs.push((l, o));
             }
         }
         let keep_outs: Vec<usize> = (first_other..all.len()).collect();
+        let mut part_pose: Option<Isometry3> = None;
         match self.cell {
             CellLayout::TorchCarried(c) => {
                 if let Some(qp) = s.qp {
@@ -879,7 +948,8 @@ impl<'a> Checker<'a> {
                         pairs.push((l, t + 1));
                     }
                     let pose = c.base_from_part(&qp);
-                    for h in hull {
+                    part_pose = Some(pose);
+                    for h in &part.hulls {
                         let p = all.len();
                         all.push(h.at(PART, pose));
                         for l in [upper, fore, wrist, flange] {
@@ -893,7 +963,8 @@ impl<'a> Checker<'a> {
             }
             CellLayout::PartCarried(c) => {
                 let pose = robot.flange_pose(s.q) * c.flange_from_part;
-                for h in hull {
+                part_pose = Some(pose);
+                for h in &part.hulls {
                     let p = all.len();
                     all.push(h.at(PART, pose));
                     for l in [column, upper, fore] {
@@ -906,8 +977,31 @@ impl<'a> Checker<'a> {
             }
         }
         memory.advance(layer, &all);
+        // the part's hulls come last: a body whose pairs with every hull
+        // are culled by the hulls' common sphere is not bounded hull by hull
+        let first_hull = all.len() - part_pose.map_or(0, |_| part.hulls.len());
+        let mut far_from_part = std::mem::take(&mut memory.far_from_part);
+        far_from_part.clear();
+        match (part_pose, part.sphere) {
+            (Some(pose), Some(sphere)) => {
+                far_from_part.extend(all[..first_hull].iter().map(|a| {
+                    let bound = sphere.lower_bound(a, &pose);
+                    bound > self.clearance && bound >= best.distance_mm - REPORT_TOLERANCE_MM
+                }));
+            }
+            _ => far_from_part.resize(first_hull, false),
+        }
         let mut hit: Option<(String, String, f64)> = None;
-        for (k, (i, j)) in pairs.into_iter().enumerate() {
+        for (k, &(i, j)) in pairs.iter().enumerate() {
+            let other = match (i >= first_hull, j >= first_hull) {
+                (false, true) => Some(i),
+                (true, false) => Some(j),
+                _ => None,
+            };
+            if other.is_some_and(|o| far_from_part[o]) {
+                stats.culled += 1;
+                continue;
+            }
             let (a, b) = (&all[i], &all[j]);
             let margin = a.margin + b.margin;
             let bound = ((a.centre - b.centre).norm() - a.radius - b.radius - margin)
@@ -936,6 +1030,8 @@ impl<'a> Checker<'a> {
                 hit = Some((a.name.to_string(), b.name.to_string(), d));
             }
         }
+        memory.pair_list = pairs;
+        memory.far_from_part = far_from_part;
         hit
     }
 }

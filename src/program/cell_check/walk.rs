@@ -13,7 +13,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::{CellClearance, CellScene, Checker, Closest, LayerCellClearance, Local, Memory};
+use super::{CellClearance, CellScene, Checker, Closest, LayerCellClearance, Memory, PartModel};
 use super::{Place, Sample, SAMPLE_STEP_MM};
 use crate::optimise::LayerPoints;
 use crate::program::{ArcFlag, Program, ProgramError};
@@ -130,18 +130,16 @@ fn runs_of_one_layer(motions: &[Motion]) -> Vec<Range<usize>> {
 /// The part's hulls a motion of `layer` is checked against: the complete
 /// bands before it and its own partial band (none for a layer not in the
 /// path).
-fn hull_of<'c>(
-    checker: &'c Checker,
-    index: &HashMap<usize, usize>,
-    layer: usize,
-) -> Vec<&'c Local> {
-    match index.get(&layer).and_then(|&i| checker.partial.get(i)) {
-        Some((before, own)) => checker.bands[..*before]
-            .iter()
-            .chain(own.as_ref())
-            .collect(),
-        None => Vec::new(),
-    }
+fn hull_of<'c>(checker: &'c Checker, index: &HashMap<usize, usize>, layer: usize) -> PartModel<'c> {
+    PartModel::new(
+        match index.get(&layer).and_then(|&i| checker.partial.get(i)) {
+            Some((before, own)) => checker.bands[..*before]
+                .iter()
+                .chain(own.as_ref())
+                .collect(),
+            None => Vec::new(),
+        },
+    )
 }
 
 /// One layer's walk: its closest approach, its counts, and its refusal
@@ -159,7 +157,7 @@ impl LayerWalk {
     fn run(
         &mut self,
         checker: &Checker,
-        hull: &[&Local],
+        hull: &PartModel,
         m: &Motion,
         memory: &mut Memory,
     ) -> Result<(), ProgramError> {
