@@ -10,7 +10,7 @@
 
 use std::sync::OnceLock;
 
-use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 
 use crate::math::{Point3, Vector3};
 use crate::robot::{CellLayout, Joints};
@@ -308,6 +308,12 @@ pub struct WallBeads {
     /// `blocks[m - 1]`: the wall of beads `m - low(m) .. m`, built on first
     /// use (capsule radius 0: queries give theirs).
     blocks: Vec<OnceLock<Wall>>,
+    /// Per bead, the box of its kept points when it has a segment (two or
+    /// more of them).
+    bead_bounds: Vec<Option<Aabb>>,
+    /// `block_bounds[m - 1]`: block `m`'s [`Wall::segment_bounds`], from
+    /// its beads' boxes without building its tree (on first use).
+    block_bounds: Vec<OnceLock<Option<Aabb>>>,
 }
 
 impl WallBeads {
@@ -336,6 +342,14 @@ impl WallBeads {
         self.solid
             .push(solid + usize::from(self.kept.last().is_some_and(|k| k.len() >= 2)));
         self.blocks.push(OnceLock::new());
+        let kept = self.kept.last().map_or(&[][..], Vec::as_slice);
+        self.bead_bounds.push((kept.len() >= 2).then(|| {
+            kept.iter().fold(Aabb::new_invalid(), |b, p| Aabb {
+                mins: b.mins.inf(p),
+                maxs: b.maxs.sup(p),
+            })
+        }));
+        self.block_bounds.push(OnceLock::new());
     }
 
     /// Beads added so far.
@@ -368,6 +382,19 @@ impl WallBeads {
         self.blocks[m - 1]
             .get_or_init(|| Wall::new(self.kept[m - low(m)..m].iter().map(Vec::as_slice), 0.0))
     }
+
+    /// Block `m`'s box around its segments, as its tree's
+    /// ([`Wall::segment_bounds`]: the smallest and largest coordinates of
+    /// their ends, taken exactly by both) without building the tree.
+    fn block_bounds(&self, m: usize) -> Option<Aabb> {
+        *self.block_bounds[m - 1].get_or_init(|| {
+            self.bead_bounds[m - low(m)..m]
+                .iter()
+                .flatten()
+                .copied()
+                .reduce(|a, b| a.merged(&b))
+        })
+    }
 }
 
 /// The largest power of two dividing `m` (> 0).
@@ -385,12 +412,16 @@ pub struct WallPrefix<'a> {
 }
 
 impl WallPrefix<'_> {
-    /// The blocks whose union is the wall, latest beads first.
-    fn blocks(&self) -> impl Iterator<Item = &Wall> + '_ {
+    /// The blocks whose union is the wall (their `m`), latest beads first.
+    fn block_indices(&self) -> impl Iterator<Item = usize> {
         std::iter::successors((self.n > 0).then_some(self.n), |&m| {
             (m > low(m)).then(|| m - low(m))
         })
-        .map(|m| self.beads.block(m))
+    }
+
+    /// The blocks whose union is the wall, latest beads first.
+    fn blocks(&self) -> impl Iterator<Item = &Wall> + '_ {
+        self.block_indices().map(|m| self.beads.block(m))
     }
 }
 
@@ -412,12 +443,17 @@ impl TransitWall for WallPrefix<'_> {
         // keeps the skip off parry's rounding at that distance
         let torch_box = torch.bounds(point, tool);
         let reach = margin_mm + self.bead_radius_mm.max(0.0) + BOX_SLACK_MM;
-        for b in self.blocks() {
-            if b.segment_bounds()
+        // (the box from the beads' boxes: a block far from every torch is
+        // never built)
+        for m in self.block_indices() {
+            if self
+                .beads
+                .block_bounds(m)
                 .is_some_and(|bb| box_gap(&bb, &torch_box) > reach)
             {
                 continue;
             }
+            let b = self.beads.block(m);
             if !b.is_clear_with_radius(torch, point, tool, margin_mm, self.bead_radius_mm)? {
                 return Ok(false);
             }
@@ -466,4 +502,39 @@ fn point_segment_distance(p: &Point3, a: &Point3, b: &Point3) -> f64 {
         0.0
     };
     (p - (a + ab * t)).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A block's box from its beads' boxes is its tree's box to the bit,
+    /// with beads of one point (no segment) and decimated beads among them;
+    /// without a segment, both are `None`.
+    #[test]
+    fn block_bounds_are_the_trees() {
+        let mut beads = WallBeads::default();
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 200.0 - 100.0
+        };
+        beads.push(&[Point3::new(1.0, 2.0, 3.0)]);
+        assert_eq!(beads.block_bounds(1), None);
+        assert!(beads.block(1).segment_bounds().is_none());
+        for k in 0..40 {
+            let n = [1, 2, 7, 300][k % 4];
+            let bead: Vec<Point3> = (0..n)
+                .map(|_| Point3::new(next(), next(), next() + k as f64))
+                .collect();
+            beads.push(&bead);
+        }
+        for m in 1..=beads.len() {
+            let ours = beads.block_bounds(m).map(|b| (b.mins, b.maxs));
+            let tree = beads.block(m).segment_bounds().map(|b| (b.mins, b.maxs));
+            assert_eq!(ours, tree, "block {m}");
+        }
+    }
 }
