@@ -112,9 +112,15 @@ pub fn late_stages(c: &mut Criterion) {
         let (program, check) = r
             .iter()
             .fold((0.0, 0.0), |(a, b), x| (a + x[0] / n, b + x[1] / n));
+        // the machine's load during the runs (the ratios hold on a loaded
+        // machine only while every stage gets the same share of it)
+        let load = std::fs::read_to_string("/proc/loadavg")
+            .ok()
+            .and_then(|l| l.split_whitespace().next().map(str::to_string))
+            .unwrap_or_else(|| "?".into());
         eprintln!(
             "late_stages {part} in {cell}: program {program:.2} x optimise, cell_check \
-             {check:.2} x optimise, sum {:.2} ({} plans)",
+             {check:.2} x optimise, sum {:.2} ({} plans, load average {load})",
             program + check,
             r.len()
         );
