@@ -8,6 +8,7 @@ use super::options::units_warning;
 use super::outcome::FeatureReport;
 use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
+use super::samples::{self, project_all, Samples};
 use super::section::{fit_circle, fit_plane, plane_basis, CircleFit, SectionPoint};
 use super::topology::{self, median_edge, Surfaces};
 use super::{ends, repair, report};
@@ -15,31 +16,7 @@ use super::{smooth, FitError, FitOptions, StartEnd, TubeMesh, Units};
 use crate::geometry::guide::{CubicSpline, GuideCurve};
 use crate::math::{Point3, UnitVector3, Vector3};
 use nalgebra::DMatrix;
-use parry3d_f64::query::PointQueryWithLocation;
-use parry3d_f64::shape::Polyline;
 use rayon::prelude::*;
-
-/// The points the fit uses: every skin vertex, with its skin.
-struct Samples {
-    pos: Vec<Point3>,
-    skin: Vec<u8>,
-    skins: usize,
-    /// The first `vertices` samples are the skins' vertices; the others
-    /// lie along the skins' long edges.
-    vertices: usize,
-}
-
-impl Samples {
-    /// The skins' vertices only.
-    fn vertex_only(&self) -> Samples {
-        Samples {
-            pos: self.pos[..self.vertices].to_vec(),
-            skin: self.skin[..self.vertices].to_vec(),
-            skins: self.skins,
-            vertices: self.vertices,
-        }
-    }
-}
 
 /// Default station spacing, in median mesh edges: two edges between
 /// stations gives each section a full ring of vertices.
@@ -98,22 +75,13 @@ const MAX_KNOTS: f64 = 1000.0;
 const WIDEN_GAP_DEG: f64 = 60.0;
 
 /// Sections are checked from this refit on (dimensionless count) when the
-/// samples hold points along a coarse bend's edges ([`with_bend_edges`]):
+/// samples hold points along a coarse bend's edges ([`samples::with_bend_edges`]):
 /// the first guides of a coarse export (level sets a few edges wide) leave
 /// sections that are not yet circles. Otherwise from the second.
 const CHECK_SECTIONS_AFTER: usize = 6;
 /// Most refits with the points along a coarse bend's edges (dimensionless
 /// count); then the vertices alone.
 const EDGE_REFITS: usize = 8;
-/// An edge spans a bend when the first guide turns by more than this
-/// between its ends (degrees): a coarse export's bend in eight stretches
-/// along 90 degrees turns by 11 degrees a stretch.
-const BEND_EDGE_MIN_TURN_DEG: f64 = 3.0;
-/// An edge runs along the tube when within this of the first guide's
-/// tangent (degrees): the long thin triangles of a coarse export do, the
-/// flat rings of a flange and the rings of vertices do not.
-const BEND_EDGE_MAX_ANGLE_DEG: f64 = 45.0;
-
 /// Fits a tube to `mesh`.
 ///
 /// # Errors
@@ -169,7 +137,7 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
 ///
 /// The fit runs on the skins' vertices; when their sections fail (not near
 /// a circle, too few), it runs again with points along the edges of a
-/// coarse bend too ([`with_bend_edges`]), and the first failure stands when
+/// coarse bend too ([`samples::with_bend_edges`]), and the first failure stands when
 /// that fails as well: a mesh that fits on its vertices is fitted as before.
 fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFit, FitError> {
     match fit_pass(mesh, opts, trimmed, false) {
@@ -207,27 +175,8 @@ fn fit_pass(
         })
         .max(MIN_KNOT_STATIONS * spacing);
     let mut guide = initial_guide(mesh, &surf, &start, &finish, edge, knot_h)?;
-    let mut samples = samples(mesh, &surf);
-    let mut check_after = 1;
-    if bend_edges {
-        samples = with_bend_edges(
-            mesh,
-            &surf,
-            samples,
-            &spline_of(mesh, &guide)?,
-            tube_range(&guide),
-            spacing,
-            PROJECT_PAST_END_RADII * r0,
-        );
-        if samples.vertices == samples.pos.len() {
-            return Err(FitError::Degenerate {
-                file: mesh.file.clone(),
-                station: 0,
-                reason: "no edge spans a bend".into(),
-            });
-        }
-        check_after = CHECK_SECTIONS_AFTER;
-    }
+    let mut samples = pass_samples(mesh, &surf, &guide, spacing, r0, bend_edges)?;
+    let check_after = if bend_edges { CHECK_SECTIONS_AFTER } else { 1 };
     let failed = |spline: &CubicSpline, stations: &[Station], samples: &Samples, t: &[f64]| {
         let cx = (mesh, &surf, spline, stations, samples, t, 2.0 * r0);
         failed_sections(cx, opts, trimmed, bend_edges)
@@ -302,16 +251,11 @@ fn fit_pass(
         let stall_level = (STALL_TOLERANCES * opts.tolerance_mm).max(STALL_NOISE_FRACTION * noise);
         let stalled = last_move < stall_level && last_move > STALL_SHRINK_RATIO * previous;
         let settled = last_move < opts.tolerance_mm || stalled;
-        if (settled || iterations >= EDGE_REFITS) && samples.vertices < samples.pos.len() {
-            // Settled on the edges' points too, or they had their refits:
-            // on to the vertices alone (the points along a coarse export's
-            // edges lie on its chords, inside the true surface, more on a
-            // bend's outer side than on its inner).
-            samples = samples.vertex_only();
-            hints = hints.map(|mut h| {
-                h.truncate(samples.vertices);
-                h
-            });
+        // Settled on the edges' points too, or they had their refits: on to
+        // the vertices alone (the points along a coarse export's edges lie
+        // on its chords, inside the true surface, more on a bend's outer
+        // side than on its inner).
+        if (settled || iterations >= EDGE_REFITS) && samples.drop_edges(&mut hints) {
             last_move = f64::INFINITY;
             continue;
         }
@@ -399,6 +343,33 @@ fn fit_pass(
     (fit.report, fit.vertex_distance_mm) = report::build(&ctx, &fit);
     fit.report.features = pieces;
     check_residual(mesh, fit, opts)
+}
+
+/// The samples of a pass of [`fit_pass`] with the first `guide` (points):
+/// the skins' vertices, and with `bend_edges` the points along a coarse
+/// bend's edges (an error when it has none). `spacing`: the stations' (mm);
+/// `r0`: the smaller end radius (mm).
+fn pass_samples(
+    mesh: &TubeMesh,
+    surf: &Surfaces,
+    guide: &[Point3],
+    spacing: f64,
+    r0: f64,
+    bend_edges: bool,
+) -> Result<Samples, FitError> {
+    let vertices = Samples::vertices(mesh, surf);
+    if !bend_edges {
+        return Ok(vertices);
+    }
+    let (spline, range) = (spline_of(mesh, guide)?, tube_range(guide));
+    let past_end = PROJECT_PAST_END_RADII * r0;
+    samples::with_bend_edges(mesh, surf, vertices, &spline, range, spacing, past_end).ok_or_else(
+        || FitError::Degenerate {
+            file: mesh.file.clone(),
+            station: 0,
+            reason: "no edge spans a bend".into(),
+        },
+    )
 }
 
 /// The median RMS of the stations' circle fits (mm; 0 with none): the
@@ -609,97 +580,6 @@ fn choose_start(
     Ok(if swap { [b, a] } else { [a, b] })
 }
 
-/// The skins' vertices, with their skins.
-fn samples(mesh: &TubeMesh, surf: &Surfaces) -> Samples {
-    let mut pos = Vec::new();
-    let mut skin = Vec::new();
-    for (k, s) in surf.skins.iter().enumerate() {
-        pos.extend(s.vertices.iter().map(|&v| mesh.vertices[v as usize]));
-        skin.extend(std::iter::repeat_n(k as u8, s.vertices.len()));
-    }
-    let vertices = pos.len();
-    Samples {
-        pos,
-        skin,
-        skins: surf.skins.len(),
-        vertices,
-    }
-}
-
-/// `vertices` with points along the skins' edges that span a bend: edges
-/// longer than a station `spacing` (mm), running along the first `guide`
-/// (within [`BEND_EDGE_MAX_ANGLE_DEG`] of its tangent) while the guide turns
-/// by more than [`BEND_EDGE_MIN_TURN_DEG`] between their ends. A coarse
-/// export's bend (a few long stretches) then gives each station a ring of
-/// points of the surface, not only those near the exporter's vertex rings,
-/// which lie askew to the stations there. Straight stretches and the faces
-/// of features across the tube (a flange's flat rings) keep their vertices
-/// alone: their chords' points lie inside the surface. The edges' points
-/// come after the vertices (the report pairs the first samples with them).
-fn with_bend_edges(
-    mesh: &TubeMesh,
-    surf: &Surfaces,
-    vertices: Samples,
-    guide: &CubicSpline,
-    range: (f64, f64),
-    spacing: f64,
-    past_end: f64,
-) -> Samples {
-    let t = project_all(guide, range, &vertices, None, past_end);
-    let mut t_of = vec![f64::NAN; mesh.vertices.len()];
-    let skin_vertices = surf.skins.iter().flat_map(|s| s.vertices.iter());
-    for (&v, &tv) in skin_vertices.zip(&t) {
-        t_of[v as usize] = tv;
-    }
-    let (min_turn, max_angle) = (
-        BEND_EDGE_MIN_TURN_DEG.to_radians(),
-        BEND_EDGE_MAX_ANGLE_DEG.to_radians(),
-    );
-    let Samples {
-        mut pos, mut skin, ..
-    } = vertices;
-    let (count, mut bend) = (pos.len(), false);
-    for (k, s) in surf.skins.iter().enumerate() {
-        let mut edges: Vec<(u32, u32)> = s
-            .triangles
-            .iter()
-            .flat_map(|&t| {
-                let v = mesh.triangles[t as usize];
-                [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])].map(|(a, b)| (a.min(b), a.max(b)))
-            })
-            .collect();
-        edges.sort_unstable();
-        edges.dedup();
-        for (a, b) in edges {
-            let (p, q) = (mesh.vertices[a as usize], mesh.vertices[b as usize]);
-            let m = ((q - p).norm() / spacing).floor() as usize;
-            if m < 2 {
-                continue;
-            }
-            let (ta, tb) = (t_of[a as usize], t_of[b as usize]);
-            let along = guide.d1(0.5 * (ta + tb));
-            if (q - p).angle(&along).min((p - q).angle(&along)) >= max_angle {
-                continue;
-            }
-            bend |= guide.d1(ta).angle(&guide.d1(tb)) > min_turn;
-            for i in 1..m {
-                pos.push(p + (q - p) * (i as f64 / m as f64));
-                skin.push(k as u8);
-            }
-        }
-    }
-    if !bend {
-        pos.truncate(count);
-        skin.truncate(count);
-    }
-    Samples {
-        pos,
-        skin,
-        skins: surf.skins.len(),
-        vertices: count,
-    }
-}
-
 /// First guide: the start end's centre, the centroids of the level sets of
 /// the geodesic distance from the start end (those before the far end), the
 /// far end's centre; thinned to points `knot_h / 2` apart.
@@ -814,64 +694,6 @@ fn end_cubic(start: &EndRing, finish: &EndRing, n: usize) -> Vec<Point3> {
             Point3::from(p0.coords * h00 + d0 * (m * h10) + p1.coords * h01 + d1 * (m * h11))
         })
         .collect()
-}
-
-/// Guide parameter of the nearest guide point of every sample: Newton from
-/// the hint, or from the nearest point of a polyline of the guide (parry3d
-/// BVH query) when there is no hint or Newton does not settle.
-fn project_all(
-    spline: &CubicSpline,
-    range: (f64, f64),
-    s: &Samples,
-    hints: Option<&[f64]>,
-    ext: f64,
-) -> Vec<f64> {
-    let (lo, hi) = (range.0 - ext, range.1 + ext);
-    let n = ((hi - lo) / 0.5).ceil().clamp(16.0, 20_000.0) as usize;
-    let ts: Vec<f64> = (0..=n)
-        .map(|i| lo + (hi - lo) * i as f64 / n as f64)
-        .collect();
-    let line = Polyline::new(ts.iter().map(|&t| spline.point(t)).collect(), None);
-    let global = |p: &Point3| {
-        let (_, (seg, loc)) = line.project_local_point_and_get_location(p, false);
-        let [u, v] = loc.barycentric_coordinates();
-        ts[seg as usize] * u + ts[seg as usize + 1] * v
-    };
-    s.pos
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let hint = hints.and_then(|h| h.get(i).copied());
-            match hint.and_then(|t0| newton(spline, p, t0, lo, hi)) {
-                Some(t) => t,
-                None => {
-                    let t0 = global(p);
-                    newton(spline, p, t0, lo, hi).unwrap_or(t0)
-                }
-            }
-        })
-        .collect()
-}
-
-/// Nearest-point parameter by Newton on `(C(t) - p) · C'(t) = 0` in `[lo, hi]`.
-fn newton(spline: &CubicSpline, p: &Point3, mut t: f64, lo: f64, hi: f64) -> Option<f64> {
-    for _ in 0..12 {
-        let d = spline.point(t) - p;
-        let d1 = spline.d1(t);
-        let f = d.dot(&d1);
-        let fp = d1.norm_squared() + d.dot(&spline.d2(t));
-        let step = if fp > 0.1 * d1.norm_squared() {
-            f / fp
-        } else {
-            f / d1.norm_squared()
-        };
-        let next = (t - step).clamp(lo, hi);
-        if (next - t).abs() < 1e-10 {
-            return Some(next);
-        }
-        t = next;
-    }
-    None
 }
 
 /// Minimal rotation taking unit `a` to unit `b`, applied to `x`.

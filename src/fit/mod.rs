@@ -36,6 +36,7 @@ mod outcome;
 mod output;
 pub mod repair;
 mod report;
+mod samples;
 pub mod section;
 pub mod smooth;
 pub mod topology;
