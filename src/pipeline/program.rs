@@ -213,3 +213,64 @@ pub(super) fn check_every_layer(layers: &[LayerPoints], plan: &Plan) -> Result<(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimise::layer_points;
+
+    /// The beads solved in parallel give the trajectory of one walk, to the
+    /// bit: the hemisphere's layers (R_Z 0 and 0.3 rad on alternate layers)
+    /// in the ROBOWAM part-carried cell, and in its torch-carried cell both
+    /// without positioner joints (one walk: the turn hint carries over) and
+    /// with the ones that walk solved (beads in parallel).
+    #[test]
+    fn trajectory_by_bead_is_one_walk() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("parts");
+        let part = crate::Part::read(root.join("hemisphere.toml")).unwrap();
+        let sliced = crate::pipeline::slice_part(&part).unwrap();
+        let layers = layer_points(
+            &sliced.path,
+            &sliced.axes.frames,
+            sliced.process.travel_speed_mm_s,
+        );
+        let inputs: Vec<PathPointInput> = layers
+            .iter()
+            .flat_map(|l| {
+                l.points
+                    .iter()
+                    .enumerate()
+                    .map(move |(m, p)| PathPointInput {
+                        layer: l.layer,
+                        bead: l.bead,
+                        point: l.first_point + m,
+                        position_mm: p.position_mm,
+                        tool_axis: p.tool_axis,
+                        build_direction: p.build_direction,
+                        r_z: if l.layer % 2 == 0 { 0.0 } else { 0.3 },
+                        positioner: p.positioner,
+                        travel_speed_mm_s: p.travel_speed_mm_s,
+                    })
+            })
+            .collect();
+        assert!(layers.len() > 2);
+        let opts = TrajectoryOptions::default();
+        for cell in ["robowam_part_carried", "robowam_torch_carried"] {
+            let cell = crate::Cell::read(root.join(format!("cells/{cell}.toml"))).unwrap();
+            let one = joint_trajectory_without_measures(&cell.layout, &inputs, &opts).unwrap();
+            assert_eq!(trajectory_by_bead(&cell.layout, &inputs).unwrap(), one);
+            if matches!(cell.layout, CellLayout::TorchCarried(_)) {
+                let planned: Vec<PathPointInput> = inputs
+                    .iter()
+                    .zip(&one.points)
+                    .map(|(p, jp)| PathPointInput {
+                        positioner: jp.positioner.or(Some([0.0, 0.0])),
+                        ..*p
+                    })
+                    .collect();
+                let one = joint_trajectory_without_measures(&cell.layout, &planned, &opts).unwrap();
+                assert_eq!(trajectory_by_bead(&cell.layout, &planned).unwrap(), one);
+            }
+        }
+    }
+}
