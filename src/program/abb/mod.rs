@@ -1085,25 +1085,21 @@ pub fn write_mod(w: &mut dyn Write, program: &Program, opts: &AbbOptions) -> std
         match (&opts.process, p.arc) {
             // written with the circular move it is the circle point of
             (_, ArcFlag::On) if p.via => {}
-            (_, ArcFlag::Approach) => {
+            (_, ArcFlag::Approach | ArcFlag::Transit) => {
+                let what = if p.arc == ArcFlag::Approach {
+                    "approach"
+                } else {
+                    "arc-off transit via point"
+                };
                 writeln!(
                     w,
-                    "    ! bead {} (layer {}): approach",
+                    "    ! bead {} (layer {}): {what}",
                     p.bead_label(),
                     p.layer
                 )?;
                 abs_j(w, k)?;
             }
             (_, ArcFlag::Retract) => writeln!(w, "    MoveL p{k}, {v}, fine, {tw};")?,
-            (_, ArcFlag::Transit) => {
-                writeln!(
-                    w,
-                    "    ! bead {} (layer {}): arc-off transit via point",
-                    p.bead_label(),
-                    p.layer
-                )?;
-                abs_j(w, k)?;
-            }
             (_, ArcFlag::Start) => {
                 // into the bead: from the approach point at its speed, else
                 // a joint move to the first point

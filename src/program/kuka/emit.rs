@@ -283,23 +283,13 @@ pub fn write_src(w: &mut dyn Write, program: &Program, opts: &KukaOptions) -> st
             bead += 1;
         }
         match p.arc {
-            ArcFlag::Approach => {
-                writeln!(
-                    w,
-                    "  ; bead {} (layer {}): approach, arc off",
-                    p.bead_label(),
-                    p.layer
-                )?;
-                restore_ptp(w, &mut extax)?;
-                writeln!(w, "  PTP {name}")?;
-            }
-            ArcFlag::Transit => {
-                writeln!(
-                    w,
-                    "  ; bead {} (layer {}): arc-off transit via point",
-                    p.bead_label(),
-                    p.layer
-                )?;
+            ArcFlag::Approach | ArcFlag::Transit => {
+                let what = if p.arc == ArcFlag::Approach {
+                    "approach, arc off"
+                } else {
+                    "arc-off transit via point"
+                };
+                writeln!(w, "  ; bead {} (layer {}): {what}", p.bead_label(), p.layer)?;
                 restore_ptp(w, &mut extax)?;
                 writeln!(w, "  PTP {name}")?;
             }
