@@ -16,7 +16,9 @@
 //!
 //! **What carries over between groups.** Each group starts and ends at the
 //! cell's home (when it has one), so group `k + 1` starts where group `k`
-//! ended. The positioner's turn is unchanged (the points keep their
+//! ended; a group that ends on a bead followed by a transit's via points
+//! ([`ArcFlag::Transit`], leading to the next group's first bead) leaves
+//! them out and goes home from the bead's retract point. The positioner's turn is unchanged (the points keep their
 //! unwound values). The payload in effect at a group's first bead is set
 //! again before it, so that a group loaded after a restart carries the
 //! right load; the interlayer dwell and interpass wait of that bead stay
@@ -138,7 +140,14 @@ fn group_of(
     beads: Range<usize>,
     k: usize,
 ) -> Program {
-    let points = blocks[beads.start].start..blocks[beads.end - 1].end;
+    let mut points = blocks[beads.start].start..blocks[beads.end - 1].end;
+    if beads.end < blocks.len() {
+        // a transit's via points lead to the next group's first bead: this
+        // group goes home from its last retract point instead
+        while points.end > points.start && program.points[points.end - 1].arc == ArcFlag::Transit {
+            points.end -= 1;
+        }
+    }
     let mut bead_setup = program
         .bead_setup
         .get(beads.clone())

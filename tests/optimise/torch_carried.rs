@@ -1103,6 +1103,19 @@ fn a_transit_the_wall_blocks_goes_through_via_points() {
         i = approach;
     }
     assert!(transits >= 1);
+    // cut into groups after a bead with vias, the group goes home from its
+    // retract point: the vias lead to the next group's first bead
+    use waam_slicer::program::split::{bead_blocks, group_program};
+    let blocks = bead_blocks(program);
+    let with_vias = blocks
+        .iter()
+        .position(|b| b.clone().any(|i| pts[i].arc == ArcFlag::Transit))
+        .expect("a block with vias");
+    assert!(with_vias + 1 < blocks.len());
+    let head = group_program(program, 0..with_vias + 1, 1);
+    assert_eq!(head.points.last().map(|p| p.arc), Some(ArcFlag::Retract));
+    let whole = group_program(program, 0..blocks.len(), 1);
+    assert_eq!(whole.points.len(), pts.len());
     // the summary names the vias on the bead they leave
     let summary = planned.summary();
     let named: usize = summary.layer_plans.iter().map(|l| l.transit_vias).sum();
