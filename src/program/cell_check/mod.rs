@@ -65,7 +65,12 @@
 //! runs only on the pairs left. A body whose bound with a sphere holding
 //! all the part's hulls (they share one pose) already passes that test is
 //! culled with every hull at once: each hull's own bound is no lower, so
-//! the pairs culled are the same. The part's hulls are built from at most
+//! the pairs culled are the same. An arm link and a hull are also bounded
+//! about the axis the part turns about ([`PartAxis`]: J6 part-carried, the
+//! table's turn torch-carried): the distance between the boxes of the two
+//! bodies in (distance from the axis, height along it), which does not
+//! change as the part turns — the nozzle spinning a full turn a layer
+//! under the fixed torch leaves its culling to this bound. The part's hulls are built from at most
 //! [`HULL_POINTS_PER_LAYER`] points a layer, its distances lowered by the
 //! largest chord deviation of a dropped point (conservative). So
 //! `closest_approach_mm` is a distance measured at a sample, at most
@@ -294,6 +299,8 @@ struct Body<'a> {
     support: Option<&'a ClusteredHull>,
     /// An arm link's capsule, for a distance query on concrete types.
     capsule: Option<&'a Capsule>,
+    /// A hull's extent about the part's turn axis ([`Local::axial`]).
+    axial: Option<(f64, f64, f64)>,
 }
 
 /// What the culling remembers between samples: each body's last place and
@@ -550,6 +557,7 @@ fn capsule_body<'a>(name: &'a str, c: &'a Capsule) -> Body<'a> {
         ends: Some((c.segment.a, c.segment.b)),
         support: None,
         capsule: Some(c),
+        axial: None,
     }
 }
 
@@ -562,6 +570,10 @@ struct Local {
     margin: f64,
     /// A hull's clustered vertices ([`ClusteredHull`]).
     support: Option<ClusteredHull>,
+    /// A hull's extent about the part's turn axis ([`PartAxis`]): the
+    /// largest distance of a vertex from the axis and the smallest and
+    /// largest height along it (mm).
+    axial: Option<(f64, f64, f64)>,
 }
 
 impl Local {
@@ -576,6 +588,7 @@ impl Local {
             ends: None,
             support: self.support.as_ref(),
             capsule: None,
+            axial: self.axial,
         }
     }
 }
@@ -598,6 +611,7 @@ fn hull(points: &[Point3]) -> Option<Local> {
         radius,
         margin: 0.0,
         support,
+        axial: None,
     })
 }
 
@@ -774,6 +788,83 @@ struct Checker<'a> {
     /// Per axis (the arm's six, the positioner's two), the largest distance
     /// from the axis to a point of a body it moves (mm).
     lever: [f64; 8],
+    /// The axis the part turns about (part frame).
+    axis: PartAxis,
+}
+
+/// The axis the part turns about while it is built, part frame: the
+/// flange's Z (J6) where the arm carries it, the table's Z (the turn)
+/// where the positioner does. Distances from it and heights along it are
+/// the same wherever the part has turned about it.
+#[derive(Clone, Copy)]
+struct PartAxis {
+    origin: Point3,
+    dir: Vector3,
+}
+
+impl PartAxis {
+    fn of(cell: &CellLayout) -> Self {
+        let part_from_axis = match cell {
+            CellLayout::PartCarried(c) => c.flange_from_part.inverse(),
+            CellLayout::TorchCarried(c) => c.table_from_part.inverse(),
+        };
+        Self {
+            origin: part_from_axis * Point3::origin(),
+            dir: part_from_axis * Vector3::z(),
+        }
+    }
+
+    /// Height along the axis and the radial part of `p` (part frame).
+    fn split(&self, p: &Point3) -> (f64, Vector3) {
+        let v = p - self.origin;
+        let h = v.dot(&self.dir);
+        (h, v - self.dir * h)
+    }
+
+    /// A hull's extent: largest distance of a vertex from the axis, lowest
+    /// and highest height (mm).
+    fn extent(&self, points: &[Point3]) -> Option<(f64, f64, f64)> {
+        let mut out: Option<(f64, f64, f64)> = None;
+        for p in points {
+            let (h, r) = self.split(p);
+            let r = r.norm();
+            out = Some(match out {
+                None => (r, h, h),
+                Some((rm, lo, hi)) => (rm.max(r), lo.min(h), hi.max(h)),
+            });
+        }
+        out
+    }
+
+    /// A segment's smallest distance from the axis and its lowest and
+    /// highest height (mm; its ends in the part frame).
+    fn segment(&self, a: &Point3, b: &Point3) -> (f64, f64, f64) {
+        let (ha, ra) = self.split(a);
+        let (hb, rb) = self.split(b);
+        let d = rb - ra;
+        let l2 = d.norm_squared();
+        let t = if l2 > 0.0 {
+            (-ra.dot(&d) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        ((ra + d * t).norm(), ha.min(hb), ha.max(hb))
+    }
+}
+
+/// What the axial bound leaves below the distance it bounds (mm): far
+/// above its rounding.
+const AXIAL_SLACK_MM: f64 = 1e-6;
+
+/// A lower bound of the distance between a capsule (its segment's
+/// [`PartAxis::segment`] and radius) and a hull (its
+/// [`PartAxis::extent`] and margin): the map of a point to its distance
+/// from the axis and its height moves no point apart, so the distance is
+/// at least that of the two sets' boxes in those two coordinates.
+fn axial_bound(seg: (f64, f64, f64), radius: f64, hull: (f64, f64, f64), margin: f64) -> f64 {
+    let dr = (seg.0 - hull.0).max(0.0);
+    let dh = (seg.1 - hull.2).max(hull.1 - seg.2).max(0.0);
+    (dr * dr + dh * dh).sqrt() - radius - margin - AXIAL_SLACK_MM
 }
 
 /// Where a sample is, for a refusal.
@@ -804,6 +895,7 @@ impl<'a> Checker<'a> {
                     radius: half.norm(),
                     margin: 0.0,
                     support: None,
+                    axial: None,
                 }
             })
             .collect();
@@ -847,6 +939,7 @@ impl<'a> Checker<'a> {
             radius: (TABLE_RADIUS_MM.powi(2) + half_t.powi(2)).sqrt(),
             margin: 0.0,
             support: None,
+            axial: None,
         };
         let tilt = Local {
             shape: Box::new(tilt_capsule()),
@@ -854,8 +947,19 @@ impl<'a> Checker<'a> {
             radius: TABLE_RADIUS_MM + TILT_BODY_RADIUS_MM,
             margin: 0.0,
             support: None,
+            axial: None,
         };
-        let (bands, partial) = wall_bands(layers);
+        let (mut bands, mut partial) = wall_bands(layers);
+        let axis = PartAxis::of(cell);
+        for h in bands
+            .iter_mut()
+            .chain(partial.iter_mut().filter_map(|(_, h)| h.as_mut()))
+        {
+            h.axial = h
+                .shape
+                .as_shape::<ConvexPolyhedron>()
+                .and_then(|c| axis.extent(c.points()));
+        }
         Self {
             cell,
             radii: LinkRadii::for_robot(cell.robot()),
@@ -867,6 +971,7 @@ impl<'a> Checker<'a> {
             partial,
             clearance: scene.clearance_mm,
             lever,
+            axis,
         }
     }
 
@@ -916,6 +1021,7 @@ impl<'a> Checker<'a> {
                 ends: None,
                 support: None,
                 capsule: None,
+                axial: None,
             });
         }
         // indices into `all` (the list kept from sample to sample)
@@ -991,6 +1097,23 @@ impl<'a> Checker<'a> {
             }
             _ => far_from_part.resize(first_hull, false),
         }
+        // each capsule about the part's axis (part frame)
+        let seg_axial: Vec<Option<(f64, f64, f64, f64)>> = match part_pose {
+            Some(pose) => {
+                let part_from_base = pose.inverse();
+                all[..first_hull]
+                    .iter()
+                    .map(|b| {
+                        let ((a, e), c) = (b.ends?, b.capsule?);
+                        let (r, lo, hi) = self
+                            .axis
+                            .segment(&(part_from_base * a), &(part_from_base * e));
+                        Some((r, lo, hi, c.radius))
+                    })
+                    .collect()
+            }
+            None => Vec::new(),
+        };
         let mut hit: Option<(String, String, f64)> = None;
         for (k, &(i, j)) in pairs.iter().enumerate() {
             let other = match (i >= first_hull, j >= first_hull) {
@@ -1004,8 +1127,11 @@ impl<'a> Checker<'a> {
             }
             let (a, b) = (&all[i], &all[j]);
             let margin = a.margin + b.margin;
-            let bound = ((a.centre - b.centre).norm() - a.radius - b.radius - margin)
+            let mut bound = ((a.centre - b.centre).norm() - a.radius - b.radius - margin)
                 .max(memory.lower_bound(k, i, j));
+            if let (Some(Some(seg)), Some(h)) = (seg_axial.get(i), b.axial) {
+                bound = bound.max(axial_bound((seg.0, seg.1, seg.2), seg.3, h, b.margin));
+            }
             if bound > self.clearance && bound >= best.distance_mm - REPORT_TOLERANCE_MM {
                 stats.culled += 1;
                 continue;
