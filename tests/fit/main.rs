@@ -40,6 +40,18 @@ fn fit_mesh(
     Part::from_tube_mesh(&mesh, opts)
 }
 
+/// The true centre line sampled every `step_mm` or a little less: (arc
+/// length, point) pairs, both ends included (mm).
+fn true_line(truth: &Truth, step_mm: f64) -> Vec<(f64, Point3)> {
+    let m = (truth.length / step_mm).ceil() as usize;
+    (0..=m)
+        .map(|i| {
+            let s = truth.length * i as f64 / m as f64;
+            (s, (truth.centre)(s))
+        })
+        .collect()
+}
+
 /// Compares the part read back from the written TOML with the truth: 400
 /// samples of the fitted guide, each against the nearest point of the truth's
 /// centre line (sampled every 0.02 mm), and the fitted radius there.
@@ -47,13 +59,7 @@ fn errors(truth: &Truth, fitted: &FittedPart) -> Errors {
     let part = Part::from_toml_str(&fitted.toml, "fitted.toml").unwrap();
     let tube = &part.tube;
     let range = tube.range();
-    let m = (truth.length / 0.02).ceil() as usize;
-    let line: Vec<(f64, Point3)> = (0..=m)
-        .map(|i| {
-            let s = truth.length * i as f64 / m as f64;
-            (s, (truth.centre)(s))
-        })
-        .collect();
+    let line = true_line(truth, 0.02);
     let (mut g2, mut gmax, mut r2, mut rmax) = (0.0, 0.0_f64, 0.0, 0.0_f64);
     let n = 400;
     for i in 0..=n {
@@ -211,13 +217,7 @@ fn surface_errors(truth: &Truth, fitted: &FittedPart) -> (f64, f64) {
     let part = Part::from_toml_str(&fitted.toml, "fitted.toml").unwrap();
     let tube = &part.tube;
     let range = tube.range();
-    let m = (truth.length / 0.05).ceil() as usize;
-    let line: Vec<(f64, Point3)> = (0..=m)
-        .map(|i| {
-            let s = truth.length * i as f64 / m as f64;
-            (s, (truth.centre)(s))
-        })
-        .collect();
+    let line = true_line(truth, 0.05);
     let (mut sum2, mut max, mut count) = (0.0, 0.0_f64, 0);
     for i in 0..=200 {
         let t = range.t_min + (range.t_max - range.t_min) * i as f64 / 200.0;
