@@ -66,7 +66,7 @@
 //! all the part's hulls (they share one pose) already passes that test is
 //! culled with every hull at once: each hull's own bound is no lower, so
 //! the pairs culled are the same. An arm link and a hull are also bounded
-//! about the axis the part turns about ([`PartAxis`]: J6 part-carried, the
+//! about the axis the part turns about (`PartAxis`: J6 part-carried, the
 //! table's turn torch-carried): the distance between the boxes of the two
 //! bodies in (distance from the axis, height along it), which does not
 //! change as the part turns — the nozzle spinning a full turn a layer
