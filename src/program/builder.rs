@@ -446,11 +446,6 @@ fn safe_transits(
             (wall, program.points[blocks[k].last], qb, pb)
         })
     };
-    let failed = |layer: usize, e: String| ProgramError::Infeasible {
-        count: 1,
-        first: format!("layer {layer}: transit check: {e}"),
-        layers: vec![layer],
-    };
     // the deepest sample of a transit, for a refusal's text
     let check = |program: &Program, k: usize| -> Result<transit::TransitClearance, ProgramError> {
         let Some((wall, from, qb, pb)) = transit_of(program, k) else {
@@ -462,7 +457,7 @@ fn safe_transits(
         };
         let a = (&from.joints, from.positioner);
         transit::joint_move_clearance(&program.cell, &wall, &torch, a, (&qb, pb))
-            .map_err(|e| failed(from.layer, e))
+            .map_err(|e| transit_failed(from.layer, e))
     };
     // whether a transit touches, stopping at its first sample that does
     let touches = |program: &Program, k: usize| -> Result<bool, ProgramError> {
@@ -471,7 +466,7 @@ fn safe_transits(
         };
         let a = (&from.joints, from.positioner);
         transit::joint_move_touches(&program.cell, &wall, &torch, a, (&qb, pb))
-            .map_err(|e| failed(from.layer, e))
+            .map_err(|e| transit_failed(from.layer, e))
     };
     // via points to insert after a block's last point, in block order
     let mut inserts: Vec<(usize, Vec<ProgramPoint>)> = Vec::new();
@@ -515,10 +510,8 @@ fn safe_transits(
                 " and the program has no retract points to raise (clearance_mm = 0)".into(),
             ));
         }
-        let mut c = opts.clearance_mm;
         let mut fixed = false;
-        while c < opts.transit_max_clearance_mm && !fixed {
-            c = (2.0 * c).min(opts.transit_max_clearance_mm);
+        for c in lifts(opts) {
             let end = program.points[blocks[k].end];
             let end_input = &inputs[blocks[k].start_input + (blocks[k].end - blocks[k].start)];
             let Ok(retract) =
@@ -551,6 +544,7 @@ fn safe_transits(
             }
             if !touches(program, k)? {
                 fixed = true;
+                break;
             } else {
                 program.points[blocks[k].last] = old_retract;
                 if let (Some((i, _)), Some(a)) = (approach, old_approach) {
@@ -627,11 +621,6 @@ fn via_points(
     let retract = program.points[transit.from.last];
     let end = program.points[transit.from.end];
     let end_input = &inputs[transit.from.start_input + (transit.from.end - transit.from.start)];
-    let failed = |e: String| ProgramError::Infeasible {
-        count: 1,
-        first: format!("layer {}: transit check: {e}", end.layer),
-        layers: vec![end.layer],
-    };
     // a via point at joints `q`, `qp`: the torch tip and axis seen from the
     // part, labelled as the bead it leaves
     let via_at = |q: Joints, qp: Option<PositionerJoints>| -> Option<ProgramPoint> {
@@ -656,7 +645,7 @@ fn via_points(
             .chain(std::iter::once(target))
         {
             if transit::joint_move_touches(cell, wall, torch, (&from.0, from.1), (&to.0, to.1))
-                .map_err(failed)?
+                .map_err(|e| transit_failed(end.layer, e))?
             {
                 return Ok(false);
             }
@@ -664,9 +653,11 @@ fn via_points(
         }
         Ok(true)
     };
-    let mut lift = opts.clearance_mm;
-    while lift < opts.transit_max_clearance_mm {
-        lift = (2.0 * lift).min(opts.transit_max_clearance_mm);
+    let home = program.home.and_then(|h| via_at(h.joints, h.positioner));
+    // a sequence already checked at a lower lift (the retract point or the
+    // approach point standing in for a lifted one) is not walked again
+    let mut tried: Vec<Vec<ProgramPoint>> = Vec::new();
+    for lift in lifts(opts) {
         let via = |p: &ProgramPoint, input: &PathPointInput| {
             // labelled as the bead the transit leaves, in whose block it is
             lifted(cell, p, input, ArcFlag::Transit, lift).map(|v| ProgramPoint {
@@ -696,16 +687,40 @@ fn via_points(
         if up.is_some() || down.is_some() {
             candidates.push([up, down].into_iter().flatten().collect());
         }
-        if let Some(h) = program.home.and_then(|h| via_at(h.joints, h.positioner)) {
+        if let Some(h) = home {
             candidates.push([up, Some(h), down].into_iter().flatten().collect());
         }
         for vias in candidates {
+            if tried.contains(&vias) {
+                continue;
+            }
             if clears(&vias)? {
                 return Ok(Some(vias));
             }
+            tried.push(vias);
         }
     }
     Ok(None)
+}
+
+/// The lifts a transit's retract and approach points are raised to, and
+/// its via points lifted to ([`via_points`]): 2, 4, 8… times
+/// `clearance_mm`, the last one `transit_max_clearance_mm` (mm).
+fn lifts(opts: &ProgramOptions) -> impl Iterator<Item = f64> + '_ {
+    std::iter::successors(Some(opts.clearance_mm), |&c| {
+        (c < opts.transit_max_clearance_mm).then(|| (2.0 * c).min(opts.transit_max_clearance_mm))
+    })
+    .skip(1)
+}
+
+/// A transit check that could not be made (a sample without a torch pose,
+/// or parry's error), named by the layer it leaves.
+fn transit_failed(layer: usize, e: String) -> ProgramError {
+    ProgramError::Infeasible {
+        count: 1,
+        first: format!("layer {layer}: transit check: {e}"),
+        layers: vec![layer],
+    }
 }
 
 /// The approach or retract point of bead point `p` at `clearance_mm`, or,
