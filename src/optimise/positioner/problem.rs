@@ -197,28 +197,85 @@ impl LawProblem<'_> {
 pub(super) struct Model {
     /// Residuals (the objective is `½|r|²`).
     pub(super) r: Vec<f64>,
-    /// Jacobian rows, dense `r.len() × 2K`.
-    pub(super) jac: Vec<Vec<f64>>,
+    /// Jacobian rows, one per residual, their non-zero entries only.
+    pub(super) jac: SparseRows,
     pub(super) rows: Vec<Row>,
     /// Largest violation of a linearised row at `δ = 0` (its own units).
     pub(super) violation: f64,
 }
 
-/// The previous sample: its index, world quantities and basis row.
-type Previous = (usize, WorldPoint, Vec<(usize, f64)>);
-
-/// The non-zero entries of a dense gradient, optionally negated.
-fn sparse(g: &[f64], sign: f64) -> Vec<(usize, f64)> {
-    g.iter()
-        .enumerate()
-        .filter(|(_, v)| **v != 0.0)
-        .map(|(i, v)| (i, sign * v))
-        .collect()
+/// Rows of a matrix over the coefficients `[c7; c8]`, each its non-zero
+/// `(coefficient, value)` entries in coefficient order.
+#[derive(Default)]
+pub(super) struct SparseRows {
+    /// Row `i`'s entries are `entries[start[i]..start[i + 1]]`.
+    start: Vec<usize>,
+    entries: Vec<(usize, f64)>,
 }
 
-/// The law's residuals, Jacobian (where `jacobian`; else rows and
-/// gradients are left empty) and linearised rows at coefficients `x` on
-/// `basis`, over the samples `idx`.
+impl SparseRows {
+    /// Row `i`'s non-zero entries.
+    pub(super) fn row(&self, i: usize) -> &[(usize, f64)] {
+        &self.entries[self.start[i]..self.start[i + 1]]
+    }
+}
+
+/// A gradient in the coefficients `[c7; c8]` of a quantity with
+/// derivatives `a7`, `a8` in `q7`, `q8` at one point, built densely (the
+/// basis rows of two points may share coefficients) and read out as its
+/// non-zero entries; the buffer is reused from row to row.
+struct Gradient {
+    g: Vec<f64>,
+    k: usize,
+}
+
+impl Gradient {
+    fn new(k: usize) -> Self {
+        Gradient {
+            g: vec![0.0; 2 * k],
+            k,
+        }
+    }
+
+    /// Adds the point's basis row `row` times `a7` (the `c7` block) and
+    /// `a8` (the `c8` block).
+    fn add(&mut self, row: &[(usize, f64)], a7: f64, a8: f64) {
+        for &(i, v) in row {
+            self.g[i] += a7 * v;
+            self.g[self.k + i] += a8 * v;
+        }
+    }
+
+    /// Subtracts the basis row `row` times `b7` and `b8`.
+    fn sub(&mut self, row: &[(usize, f64)], b7: f64, b8: f64) {
+        for &(i, v) in row {
+            self.g[i] -= b7 * v;
+            self.g[self.k + i] -= b8 * v;
+        }
+    }
+
+    /// The non-zero entries times `sign`, in coefficient order, pushed
+    /// onto `out`; the gradient is zero again.
+    fn drain_into(&mut self, sign: f64, out: &mut Vec<(usize, f64)>) {
+        for (i, v) in self.g.iter_mut().enumerate() {
+            if *v != 0.0 {
+                out.push((i, sign * *v));
+            }
+            *v = 0.0;
+        }
+    }
+
+    /// The non-zero entries times `sign` as a row's coefficients.
+    fn drain(&mut self, sign: f64) -> Vec<(usize, f64)> {
+        let mut out = Vec::new();
+        self.drain_into(sign, &mut out);
+        out
+    }
+}
+
+/// The law's residuals, Jacobian (where `jacobian`; else the Jacobian and
+/// the rows' gradients are left empty) and linearised rows at coefficients
+/// `x` on `basis`, over the samples `idx`.
 // the axes' loops index several per-axis arrays together
 #[allow(clippy::needless_range_loop)]
 pub(super) fn build_model(
@@ -232,9 +289,9 @@ pub(super) fn build_model(
     let (c7, c8) = x.split_at(k);
     let q7 = basis.eval(c7);
     let q8 = basis.eval(c8);
-    let mut row = Vec::new();
     let mut r = Vec::new();
-    let mut jac: Vec<Vec<f64>> = Vec::new();
+    let mut jac = SparseRows::default();
+    jac.start.push(0);
     let mut rows = Vec::new();
     let mut violation: f64 = 0.0;
     let n_all = basis.points().max(1) as f64;
@@ -243,23 +300,27 @@ pub(super) fn build_model(
         violation = violation.max(-b);
         rows.push(Row { a, b });
     };
-    let mut prev: Option<Previous> = None;
+    let mut g = Gradient::new(if jacobian { k } else { 0 });
+    // a residual's value and its Jacobian row `g` (emptied)
+    let mut push_residual = |g: &mut Gradient, v: f64| {
+        r.push(v);
+        if jacobian {
+            g.drain_into(1.0, &mut jac.entries);
+            jac.start.push(jac.entries.len());
+        }
+    };
+    // this sample's basis row, and the previous sample's
+    let (mut brow, mut rowp) = (Vec::new(), Vec::new());
+    let mut prev: Option<(usize, WorldPoint)> = None;
     for (si, &m) in idx.iter().enumerate() {
         let q = [q7[m], q8[m]];
         let w = pb.world(m, &q);
-        basis.row(m, &mut row);
-        let brow = row.clone();
-        // d/dx of a quantity with d/dq7 = a7, d/dq8 = a8
-        let grad = |a7: f64, a8: f64| {
-            if !jacobian {
-                return Vec::new();
+        basis.row(m, &mut brow);
+        // d/dx of a quantity with d/dq7 = a7, d/dq8 = a8, into `g`
+        let grad = |g: &mut Gradient, a7: f64, a8: f64| {
+            if jacobian {
+                g.add(&brow, a7, a8);
             }
-            let mut g = vec![0.0; 2 * k];
-            for &(i, v) in &brow {
-                g[i] += a7 * v;
-                g[k + i] += a8 * v;
-            }
-            g
         };
         // samples' share of the layer's points
         let lo = if si == 0 { 0 } else { idx[si - 1] };
@@ -275,69 +336,68 @@ pub(super) fn build_model(
         // tilt: λ·share·(b_x² + b_y²)
         let wt = (pb.opts.tilt_weight * share).sqrt();
         for c in 0..2 {
-            r.push(wt * w.b[0][c]);
-            jac.push(grad(wt * w.b[1][c], wt * w.b[2][c]));
+            grad(&mut g, wt * w.b[1][c], wt * w.b[2][c]);
+            push_residual(&mut g, wt * w.b[0][c]);
         }
         // cone: b_z >= cos(cone)
-        let gz = grad(w.b[1].z, w.b[2].z);
-        push_row(&mut rows, sparse(&gz, -1.0), w.b[0].z - cone_target);
+        grad(&mut g, w.b[1].z, w.b[2].z);
+        push_row(&mut rows, g.drain(-1.0), w.b[0].z - cone_target);
         // travel
         for a in 0..2 {
-            let g = grad(
-                if a == 0 { 1.0 } else { 0.0 },
-                if a == 1 { 1.0 } else { 0.0 },
-            );
+            let (a7, a8) = if a == 0 { (1.0, 0.0) } else { (0.0, 1.0) };
             if pb.upper[a].is_finite() {
-                push_row(&mut rows, sparse(&g, 1.0), pb.upper[a] - q[a]);
+                grad(&mut g, a7, a8);
+                push_row(&mut rows, g.drain(1.0), pb.upper[a] - q[a]);
             }
             if pb.lower[a].is_finite() {
-                push_row(&mut rows, sparse(&g, -1.0), q[a] - pb.lower[a]);
+                grad(&mut g, a7, a8);
+                push_row(&mut rows, g.drain(-1.0), q[a] - pb.lower[a]);
             }
         }
         // the arm's rows at this point: grad·(q + δ − q0) ≤ slack
         for a in pb.arm.iter().filter(|a| a.point == m) {
-            let g = grad(a.grad[0], a.grad[1]);
+            grad(&mut g, a.grad[0], a.grad[1]);
             let at = a.grad[0] * (q[0] - a.q0[0]) + a.grad[1] * (q[1] - a.q0[1]);
-            push_row(&mut rows, sparse(&g, 1.0), a.slack_rad - at);
+            push_row(&mut rows, g.drain(1.0), a.slack_rad - at);
         }
-        if let Some((mp, wp, rowp)) = &prev {
+        if let Some((mp, wp)) = &prev {
             let gap = (m - mp) as f64;
             let dq = [q7[m] - q7[*mp], q8[m] - q8[*mp]];
             // d(Δ)/dx = row_m − row_prev
-            let diff = |a7: f64, a8: f64, b7: f64, b8: f64| {
-                let mut g = grad(a7, a8);
-                for &(i, v) in rowp.iter().filter(|_| jacobian) {
-                    g[i] -= b7 * v;
-                    g[k + i] -= b8 * v;
+            let diff = |g: &mut Gradient, a7: f64, a8: f64, b7: f64, b8: f64| {
+                if jacobian {
+                    g.add(&brow, a7, a8);
+                    g.sub(&rowp, b7, b8);
                 }
-                g
             };
             let s = 1.0 / gap.sqrt();
             for a in 0..2 {
                 let wa = pb.gamma[a].sqrt() * s;
                 if wa > 0.0 {
-                    r.push(wa * dq[a]);
                     let (a7, a8) = if a == 0 { (1.0, 0.0) } else { (0.0, 1.0) };
-                    jac.push(diff(wa * a7, wa * a8, wa * a7, wa * a8));
+                    diff(&mut g, wa * a7, wa * a8, wa * a7, wa * a8);
+                    push_residual(&mut g, wa * dq[a]);
                 }
             }
             let wp_ = pb.gamma_arm.sqrt() * s / pb.opts.arm_length_mm;
             let wtv = pb.gamma_arm.sqrt() * s;
             for c in 0..3 {
-                r.push(wp_ * (w.p[0][c] - wp.p[0][c]));
-                jac.push(diff(
+                diff(
+                    &mut g,
                     wp_ * w.p[1][c],
                     wp_ * w.p[2][c],
                     wp_ * wp.p[1][c],
                     wp_ * wp.p[2][c],
-                ));
-                r.push(wtv * (w.t[0][c] - wp.t[0][c]));
-                jac.push(diff(
+                );
+                push_residual(&mut g, wp_ * (w.p[0][c] - wp.p[0][c]));
+                diff(
+                    &mut g,
                     wtv * w.t[1][c],
                     wtv * w.t[2][c],
                     wtv * wp.t[1][c],
                     wtv * wp.t[2][c],
-                ));
+                );
+                push_residual(&mut g, wtv * (w.t[0][c] - wp.t[0][c]));
             }
             // speeds over the samples' time
             let time: f64 = pb.dt[mp + 1..=m].iter().sum();
@@ -345,13 +405,15 @@ pub(super) fn build_model(
                 if pb.max_speed[a].is_finite() && time > 0.0 {
                     let cap = 0.98 * pb.max_speed[a] * time;
                     let (a7, a8) = if a == 0 { (1.0, 0.0) } else { (0.0, 1.0) };
-                    let g = diff(a7, a8, a7, a8);
-                    push_row(&mut rows, sparse(&g, 1.0), cap - dq[a]);
-                    push_row(&mut rows, sparse(&g, -1.0), cap + dq[a]);
+                    diff(&mut g, a7, a8, a7, a8);
+                    push_row(&mut rows, g.drain(1.0), cap - dq[a]);
+                    diff(&mut g, a7, a8, a7, a8);
+                    push_row(&mut rows, g.drain(-1.0), cap + dq[a]);
                 }
             }
         }
-        prev = Some((m, w, brow));
+        prev = Some((m, w));
+        std::mem::swap(&mut brow, &mut rowp);
     }
     Model {
         r,

@@ -52,16 +52,15 @@ pub(super) fn sqp(
     for _ in 0..pb.opts.max_iterations {
         iterations += 1;
         // P = JᵀJ (+ a small ridge), g = Jᵀr
+        // (over each row's non-zero entries: the zero ones add nothing)
         let mut p = vec![0.0; n * n];
         let mut g = vec![0.0; n];
-        for (ri, row) in model.r.iter().zip(&model.jac) {
-            for i in 0..n {
-                if row[i] == 0.0 {
-                    continue;
-                }
-                g[i] += row[i] * ri;
-                for j in 0..n {
-                    p[i * n + j] += row[i] * row[j];
+        for (i_r, ri) in model.r.iter().enumerate() {
+            let row = model.jac.row(i_r);
+            for &(i, vi) in row {
+                g[i] += vi * ri;
+                for &(j, vj) in row {
+                    p[i * n + j] += vi * vj;
                 }
             }
         }
