@@ -301,6 +301,11 @@ pub struct ToolAxisSpec {
     /// Project every build direction into the plane with this normal (part
     /// frame; thesis §3.3.1 uses `[1, 0, 0]` for the torus on a cylinder).
     pub project_build: Option<Vec3Field>,
+    /// With `project_build`: a build direction within this angle (deg, in
+    /// (0, 90)) of the plane is projected fully; beyond it the projection
+    /// fades to none for a direction along the plane's normal, so the build
+    /// direction stays continuous there (default: projected fully everywhere).
+    pub project_build_full_deg: Option<Scalar>,
     /// First layer's build direction along the substrate normal (§2.4.2).
     #[serde(default)]
     pub first_layer_along_substrate: bool,
@@ -924,6 +929,25 @@ impl Ctx<'_> {
             rule,
             project_build: match &s.project_build {
                 Some(n) => Some(self.unit("tool_axis.project_build", n)?.into_inner().into()),
+                None => None,
+            },
+            project_build_full_rad: match &s.project_build_full_deg {
+                Some(_) if s.project_build.is_none() => {
+                    return Err(self.field(
+                        "tool_axis.project_build_full_deg",
+                        "has no effect without `project_build`",
+                    ))
+                }
+                Some(v) => {
+                    let d = self.positive("tool_axis.project_build_full_deg", v)?;
+                    if d >= 90.0 {
+                        return Err(self.field(
+                            "tool_axis.project_build_full_deg",
+                            &format!("must be below 90 degrees, got {d}"),
+                        ));
+                    }
+                    Some(d.to_radians())
+                }
                 None => None,
             },
             first_layer_along_substrate: s.first_layer_along_substrate,

@@ -99,6 +99,15 @@ pub struct ToolAxisOptions {
     /// frame, need not be unit) before computing `T` (thesis §3.3.1: the
     /// torus on a cylinder uses the YZ plane, normal `[1, 0, 0]`).
     pub project_build: Option<[f64; 3]>,
+    /// With [`Self::project_build`]: a build direction within this angle of
+    /// the plane (rad, in (0, π/2)) is projected fully; beyond it the
+    /// projection fades linearly with the angle, to none for a direction along
+    /// the plane's normal. The full projection turns fast where `b` passes
+    /// near the normal (its projection's direction is ill-conditioned there,
+    /// 1 / cos of the angle): the fade bounds that to `π / 2 / (π / 2 - this)`
+    /// times the turn of `b` itself. `None`: projected fully everywhere
+    /// (thesis §3.3.1).
+    pub project_build_full_rad: Option<f64>,
     /// Take the build direction of the first layer along the substrate's
     /// outward normal (made perpendicular to `t`) instead of `t × n` (thesis
     /// §2.4.2, for features added on a non-planar substrate).
@@ -126,6 +135,7 @@ impl Default for ToolAxisOptions {
             tilt_rad: 0.0,
             rule: AxisRule::None,
             project_build: None,
+            project_build_full_rad: None,
             first_layer_along_substrate: false,
             max_rate_rad_per_mm: None,
             max_axis_rate_rad_per_mm: None,
@@ -177,6 +187,14 @@ impl ToolAxisOptions {
                 return bad(
                     "project_build",
                     format!("plane normal must be finite and non-zero, got {p:?}"),
+                );
+            }
+        }
+        if let Some(a) = self.project_build_full_rad {
+            if !(a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
+                return bad(
+                    "project_build_full_rad",
+                    format!("must be within (0, π/2), got {a}"),
                 );
             }
         }
@@ -356,7 +374,10 @@ pub fn tool_axes(
     }
     // 2. Projection of b into a plane.
     if let Some(p) = opts.project_build {
-        rules::project_build(&mut frames, &Vector3::from(p).normalize());
+        let full = opts
+            .project_build_full_rad
+            .unwrap_or(std::f64::consts::FRAC_PI_2);
+        rules::project_build(&mut frames, &Vector3::from(p).normalize(), full);
     }
     // 3.–5. Per layer, independently (in parallel, results in layer order):
     // lead / tilt, constant or by rule; smoothing of the angles; bound on

@@ -247,13 +247,26 @@ pub(crate) fn check_shape(
 
 /// Projects every build direction into the plane of unit normal `p`
 /// (thesis §3.3.1) and re-orthonormalises `t` and `n` against it; the tool
-/// axis is reset to the projected `b`. A `b` along `p` is left as is.
-pub(crate) fn project_build(frames: &mut [Vec<LocalFrame>], p: &Vector3) {
+/// axis is reset to the projected `b`. A `b` within `full_rad` of the plane
+/// is projected fully; beyond it, at an angle `α` from the plane, it is left
+/// at `π/2 · (α - full_rad) / (π/2 - full_rad)` from the plane, toward `b`
+/// (so `full_rad = π/2` projects fully everywhere). A `b` along `p` is left
+/// as is.
+pub(crate) fn project_build(frames: &mut [Vec<LocalFrame>], p: &Vector3, full_rad: f64) {
+    use std::f64::consts::FRAC_PI_2;
     for f in frames.iter_mut().flatten() {
-        let b = f.build - p * f.build.dot(p);
+        let along = f.build.dot(p);
+        let b = f.build - p * along;
         if b.norm() < tol::ANGLE_RAD {
             continue;
         }
+        let alpha = along.abs().min(1.0).asin();
+        let b = if alpha <= full_rad {
+            b.normalize()
+        } else {
+            let left = FRAC_PI_2 * (alpha - full_rad) / (FRAC_PI_2 - full_rad);
+            b.normalize() * left.cos() + p * (left.sin() * along.signum())
+        };
         let b = b.normalize();
         let t = f.tangent - b * f.tangent.dot(&b);
         let t = if t.norm() > tol::ANGLE_RAD {

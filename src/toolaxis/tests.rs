@@ -89,7 +89,7 @@ fn projection_into_a_plane() {
     let mut frames = vec![vec![leaning_frame(0.6)]];
     let b0 = frames[0][0].build;
     frames[0][0].build = (b0 + Vector3::y() * 0.3).normalize();
-    project_build(&mut frames, &Vector3::y());
+    project_build(&mut frames, &Vector3::y(), std::f64::consts::FRAC_PI_2);
     let f = frames[0][0];
     assert!(f.build.y.abs() < 1e-15);
     assert_relative_eq!(f.build, b0, epsilon = 1e-12);

@@ -205,7 +205,7 @@ fn missing_stl_substrate_names_the_field() {
 #[test]
 fn tool_axis_and_process_tables() {
     let text = format!(
-        "{}\n[tool_axis]\nlead_deg = 5\ntilt_deg = -3\nmax_lean_deg = 50\nproject_build = [1, 0, 0]\nmax_axis_rate_deg_per_mm = 10\n\n[process]\npreset = \"pla\"\ntravel_speed_mm_s = 5\n",
+        "{}\n[tool_axis]\nlead_deg = 5\ntilt_deg = -3\nmax_lean_deg = 50\nproject_build = [1, 0, 0]\nproject_build_full_deg = 45\nmax_axis_rate_deg_per_mm = 10\n\n[process]\npreset = \"pla\"\ntravel_speed_mm_s = 5\n",
         good()
     );
     let part = parse_part(&text, "good.toml", Path::new(".")).unwrap();
@@ -214,6 +214,7 @@ fn tool_axis_and_process_tables() {
     assert!((o.tilt_rad + 3f64.to_radians()).abs() < 1e-15);
     assert_eq!(o.rule, waam_slicer::toolaxis::AxisRule::thesis_50_deg());
     assert_eq!(o.project_build, Some([1.0, 0.0, 0.0]));
+    assert!((o.project_build_full_rad.unwrap() - 45f64.to_radians()).abs() < 1e-15);
     assert!((o.max_axis_rate_rad_per_mm.unwrap() - 10f64.to_radians()).abs() < 1e-15);
     assert_eq!(part.process.material, "PLA");
     assert_eq!(part.process.travel_speed_mm_s, 5.0);
@@ -231,6 +232,16 @@ fn tool_axis_and_process_tables() {
         ("tool_axis", "max_lean_deg = 95", "tool_axis.max_lean_deg"),
         ("tool_axis", "lead_deg = 90", "tool_axis.lead_deg"),
         ("tool_axis", "lean_axis = [0, 0, 1]", "tool_axis.lean_axis"),
+        (
+            "tool_axis",
+            "project_build_full_deg = 45",
+            "tool_axis.project_build_full_deg",
+        ),
+        (
+            "tool_axis",
+            "project_build = [1, 0, 0]\nproject_build_full_deg = 90",
+            "tool_axis.project_build_full_deg",
+        ),
         (
             "tool_axis",
             "project_build = [0, 0, 0]",

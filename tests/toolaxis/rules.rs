@@ -216,3 +216,96 @@ fn axis_rate_bound_spreads_the_cusps_of_constant_distance_layers() {
         }
     }
 }
+
+/// The projection's fade (thesis §3.3.1 plus `project_build_full_deg`) on
+/// the torus on cylinder at its own grid. Projected fully, a build direction
+/// that passes near the plane's normal turns by 1 / cos of its angle to the
+/// plane: on layer 6, `b` lies 88.6° from the YZ plane at point 250 and its
+/// projection flips through the vertical, 17.6° between two points 0.19 mm
+/// apart where `b` itself turns 0.7°. With the part file's 45°, a `b`
+/// within 45° of the plane is projected exactly as before, and on the
+/// layers' smooth stretches (where `b` turns under 5° a step) the projected
+/// direction turns at most 3× what `b` does (the fade's bound: 1 / cos 45°
+/// inside, 2 = 90 / (90 - 45) in the angle and ≤ 2 across beyond). The
+/// projection's purpose, the torch's clearance (CMT torch, the part built
+/// so far and the cylinder), is kept on every layer, and layer 6's torch,
+/// which the full projection leaned into the layers below at the flip,
+/// clears them.
+#[test]
+fn a_faded_projection_keeps_the_build_direction_continuous_on_the_torus_on_cylinder() {
+    use waam_slicer::toolaxis::{check_collisions, CollisionOptions, Torch, TorchSpec};
+    let part = load_part("torus-on-cylinder.toml");
+    let full = part
+        .tool_axis
+        .project_build_full_rad
+        .expect("the part file fades its projection");
+    assert!((full.to_degrees() - 45.0).abs() < 1e-9);
+    let path = slice(&part.tube, &part.substrate, &part.slice_options()).unwrap();
+    let frames = |proj: Option<[f64; 3]>, full: Option<f64>| {
+        tool_axes(
+            &path,
+            Some(&part.tube),
+            Some(&part.substrate),
+            &ToolAxisOptions {
+                project_build: proj,
+                project_build_full_rad: full,
+                ..ToolAxisOptions::default()
+            },
+        )
+        .unwrap()
+        .frames
+    };
+    let x = Some([1.0, 0.0, 0.0]);
+    let raw = frames(None, None);
+    let projected = frames(x, None);
+    let faded = frames(x, Some(full));
+    let turn = |a: &waam_slicer::nalgebra::Vector3<f64>,
+                b: &waam_slicer::nalgebra::Vector3<f64>| {
+        a.cross(b).norm().atan2(a.dot(b))
+    };
+    let (mut exact, mut worst_faded, mut worst_projected) = (0, 0.0f64, 0.0f64);
+    for ((r, p), f) in raw.iter().zip(&projected).zip(&faded) {
+        for i in 0..r.len() {
+            let alpha = r[i].build.x.abs().min(1.0).asin();
+            if alpha <= full {
+                assert!((f[i].build - p[i].build).norm() < 1e-12);
+                exact += 1;
+            }
+            if i == 0 {
+                continue;
+            }
+            let step = turn(&r[i - 1].build, &r[i].build);
+            if step > 5f64.to_radians() || step < 1e-6 {
+                continue;
+            }
+            worst_faded = worst_faded.max(turn(&f[i - 1].build, &f[i].build) / step);
+            worst_projected = worst_projected.max(turn(&p[i - 1].build, &p[i].build) / step);
+        }
+    }
+    eprintln!(
+        "{exact} points projected exactly; turn / b's turn: faded {worst_faded:.2}, projected {worst_projected:.2}"
+    );
+    assert!(exact > path.layers.iter().map(|l| l.points.len()).sum::<usize>() / 2);
+    assert!(worst_faded <= 3.0, "{worst_faded}");
+    assert!(worst_projected > 10.0, "{worst_projected}");
+
+    let torch = Torch::new(&TorchSpec::cmt_torch()).unwrap();
+    let copts = CollisionOptions::default();
+    let clear = |fr: &[Vec<waam_slicer::toolaxis::LocalFrame>]| {
+        check_collisions(&path, fr, Some(&part.substrate), &torch, &copts).unwrap()
+    };
+    let (p, f) = (clear(&projected), clear(&faded));
+    assert!(p.substrate_checked && f.substrate_checked);
+    for (lp, lf) in p.layers.iter().zip(&f.layers) {
+        eprintln!(
+            "layer {}: torch clearance {:.2} mm projected, {:.2} faded",
+            lp.layer, lp.min_clearance_mm, lf.min_clearance_mm
+        );
+        assert!(
+            lf.min_clearance_mm >= lp.min_clearance_mm - 0.05,
+            "layer {}",
+            lp.layer
+        );
+    }
+    assert!(p.layers[6].min_clearance_mm < 0.0 && f.layers[6].min_clearance_mm > 0.0);
+}
