@@ -39,10 +39,12 @@ pub struct SplitPlan {
 }
 
 /// Splits the layers that `plan` (made from `layers`) could not build whole
-/// at the points `splits_of(k)` gives for `layers[k]` (indices in the layer;
-/// none: the layer is left), when every one of its beads then plans in
-/// `cell` ([module doc](self)). The beads' turns are shifted by whole turns
-/// to start nearest the previous bead's end, within the turn's travel.
+/// into the beads `beads_of(k, &layers[k])` gives (in order, each starting
+/// where the one before ends, as [`LayerPoints::split_at`] makes them;
+/// fewer than two: the layer is left), when every one of its beads then
+/// plans in `cell` ([module doc](self)). The beads' turns are shifted by
+/// whole turns to start nearest the previous bead's end, within the turn's
+/// travel.
 ///
 /// # Errors
 /// As [`optimise`] on the beads.
@@ -50,7 +52,7 @@ pub fn split_refused_layers(
     cell: &CellLayout,
     layers: Vec<LayerPoints>,
     plan: Plan,
-    splits_of: &dyn Fn(usize) -> Vec<usize>,
+    beads_of: &dyn Fn(usize, &LayerPoints) -> Vec<LayerPoints>,
     opts: &OptimiseOptions,
 ) -> Result<SplitPlan, OptimiseError> {
     // the beads of every refused layer with corners inside its bead
@@ -60,8 +62,7 @@ pub fn split_refused_layers(
         if pl.status.is_feasible() || lp.bead != 0 {
             continue;
         }
-        let points = splits_of(k);
-        let split = lp.split_at(&points);
+        let split = beads_of(k, lp);
         if split.len() < 2 {
             continue;
         }

@@ -14,12 +14,14 @@ use super::summary::{
     TransitionSummary, UnbuildableLayer, UnbuildableProof,
 };
 use super::{slice_part_with, Cell, Control, Part, PlanOptions, RzLaw, SlicedPart};
+use crate::math::UnitVector3;
 use crate::optimise::{
     layer_points, optimise_with, slow_refused_layers, split_refused_layers, LayerPlan, LayerPoints,
     OptimiseOptions, Plan, SplitPlan,
 };
 use crate::program::{check_vendor, write_files, ArcFlag, Program, ProgramError};
 use crate::robot::Vendor;
+use crate::toolaxis::bead_tool_axes;
 use crate::Error;
 
 /// Wall-clock time of each planning stage (s).
@@ -247,24 +249,51 @@ fn split_at_corners(
     }
     let threshold = sliced.options.corner_threshold_rad;
     let path = &sliced.path;
-    let corners_of = |k: usize| -> Vec<usize> {
-        layers
-            .get(k)
-            .and_then(|lp| path.layers.get(lp.layer))
-            .map(|l| {
-                l.inside_corners(threshold)
-                    .iter()
-                    .map(|c| c.point)
-                    .collect()
-            })
-            .unwrap_or_default()
+    let beads_of = |_: usize, lp: &LayerPoints| -> Vec<LayerPoints> {
+        let (Some(layer), Some(frames)) =
+            (path.layers.get(lp.layer), sliced.axes.frames.get(lp.layer))
+        else {
+            return Vec::new();
+        };
+        if lp.points.len() < 3 {
+            return Vec::new();
+        }
+        let corners: Vec<usize> = layer
+            .inside_corners(threshold)
+            .iter()
+            .map(|c| c.point)
+            .collect();
+        // each bead's tool axes as on an open layer from its first point to
+        // its last, the corners left out (their frames lie half way round:
+        // `split_at` gives each bead's end on a corner its neighbour's): the
+        // rate bound spreads no corner across a bead's end
+        let mut retooled = lp.clone();
+        let first = lp.first_point;
+        let last = first + lp.points.len() - 1;
+        let ends: Vec<usize> = std::iter::once(first)
+            .chain(corners.iter().copied())
+            .chain(std::iter::once(last))
+            .collect();
+        for w in ends.windows(2) {
+            let lo = if w[0] == first { w[0] } else { w[0] + 1 };
+            let hi = if w[1] == last { w[1] } else { w[1] - 1 };
+            let axes = bead_tool_axes(path, lp.layer, frames, lo..hi + 1, &sliced.tool_axis);
+            for (i, t) in (lo..).zip(axes) {
+                if let Some(p) = i
+                    .checked_sub(first)
+                    .and_then(|i| retooled.points.get_mut(i))
+                {
+                    p.tool_axis = UnitVector3::new_normalize(t);
+                }
+            }
+        }
+        retooled.split_at(&corners)
     };
-    let points: Vec<Vec<usize>> = (0..layers.len()).map(corners_of).collect();
     Ok(split_refused_layers(
         &cell.layout,
         layers,
         plan,
-        &|k| points[k].clone(),
+        &beads_of,
         opts,
     )?)
 }

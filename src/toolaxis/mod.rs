@@ -438,6 +438,54 @@ fn layer_axes(
     frames: &mut [LocalFrame],
     opts: &ToolAxisOptions,
 ) -> (Vec<(f64, f64)>, LayerAxisReport) {
+    let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
+    axes_along(&positions, layer.bead_wraps(), li, 0, frames, opts)
+}
+
+/// The tool axes `T` (part frame, unit) of one bead of a layer split into
+/// beads: points `range` of layer `li` of `path`, whose frames (`b`, `t`,
+/// `n`; [`tool_axes`]'s output) are `frames`, set by steps 3–5 of
+/// [`tool_axes`] as on an open layer that runs from the bead's first point
+/// to its last. The rate bound then spreads no jump of the build direction
+/// across the bead's ends: where the layer is split at a corner, each bead
+/// keeps its own side's axes up to the corner instead of turning half way
+/// round it toward the other bead's.
+///
+/// # Panics
+/// Never; an empty or out-of-range `range` gives the axes of the points it
+/// holds within the layer (none for an empty one).
+pub fn bead_tool_axes(
+    path: &Path,
+    li: usize,
+    frames: &[LocalFrame],
+    range: std::ops::Range<usize>,
+    opts: &ToolAxisOptions,
+) -> Vec<Vector3> {
+    let Some(layer) = path.layers.get(li) else {
+        return Vec::new();
+    };
+    let end = range.end.min(layer.points.len()).min(frames.len());
+    let start = range.start.min(end);
+    let positions: Vec<_> = layer.points[start..end]
+        .iter()
+        .map(|p| p.position)
+        .collect();
+    let mut bead = frames[start..end].to_vec();
+    axes_along(&positions, false, li, start, &mut bead, opts);
+    bead.iter().map(|f| f.tool).collect()
+}
+
+/// Steps 3–5 of [`tool_axes`] on the points `positions` (part frame, mm)
+/// of layer `li` from its point `first` on, whose frames are `frames`;
+/// `wraps`: the bead runs across the last point to the first.
+fn axes_along(
+    positions: &[crate::math::Point3],
+    wraps: bool,
+    li: usize,
+    first: usize,
+    frames: &mut [LocalFrame],
+    opts: &ToolAxisOptions,
+) -> (Vec<(f64, f64)>, LayerAxisReport) {
     let mut report = LayerAxisReport {
         rule_active_points: 0,
         rule_unreachable: Vec::new(),
@@ -448,21 +496,21 @@ fn layer_axes(
     // 3. Lead / tilt, constant or by rule.
     let mut angles = Vec::with_capacity(frames.len());
     for (pi, f) in frames.iter_mut().enumerate() {
-        let out = opts.rule.apply(f, opts.lead_rad, opts.tilt_rad, li, pi);
+        let out = opts
+            .rule
+            .apply(f, opts.lead_rad, opts.tilt_rad, li, first + pi);
         if out.active {
             report.rule_active_points += 1;
         }
         if !out.reached {
-            report.rule_unreachable.push(pi);
+            report.rule_unreachable.push(first + pi);
         }
         f.tool = tool_axis(f, out.lead_rad, out.tilt_rad);
         angles.push((out.lead_rad, out.tilt_rad));
     }
-    let positions: Vec<_> = layer.points.iter().map(|p| p.position).collect();
-    let wraps = layer.bead_wraps();
     // 4. Smoothing of the lead/tilt angles along the layer.
     if let Some(rate) = opts.max_rate_rad_per_mm {
-        let moved = smooth_angles(&positions, &mut angles, wraps, rate);
+        let moved = smooth_angles(positions, &mut angles, wraps, rate);
         report.smoothed_points += moved;
         if moved > 0 {
             for (f, &(lead, tilt)) in frames.iter_mut().zip(&angles) {
@@ -473,7 +521,7 @@ fn layer_axes(
     // 5. Bound on the rate of T itself.
     let mut axes: Vec<Vector3> = frames.iter().map(|f| f.tool).collect();
     if let Some(rate) = opts.max_axis_rate_rad_per_mm {
-        let moved = smooth_layer(&positions, &mut axes, wraps, rate);
+        let moved = smooth_layer(positions, &mut axes, wraps, rate);
         report.smoothed_points += moved;
         if moved > 0 {
             for ((f, t), a) in frames.iter_mut().zip(&axes).zip(angles.iter_mut()) {
@@ -482,7 +530,7 @@ fn layer_axes(
             }
         }
     }
-    report.max_rate_rad_per_mm = rules::max_rate(&positions, &axes, wraps);
+    report.max_rate_rad_per_mm = rules::max_rate(positions, &axes, wraps);
     for a in &axes {
         report.max_angle_from_z_rad = report.max_angle_from_z_rad.max(a.z.clamp(-1.0, 1.0).acos());
     }

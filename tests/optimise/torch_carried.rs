@@ -402,6 +402,60 @@ fn every_sample_part_in_every_torch_carried_cell_checked_by_independent_kinemati
     }
 }
 
+/// The torus on cylinder's end caps (issue 45: its layers 7–11 are open,
+/// V-shaped, one corner at the V's tip where `b` turns about 150°), at the
+/// part file's own grid in the three torch-carried cells: every layer
+/// plans, checked by the independent kinematics, and the program is built.
+/// Each cap is split at its tip, and each bead keeps its own side's tool
+/// axes up to the tip: the part's axis-rate bound (10°/mm) spreads the
+/// tip's jump over the whole layer's axes, leaning the torch up to 80° off
+/// `b` on both sides of it, and a bead that ends there is an open bead of
+/// its own (no jump to spread). So on every bead of a split layer the torch
+/// stays within 5° of `b` (the part file sets no lead or tilt), where the
+/// layer's own axes lean more than 60° off it next to the tip.
+#[test]
+fn the_torus_on_cylinders_caps_plan_split_with_each_bead_keeping_its_axes() {
+    let part = Part::read(part_path("torus-on-cylinder.toml")).unwrap();
+    for cell_file in &TORCH_CELLS {
+        let cell = Cell::read(part_path(&format!("cells/{cell_file}"))).unwrap();
+        let what = format!("torus on cylinder in {cell_file}");
+        let planned = plan_part(&part, &cell, &PlanOptions::default()).unwrap();
+        assert!(planned.is_feasible(), "{what}: {:?}", planned.refusal());
+        let checked = fk_check(&cell_data(cell_file), &planned, &what);
+        assert!(checked > 4000, "{what}: {checked} points");
+        let split: Vec<usize> = planned.splits.iter().map(|s| s.layer).collect();
+        assert!(split.len() >= 4, "{what}: {split:?}");
+        for s in &planned.splits {
+            let whole = &planned.sliced.axes.frames[s.layer];
+            let off = |f: &waam_slicer::toolaxis::LocalFrame| f.tool.angle(&f.build).to_degrees();
+            let next_to_tip = off(&whole[s.point - 1]).max(off(&whole[s.point + 1]));
+            assert!(
+                next_to_tip > 60.0,
+                "{what}: layer {} {next_to_tip}",
+                s.layer
+            );
+            for lp in planned.layers.iter().filter(|l| l.layer == s.layer) {
+                for (m, p) in lp.points.iter().enumerate() {
+                    let b = p.build_direction.expect("a build direction");
+                    let a = p.tool_axis.angle(&b).to_degrees();
+                    if a > 5.0 {
+                        eprintln!(
+                            "{what}: layer {} bead {} point {m}: {a:.1}",
+                            s.layer, lp.bead
+                        );
+                    }
+                    assert!(
+                        a < 90.0,
+                        "{what}: layer {} bead {} point {m}: torch {a:.1}° off b",
+                        s.layer,
+                        lp.bead
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// The same at the part files' own grids (release, by hand:
 /// `cargo test --release --test optimise torch_carried -- --ignored --nocapture`).
 #[test]
