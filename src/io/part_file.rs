@@ -896,22 +896,24 @@ impl Ctx<'_> {
                 None => Ok(0.0),
             }
         };
+        // an angle in (0, 90) degrees, in rad
+        let acute = |field: &str, v: &Scalar| -> Result<f64, PartFileError> {
+            let d = self.positive(field, v)?;
+            if d >= 90.0 {
+                return Err(self.field(field, &format!("must be below 90 degrees, got {d}")));
+            }
+            Ok(d.to_radians())
+        };
         let rule = match &s.max_lean_deg {
             Some(v) => {
-                let d = self.positive("tool_axis.max_lean_deg", v)?;
-                if d >= 90.0 {
-                    return Err(self.field(
-                        "tool_axis.max_lean_deg",
-                        &format!("must be below 90 degrees, got {d}"),
-                    ));
-                }
+                let max_angle_rad = acute("tool_axis.max_lean_deg", v)?;
                 let axis = match &s.lean_axis {
                     Some(a) => self.unit("tool_axis.lean_axis", a)?.into_inner(),
                     None => Vector3::z(),
                 };
                 AxisRule::MaxAngleFromAxis {
                     axis: axis.into(),
-                    max_angle_rad: d.to_radians(),
+                    max_angle_rad,
                 }
             }
             None if s.lean_axis.is_some() => {
@@ -938,16 +940,7 @@ impl Ctx<'_> {
                         "has no effect without `project_build`",
                     ))
                 }
-                Some(v) => {
-                    let d = self.positive("tool_axis.project_build_full_deg", v)?;
-                    if d >= 90.0 {
-                        return Err(self.field(
-                            "tool_axis.project_build_full_deg",
-                            &format!("must be below 90 degrees, got {d}"),
-                        ));
-                    }
-                    Some(d.to_radians())
-                }
+                Some(v) => Some(acute("tool_axis.project_build_full_deg", v)?),
                 None => None,
             },
             first_layer_along_substrate: s.first_layer_along_substrate,
