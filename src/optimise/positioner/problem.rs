@@ -227,6 +227,10 @@ impl SparseRows {
 struct Gradient {
     g: Vec<f64>,
     k: usize,
+    /// The coefficients touched since the last drain lie in `lo..hi` of
+    /// each block.
+    lo: usize,
+    hi: usize,
 }
 
 impl Gradient {
@@ -234,6 +238,8 @@ impl Gradient {
         Gradient {
             g: vec![0.0; 2 * k],
             k,
+            lo: k,
+            hi: 0,
         }
     }
 
@@ -243,6 +249,8 @@ impl Gradient {
         for &(i, v) in row {
             self.g[i] += a7 * v;
             self.g[self.k + i] += a8 * v;
+            self.lo = self.lo.min(i);
+            self.hi = self.hi.max(i + 1);
         }
     }
 
@@ -251,23 +259,29 @@ impl Gradient {
         for &(i, v) in row {
             self.g[i] -= b7 * v;
             self.g[self.k + i] -= b8 * v;
+            self.lo = self.lo.min(i);
+            self.hi = self.hi.max(i + 1);
         }
     }
 
     /// The non-zero entries times `sign`, in coefficient order, pushed
     /// onto `out`; the gradient is zero again.
     fn drain_into(&mut self, sign: f64, out: &mut Vec<(usize, f64)>) {
-        for (i, v) in self.g.iter_mut().enumerate() {
-            if *v != 0.0 {
-                out.push((i, sign * *v));
+        for block in [0, self.k] {
+            for i in block + self.lo..block + self.hi {
+                let v = &mut self.g[i];
+                if *v != 0.0 {
+                    out.push((i, sign * *v));
+                }
+                *v = 0.0;
             }
-            *v = 0.0;
         }
+        (self.lo, self.hi) = (self.k, 0);
     }
 
     /// The non-zero entries times `sign` as a row's coefficients.
     fn drain(&mut self, sign: f64) -> Vec<(usize, f64)> {
-        let mut out = Vec::new();
+        let mut out = Vec::with_capacity(2 * self.hi.saturating_sub(self.lo));
         self.drain_into(sign, &mut out);
         out
     }
@@ -289,10 +303,16 @@ pub(super) fn build_model(
     let (c7, c8) = x.split_at(k);
     let q7 = basis.eval(c7);
     let q8 = basis.eval(c8);
-    let mut r = Vec::new();
+    // per sample: at most 10 residuals (2 tilt, 2 axes, 6 arm) of at most
+    // 16 entries (two points' basis rows, both axes) and 9 rows
+    let mut r = Vec::with_capacity(10 * idx.len());
     let mut jac = SparseRows::default();
+    if jacobian {
+        jac.start.reserve(10 * idx.len() + 1);
+        jac.entries.reserve(160 * idx.len());
+    }
     jac.start.push(0);
-    let mut rows = Vec::new();
+    let mut rows = Vec::with_capacity(9 * idx.len() + pb.arm.len());
     let mut violation: f64 = 0.0;
     let n_all = basis.points().max(1) as f64;
     let cone_target = pb.cos_cone;
