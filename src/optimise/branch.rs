@@ -149,6 +149,7 @@ pub(super) fn optimise_layer(
                 quality: LayerQuality::default(),
                 solver: solver(t0.elapsed().as_secs_f64()),
                 violations: Vec::new(),
+                solved: None,
             };
             return (plan, end_floor);
         }

@@ -314,6 +314,12 @@ pub struct LayerPlan {
     /// The positioner's laws (torch-carried cell): seed, largest tilt of
     /// `b` from the vertical and where, binding constraint.
     pub positioner: Option<crate::optimise::positioner::PositionerLaw>,
+    /// The trajectory stage's re-check of the layer as solved (joints,
+    /// speeds, violations), which the program's trajectory takes where it
+    /// would solve the same points in the same cell
+    /// ([`SolvedBead::reuse`](crate::robot::trajectory::SolvedBead)); `None`
+    /// where the re-check refused its input or the layer has no solution.
+    pub(crate) solved: Option<std::sync::Arc<crate::robot::trajectory::SolvedBead>>,
 }
 
 /// The arc-off move from the last point of a layer to the first of the next.

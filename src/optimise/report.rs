@@ -12,7 +12,7 @@ use super::{
 };
 use crate::robot::cell::CellLayout;
 use crate::robot::model::Joints;
-use crate::robot::trajectory::{joint_trajectory, PathPointInput, ViolationKind};
+use crate::robot::trajectory::{joint_trajectory, PathPointInput, SolvedBead, ViolationKind};
 
 /// A constraint violated by more than this (its own units, as
 /// [`LayerProblem::binding`] takes them) is reported as binding.
@@ -68,7 +68,7 @@ pub(super) fn finish(
         .collect();
     let mut topts = opts.trajectory;
     topts.with_derivatives = false;
-    let violations = match joint_trajectory(&cell, &inputs, &topts) {
+    let (violations, solved) = match joint_trajectory(&cell, &inputs, &topts) {
         Ok(t) => {
             // its dexterity is the exact value the plan reports, wherever
             // it solved the same joints (it does everywhere: same IK, same
@@ -78,9 +78,11 @@ pub(super) fn finish(
                     e.set_exact_dexterity(m, jp.dexterity);
                 }
             }
-            t.report.violations
+            let violations = t.report.violations.clone();
+            let solved = SolvedBead::new(&cell, &topts, inputs.clone(), t);
+            (violations, Some(std::sync::Arc::new(solved)))
         }
-        Err(_) => Vec::new(),
+        Err(_) => (Vec::new(), None),
     };
     problem.exact_dexterity(&mut e);
     let binding = problem.binding(&e, BINDING_VIOLATION).or_else(|| {
@@ -169,6 +171,7 @@ pub(super) fn finish(
         solver: solver(t0.elapsed().as_secs_f64()),
         violations,
         positioner: None,
+        solved,
     }
 }
 

@@ -7,6 +7,7 @@
 //! programs here; they differ only in the feed they pass and the payload the
 //! build starts with. SPEC §8.
 
+use std::collections::HashMap;
 use std::time::Instant;
 
 use super::Cell;
@@ -16,7 +17,8 @@ use crate::program::{
     build_program_with, LayerRefusal, PointFeed, Program, ProgramError, ProgramOptions,
 };
 use crate::robot::trajectory::{
-    joint_trajectory_without_measures, JointTrajectory, PathPointInput, TrajectoryOptions,
+    joint_trajectory_without_measures, JointTrajectory, PathPointInput, SolvedBead,
+    TrajectoryOptions,
 };
 use crate::robot::{CellLayout, RobotError};
 
@@ -61,9 +63,18 @@ impl ProgramBuild<'_> {
         let (cell, layers, common) = (self.cell, self.layers, self.common);
         check_every_layer(layers, self.plan)?;
         let inputs = trajectory_inputs(layers, self.plan);
+        // the optimiser's re-check of each layer, by where its points start
+        let mut solved = HashMap::new();
+        let mut start = 0;
+        for (lp, pl) in layers.iter().zip(&self.plan.layers) {
+            if let Some(s) = &pl.solved {
+                solved.insert(start, s.as_ref());
+            }
+            start += lp.points.len();
+        }
         // the program reads the joints, speeds and violations only: no
         // dexterity (an SVD a point) nor dq/dR_Z
-        let traj = trajectory_by_bead(&cell.layout, &inputs)
+        let traj = trajectory_by_bead(&cell.layout, &inputs, &solved)
             .map_err(|source| ProgramError::Trajectory { source })?;
         if self.wire_feed_mm_s.len() != inputs.len() {
             return Err(ProgramError::InvalidOptions {
@@ -104,7 +115,7 @@ impl ProgramBuild<'_> {
                 .map(|w| (w[1].position_mm - w[0].position_mm).norm())
                 .sum()
         };
-        let mut layer_length = std::collections::HashMap::new();
+        let mut layer_length = HashMap::new();
         for l in self.layers {
             *layer_length.entry(l.layer).or_insert(0.0) += length(l);
         }
@@ -131,7 +142,9 @@ impl ProgramBuild<'_> {
 /// speed from the previous bead), and the positioner's turn hint it
 /// carries from bead to bead is read only for a point without planned
 /// positioner joints: where one has none in a torch-carried cell, the
-/// walk is one.
+/// walk is one. A bead starting at input `i` whose points `solved[&i]`
+/// solved already ([`SolvedBead::reuse`]: the same points in the same
+/// cell) takes its joints from there instead of solving them again.
 ///
 /// # Errors
 /// As [`joint_trajectory_without_measures`]: the first bad input point in
@@ -139,6 +152,7 @@ impl ProgramBuild<'_> {
 fn trajectory_by_bead(
     cell: &CellLayout,
     inputs: &[PathPointInput],
+    solved: &HashMap<usize, &SolvedBead>,
 ) -> Result<JointTrajectory, RobotError> {
     use rayon::prelude::*;
     let opts = TrajectoryOptions::default();
@@ -157,7 +171,16 @@ fn trajectory_by_bead(
     }
     let parts: Vec<Result<JointTrajectory, RobotError>> = beads
         .par_iter()
-        .map(|r| joint_trajectory_without_measures(cell, &inputs[r.clone()], &opts))
+        .map(|r| {
+            let bead = &inputs[r.clone()];
+            match solved
+                .get(&r.start)
+                .and_then(|s| s.reuse(cell, bead, &opts))
+            {
+                Some(t) => Ok(t),
+                None => joint_trajectory_without_measures(cell, bead, &opts),
+            }
+        })
         .collect();
     let mut whole = JointTrajectory {
         configuration: cell.configuration(),
@@ -218,6 +241,7 @@ pub(super) fn check_every_layer(layers: &[LayerPoints], plan: &Plan) -> Result<(
 mod tests {
     use super::*;
     use crate::optimise::layer_points;
+    use crate::robot::ik::Wrist;
 
     /// The beads solved in parallel give the trajectory of one walk, to the
     /// bit: the hemisphere's layers (R_Z 0 and 0.3 rad on alternate layers)
@@ -258,7 +282,10 @@ mod tests {
         for cell in ["robowam_part_carried", "robowam_torch_carried"] {
             let cell = crate::Cell::read(root.join(format!("cells/{cell}.toml"))).unwrap();
             let one = joint_trajectory_without_measures(&cell.layout, &inputs, &opts).unwrap();
-            assert_eq!(trajectory_by_bead(&cell.layout, &inputs).unwrap(), one);
+            assert_eq!(
+                trajectory_by_bead(&cell.layout, &inputs, &HashMap::new()).unwrap(),
+                one
+            );
             if matches!(cell.layout, CellLayout::TorchCarried(_)) {
                 let planned: Vec<PathPointInput> = inputs
                     .iter()
@@ -269,8 +296,87 @@ mod tests {
                     })
                     .collect();
                 let one = joint_trajectory_without_measures(&cell.layout, &planned, &opts).unwrap();
-                assert_eq!(trajectory_by_bead(&cell.layout, &planned).unwrap(), one);
+                assert_eq!(
+                    trajectory_by_bead(&cell.layout, &planned, &HashMap::new()).unwrap(),
+                    one
+                );
             }
+        }
+    }
+
+    /// The optimiser's re-check of each layer is the program's trajectory
+    /// of its bead, to the bit: the hemisphere planned in the ROBOWAM
+    /// part-carried and torch-carried cells (at a coarser grid), its
+    /// trajectory with the solved beads taken is the one solved afresh,
+    /// and in the part-carried cell every bead is taken; a bead one of
+    /// whose points moved (`R_Z` by one ulp) or in another cell (the other
+    /// branch) is solved again.
+    #[test]
+    fn solved_beads_are_the_program_trajectory() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("parts");
+        let mut part = crate::Part::read(root.join("hemisphere.toml")).unwrap();
+        part.slicing.delta_mm *= 2.0;
+        let sliced = crate::pipeline::slice_part(&part).unwrap();
+        let layers = layer_points(
+            &sliced.path,
+            &sliced.axes.frames,
+            sliced.process.travel_speed_mm_s,
+        );
+        let opts = crate::PlanOptions::default().optimise;
+        for name in ["robowam_part_carried", "robowam_torch_carried"] {
+            let cell = crate::Cell::read(root.join(format!("cells/{name}.toml"))).unwrap();
+            let plan = crate::optimise::optimise(&cell.layout, &layers, &opts).unwrap();
+            let inputs = trajectory_inputs(&layers, &plan);
+            let mut solved = HashMap::new();
+            let mut start = 0;
+            for (lp, pl) in layers.iter().zip(&plan.layers) {
+                if let Some(s) = &pl.solved {
+                    solved.insert(start, s.as_ref());
+                }
+                start += lp.points.len();
+            }
+            let fresh = trajectory_by_bead(&cell.layout, &inputs, &HashMap::new()).unwrap();
+            assert_eq!(
+                trajectory_by_bead(&cell.layout, &inputs, &solved).unwrap(),
+                fresh,
+                "{name}"
+            );
+            let opts = TrajectoryOptions::default();
+            let (mut start, mut taken) = (0, 0);
+            for lp in &layers {
+                let bead = &inputs[start..start + lp.points.len()];
+                if let Some(s) = solved.get(&start) {
+                    let t = s.reuse(&cell.layout, bead, &opts);
+                    taken += usize::from(t.is_some());
+                    if let Some(t) = t {
+                        let one = joint_trajectory_without_measures(&cell.layout, bead, &opts);
+                        assert_eq!(t, one.unwrap(), "{name}, layer {}", lp.layer);
+                    }
+                    let mut moved = bead.to_vec();
+                    moved[bead.len() / 2].r_z =
+                        f64::from_bits(moved[bead.len() / 2].r_z.to_bits() + 1);
+                    assert!(s.reuse(&cell.layout, &moved, &opts).is_none());
+                    let mut other = cell.layout.clone();
+                    let flip = |w| match w {
+                        Wrist::NoFlip => Wrist::Flip,
+                        Wrist::Flip => Wrist::NoFlip,
+                    };
+                    match &mut other {
+                        CellLayout::PartCarried(c) => {
+                            c.configuration.wrist = flip(c.configuration.wrist)
+                        }
+                        CellLayout::TorchCarried(c) => {
+                            c.configuration.wrist = flip(c.configuration.wrist)
+                        }
+                    }
+                    assert!(s.reuse(&other, bead, &opts).is_none());
+                }
+                start += lp.points.len();
+            }
+            if name == "robowam_part_carried" {
+                assert_eq!(taken, layers.len(), "{name}");
+            }
+            assert!(taken > 0, "{name}");
         }
     }
 }

@@ -661,3 +661,146 @@ fn point_measures(
     };
     (dex, dq_drz)
 }
+
+/// One bead's joint trajectory as a stage solved it (the optimiser's
+/// re-check of a layer in its branch), kept with the cell, the options and
+/// the points it was solved from so that a later stage (the program's
+/// trajectory) takes it instead of solving the same joints again
+/// ([`SolvedBead::reuse`]).
+#[derive(Clone, PartialEq)]
+pub(crate) struct SolvedBead {
+    cell: CellLayout,
+    opts: TrajectoryOptions,
+    inputs: Vec<PathPointInput>,
+    trajectory: JointTrajectory,
+}
+
+impl fmt::Debug for SolvedBead {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("SolvedBead")
+            .field("points", &self.inputs.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl SolvedBead {
+    /// What [`joint_trajectory`] (or its form without measures) gave for
+    /// `inputs` in `cell` with `opts`.
+    pub(crate) fn new(
+        cell: &CellLayout,
+        opts: &TrajectoryOptions,
+        inputs: Vec<PathPointInput>,
+        trajectory: JointTrajectory,
+    ) -> Self {
+        Self {
+            cell: cell.clone(),
+            opts: *opts,
+            inputs,
+            trajectory,
+        }
+    }
+
+    /// The trajectory [`joint_trajectory_without_measures`] gives for
+    /// `inputs` in `cell` with `opts`, to the bit, where it is this one
+    /// renamed: `None` unless `inputs` and the solved points are each one
+    /// bead, of the same points bit for bit but for their layer, bead and
+    /// point numbers (position, axes, `R_Z`, positioner joints, travel
+    /// speed), in an equal cell, with the same singularity margins. Then
+    /// every step of the walk is the same (a bead starts afresh whatever
+    /// the options' rewinding; the numbers only label the output, the
+    /// dexterity and `dq/dR_Z` are left out as that form leaves them):
+    /// the same joints, speeds and violations, labelled with `inputs`'
+    /// numbers.
+    pub(crate) fn reuse(
+        &self,
+        cell: &CellLayout,
+        inputs: &[PathPointInput],
+        opts: &TrajectoryOptions,
+    ) -> Option<JointTrajectory> {
+        let margins = |o: &TrajectoryOptions| {
+            [
+                o.wrist_singularity_margin_rad.to_bits(),
+                o.elbow_singularity_margin_rad.to_bits(),
+                o.shoulder_singularity_margin_mm.to_bits(),
+            ]
+        };
+        let one_bead = |ps: &[PathPointInput]| ps.iter().all(|p| p.same_bead(&ps[0]));
+        let same = inputs.len() == self.inputs.len()
+            && !inputs.is_empty()
+            && self.trajectory.points.len() == inputs.len()
+            && margins(opts) == margins(&self.opts)
+            && opts.validate().is_ok()
+            && one_bead(inputs)
+            && one_bead(&self.inputs)
+            && inputs
+                .iter()
+                .zip(&self.inputs)
+                .all(|(a, b)| same_point(a, b))
+            && *cell == self.cell;
+        if !same {
+            return None;
+        }
+        let points = self
+            .trajectory
+            .points
+            .iter()
+            .zip(inputs)
+            .map(|(jp, p)| JointPoint {
+                layer: p.layer,
+                bead: p.bead,
+                point: p.point,
+                dexterity: 0.0,
+                dq_drz: None,
+                ..*jp
+            })
+            .collect();
+        // each violation names its point: found in order along the bead
+        let mut at = 0;
+        let mut violations = Vec::with_capacity(self.trajectory.report.violations.len());
+        for v in &self.trajectory.report.violations {
+            while self.inputs[at].point != v.point || self.inputs[at].layer != v.layer {
+                at += 1;
+                if at == self.inputs.len() {
+                    return None;
+                }
+            }
+            violations.push(Violation {
+                layer: inputs[at].layer,
+                point: inputs[at].point,
+                kind: v.kind.clone(),
+            });
+        }
+        Some(JointTrajectory {
+            configuration: cell.configuration(),
+            points,
+            report: TrajectoryReport { violations },
+        })
+    }
+}
+
+/// Whether two path points are the same but for their layer, bead and
+/// point numbers, bit for bit.
+fn same_point(a: &PathPointInput, b: &PathPointInput) -> bool {
+    let bits = |p: &PathPointInput| -> [u64; 14] {
+        let d = p.build_direction.map_or([0.0; 3], |b| [b.x, b.y, b.z]);
+        let q = p.positioner.unwrap_or([0.0; 2]);
+        let v = [
+            p.position_mm.x,
+            p.position_mm.y,
+            p.position_mm.z,
+            p.tool_axis.x,
+            p.tool_axis.y,
+            p.tool_axis.z,
+            d[0],
+            d[1],
+            d[2],
+            p.r_z,
+            q[0],
+            q[1],
+            p.travel_speed_mm_s,
+        ];
+        let flags = u64::from(p.build_direction.is_some()) | u64::from(p.positioner.is_some()) << 1;
+        std::array::from_fn(|i| v.get(i).map_or(flags, |x| x.to_bits()))
+    };
+    bits(a) == bits(b)
+}
