@@ -17,7 +17,7 @@ use crate::program::{
     build_program_with, LayerRefusal, PointFeed, Program, ProgramError, ProgramOptions,
 };
 use crate::robot::trajectory::{
-    joint_trajectory_without_measures, JointTrajectory, PathPointInput, SolvedBead,
+    joint_trajectory_without_measures, JointTrajectory, PathPointInput, ReusedBead, SolvedBead,
     TrajectoryOptions,
 };
 use crate::robot::{CellLayout, RobotError};
@@ -169,7 +169,8 @@ fn trajectory_by_bead(
             _ => beads.push(i..i + 1),
         }
     }
-    let parts: Vec<Result<JointTrajectory, RobotError>> = beads
+    // each bead taken from its solved points, or solved
+    let parts: Vec<Result<Result<ReusedBead, JointTrajectory>, RobotError>> = beads
         .par_iter()
         .map(|r| {
             let bead = &inputs[r.clone()];
@@ -177,8 +178,8 @@ fn trajectory_by_bead(
                 .get(&r.start)
                 .and_then(|s| s.reuse(cell, bead, &opts))
             {
-                Some(t) => Ok(t),
-                None => joint_trajectory_without_measures(cell, bead, &opts),
+                Some(t) => Ok(Ok(t)),
+                None => joint_trajectory_without_measures(cell, bead, &opts).map(Err),
             }
         })
         .collect();
@@ -187,10 +188,14 @@ fn trajectory_by_bead(
         points: Vec::with_capacity(inputs.len()),
         report: Default::default(),
     };
-    for part in parts {
-        let part = part?;
-        whole.points.extend(part.points);
-        whole.report.violations.extend(part.report.violations);
+    for (part, r) in parts.into_iter().zip(&beads) {
+        match part? {
+            Ok(taken) => taken.append_to(&inputs[r.clone()], &mut whole),
+            Err(part) => {
+                whole.points.extend(part.points);
+                whole.report.violations.extend(part.report.violations);
+            }
+        }
     }
     Ok(whole)
 }
@@ -349,8 +354,14 @@ mod tests {
                     let t = s.reuse(&cell.layout, bead, &opts);
                     taken += usize::from(t.is_some());
                     if let Some(t) = t {
+                        let mut whole = JointTrajectory {
+                            configuration: cell.layout.configuration(),
+                            points: Vec::new(),
+                            report: Default::default(),
+                        };
+                        t.append_to(bead, &mut whole);
                         let one = joint_trajectory_without_measures(&cell.layout, bead, &opts);
-                        assert_eq!(t, one.unwrap(), "{name}, layer {}", lp.layer);
+                        assert_eq!(whole, one.unwrap(), "{name}, layer {}", lp.layer);
                     }
                     let mut moved = bead.to_vec();
                     moved[bead.len() / 2].r_z =

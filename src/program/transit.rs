@@ -12,9 +12,9 @@ use std::sync::OnceLock;
 
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 
-use crate::math::{Point3, Vector3};
+use crate::math::{Isometry3, Point3, Vector3};
 use crate::robot::{CellLayout, Joints};
-use crate::toolaxis::collision::{Torch, Wall};
+use crate::toolaxis::collision::{part_from_torch, Torch, Wall};
 use crate::toolaxis::ToolAxisError;
 
 /// Largest change of any joint between two samples of a joint move (rad,
@@ -148,6 +148,18 @@ pub fn joint_move_touches(
 /// The samples of a joint move ([`joint_move_clearance`]): at each where
 /// the torch is not clear of the wall, `seen(fraction, clearance_mm, tip)`,
 /// which returns whether to go on.
+///
+/// A sample whose torch is clear of the wall by more than
+/// [`TRANSIT_ROOM_MM`] vouches for the samples after it whose torch has
+/// moved less than that from it (less [`TRANSIT_ROOM_SLACK_MM`], far above
+/// the queries' rounding): they are clear, and are not asked. How far the
+/// torch moved is bounded from its two poses as the wall sees them
+/// ([`part_from_torch`]): the tip's displacement plus the rotation's
+/// (`|R − R'| ≤ 2 |q − q'|` for unit quaternions of the same sign) times
+/// the torch's farthest point from its tip. A sample is not clear by that
+/// much asks the plain question, as every sample did before; it asks the
+/// larger one again only after a few samples, more the more often it was
+/// refused. So `seen` sees the same samples with the same clearances.
 fn walk_joint_move(
     cell: &CellLayout,
     wall: &(impl TransitWall + ?Sized),
@@ -168,6 +180,16 @@ fn walk_joint_move(
         largest = largest.max((a[0] - b[0]).abs()).max((a[1] - b[1]).abs());
     }
     let n = ((largest / TRANSIT_STEP_RAD).ceil() as usize).clamp(1, 100_000);
+    // the torch's farthest point from its tip (torch frame, mm)
+    let reach = {
+        let b = torch.bounds(&Point3::origin(), &Vector3::z());
+        let far = |i: usize| b.mins[i].abs().max(b.maxs[i].abs());
+        Vector3::new(far(0), far(1), far(2)).norm()
+    };
+    // the last sample clear by the room: the torch's pose there
+    let mut vouch: Option<Isometry3> = None;
+    // when to ask for the room again, and after how many samples next
+    let (mut ask_room_at, mut wait) = (0, 1);
     for i in 0..=n {
         let s = i as f64 / n as f64;
         let q: Joints = std::array::from_fn(|j| qa[j] + s * (qb[j] - qa[j]));
@@ -177,6 +199,28 @@ fn walk_joint_move(
         };
         let (tip, axis) = torch_in_part(cell, &q, p)
             .ok_or_else(|| "a torch-carried move without positioner joints".to_string())?;
+        if let Some(v) = &vouch {
+            let pose = part_from_torch(&tip, &axis);
+            let (a, b) = (v.rotation.coords, pose.rotation.coords);
+            let turn = 2.0 * (a - b).norm().min((a + b).norm());
+            let moved = (pose.translation.vector - v.translation.vector).norm() + turn * reach;
+            if moved < TRANSIT_ROOM_MM - TRANSIT_ROOM_SLACK_MM {
+                continue;
+            }
+            vouch = None;
+        }
+        if i >= ask_room_at {
+            if wall
+                .is_clear(torch, &tip, &axis, TRANSIT_ROOM_MM)
+                .map_err(|e| e.to_string())?
+            {
+                vouch = Some(part_from_torch(&tip, &axis));
+                wait = 1;
+                continue;
+            }
+            ask_room_at = i + wait;
+            wait = (2 * wait).min(TRANSIT_ROOM_MAX_WAIT);
+        }
         // a bounded query first; the distance only where the torch touches
         if wall
             .is_clear(torch, &tip, &axis, 0.0)
@@ -193,6 +237,19 @@ fn walk_joint_move(
     }
     Ok(())
 }
+
+/// The clearance a sample of a joint move is asked for before the plain
+/// question, so that it vouches for the samples after it whose torch
+/// moves less than this (mm; [`walk_joint_move`]).
+pub const TRANSIT_ROOM_MM: f64 = 10.0;
+
+/// How much of [`TRANSIT_ROOM_MM`] a vouched sample leaves unused (mm):
+/// far above the rounding of the clearance queries and of the poses.
+const TRANSIT_ROOM_SLACK_MM: f64 = 0.1;
+
+/// Most samples between two asks for [`TRANSIT_ROOM_MM`] after it was
+/// refused.
+const TRANSIT_ROOM_MAX_WAIT: usize = 16;
 
 /// The wall of `beads` (part frame, mm) for a transit check, as one
 /// segment tree: each bead decimated to at most [`WALL_POINTS_PER_BEAD`]
@@ -536,5 +593,143 @@ mod tests {
             let tree = beads.block(m).segment_bounds().map(|b| (b.mins, b.maxs));
             assert_eq!(ours, tree, "block {m}");
         }
+    }
+
+    /// A wall that counts the plain questions (margin 0) it is asked.
+    struct Counted<'a> {
+        wall: WallPrefix<'a>,
+        plain: std::cell::Cell<usize>,
+    }
+
+    impl TransitWall for Counted<'_> {
+        fn is_empty(&self) -> bool {
+            self.wall.is_empty()
+        }
+
+        fn is_clear(
+            &self,
+            torch: &Torch,
+            point: &Point3,
+            tool: &Vector3,
+            margin_mm: f64,
+        ) -> Result<bool, ToolAxisError> {
+            if margin_mm == 0.0 {
+                self.plain.set(self.plain.get() + 1);
+            }
+            self.wall.is_clear(torch, point, tool, margin_mm)
+        }
+
+        fn clearance(
+            &self,
+            torch: &Torch,
+            point: &Point3,
+            tool: &Vector3,
+        ) -> Result<f64, ToolAxisError> {
+            self.wall.clearance(torch, point, tool)
+        }
+    }
+
+    /// The samples a walk sees (fraction, clearance, tip), every sample
+    /// asked: the walk without vouching.
+    fn every_sample(
+        cell: &CellLayout,
+        wall: &impl TransitWall,
+        torch: &Torch,
+        (qa, qb): (&Joints, &Joints),
+    ) -> Vec<(f64, f64, Point3)> {
+        let largest = qa
+            .iter()
+            .zip(qb)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let n = ((largest / TRANSIT_STEP_RAD).ceil() as usize).clamp(1, 100_000);
+        let mut out = Vec::new();
+        for i in 0..=n {
+            let s = i as f64 / n as f64;
+            let q: Joints = std::array::from_fn(|j| qa[j] + s * (qb[j] - qa[j]));
+            let (tip, axis) = torch_in_part(cell, &q, None).unwrap();
+            if !wall.is_clear(torch, &tip, &axis, 0.0).unwrap() {
+                out.push((s, wall.clearance(torch, &tip, &axis).unwrap(), tip));
+            }
+        }
+        out
+    }
+
+    /// The samples a sample clear by the room vouches for are clear: the
+    /// hemisphere's program in the ROBOWAM part-carried cell, each bead's
+    /// retract point joint-moved to the next bead's approach and first
+    /// point and back to its own first point (into the wall), against the
+    /// wall so far: the walk sees the samples every sample asked sees, with
+    /// the same clearances, and asks the plain question of fewer samples.
+    #[test]
+    fn vouched_samples_are_clear() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("parts");
+        let part = crate::Part::read(root.join("hemisphere.toml")).unwrap();
+        let cell = crate::Cell::read(root.join("cells/robowam_part_carried.toml")).unwrap();
+        let planned = crate::plan_part(&part, &cell, &crate::PlanOptions::default()).unwrap();
+        let program = planned.program.as_ref().unwrap();
+        let pts = &program.points;
+        // each bead: the range of its points
+        let mut beads: Vec<std::ops::Range<usize>> = Vec::new();
+        for (i, p) in pts.iter().enumerate() {
+            if !p.arc.is_bead() {
+                continue;
+            }
+            match beads.last_mut() {
+                Some(r) if r.end == i && pts[r.start].same_bead(p) => r.end = i + 1,
+                _ => beads.push(i..i + 1),
+            }
+        }
+        let mut wall = WallBeads::default();
+        for r in &beads {
+            let b: Vec<Point3> = pts[r.clone()].iter().map(|p| p.position_mm).collect();
+            wall.push(&b);
+        }
+        let torch = Torch::new(&Default::default()).unwrap();
+        let (mut samples, mut plain, mut seen_any) = (0, 0, false);
+        for (k, r) in beads.iter().enumerate() {
+            let from = pts[(r.end).min(pts.len() - 1)].joints;
+            let mut to = vec![pts[r.start].joints];
+            if let Some(next) = beads.get(k + 1) {
+                to.extend([pts[next.start - 1].joints, pts[next.start].joints]);
+            }
+            for qb in &to {
+                let counted = Counted {
+                    wall: wall.wall(k + 1, 2.0),
+                    plain: std::cell::Cell::new(0),
+                };
+                let mut seen = Vec::new();
+                walk_joint_move(
+                    &program.cell,
+                    &counted,
+                    &torch,
+                    (&from, None),
+                    (qb, None),
+                    |s, c, t| {
+                        seen.push((s, c, t));
+                        true
+                    },
+                )
+                .unwrap();
+                plain += counted.plain.get();
+                let every = every_sample(&program.cell, &counted.wall, &torch, (&from, qb));
+                samples += ((from
+                    .iter()
+                    .zip(qb)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max)
+                    / TRANSIT_STEP_RAD)
+                    .ceil() as usize)
+                    .clamp(1, 100_000)
+                    + 1;
+                seen_any |= !every.is_empty();
+                assert_eq!(seen, every, "bead {k}");
+            }
+        }
+        assert!(seen_any, "no move touches the wall");
+        assert!(
+            plain < samples / 2,
+            "{plain} plain questions of {samples} samples"
+        );
     }
 }

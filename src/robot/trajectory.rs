@@ -702,21 +702,21 @@ impl SolvedBead {
 
     /// The trajectory [`joint_trajectory_without_measures`] gives for
     /// `inputs` in `cell` with `opts`, to the bit, where it is this one
-    /// renamed: `None` unless `inputs` and the solved points are each one
-    /// bead, of the same points bit for bit but for their layer, bead and
-    /// point numbers (position, axes, `R_Z`, positioner joints, travel
-    /// speed), in an equal cell, with the same singularity margins. Then
-    /// every step of the walk is the same (a bead starts afresh whatever
-    /// the options' rewinding; the numbers only label the output, the
-    /// dexterity and `dq/dR_Z` are left out as that form leaves them):
-    /// the same joints, speeds and violations, labelled with `inputs`'
-    /// numbers.
+    /// renamed ([`ReusedBead::append_to`]): `None` unless `inputs` and the
+    /// solved points are each one bead, of the same points bit for bit but
+    /// for their layer, bead and point numbers (position, axes, `R_Z`,
+    /// positioner joints, travel speed), in an equal cell, with the same
+    /// singularity margins. Then every step of the walk is the same (a bead
+    /// starts afresh whatever the options' rewinding; the numbers only
+    /// label the output, the dexterity and `dq/dR_Z` are left out as that
+    /// form leaves them): the same joints, speeds and violations, labelled
+    /// with `inputs`' numbers.
     pub(crate) fn reuse(
         &self,
         cell: &CellLayout,
         inputs: &[PathPointInput],
         opts: &TrajectoryOptions,
-    ) -> Option<JointTrajectory> {
+    ) -> Option<ReusedBead<'_>> {
         let margins = |o: &TrajectoryOptions| {
             [
                 o.wrist_singularity_margin_rad.to_bits(),
@@ -740,23 +740,9 @@ impl SolvedBead {
         if !same {
             return None;
         }
-        let points = self
-            .trajectory
-            .points
-            .iter()
-            .zip(inputs)
-            .map(|(jp, p)| JointPoint {
-                layer: p.layer,
-                bead: p.bead,
-                point: p.point,
-                dexterity: 0.0,
-                dq_drz: None,
-                ..*jp
-            })
-            .collect();
         // each violation names its point: found in order along the bead
         let mut at = 0;
-        let mut violations = Vec::with_capacity(self.trajectory.report.violations.len());
+        let mut violations_at = Vec::with_capacity(self.trajectory.report.violations.len());
         for v in &self.trajectory.report.violations {
             while self.inputs[at].point != v.point || self.inputs[at].layer != v.layer {
                 at += 1;
@@ -764,17 +750,53 @@ impl SolvedBead {
                     return None;
                 }
             }
-            violations.push(Violation {
-                layer: inputs[at].layer,
-                point: inputs[at].point,
-                kind: v.kind.clone(),
-            });
+            violations_at.push(at);
         }
-        Some(JointTrajectory {
-            configuration: cell.configuration(),
-            points,
-            report: TrajectoryReport { violations },
+        Some(ReusedBead {
+            solved: self,
+            violations_at,
         })
+    }
+}
+
+/// A [`SolvedBead`] found to be the trajectory of a bead's points
+/// ([`SolvedBead::reuse`]).
+pub(crate) struct ReusedBead<'a> {
+    solved: &'a SolvedBead,
+    /// The index in the bead of each violation's point.
+    violations_at: Vec<usize>,
+}
+
+impl ReusedBead<'_> {
+    /// Appends the bead's joint points and violations to `whole`, labelled
+    /// with the numbers of `inputs` (the points it was found the
+    /// trajectory of), without dexterity nor `dq/dR_Z`.
+    pub(crate) fn append_to(&self, inputs: &[PathPointInput], whole: &mut JointTrajectory) {
+        let t = &self.solved.trajectory;
+        whole
+            .points
+            .extend(t.points.iter().zip(inputs).map(|(jp, p)| JointPoint {
+                layer: p.layer,
+                bead: p.bead,
+                point: p.point,
+                dexterity: 0.0,
+                dq_drz: None,
+                ..*jp
+            }));
+        whole
+            .report
+            .violations
+            .extend(
+                t.report
+                    .violations
+                    .iter()
+                    .zip(&self.violations_at)
+                    .map(|(v, &at)| Violation {
+                        layer: inputs[at].layer,
+                        point: inputs[at].point,
+                        kind: v.kind.clone(),
+                    }),
+            );
     }
 }
 

@@ -10,7 +10,7 @@
 //!
 //! **Bodies** (robot base frame):
 //! * the arm's links as capsules between its joint frame origins
-//!   ([`arm_chain`]: the kinematic
+//!   ([`arm_chain`](crate::robot::chain::arm_chain): the kinematic
 //!   lengths of the preset): the J1 column (base origin → J2 height), the
 //!   upper arm (J2 axis → J3 axis), the forearm (J3 offset point → the
 //!   wrist unit) and the wrist (two capsules: the wrist unit behind the
@@ -85,7 +85,7 @@ pub use walk::check_cell;
 use crate::math::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use crate::optimise::LayerPoints;
 use crate::program::ProgramError;
-use crate::robot::chain::arm_chain;
+use crate::robot::chain::arm_chain_and_flange;
 use crate::robot::{CellLayout, Joints, RobotModel};
 use crate::toolaxis::collision::support::ClusteredHull;
 
@@ -320,6 +320,10 @@ struct Memory {
     /// Per body before the part's hulls, whether the hulls' common sphere
     /// culls its pairs with every hull (a buffer, as `pair_list`).
     far_from_part: Vec<bool>,
+    /// Per body before the part's hulls, its capsule's extent about the
+    /// part's turn axis and its radius where needed (a buffer, as
+    /// `pair_list`).
+    seg_axial: Vec<Option<(f64, f64, f64, f64)>>,
 }
 
 impl Memory {
@@ -404,7 +408,18 @@ const PART: &str = "part";
 /// [`LinkRadii::wrist_unit_mm`] before the wrist centre, where the wrist
 /// unit (J5 housing) begins, which is the wrist capsule up to the flange.
 fn links(robot: &RobotModel, r: &LinkRadii, q: &Joints) -> [(&'static str, Capsule); 5] {
-    let c = arm_chain(robot, q);
+    links_and_flange(robot, r, q).0
+}
+
+/// [`links`] and the flange's pose at `q` (`base_from_flange`, base frame,
+/// mm; [`RobotModel::flange_pose`]'s to the bit) from one forward
+/// kinematics.
+fn links_and_flange(
+    robot: &RobotModel,
+    r: &LinkRadii,
+    q: &Joints,
+) -> ([(&'static str, Capsule); 5], Isometry3) {
+    let (c, base_from_flange) = arm_chain_and_flange(robot, q);
     let along = c[5] - c[4];
     let len = along.norm();
     let cut = if len > 0.0 {
@@ -412,13 +427,16 @@ fn links(robot: &RobotModel, r: &LinkRadii, q: &Joints) -> [(&'static str, Capsu
     } else {
         c[5]
     };
-    [
-        (COLUMN, Capsule::new(c[0], c[1], r.column_mm)),
-        (UPPER_ARM, Capsule::new(c[2], c[3], r.upper_arm_mm)),
-        (FOREARM, Capsule::new(c[4], cut, r.forearm_mm)),
-        (WRIST, Capsule::new(cut, c[5], r.wrist_mm)),
-        (WRIST, Capsule::new(c[5], c[6], r.wrist_mm)),
-    ]
+    (
+        [
+            (COLUMN, Capsule::new(c[0], c[1], r.column_mm)),
+            (UPPER_ARM, Capsule::new(c[2], c[3], r.upper_arm_mm)),
+            (FOREARM, Capsule::new(c[4], cut, r.forearm_mm)),
+            (WRIST, Capsule::new(cut, c[5], r.wrist_mm)),
+            (WRIST, Capsule::new(c[5], c[6], r.wrist_mm)),
+        ],
+        base_from_flange,
+    )
 }
 
 /// The positioner's table as the check models it: a cylinder of
@@ -1002,7 +1020,7 @@ impl<'a> Checker<'a> {
     ) -> Option<(String, String, f64)> {
         stats.samples += 1;
         let robot = self.cell.robot();
-        let capsules = links(robot, &self.radii, s.q);
+        let (capsules, base_from_flange) = links_and_flange(robot, &self.radii, s.q);
         let mut all: Vec<Body> =
             Vec::with_capacity(capsules.len() + self.keep_out.len() + 2 + part.hulls.len());
         all.extend(capsules.iter().map(|(n, c)| capsule_body(n, c)));
@@ -1040,7 +1058,7 @@ impl<'a> Checker<'a> {
                 pairs.push((l, o));
             }
         }
-        let keep_outs: Vec<usize> = (first_other..all.len()).collect();
+        let keep_outs = first_other..all.len();
         let mut part_pose: Option<Isometry3> = None;
         match self.cell {
             CellLayout::TorchCarried(c) => {
@@ -1061,14 +1079,14 @@ impl<'a> Checker<'a> {
                         for l in [upper, fore, wrist, flange] {
                             pairs.push((l, p));
                         }
-                        for &k in &keep_outs {
+                        for k in keep_outs.clone() {
                             pairs.push((p, k));
                         }
                     }
                 }
             }
             CellLayout::PartCarried(c) => {
-                let pose = robot.flange_pose(s.q) * c.flange_from_part;
+                let pose = base_from_flange * c.flange_from_part;
                 part_pose = Some(pose);
                 for h in &part.hulls {
                     let p = all.len();
@@ -1076,7 +1094,7 @@ impl<'a> Checker<'a> {
                     for l in [column, upper, fore] {
                         pairs.push((l, p));
                     }
-                    for &k in &keep_outs {
+                    for k in keep_outs.clone() {
                         pairs.push((p, k));
                     }
                 }
@@ -1097,23 +1115,28 @@ impl<'a> Checker<'a> {
             }
             _ => far_from_part.resize(first_hull, false),
         }
-        // each capsule about the part's axis (part frame)
-        let seg_axial: Vec<Option<(f64, f64, f64, f64)>> = match part_pose {
-            Some(pose) => {
-                let part_from_base = pose.inverse();
+        // each capsule about the part's axis (part frame), where a pair of
+        // it with a hull is left to bound (not culled by the common sphere)
+        let mut seg_axial = std::mem::take(&mut memory.seg_axial);
+        seg_axial.clear();
+        if let Some(pose) = part_pose {
+            let part_from_base = pose.inverse();
+            seg_axial.extend(
                 all[..first_hull]
                     .iter()
-                    .map(|b| {
+                    .zip(&far_from_part)
+                    .map(|(b, &far)| {
+                        if far {
+                            return None;
+                        }
                         let ((a, e), c) = (b.ends?, b.capsule?);
                         let (r, lo, hi) = self
                             .axis
                             .segment(&(part_from_base * a), &(part_from_base * e));
                         Some((r, lo, hi, c.radius))
-                    })
-                    .collect()
-            }
-            None => Vec::new(),
-        };
+                    }),
+            );
+        }
         let mut hit: Option<(String, String, f64)> = None;
         for (k, &(i, j)) in pairs.iter().enumerate() {
             let other = match (i >= first_hull, j >= first_hull) {
@@ -1158,6 +1181,7 @@ impl<'a> Checker<'a> {
         }
         memory.pair_list = pairs;
         memory.far_from_part = far_from_part;
+        memory.seg_axial = seg_axial;
         hit
     }
 }
