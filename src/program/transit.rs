@@ -30,7 +30,7 @@ pub const WALL_POINTS_PER_BEAD: usize = 256;
 /// The torch seen from the part at robot joints `q` (controller convention,
 /// rad) and positioner joints `qp` (rad, torch-carried cell): the point it
 /// deposits at (part frame, mm) and its axis from that point towards the
-/// torch (part frame, unit), the [`part_from_torch`](crate::toolaxis::collision::part_from_torch)
+/// torch (part frame, unit), the [`part_from_torch`]
 /// inputs. `None` in a torch-carried cell without positioner joints.
 pub fn torch_in_part(
     cell: &CellLayout,
@@ -240,7 +240,7 @@ fn walk_joint_move(
 
 /// The clearance a sample of a joint move is asked for before the plain
 /// question, so that it vouches for the samples after it whose torch
-/// moves less than this (mm; [`walk_joint_move`]).
+/// moves less than this (mm; [`joint_move_clearance`], [`joint_move_touches`]).
 pub const TRANSIT_ROOM_MM: f64 = 10.0;
 
 /// How much of [`TRANSIT_ROOM_MM`] a vouched sample leaves unused (mm):
