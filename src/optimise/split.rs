@@ -39,7 +39,7 @@ pub struct SplitPlan {
 }
 
 /// Splits the layers that `plan` (made from `layers`) could not build whole
-/// into the beads `beads_of(k, &layers[k])` gives (in order, each starting
+/// into the beads `beads_of(&layers[k])` gives (in order, each starting
 /// where the one before ends, as [`LayerPoints::split_at`] makes them;
 /// fewer than two: the layer is left), when every one of its beads then
 /// plans in `cell` ([module doc](self)). The beads' turns are shifted by
@@ -52,7 +52,7 @@ pub fn split_refused_layers(
     cell: &CellLayout,
     layers: Vec<LayerPoints>,
     plan: Plan,
-    beads_of: &dyn Fn(usize, &LayerPoints) -> Vec<LayerPoints>,
+    beads_of: &dyn Fn(&LayerPoints) -> Vec<LayerPoints>,
     opts: &OptimiseOptions,
 ) -> Result<SplitPlan, OptimiseError> {
     // the beads of every refused layer with corners inside its bead
@@ -62,7 +62,7 @@ pub fn split_refused_layers(
         if pl.status.is_feasible() || lp.bead != 0 {
             continue;
         }
-        let split = beads_of(k, lp);
+        let split = beads_of(lp);
         if split.len() < 2 {
             continue;
         }

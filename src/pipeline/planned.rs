@@ -249,7 +249,7 @@ fn split_at_corners(
     }
     let threshold = sliced.options.corner_threshold_rad;
     let path = &sliced.path;
-    let beads_of = |_: usize, lp: &LayerPoints| -> Vec<LayerPoints> {
+    let beads_of = |lp: &LayerPoints| -> Vec<LayerPoints> {
         let (Some(layer), Some(frames)) =
             (path.layers.get(lp.layer), sliced.axes.frames.get(lp.layer))
         else {
@@ -263,6 +263,9 @@ fn split_at_corners(
             .iter()
             .map(|c| c.point)
             .collect();
+        if corners.is_empty() {
+            return Vec::new();
+        }
         // each bead's tool axes as on an open layer from its first point to
         // its last, the corners left out (their frames lie half way round:
         // `split_at` gives each bead's end on a corner its neighbour's): the

@@ -571,13 +571,7 @@ mod tests {
     #[test]
     fn block_bounds_are_the_trees() {
         let mut beads = WallBeads::default();
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 200.0 - 100.0
-        };
+        let mut next = crate::util::uniform(0x2545_f491_4f6c_dd1d, -100.0, 100.0);
         beads.push(&[Point3::new(1.0, 2.0, 3.0)]);
         assert_eq!(beads.block_bounds(1), None);
         assert!(beads.block(1).segment_bounds().is_none());

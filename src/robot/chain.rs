@@ -46,13 +46,7 @@ mod tests {
     /// for every preset arm at joints spread over their travel and beyond.
     #[test]
     fn chain_flange_is_flange_pose() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 8.0 - 4.0
-        };
+        let mut next = crate::util::uniform(0x9e37_79b9_7f4a_7c15, -4.0, 4.0);
         for robot in [
             RobotModel::arcmate_120ic_nominal(),
             RobotModel::arcmate_120ic_axis_by_axis(),
