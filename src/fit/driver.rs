@@ -82,6 +82,10 @@ const CHECK_SECTIONS_AFTER: usize = 6;
 /// Most refits with the points along a coarse bend's edges (dimensionless
 /// count); then the vertices alone.
 const EDGE_REFITS: usize = 8;
+
+/// Fewest stations with rings of their own that a radius or thickness law
+/// is fitted to alone, leaving out the widened ones ([`fit_law`]).
+const MIN_OWN_LAW_STATIONS: usize = 3;
 /// Fits a tube to `mesh`.
 ///
 /// # Errors
@@ -228,7 +232,7 @@ fn fit_pass(
             }
         }
         let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
-        slope = fit_law(mesh, &stations, &knots, &|s| s.radius)
+        slope = fit_law(mesh, &stations, &knots, &|s| s.radius, false)
             .ok()
             .map(|v| (knots.clone(), v));
         let mut next = refit_guide(mesh, &stations, &knots)?;
@@ -282,7 +286,7 @@ fn fit_pass(
         return exit;
     }
     let pieces = separate_pieces(mesh, &surf, &stations, &spline, opts)?;
-    let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick);
+    let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick, true);
     let mut radius_mm = law(&|s| s.radius)?;
     let spread = radius_mm
         .iter()
@@ -775,6 +779,7 @@ fn sections(
                 .collect();
             let mut points = (0..s.skins).map(|k| bins[i * s.skins + k].len()).sum();
             let mut full = 2 * points >= median;
+            let mut widened = false;
             if !closed(&fits) {
                 let mut wide: Vec<Vec<SectionPoint>> = (0..s.skins)
                     .map(|k| bins[i * s.skins + k].clone())
@@ -796,6 +801,7 @@ fn sections(
                         wide.iter().map(|pts| fit_circle(pts, slope)).collect();
                     if closed(&f) {
                         (fits, points, full) = (f, wide.iter().map(Vec::len).sum(), true);
+                        widened = true;
                         break;
                     }
                 }
@@ -823,6 +829,7 @@ fn sections(
                 radius,
                 thickness,
                 points,
+                widened,
             }
         })
         .collect()
@@ -889,15 +896,28 @@ fn anchor_ends(points: &mut [Point3], start: &EndRing, finish: &EndRing) {
     }
 }
 
-/// A law over `knots` fitted to the stations' values.
+/// A law over `knots` fitted to the stations' values. With `own_rings`
+/// (the final laws), to those of the stations whose rings are their own
+/// when at least [`MIN_OWN_LAW_STATIONS`] have a value: a widened station's
+/// value (a coarse mesh) leans on the refits' slope across the points it
+/// borrowed, tens of mm away, and swung the law by ±2 mm between the rings
+/// of a coarse export. The refits' slope law takes every station (its knot
+/// spacing, [`coupling_gap`], keeps the guide of a coarse bend smooth).
 fn fit_law(
     mesh: &TubeMesh,
     stations: &[Station],
     knots: &[f64],
     pick: &dyn Fn(&Station) -> Option<f64>,
+    own_rings: bool,
 ) -> Result<Vec<f64>, FitError> {
+    let own = stations
+        .iter()
+        .filter(|s| !s.widened && pick(s).is_some())
+        .count();
+    let all = !own_rings || own < MIN_OWN_LAW_STATIONS;
     let ok: Vec<(f64, f64, f64)> = stations
         .iter()
+        .filter(|s| all || !s.widened)
         .filter_map(|s| pick(s).map(|v| (s.t, v, s.points as f64)))
         .collect();
     let ts: Vec<f64> = ok.iter().map(|x| x.0).collect();

@@ -95,6 +95,9 @@ pub(super) struct Station {
     pub radius: Option<f64>,
     pub thickness: Option<f64>,
     pub points: usize,
+    /// Whether its rings took its neighbours' points (a coarse mesh): its
+    /// radius then leans on the radius law's slope across them.
+    pub widened: bool,
 }
 
 /// One open end of the tube as found in the mesh (mesh frame, mm).
