@@ -307,15 +307,30 @@ struct Body<'a> {
 /// odometer (mm), each pair's last exact distance and the two odometers then
 /// (by the pair's index in the sample's list of pairs, the same list at
 /// every sample with the same bodies).
+///
+/// The part's hulls share one pose: their odometers are brought up to date
+/// only when a pair of them needs one (a remembered distance to bound, an
+/// exact distance to remember), by the same sums in the same order as at
+/// every sample, from the part's poses kept since the memory last forgot.
 #[derive(Default)]
 struct Memory {
     /// Which layer's hull the bodies are for (the part changes with it).
     layer: Option<usize>,
+    /// How many bodies the sample has, the part's hulls included.
+    count: usize,
+    /// The bodies before the part's hulls: their places and odometers.
     places: Vec<(Point3, Point3, UnitQuaternion)>,
     odometer: Vec<f64>,
     pairs: Vec<Option<(f64, f64, f64)>>,
-    /// The sample's pairs (indices into its bodies): a buffer kept from
-    /// sample to sample, rebuilt at each.
+    /// The part's pose at each sample since the memory last forgot.
+    part_poses: Vec<Isometry3>,
+    /// The part's turn from the sample before to each (rad), once computed.
+    part_turns: Vec<Option<f64>>,
+    /// Per hull of the part: its odometer and the sample (into
+    /// `part_poses`) it is up to date with.
+    hull_odometer: Vec<(f64, usize)>,
+    /// The sample's pairs before the part's hulls' (indices into its
+    /// bodies): a buffer kept from sample to sample, rebuilt at each.
     pair_list: Vec<(usize, usize)>,
     /// Per body before the part's hulls, whether the hulls' common sphere
     /// culls its pairs with every hull (a buffer, as `pair_list`).
@@ -326,18 +341,37 @@ struct Memory {
     seg_axial: Vec<Option<(f64, f64, f64, f64)>>,
 }
 
+/// The part's hulls at one sample: the index of the first in the sample's
+/// bodies (they follow every other body) and their local shapes.
+#[derive(Clone, Copy)]
+struct HullBodies<'h, 'c> {
+    first: usize,
+    hulls: &'h [&'c Local],
+}
+
 impl Memory {
     /// Moves each body's odometer on by its displacement since the last
-    /// sample; forgets everything when the bodies are others.
-    fn advance(&mut self, layer: usize, bodies: &[Body]) {
-        if self.layer != Some(layer) || self.places.len() != bodies.len() {
+    /// sample; forgets everything when the bodies are others. `bodies` are
+    /// those before the part's hulls; `part` the hulls' pose and how many
+    /// there are (their odometers move on when needed,
+    /// [`Memory::odometer_of`]).
+    fn advance(&mut self, layer: usize, bodies: &[Body], part: Option<(Isometry3, usize)>) {
+        let hulls = part.map_or(0, |(_, n)| n);
+        let count = bodies.len() + hulls;
+        if self.layer != Some(layer) || self.count != count {
             self.layer = Some(layer);
+            self.count = count;
             self.places = bodies.iter().map(place_of).collect();
             self.odometer = vec![0.0; bodies.len()];
             self.pairs.clear();
+            self.part_poses.clear();
+            self.part_turns.clear();
+            self.part_poses.extend(part.map(|(pose, _)| pose));
+            self.part_turns.extend(part.map(|_| Some(0.0)));
+            self.hull_odometer = vec![(0.0, 0); hulls];
             return;
         }
-        // the part's hulls share one pose: their turn is computed once
+        // bodies with the same turn share its angle
         let mut turn: Option<([u64; 4], [u64; 4], f64)> = None;
         for (i, b) in bodies.iter().enumerate() {
             let now = place_of(b);
@@ -360,22 +394,57 @@ impl Memory {
             self.odometer[i] += moved;
             self.places[i] = now;
         }
+        if let Some((pose, _)) = part {
+            self.part_poses.push(pose);
+            self.part_turns.push(None);
+        }
+    }
+
+    /// Body `i`'s odometer at this sample (mm); a hull's brought up to
+    /// date: at each sample since it last was, its centre's displacement
+    /// plus its radius times the part's turn, as [`Memory::advance`] adds
+    /// them for the other bodies.
+    fn odometer_of(&mut self, i: usize, part: HullBodies) -> f64 {
+        let Some(h) = i.checked_sub(part.first) else {
+            return self.odometer[i];
+        };
+        let hull = part.hulls[h];
+        let (mut odometer, since) = self.hull_odometer[h];
+        let now_at = self.part_poses.len().saturating_sub(1);
+        if since < now_at {
+            let mut was = self.part_poses[since] * hull.centre;
+            for s in since + 1..=now_at {
+                let now = self.part_poses[s] * hull.centre;
+                let angle = match self.part_turns[s] {
+                    Some(a) => a,
+                    None => {
+                        let a = self.part_poses[s - 1]
+                            .rotation
+                            .angle_to(&self.part_poses[s].rotation);
+                        self.part_turns[s] = Some(a);
+                        a
+                    }
+                };
+                odometer += (now - was).norm() + hull.radius * angle;
+                was = now;
+            }
+            self.hull_odometer[h] = (odometer, now_at);
+        }
+        odometer
     }
 
     /// Pair `k` (bodies `i`, `j`): its last exact distance less how far its
     /// bodies moved since.
-    fn lower_bound(&self, k: usize, i: usize, j: usize) -> f64 {
-        self.pairs
-            .get(k)
-            .copied()
-            .flatten()
-            .map_or(f64::NEG_INFINITY, |(d, oi, oj)| {
-                d - (self.odometer[i] - oi) - (self.odometer[j] - oj)
-            })
+    fn lower_bound(&mut self, k: usize, i: usize, j: usize, part: HullBodies) -> f64 {
+        let Some((d, oi, oj)) = self.pairs.get(k).copied().flatten() else {
+            return f64::NEG_INFINITY;
+        };
+        let (ni, nj) = (self.odometer_of(i, part), self.odometer_of(j, part));
+        d - (ni - oi) - (nj - oj)
     }
 
-    fn remember(&mut self, k: usize, i: usize, j: usize, d: f64) {
-        let (oi, oj) = (self.odometer[i], self.odometer[j]);
+    fn remember(&mut self, k: usize, i: usize, j: usize, d: f64, part: HullBodies) {
+        let (oi, oj) = (self.odometer_of(i, part), self.odometer_of(j, part));
         if self.pairs.len() <= k {
             self.pairs.resize(k + 1, None);
         }
@@ -695,30 +764,79 @@ fn hull_or_slab(pts: &[Point3], margin: f64) -> Option<Local> {
 /// [`LAYERS_PER_BAND`] layers before it, each one convex hull, and the hull
 /// of its own band up to and including it; each from the layers' points
 /// thinned by [`thin_layer`], with the margin (mm) its distances are
-/// lowered by. Returns the complete bands and, per layer, how many of them
-/// come before it and its partial band.
-fn wall_bands(layers: &[LayerPoints]) -> (Vec<Local>, Vec<(usize, Option<Local>)>) {
-    let mut bands: Vec<Local> = Vec::new();
-    let mut per_layer: Vec<(usize, Option<Local>)> = Vec::with_capacity(layers.len());
-    let mut pts: Vec<Point3> = Vec::new();
-    let mut margin: f64 = 0.0;
-    for (k, l) in layers.iter().enumerate() {
-        let raw: Vec<Point3> = l.points.iter().map(|p| p.position_mm).collect();
-        let (thin, m) = thin_layer(&raw);
-        margin = margin.max(m);
-        pts.extend(thin.iter().copied());
-        per_layer.push((bands.len(), hull_or_slab(&pts, margin)));
-        if (k + 1) % LAYERS_PER_BAND == 0 {
-            if let Some(band) = hull_or_slab(&pts, margin) {
-                bands.push(band);
+/// lowered by, and its extent about `axis` ([`PartAxis::extent`]).
+///
+/// A band's hull is the hull of its last layer's own band: each hull is
+/// built once, and the layers' hulls are built in parallel.
+struct WallBands {
+    /// Per layer, the hull of its band up to and including it.
+    own: Vec<Option<Local>>,
+    /// The layers whose hull closes a band, in order.
+    closing: Vec<usize>,
+    /// Per layer, how many bands are complete before it.
+    before: Vec<usize>,
+}
+
+impl WallBands {
+    fn new(layers: &[LayerPoints], axis: &PartAxis) -> Self {
+        use rayon::prelude::*;
+        let mut inputs: Vec<(Vec<Point3>, f64)> = Vec::with_capacity(layers.len());
+        let mut ends_band: Vec<bool> = Vec::with_capacity(layers.len());
+        let mut pts: Vec<Point3> = Vec::new();
+        let mut margin: f64 = 0.0;
+        for (k, l) in layers.iter().enumerate() {
+            let raw: Vec<Point3> = l.points.iter().map(|p| p.position_mm).collect();
+            let (thin, m) = thin_layer(&raw);
+            margin = margin.max(m);
+            pts.extend(thin.iter().copied());
+            inputs.push((pts.clone(), margin));
+            let closes = (k + 1) % LAYERS_PER_BAND == 0;
+            ends_band.push(closes);
+            if closes {
+                // the next band starts from this layer, so that the wall
+                // between two bands' layers is inside a hull
+                pts = thin;
+                margin = m;
             }
-            // the next band starts from this layer, so that the wall
-            // between two bands' layers is inside a hull
-            pts = thin;
-            margin = m;
+        }
+        let own: Vec<Option<Local>> = inputs
+            .par_iter()
+            .map(|(pts, margin)| {
+                let mut h = hull_or_slab(pts, *margin)?;
+                h.axial = h
+                    .shape
+                    .as_shape::<ConvexPolyhedron>()
+                    .and_then(|c| axis.extent(c.points()));
+                Some(h)
+            })
+            .collect();
+        let mut closing = Vec::new();
+        let mut before = Vec::with_capacity(layers.len());
+        for (k, h) in own.iter().enumerate() {
+            before.push(closing.len());
+            if ends_band[k] && h.is_some() {
+                closing.push(k);
+            }
+        }
+        Self {
+            own,
+            closing,
+            before,
         }
     }
-    (bands, per_layer)
+
+    /// The hulls of the layer at index `k` (into the layers): the complete
+    /// bands before it, then its own band (none for an index out of range).
+    fn hulls_of(&self, k: usize) -> Vec<&Local> {
+        let Some(&before) = self.before.get(k) else {
+            return Vec::new();
+        };
+        self.closing[..before]
+            .iter()
+            .filter_map(|&c| self.own[c].as_ref())
+            .chain(self.own[k].as_ref())
+            .collect()
+    }
 }
 
 /// The part's model a layer's motions are checked against: its hulls
@@ -800,8 +918,8 @@ struct Checker<'a> {
     keep_out_names: Vec<&'a str>,
     table: Local,
     tilt: Local,
-    bands: Vec<Local>,
-    partial: Vec<(usize, Option<Local>)>,
+    /// The part's hulls per layer.
+    wall: WallBands,
     clearance: f64,
     /// Per axis (the arm's six, the positioner's two), the largest distance
     /// from the axis to a point of a body it moves (mm).
@@ -967,17 +1085,8 @@ impl<'a> Checker<'a> {
             support: None,
             axial: None,
         };
-        let (mut bands, mut partial) = wall_bands(layers);
         let axis = PartAxis::of(cell);
-        for h in bands
-            .iter_mut()
-            .chain(partial.iter_mut().filter_map(|(_, h)| h.as_mut()))
-        {
-            h.axial = h
-                .shape
-                .as_shape::<ConvexPolyhedron>()
-                .and_then(|c| axis.extent(c.points()));
-        }
+        let wall = WallBands::new(layers, &axis);
         Self {
             cell,
             radii: LinkRadii::for_robot(cell.robot()),
@@ -985,8 +1094,7 @@ impl<'a> Checker<'a> {
             keep_out_names: scene.keep_out.iter().map(|k| k.name.as_str()).collect(),
             table,
             tilt,
-            bands,
-            partial,
+            wall,
             clearance: scene.clearance_mm,
             lever,
             axis,
@@ -1010,6 +1118,11 @@ impl<'a> Checker<'a> {
 
     /// Checks one sample; updates `best`; the first pair closer than the
     /// clearance is returned.
+    ///
+    /// The pairs, in order: link with link, each link with each keep-out
+    /// box, each link with the table and the tilt body, then per hull of
+    /// the part its links and the keep-out boxes. A hull's body is placed
+    /// only where a pair of it is not culled by the hulls' common sphere.
     fn check(
         &self,
         s: &Sample,
@@ -1021,8 +1134,7 @@ impl<'a> Checker<'a> {
         stats.samples += 1;
         let robot = self.cell.robot();
         let (capsules, base_from_flange) = links_and_flange(robot, &self.radii, s.q);
-        let mut all: Vec<Body> =
-            Vec::with_capacity(capsules.len() + self.keep_out.len() + 2 + part.hulls.len());
+        let mut all: Vec<Body> = Vec::with_capacity(capsules.len() + self.keep_out.len() + 2);
         all.extend(capsules.iter().map(|(n, c)| capsule_body(n, c)));
         let first_other = all.len();
         for (k, name) in self.keep_out.iter().zip(&self.keep_out_names) {
@@ -1059,10 +1171,10 @@ impl<'a> Checker<'a> {
             }
         }
         let keep_outs = first_other..all.len();
-        let mut part_pose: Option<Isometry3> = None;
-        match self.cell {
-            CellLayout::TorchCarried(c) => {
-                if let Some(qp) = s.qp {
+        // the part's pose and the links its hulls pair with
+        let (part_pose, part_links): (Option<Isometry3>, &[usize]) = match self.cell {
+            CellLayout::TorchCarried(c) => match s.qp {
+                Some(qp) => {
                     let (table_pose, tilt_pose) = positioner_poses(c, &qp);
                     let t = all.len();
                     all.push(self.table.at(TABLE, table_pose));
@@ -1071,49 +1183,33 @@ impl<'a> Checker<'a> {
                         pairs.push((l, t));
                         pairs.push((l, t + 1));
                     }
-                    let pose = c.base_from_part(&qp);
-                    part_pose = Some(pose);
-                    for h in &part.hulls {
-                        let p = all.len();
-                        all.push(h.at(PART, pose));
-                        for l in [upper, fore, wrist, flange] {
-                            pairs.push((l, p));
-                        }
-                        for k in keep_outs.clone() {
-                            pairs.push((p, k));
-                        }
-                    }
+                    (Some(c.base_from_part(&qp)), &[upper, fore, wrist, flange])
                 }
-            }
-            CellLayout::PartCarried(c) => {
-                let pose = base_from_flange * c.flange_from_part;
-                part_pose = Some(pose);
-                for h in &part.hulls {
-                    let p = all.len();
-                    all.push(h.at(PART, pose));
-                    for l in [column, upper, fore] {
-                        pairs.push((l, p));
-                    }
-                    for k in keep_outs.clone() {
-                        pairs.push((p, k));
-                    }
-                }
-            }
-        }
-        memory.advance(layer, &all);
+                None => (None, &[]),
+            },
+            CellLayout::PartCarried(c) => (
+                Some(base_from_flange * c.flange_from_part),
+                &[column, upper, fore],
+            ),
+        };
+        let hull_count = part_pose.map_or(0, |_| part.hulls.len());
+        memory.advance(layer, &all, part_pose.map(|p| (p, hull_count)));
         // the part's hulls come last: a body whose pairs with every hull
         // are culled by the hulls' common sphere is not bounded hull by hull
-        let first_hull = all.len() - part_pose.map_or(0, |_| part.hulls.len());
+        let hulls = HullBodies {
+            first: all.len(),
+            hulls: &part.hulls[..hull_count],
+        };
         let mut far_from_part = std::mem::take(&mut memory.far_from_part);
         far_from_part.clear();
         match (part_pose, part.sphere) {
             (Some(pose), Some(sphere)) => {
-                far_from_part.extend(all[..first_hull].iter().map(|a| {
+                far_from_part.extend(all.iter().map(|a| {
                     let bound = sphere.lower_bound(a, &pose);
                     bound > self.clearance && bound >= best.distance_mm - REPORT_TOLERANCE_MM
                 }));
             }
-            _ => far_from_part.resize(first_hull, false),
+            _ => far_from_part.resize(all.len(), false),
         }
         // each capsule about the part's axis (part frame), where a pair of
         // it with a hull is left to bound (not culled by the common sphere)
@@ -1121,69 +1217,122 @@ impl<'a> Checker<'a> {
         seg_axial.clear();
         if let Some(pose) = part_pose {
             let part_from_base = pose.inverse();
-            seg_axial.extend(
-                all[..first_hull]
-                    .iter()
-                    .zip(&far_from_part)
-                    .map(|(b, &far)| {
-                        if far {
-                            return None;
-                        }
-                        let ((a, e), c) = (b.ends?, b.capsule?);
-                        let (r, lo, hi) = self
-                            .axis
-                            .segment(&(part_from_base * a), &(part_from_base * e));
-                        Some((r, lo, hi, c.radius))
-                    }),
-            );
+            seg_axial.extend(all.iter().zip(&far_from_part).map(|(b, &far)| {
+                if far {
+                    return None;
+                }
+                let ((a, e), c) = (b.ends?, b.capsule?);
+                let (r, lo, hi) = self
+                    .axis
+                    .segment(&(part_from_base * a), &(part_from_base * e));
+                Some((r, lo, hi, c.radius))
+            }));
         }
-        let mut hit: Option<(String, String, f64)> = None;
+        let mut pass = Pass {
+            best,
+            memory,
+            stats,
+            hulls,
+            hit: None,
+        };
         for (k, &(i, j)) in pairs.iter().enumerate() {
-            let other = match (i >= first_hull, j >= first_hull) {
-                (false, true) => Some(i),
-                (true, false) => Some(j),
-                _ => None,
-            };
-            if other.is_some_and(|o| far_from_part[o]) {
-                stats.culled += 1;
-                continue;
-            }
-            let (a, b) = (&all[i], &all[j]);
-            let margin = a.margin + b.margin;
-            let mut bound = ((a.centre - b.centre).norm() - a.radius - b.radius - margin)
-                .max(memory.lower_bound(k, i, j));
-            if let (Some(Some(seg)), Some(h)) = (seg_axial.get(i), b.axial) {
-                bound = bound.max(axial_bound((seg.0, seg.1, seg.2), seg.3, h, b.margin));
-            }
-            if bound > self.clearance && bound >= best.distance_mm - REPORT_TOLERANCE_MM {
-                stats.culled += 1;
-                continue;
-            }
-            stats.exact_queries += 1;
-            let Ok(mut d) = exact_distance(a, b) else {
-                continue;
-            };
-            if d <= 0.0 {
-                // penetrating: the depth from the contact query
-                if let Ok(Some(c)) = query::contact(&a.pose, a.shape, &b.pose, b.shape, 0.0) {
-                    d = c.dist.min(0.0);
+            let seg = seg_axial.get(i).copied().flatten();
+            self.pair(&mut pass, k, (i, &all[i]), (j, &all[j]), seg);
+        }
+        if let Some(pose) = part_pose {
+            // per hull: its links, then the keep-out boxes
+            let partners: usize = part_links.len() + keep_outs.len();
+            let far = part_links
+                .iter()
+                .copied()
+                .chain(keep_outs.clone())
+                .filter(|&o| far_from_part[o])
+                .count();
+            if far == partners {
+                pass.stats.culled += partners * hull_count;
+            } else {
+                for (h, local) in hulls.hulls.iter().enumerate() {
+                    let p = hulls.first + h;
+                    let mut body: Option<Body> = None;
+                    let partner_of = part_links.iter().copied().chain(keep_outs.clone());
+                    for (m, o) in partner_of.enumerate() {
+                        if far_from_part[o] {
+                            pass.stats.culled += 1;
+                            continue;
+                        }
+                        let hull = body.get_or_insert_with(|| local.at(PART, pose));
+                        let k = pairs.len() + h * partners + m;
+                        if m < part_links.len() {
+                            let seg = seg_axial.get(o).copied().flatten();
+                            self.pair(&mut pass, k, (o, &all[o]), (p, hull), seg);
+                        } else {
+                            self.pair(&mut pass, k, (p, hull), (o, &all[o]), None);
+                        }
+                    }
                 }
             }
-            d -= margin;
-            memory.remember(k, i, j, d);
-            if d < best.distance_mm {
-                best.distance_mm = d;
-                best.pair = Some((a.name.to_string(), b.name.to_string()));
-            }
-            if d < self.clearance && hit.as_ref().is_none_or(|h| d < h.2) {
-                hit = Some((a.name.to_string(), b.name.to_string(), d));
-            }
         }
+        let hit = pass.hit;
         memory.pair_list = pairs;
         memory.far_from_part = far_from_part;
         memory.seg_axial = seg_axial;
         hit
     }
+
+    /// One pair of a sample (`k`: its index in the sample's pairs; `i`, `j`:
+    /// the bodies' indices in the sample; `seg`: the first body's extent
+    /// about the part's axis, where it is to bound the pair): bounded from
+    /// below, culled when the bound clears the clearance and cannot lower
+    /// the closest approach, else measured.
+    fn pair(
+        &self,
+        pass: &mut Pass,
+        k: usize,
+        (i, a): (usize, &Body),
+        (j, b): (usize, &Body),
+        seg: Option<(f64, f64, f64, f64)>,
+    ) {
+        let margin = a.margin + b.margin;
+        let mut bound = ((a.centre - b.centre).norm() - a.radius - b.radius - margin)
+            .max(pass.memory.lower_bound(k, i, j, pass.hulls));
+        if let (Some(seg), Some(h)) = (seg, b.axial) {
+            bound = bound.max(axial_bound((seg.0, seg.1, seg.2), seg.3, h, b.margin));
+        }
+        if bound > self.clearance && bound >= pass.best.distance_mm - REPORT_TOLERANCE_MM {
+            pass.stats.culled += 1;
+            return;
+        }
+        pass.stats.exact_queries += 1;
+        let Ok(mut d) = exact_distance(a, b) else {
+            return;
+        };
+        if d <= 0.0 {
+            // penetrating: the depth from the contact query
+            if let Ok(Some(c)) = query::contact(&a.pose, a.shape, &b.pose, b.shape, 0.0) {
+                d = c.dist.min(0.0);
+            }
+        }
+        d -= margin;
+        pass.memory.remember(k, i, j, d, pass.hulls);
+        if d < pass.best.distance_mm {
+            pass.best.distance_mm = d;
+            pass.best.pair = Some((a.name.to_string(), b.name.to_string()));
+        }
+        if d < self.clearance && pass.hit.as_ref().is_none_or(|h| d < h.2) {
+            pass.hit = Some((a.name.to_string(), b.name.to_string(), d));
+        }
+    }
+}
+
+/// What one sample's pairs share: the closest approach so far, the
+/// culling's memory, the counts, the part's hulls and the closest pair
+/// under the clearance.
+struct Pass<'s, 'h, 'c> {
+    best: &'s mut Closest,
+    memory: &'s mut Memory,
+    stats: &'s mut CellClearance,
+    hulls: HullBodies<'h, 'c>,
+    hit: Option<(String, String, f64)>,
 }
 
 /// The refusal of a sample at `place` where the pair `hit` (its two bodies

@@ -132,13 +132,9 @@ fn runs_of_one_layer(motions: &[Motion]) -> Vec<Range<usize>> {
 /// path).
 fn hull_of<'c>(checker: &'c Checker, index: &HashMap<usize, usize>, layer: usize) -> PartModel<'c> {
     PartModel::new(
-        match index.get(&layer).and_then(|&i| checker.partial.get(i)) {
-            Some((before, own)) => checker.bands[..*before]
-                .iter()
-                .chain(own.as_ref())
-                .collect(),
-            None => Vec::new(),
-        },
+        index
+            .get(&layer)
+            .map_or_else(Vec::new, |&i| checker.wall.hulls_of(i)),
     )
 }
 
