@@ -1379,3 +1379,78 @@ fn exact_distance(a: &Body, b: &Body) -> Result<f64, query::Unsupported> {
         &pos12, s1, s2,
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The part's hulls' odometers, brought up to date only when needed
+    /// ([`Memory::odometer_of`]), are to the bit the running sums that
+    /// [`Memory::advance`] keeps for every other body (a hull's centre's
+    /// displacement plus its radius times the turn, at every sample): read
+    /// at random samples, with samples skipped, after the memory forgets.
+    #[test]
+    fn a_hulls_odometer_brought_up_to_date_late_is_its_running_sum() {
+        let mut next = crate::util::uniform(0x5851_f42d_4c95_7f2d, -1.0, 1.0);
+        let ring = |z: f64, r: f64| -> Vec<Point3> {
+            (0..12)
+                .map(|i| {
+                    let a = i as f64 * std::f64::consts::TAU / 12.0;
+                    Point3::new(r * a.cos() + 3.0, r * a.sin() - 7.0, z)
+                })
+                .collect()
+        };
+        let hulls: Vec<Local> = (0..3)
+            .map(|k| {
+                let mut pts = ring(10.0 * k as f64, 40.0 + k as f64);
+                pts.extend(ring(10.0 * k as f64 + 12.5, 41.0 + k as f64));
+                hull(&pts).expect("a hull")
+            })
+            .collect();
+        let refs: Vec<&Local> = hulls.iter().collect();
+        let part = HullBodies {
+            first: 0,
+            hulls: &refs,
+        };
+        let mut memory = Memory::default();
+        let mut pose = Isometry3::identity();
+        // the running sums, as `advance` adds them for a body it places
+        let mut sums = [0.0; 3];
+        let mut was: Vec<Point3> = Vec::new();
+        let mut was_rotation = UnitQuaternion::identity();
+        let mut read = 0;
+        for s in 0..400 {
+            // a layer change at 250: the memory forgets
+            let layer = usize::from(s >= 250);
+            let step = Isometry3::from_parts(
+                Translation3::new(next(), next(), next()),
+                UnitQuaternion::from_euler_angles(0.05 * next(), 0.05 * next(), 0.05 * next()),
+            );
+            pose = step * pose;
+            memory.advance(layer, &[], Some((pose, refs.len())));
+            let now: Vec<Point3> = refs.iter().map(|h| pose * h.centre).collect();
+            if s == 0 || s == 250 {
+                sums = [0.0; 3];
+            } else {
+                let angle = was_rotation.angle_to(&pose.rotation);
+                for (h, hull) in refs.iter().enumerate() {
+                    sums[h] += (now[h] - was[h]).norm() + hull.radius * angle;
+                }
+            }
+            was = now;
+            was_rotation = pose.rotation;
+            for (h, sum) in sums.iter().enumerate() {
+                if next() > 0.6 {
+                    assert_eq!(
+                        memory.odometer_of(h, part).to_bits(),
+                        sum.to_bits(),
+                        "hull {h} at sample {s}"
+                    );
+                    read += 1;
+                }
+            }
+        }
+        assert!(read > 100, "{read} reads");
+        assert!(sums.iter().all(|&o| o > 10.0), "{sums:?}");
+    }
+}
