@@ -333,11 +333,12 @@ struct Memory {
     /// bodies): a buffer kept from sample to sample, rebuilt at each.
     pair_list: Vec<(usize, usize)>,
     /// Per body before the part's hulls, whether the hulls' common sphere
-    /// culls its pairs with every hull (a buffer, as `pair_list`).
+    /// culls its pairs with every hull (false for a body no hull pairs
+    /// with; a buffer, as `pair_list`).
     far_from_part: Vec<bool>,
     /// Per body before the part's hulls, its capsule's extent about the
-    /// part's turn axis and its radius where needed (a buffer, as
-    /// `pair_list`).
+    /// part's turn axis and its radius where needed (a link the hulls pair
+    /// with, not culled by their common sphere; a buffer, as `pair_list`).
     seg_axial: Vec<Option<(f64, f64, f64, f64)>>,
 }
 
@@ -885,10 +886,11 @@ const HULLS_SPHERE_SLACK_MM: f64 = 1e-6;
 
 impl HullsSphere {
     /// A lower bound of the sphere bound of `a` with each of the hulls
-    /// placed at `pose` (`|centre_a - centre_h| - r_a - r_h - margin_h`):
-    /// each hull's sphere lies in this one.
-    fn lower_bound(&self, a: &Body, pose: &Isometry3) -> f64 {
-        (a.centre - pose * self.centre).norm()
+    /// placed at a pose (`|centre_a - centre_h| - r_a - r_h - margin_h`):
+    /// each hull's sphere lies in this one. `centre`: this sphere's centre
+    /// at that pose (base frame).
+    fn lower_bound(&self, a: &Body, centre: &Point3) -> f64 {
+        (a.centre - centre).norm()
             - a.radius
             - self.radius
             - a.margin
@@ -1200,33 +1202,46 @@ impl<'a> Checker<'a> {
             first: all.len(),
             hulls: &part.hulls[..hull_count],
         };
+        // the bodies the hulls pair with: only theirs are bounded against
+        // the hulls' common sphere and about the part's axis
+        let partners = |o: usize| part_links.contains(&o) || keep_outs.contains(&o);
         let mut far_from_part = std::mem::take(&mut memory.far_from_part);
         far_from_part.clear();
         match (part_pose, part.sphere) {
             (Some(pose), Some(sphere)) => {
-                far_from_part.extend(all.iter().map(|a| {
-                    let bound = sphere.lower_bound(a, &pose);
+                let centre = pose * sphere.centre;
+                far_from_part.extend(all.iter().enumerate().map(|(o, a)| {
+                    if !partners(o) {
+                        return false;
+                    }
+                    let bound = sphere.lower_bound(a, &centre);
                     bound > self.clearance && bound >= best.distance_mm - REPORT_TOLERANCE_MM
                 }));
             }
             _ => far_from_part.resize(all.len(), false),
         }
-        // each capsule about the part's axis (part frame), where a pair of
-        // it with a hull is left to bound (not culled by the common sphere)
+        // each link the hulls pair with about the part's axis (part
+        // frame), where a pair of it with a hull is left to bound (not
+        // culled by the common sphere)
         let mut seg_axial = std::mem::take(&mut memory.seg_axial);
         seg_axial.clear();
         if let Some(pose) = part_pose {
             let part_from_base = pose.inverse();
-            seg_axial.extend(all.iter().zip(&far_from_part).map(|(b, &far)| {
-                if far {
-                    return None;
-                }
-                let ((a, e), c) = (b.ends?, b.capsule?);
-                let (r, lo, hi) = self
-                    .axis
-                    .segment(&(part_from_base * a), &(part_from_base * e));
-                Some((r, lo, hi, c.radius))
-            }));
+            seg_axial.extend(
+                all.iter()
+                    .zip(&far_from_part)
+                    .enumerate()
+                    .map(|(o, (b, &far))| {
+                        if far || !part_links.contains(&o) {
+                            return None;
+                        }
+                        let ((a, e), c) = (b.ends?, b.capsule?);
+                        let (r, lo, hi) = self
+                            .axis
+                            .segment(&(part_from_base * a), &(part_from_base * e));
+                        Some((r, lo, hi, c.radius))
+                    }),
+            );
         }
         let mut pass = Pass {
             best,
