@@ -152,6 +152,12 @@ pub fn thin_beads(
     // the part frame is the moving frame unless a torch-carried cell moves
     // without coordination
     let in_part = moves_in_part_frame(&cell, opts);
+    // the fixed torch of a part-carried cell, once (the same pose at every
+    // call)
+    let fixed_torch = match &cell {
+        CellLayout::PartCarried(c) => fixed_torch_at(&c.deposition_point_mm),
+        CellLayout::TorchCarried(_) => Isometry3::identity(),
+    };
     let map = |pose: &ControllerPose| -> (crate::math::Point3, crate::math::Vector3) {
         let controller = Isometry3::from_parts(pose.p.coords.into(), pose.q);
         let frame = match (&cell, in_part) {
@@ -162,7 +168,7 @@ pub fn thin_beads(
             }
             // the fixed torch seen from the part held by the interpolated flange
             (CellLayout::PartCarried(c), false) => {
-                (controller * c.flange_from_part).inverse() * fixed_torch_at(&c.deposition_point_mm)
+                (controller * c.flange_from_part).inverse() * fixed_torch
             }
         };
         (
