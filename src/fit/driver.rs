@@ -4,14 +4,15 @@
 //! fits the radius law (and wall thickness) and measures the residuals.
 
 use super::features;
+use super::first_guide::first_guide;
 use super::options::units_warning;
 use super::outcome::FeatureReport;
 use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
 use super::samples::{self, project_all, Samples};
-use super::section::{fit_circle, fit_plane, plane_basis, CircleFit, SectionPoint};
+use super::section::{fit_circle, fit_plane, plane_basis, station_frames, CircleFit, SectionPoint};
 use super::topology::{self, median_edge, Surfaces};
-use super::{ends, repair, report};
+use super::{cut, ends, repair, report};
 use super::{smooth, FitError, FitOptions, StartEnd, TubeMesh, Units};
 use crate::geometry::guide::{CubicSpline, GuideCurve};
 use crate::math::{Point3, UnitVector3, Vector3};
@@ -144,48 +145,59 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
 /// coarse bend too ([`samples::with_bend_edges`]), and the first failure stands when
 /// that fails as well: a mesh that fits on its vertices is fitted as before.
 fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFit, FitError> {
-    match fit_pass(mesh, opts, trimmed, false) {
+    match fit_pass(mesh, opts, trimmed, Pass::Vertices) {
         Err(e @ (FitError::SectionNotCircle { .. } | FitError::Degenerate { .. })) => {
-            fit_pass(mesh, opts, trimmed, true).map_err(|_| e)
+            fit_pass(mesh, opts, trimmed, Pass::BendEdges)
+                .or_else(|_| fit_pass(mesh, opts, trimmed, Pass::Cuts))
+                .map_err(|_| e)
         }
         fitted => fitted,
     }
 }
 
-/// One fit of [`fit_in_mm`]: on the skins' vertices, or with `bend_edges`
-/// on points along a coarse bend's edges first (an error when the mesh has
-/// no such edges: nothing new to try).
+/// What a pass of [`fit_pass`] refits the guide to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pass {
+    /// Sections of the skins' vertices.
+    Vertices,
+    /// Sections of the skins' vertices and of points along a coarse bend's
+    /// edges ([`samples::with_bend_edges`]), then of the vertices alone.
+    BendEdges,
+    /// Sections cut from the skins' triangles by the stations' planes
+    /// ([`cut::cut_sections`]): a coarse export whose rings lie askew to
+    /// the stations all along (a helix, an S-bend in a few stretches).
+    Cuts,
+}
+
+/// One fit of [`fit_in_mm`]: on the skins' vertices, or with
+/// [`Pass::BendEdges`] on points along a coarse bend's edges first (an error
+/// when the mesh has no such edges: nothing new to try), or with
+/// [`Pass::Cuts`] on the skins' plane cuts. The final sections, the laws
+/// and the residuals are the vertices' in every pass.
 fn fit_pass(
     mesh: &TubeMesh,
     opts: &FitOptions,
     trimmed: bool,
-    bend_edges: bool,
+    pass: Pass,
 ) -> Result<TubeFit, FitError> {
     let surf = topology::surfaces(mesh, opts)?;
     let ends = end_rings(mesh, &surf)?;
     let [mut start, mut finish] = choose_start(mesh, ends, opts)?;
     let edge = median_edge(mesh, &surf.skins[0].triangles);
     let r0 = start.radius.min(finish.radius);
-    let spacing = opts.station_spacing_mm.unwrap_or_else(|| {
-        (STATION_SPACING_EDGES * edge).clamp(
-            MIN_STATION_SPACING_MM,
-            (MAX_STATION_SPACING_RADII * r0).max(MIN_STATION_SPACING_MM),
-        )
-    });
-    let knot_h = opts
-        .knot_spacing_mm
-        .unwrap_or_else(|| {
-            (KNOT_SPACING_RADII * r0).clamp(KNOT_SPACING_RANGE_MM.0, KNOT_SPACING_RANGE_MM.1)
-        })
-        .max(MIN_KNOT_STATIONS * spacing);
-    let mut guide = initial_guide(mesh, &surf, &start, &finish, edge, knot_h)?;
-    let mut samples = pass_samples(mesh, &surf, &guide, spacing, r0, bend_edges)?;
-    let check_after = if bend_edges { CHECK_SECTIONS_AFTER } else { 1 };
+    let (spacing, knot_h) = spacings(opts, edge, r0);
+    let march = pass == Pass::Cuts;
+    let mut guide = first_guide(mesh, &surf, [&start, &finish], edge, knot_h, march)?;
+    let later = pass != Pass::Vertices;
+    let mut samples = pass_samples(mesh, &surf, &guide, spacing, r0, pass)?;
+    let check_after = if later { CHECK_SECTIONS_AFTER } else { 1 };
     let failed = |spline: &CubicSpline, stations: &[Station], samples: &Samples, t: &[f64]| {
         let cx = (mesh, &surf, spline, stations, samples, t, 2.0 * r0);
-        failed_sections(cx, opts, trimmed, bend_edges)
+        failed_sections(cx, opts, trimmed, later)
     };
     let mut hints: Option<Vec<f64>> = None;
+    // Refits to the plane cuts first (Pass::Cuts), then to the vertices.
+    let mut cutting = pass == Pass::Cuts;
     // The radius law's slope from the previous pass (none at first).
     let mut slope: Option<(Vec<f64>, Vec<f64>)> = None;
     let (mut iterations, mut converged, mut last_move) = (0, false, f64::INFINITY);
@@ -225,7 +237,14 @@ fn fit_pass(
                 ),
             });
         }
-        let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
+        let stations = if cutting {
+            let (step, frames) = station_frames(&spline, range, spacing);
+            let mut cuts = cut::cut_sections(mesh, &surf, &samples, &t, &frames, step, 2.0 * r0);
+            cut::hold_ends(&mut cuts, [&start, &finish]);
+            cuts
+        } else {
+            sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0)
+        };
         if iterations > check_after {
             if let Some(exit) = failed(&spline, &stations, &samples, &t) {
                 return exit;
@@ -259,6 +278,10 @@ fn fit_pass(
         // the vertices alone (the points along a coarse export's edges lie
         // on its chords, inside the true surface, more on a bend's outer
         // side than on its inner).
+        if (settled || iterations >= EDGE_REFITS) && std::mem::take(&mut cutting) {
+            last_move = f64::INFINITY;
+            continue;
+        }
         if (settled || iterations >= EDGE_REFITS) && samples.drop_edges(&mut hints) {
             last_move = f64::INFINITY;
             continue;
@@ -349,9 +372,28 @@ fn fit_pass(
     check_residual(mesh, fit, opts)
 }
 
+/// The stations' spacing and the guide's knot spacing (mm), from the
+/// options or else the mesh's median edge `edge` and the smaller end
+/// radius `r0` (mm).
+fn spacings(opts: &FitOptions, edge: f64, r0: f64) -> (f64, f64) {
+    let spacing = opts.station_spacing_mm.unwrap_or_else(|| {
+        (STATION_SPACING_EDGES * edge).clamp(
+            MIN_STATION_SPACING_MM,
+            (MAX_STATION_SPACING_RADII * r0).max(MIN_STATION_SPACING_MM),
+        )
+    });
+    let knot_h = opts
+        .knot_spacing_mm
+        .unwrap_or_else(|| {
+            (KNOT_SPACING_RADII * r0).clamp(KNOT_SPACING_RANGE_MM.0, KNOT_SPACING_RANGE_MM.1)
+        })
+        .max(MIN_KNOT_STATIONS * spacing);
+    (spacing, knot_h)
+}
+
 /// The samples of a pass of [`fit_pass`] with the first `guide` (points):
-/// the skins' vertices, and with `bend_edges` the points along a coarse
-/// bend's edges (an error when it has none). `spacing`: the stations' (mm);
+/// the skins' vertices, and with [`Pass::BendEdges`] the points along a
+/// coarse bend's edges (an error when it has none). `spacing`: the stations' (mm);
 /// `r0`: the smaller end radius (mm).
 fn pass_samples(
     mesh: &TubeMesh,
@@ -359,10 +401,10 @@ fn pass_samples(
     guide: &[Point3],
     spacing: f64,
     r0: f64,
-    bend_edges: bool,
+    pass: Pass,
 ) -> Result<Samples, FitError> {
     let vertices = Samples::vertices(mesh, surf);
-    if !bend_edges {
+    if pass != Pass::BendEdges {
         return Ok(vertices);
     }
     let (spline, range) = (spline_of(mesh, guide)?, tube_range(guide));
@@ -466,13 +508,6 @@ pub(super) fn chord_knots(points: &[Point3]) -> Vec<f64> {
         k.push(k[k.len() - 1] + (w[1] - w[0]).norm());
     }
     k
-}
-
-fn centroid(points: impl Iterator<Item = Point3>) -> Point3 {
-    let (s, n) = points.fold((Vector3::zeros(), 0usize), |(s, n), p| {
-        (s + p.coords, n + 1)
-    });
-    Point3::from(s / n.max(1) as f64)
 }
 
 /// Plane and circle of one open end.
@@ -584,122 +619,6 @@ fn choose_start(
     Ok(if swap { [b, a] } else { [a, b] })
 }
 
-/// First guide: the start end's centre, the centroids of the level sets of
-/// the geodesic distance from the start end (those before the far end), the
-/// far end's centre; thinned to points `knot_h / 2` apart.
-fn initial_guide(
-    mesh: &TubeMesh,
-    surf: &Surfaces,
-    start: &EndRing,
-    finish: &EndRing,
-    edge: f64,
-    knot_h: f64,
-) -> Result<Vec<Point3>, FitError> {
-    let skin = &surf.skins[0];
-    let width = (3.0 * edge).max(start.radius / 3.0);
-    let sets = topology::level_sets(mesh, &skin.triangles, &skin.loops[start.loops[0]], width);
-    let far = skin.loops[finish.loops[0]]
-        .iter()
-        .map(|&v| sets.distance[v as usize])
-        .fold(f64::INFINITY, f64::min);
-    if !far.is_finite() {
-        return Err(FitError::NotATube {
-            file: mesh.file.clone(),
-            found: "the two open ends are not connected by the surface".into(),
-        });
-    }
-    let complete = ((far / width).floor() as usize).saturating_sub(1);
-    let mut raw = vec![start.centre];
-    for (k, band) in sets.bands.iter().take(complete).enumerate() {
-        if band.pieces >= 2 {
-            return Err(FitError::Branch {
-                file: mesh.file.clone(),
-                station: k,
-                t_mm: (k as f64 + 0.5) * width,
-                x: band.centroid.x,
-                y: band.centroid.y,
-                z: band.centroid.z,
-                found: format!("the level set falls apart in {} rings", band.pieces),
-            });
-        }
-        if band.vertices > 0 {
-            raw.push(band.centroid);
-        }
-    }
-    let mut pts = vec![start.centre];
-    for p in raw.into_iter().skip(1) {
-        if (p - pts[pts.len() - 1]).norm() >= 0.5 * knot_h
-            && (finish.centre - p).norm() >= 0.5 * knot_h
-        {
-            pts.push(p);
-        }
-    }
-    pts.push(finish.centre);
-    if pts.len() == 2 {
-        // No level set between the ends (a coarse mesh, whose bands are
-        // wide): the cubic leaving each end along its normal.
-        let n = ((finish.centre - start.centre).norm() / (0.5 * knot_h))
-            .ceil()
-            .max(2.0) as usize;
-        let inner = end_cubic(start, finish, n);
-        pts.splice(1..1, inner);
-    }
-    if (pts[pts.len() - 1] - pts[0]).norm() < 1e-3 {
-        return Err(FitError::NotATube {
-            file: mesh.file.clone(),
-            found: "the two open ends have the same centre".into(),
-        });
-    }
-    // One point past each end, along the end chord.
-    let n = pts.len();
-    let before = pts[0] + (pts[0] - pts[1]).normalize() * (0.25 * knot_h);
-    let after = pts[n - 1] + (pts[n - 1] - pts[n - 2]).normalize() * (0.25 * knot_h);
-    pts.insert(0, before);
-    pts.push(after);
-    Ok(pts)
-}
-
-/// `n - 1` points evenly spaced in the parameter of the cubic (Hermite)
-/// from `start`'s centre to `finish`'s, leaving each along its end's normal
-/// with the length that makes it a circular arc when the normals allow one;
-/// the chord's midpoint when the normals are nearly opposed to the chord.
-fn end_cubic(start: &EndRing, finish: &EndRing, n: usize) -> Vec<Point3> {
-    let (p0, p1) = (start.centre, finish.centre);
-    let chord = p1 - p0;
-    let c = chord.norm();
-    let along = |n: &UnitVector3| {
-        let n = n.into_inner();
-        if n.dot(&chord) < 0.0 {
-            -n
-        } else {
-            n
-        }
-    };
-    let (d0, d1) = (along(&start.normal), along(&finish.normal));
-    let turn = d0.angle(&d1);
-    if d0.dot(&chord) < 0.3 * c || d1.dot(&chord) < 0.3 * c || turn > 0.75 * std::f64::consts::PI {
-        return vec![centroid([p0, p1].into_iter())];
-    }
-    // A circular arc of turn θ and chord c: end tangents of length
-    // 4 tan(θ / 4) R with R = c / (2 sin(θ / 2)); c when straight.
-    let m = if turn < 1e-6 {
-        c
-    } else {
-        4.0 * (turn / 4.0).tan() * c / (2.0 * (turn / 2.0).sin())
-    };
-    (1..n)
-        .map(|i| {
-            let u = i as f64 / n as f64;
-            let (u2, u3) = (u * u, u * u * u);
-            let h00 = 2.0 * u3 - 3.0 * u2 + 1.0;
-            let h10 = u3 - 2.0 * u2 + u;
-            let h01 = -2.0 * u3 + 3.0 * u2;
-            let h11 = u3 - u2;
-            Point3::from(p0.coords * h00 + d0 * (m * h10) + p1.coords * h01 + d1 * (m * h11))
-        })
-        .collect()
-}
-
 /// Minimal rotation taking unit `a` to unit `b`, applied to `x`.
 fn rotate(a: &Vector3, b: &Vector3, x: &Vector3) -> Vector3 {
     let v = a.cross(b);
@@ -731,18 +650,9 @@ fn sections(
             (smooth::eval(k, v, m, t + h) - smooth::eval(k, v, m, t - h)) / (2.0 * h)
         })
     };
-    let len = range.1 - range.0;
-    let n = ((len / spacing).ceil() as usize).max(2);
-    let step = len / n as f64;
+    let (step, frames) = station_frames(spline, range, spacing);
+    let n = frames.len() - 1;
     let mut bins: Vec<Vec<SectionPoint>> = vec![Vec::new(); (n + 1) * s.skins];
-    let frames: Vec<(f64, Point3, Vector3, Vector3, Vector3)> = (0..=n)
-        .map(|i| {
-            let ti = range.0 + i as f64 * step;
-            let tan = UnitVector3::new_normalize(spline.d1(ti));
-            let (e1, e2) = plane_basis(&tan);
-            (ti, spline.point(ti), tan.into_inner(), e1, e2)
-        })
-        .collect();
     for (k, (p, &tv)) in s.pos.iter().zip(t).enumerate() {
         let i = (((tv - range.0) / step).round().max(0.0) as usize).min(n);
         let (ti, _, tan_i, e1, e2) = &frames[i];
@@ -772,7 +682,7 @@ fn sections(
     frames
         .par_iter()
         .enumerate()
-        .map(|(i, (ti, c, _, e1, e2))| {
+        .map(|(i, (ti, ..))| {
             let slope = slope_at(*ti);
             let mut fits: Vec<Option<CircleFit>> = (0..s.skins)
                 .map(|k| fit_circle(&bins[i * s.skins + k], slope))
@@ -806,31 +716,9 @@ fn sections(
                     }
                 }
             }
-            let all: Option<Vec<CircleFit>> = if full {
-                fits.iter().copied().collect()
-            } else {
-                None
-            };
-            let (centre, radius, thickness) = match all {
-                Some(f) => {
-                    let m = f.len() as f64;
-                    let cx = f.iter().map(|f| f.centre[0]).sum::<f64>() / m;
-                    let cy = f.iter().map(|f| f.centre[1]).sum::<f64>() / m;
-                    let r = f.iter().map(|f| f.radius).sum::<f64>() / m;
-                    let e = (f.len() == 2).then(|| (f[0].radius - f[1].radius).abs());
-                    (Some(c + e1 * cx + e2 * cy), Some(r), e)
-                }
-                None => (None, None, None),
-            };
-            Station {
-                t: *ti,
-                fits,
-                centre,
-                radius,
-                thickness,
-                points,
-                widened,
-            }
+            let mut station = Station::from_fits(&frames[i], fits, points, full);
+            station.widened = widened;
+            station
         })
         .collect()
 }
@@ -1058,16 +946,16 @@ type NotTube<'a> = (
 
 /// The exit of a pass whose sections fail [`check_sections`] (`None` when
 /// they pass): [`not_tube`] on the vertices' pass, the sections' own error
-/// on the pass with points along a coarse bend's edges (`bend_edges`: its
+/// on a later pass (`later`: its
 /// failure gives way to the vertices' pass's, features and all).
 fn failed_sections(
     cx: NotTube<'_>,
     opts: &FitOptions,
     trimmed: bool,
-    bend_edges: bool,
+    later: bool,
 ) -> Option<Result<TubeFit, FitError>> {
     let error = check_sections(cx.0, cx.3, opts).err()?;
-    Some(if bend_edges {
+    Some(if later {
         Err(error)
     } else {
         not_tube(cx, opts, trimmed, error)

@@ -23,13 +23,19 @@
 //! faces ([`topology`]), a first guide through the centroids of the level
 //! sets of the geodesic distance from the start end, then sections normal to
 //! the current guide, a circle per section, a smooth refit, until the guide
-//! stops moving. A mesh that is not one tube (a branch, a closed blob, a
+//! stops moving. Where the vertices' sections fail (a coarse export whose
+//! rings lie askew to the stations), the refits take points along a bend's
+//! edges too, or else start from plane cuts of the skin (`cut`: a first
+//! guide marched through them, sections cut from the triangles), and end on
+//! the vertices. A mesh that is not one tube (a branch, a closed blob, a
 //! section far from a circle, a residual over [`FitOptions::max_rms_mm`]) is
 //! refused with a [`FitError`] naming the file, the station and what was found.
 
+mod cut;
 mod driver;
 pub mod ends;
 pub mod features;
+mod first_guide;
 mod mesh;
 mod options;
 mod outcome;

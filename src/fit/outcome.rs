@@ -3,7 +3,7 @@
 //! values the driver hands to the report builder (an open end's ring, a
 //! station's sections). Mesh frame = part frame, mm.
 
-use super::section::CircleFit;
+use super::section::{CircleFit, Frame};
 use super::{smooth, Units};
 use crate::geometry::guide::CubicSpline;
 use crate::math::{Point3, UnitVector3};
@@ -98,6 +98,45 @@ pub(super) struct Station {
     /// Whether its rings took its neighbours' points (a coarse mesh): its
     /// radius then leans on the radius law's slope across them.
     pub widened: bool,
+}
+
+impl Station {
+    /// The station at `frame` from its circle per skin (`fits`) over `points`
+    /// samples: its centre (the circles' mean) and radius and, with two skins,
+    /// its wall thickness, when every skin has a circle and the ring is `full`.
+    pub(super) fn from_fits(
+        frame: &Frame,
+        fits: Vec<Option<CircleFit>>,
+        points: usize,
+        full: bool,
+    ) -> Station {
+        let (ti, c, _, e1, e2) = frame;
+        let all: Option<Vec<CircleFit>> = if full {
+            fits.iter().copied().collect()
+        } else {
+            None
+        };
+        let (centre, radius, thickness) = match all {
+            Some(f) => {
+                let m = f.len() as f64;
+                let cx = f.iter().map(|f| f.centre[0]).sum::<f64>() / m;
+                let cy = f.iter().map(|f| f.centre[1]).sum::<f64>() / m;
+                let r = f.iter().map(|f| f.radius).sum::<f64>() / m;
+                let e = (f.len() == 2).then(|| (f[0].radius - f[1].radius).abs());
+                (Some(c + e1 * cx + e2 * cy), Some(r), e)
+            }
+            None => (None, None, None),
+        };
+        Station {
+            t: *ti,
+            fits,
+            centre,
+            radius,
+            thickness,
+            points,
+            widened: false,
+        }
+    }
 }
 
 /// One open end of the tube as found in the mesh (mesh frame, mm).

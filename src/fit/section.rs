@@ -7,6 +7,7 @@
 //! Gauss–Newton on the geometric distances; both solve small normal
 //! equations with nalgebra's Cholesky factorisation.
 
+use crate::geometry::guide::{CubicSpline, GuideCurve};
 use crate::math::{Point3, UnitVector3, Vector3};
 use nalgebra::{Matrix3, SymmetricEigen};
 
@@ -163,6 +164,27 @@ pub fn plane_basis(normal: &UnitVector3) -> (Vector3, Vector3) {
     let e1 = normal.cross(&pick).normalize();
     let e2 = normal.cross(&e1);
     (e1, e2)
+}
+
+/// A station's frame: its guide parameter (mm), guide point (mm), unit
+/// tangent and the unit basis of its plane.
+pub type Frame = (f64, Point3, Vector3, Vector3, Vector3);
+
+/// The stations' frames every `spacing` mm or a little less over `range`
+/// (both ends included), and their step (mm).
+pub fn station_frames(spline: &CubicSpline, range: (f64, f64), spacing: f64) -> (f64, Vec<Frame>) {
+    let len = range.1 - range.0;
+    let n = ((len / spacing).ceil() as usize).max(2);
+    let step = len / n as f64;
+    let frames = (0..=n)
+        .map(|i| {
+            let ti = range.0 + i as f64 * step;
+            let tan = UnitVector3::new_normalize(spline.d1(ti));
+            let (e1, e2) = plane_basis(&tan);
+            (ti, spline.point(ti), tan.into_inner(), e1, e2)
+        })
+        .collect();
+    (step, frames)
 }
 
 #[cfg(test)]

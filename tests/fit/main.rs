@@ -160,10 +160,10 @@ fn coarse_meshes_with_and_without_noise() {
 /// Coarse exports (facets within 0.5 mm of the surface: a straight pipe in
 /// one stretch of long thin triangles, a 90° bend in eight rings), untidy
 /// (duplicated seam, zero-area and flipped triangles, a stray piece) and in
-/// metres, as other people's CAD tools write them. Coarse exports of the
-/// S-bend and of the helix do not fit yet: issue 47 (the bends:
-/// `coarse_bends_fit_against_the_generators_tube`; the swelling radius:
-/// `a_coarse_swelling_radius_export_fits_within_what_its_rings_hold`).
+/// metres, as other people's CAD tools write them. The other coarse exports:
+/// `coarse_bends_fit_against_the_generators_tube`,
+/// `a_coarse_swelling_radius_export_fits_within_what_its_rings_hold`,
+/// `coarse_s_bend_and_helix_exports_fit_through_plane_cuts`.
 #[test]
 fn coarse_untidy_exports_in_metres_meet_the_goals() {
     for truth in [gen::straight(), gen::torus()] {
@@ -252,13 +252,15 @@ fn surface_errors(truth: &Truth, fitted: &FittedPart) -> (f64, f64) {
 /// straight legs of 20 mm in one stretch each (`gen::coarse_bend`, 30
 /// meshes), and the elbow of `gen::coarse`. Their vertex rings lie askew
 /// to the stations in the bend; the fit takes points along the edges there
-/// too. Against the generator's exact tube: guide within 0.3 mm RMS and
+/// too, or, where that fails, plane cuts of the skin (`fit::cut`). Against the generator's exact tube: guide within 0.3 mm RMS and
 /// 0.75 mm at most, radius within 0.08 mm RMS, the fitted surface within
 /// 0.3 mm RMS and 0.8 mm at most of the true one (the facets lie up to
 /// r (1 - cos(pi / around)) = 0.19 mm inside the true surface at 16 around,
-/// and a bend's stretches cut its corners). At least 22 of the 30 bends fit
-/// (none did before); the others, with 3 to 5 stretches along the bend, are
-/// refused as sections not near a circle.
+/// and a bend's stretches cut its corners). At least 25 of the 30 bends fit
+/// (none did before the edges' points, 22 before the plane cuts); the
+/// others, with 3 to 5 stretches along the bend (each stretch a straight
+/// cylinder up to 1.4 mm off the torus), are refused as sections not near
+/// a circle.
 #[test]
 fn coarse_bends_fit_against_the_generators_tube() {
     let mut cases = Vec::new();
@@ -303,7 +305,7 @@ fn coarse_bends_fit_against_the_generators_tube() {
             "{name}: surface {surface_rms} {surface_max}"
         );
     }
-    assert!(bends_fitted >= 22, "{bends_fitted} of 30 coarse bends fit");
+    assert!(bends_fitted >= 25, "{bends_fitted} of 30 coarse bends fit");
 }
 
 /// The fine meshes (0.2 mm, up to ~1 M triangles): `cargo test --release
@@ -615,5 +617,58 @@ fn a_coarse_swelling_radius_export_fits_within_what_its_rings_hold() {
         );
         assert!(e.radius_rms < 0.2 && e.radius_max < 0.3, "{name}: {e:?}");
         assert!(e.guide_rms < 0.01, "{name}: {e:?}");
+    }
+}
+
+/// Coarse exports of the S-bend (15 rings of 10) and of the helix (18 rings
+/// of 9), facets within 0.5 mm of the surface (issue 47), plain and untidy
+/// in metres. Their rings lie askew to the stations all along: both were
+/// refused "not near a circle" (0.70 and 1.44 mm RMS) on their vertices and
+/// on the points along their edges. The third pass marches a first guide
+/// through plane cuts of the skin and refits it to plane cuts before the
+/// vertices (`fit::cut`). Against the generator's tube: guide within
+/// 0.1 mm RMS and 0.3 mm at most, radius within 0.05 mm RMS, the fitted
+/// surface within 0.1 mm RMS and 0.3 mm at most (issue 47's goal for
+/// exported meshes).
+#[test]
+fn coarse_s_bend_and_helix_exports_fit_through_plane_cuts() {
+    for truth in [gen::s_bend(), gen::helix()] {
+        let (v, f, around) = gen::coarse(&truth, 0.5);
+        let rings = v.len() / around;
+        assert!(
+            rings >= 15 && around <= 10,
+            "{}: {rings} rings of {around}",
+            truth.name
+        );
+        let (v_m, f_m) = gen::untidy(&v, &f, around, Point3::new(300.0, 300.0, 300.0), 0.1);
+        let metres = FitOptions {
+            units: waam_slicer::fit::Units::M,
+            ..FitOptions::default()
+        };
+        for (name, v, f, opts) in [
+            (
+                format!("{}-coarse.stl", truth.name),
+                v.clone(),
+                f.clone(),
+                FitOptions::default(),
+            ),
+            (
+                format!("{}-coarse-m.stl", truth.name),
+                gen::in_metres(&v_m),
+                f_m,
+                metres,
+            ),
+        ] {
+            let fitted = fit_mesh(v, f, &name, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let e = errors(&truth, &fitted);
+            let (s_rms, s_max) = surface_errors(&truth, &fitted);
+            eprintln!(
+                "{name}: {rings} rings of {around}: guide rms {:.3} max {:.3}, radius rms {:.3}, surface rms {s_rms:.3} max {s_max:.3}",
+                e.guide_rms, e.guide_max, e.radius_rms
+            );
+            assert!(e.guide_rms < 0.1 && e.guide_max < 0.3, "{name}: {e:?}");
+            assert!(e.radius_rms < 0.05, "{name}: {e:?}");
+            assert!(s_rms < 0.1 && s_max < 0.3, "{name}: {s_rms} {s_max}");
+        }
     }
 }

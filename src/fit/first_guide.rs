@@ -1,0 +1,154 @@
+//! **The first guide** (stage 0a, inside the driver): the guide the
+//! refits start from, end to end through the tube, with one point past
+//! each end. Through the centroids of the level sets of the geodesic
+//! distance from the start end, or the cubic leaving each end along its
+//! normal when the mesh is too coarse for level sets; on the plane-cut pass,
+//! marched through plane cuts of the skin ([`cut::march`]). Mesh frame, mm.
+
+use super::cut;
+use super::outcome::EndRing;
+use super::topology::{self, Surfaces};
+use super::{FitError, TubeMesh};
+use crate::math::{Point3, UnitVector3};
+
+/// The first guide of a pass (points, one past each end): marched through
+/// plane cuts of the first skin with `march` ([`cut::march`]), else
+/// (or when the march is lost) through the level sets ([`initial_guide`]).
+pub(super) fn first_guide(
+    mesh: &TubeMesh,
+    surf: &Surfaces,
+    [start, finish]: [&EndRing; 2],
+    edge: f64,
+    knot_h: f64,
+    march: bool,
+) -> Result<Vec<Point3>, FitError> {
+    let tris = &surf.skins[0].triangles;
+    march
+        .then(|| cut::march(mesh, tris, start, finish, 0.5 * knot_h))
+        .flatten()
+        .map_or_else(
+            || initial_guide(mesh, surf, start, finish, edge, knot_h),
+            |g| Ok(with_ends_past(g, knot_h)),
+        )
+}
+
+/// First guide: the start end's centre, the centroids of the level sets of
+/// the geodesic distance from the start end (those before the far end), the
+/// far end's centre; thinned to points `knot_h / 2` apart.
+fn initial_guide(
+    mesh: &TubeMesh,
+    surf: &Surfaces,
+    start: &EndRing,
+    finish: &EndRing,
+    edge: f64,
+    knot_h: f64,
+) -> Result<Vec<Point3>, FitError> {
+    let skin = &surf.skins[0];
+    let width = (3.0 * edge).max(start.radius / 3.0);
+    let sets = topology::level_sets(mesh, &skin.triangles, &skin.loops[start.loops[0]], width);
+    let far = skin.loops[finish.loops[0]]
+        .iter()
+        .map(|&v| sets.distance[v as usize])
+        .fold(f64::INFINITY, f64::min);
+    if !far.is_finite() {
+        return Err(FitError::NotATube {
+            file: mesh.file.clone(),
+            found: "the two open ends are not connected by the surface".into(),
+        });
+    }
+    let complete = ((far / width).floor() as usize).saturating_sub(1);
+    let mut raw = vec![start.centre];
+    for (k, band) in sets.bands.iter().take(complete).enumerate() {
+        if band.pieces >= 2 {
+            return Err(FitError::Branch {
+                file: mesh.file.clone(),
+                station: k,
+                t_mm: (k as f64 + 0.5) * width,
+                x: band.centroid.x,
+                y: band.centroid.y,
+                z: band.centroid.z,
+                found: format!("the level set falls apart in {} rings", band.pieces),
+            });
+        }
+        if band.vertices > 0 {
+            raw.push(band.centroid);
+        }
+    }
+    let mut pts = vec![start.centre];
+    for p in raw.into_iter().skip(1) {
+        if (p - pts[pts.len() - 1]).norm() >= 0.5 * knot_h
+            && (finish.centre - p).norm() >= 0.5 * knot_h
+        {
+            pts.push(p);
+        }
+    }
+    pts.push(finish.centre);
+    if pts.len() == 2 {
+        // No level set between the ends (a coarse mesh, whose bands are
+        // wide): the cubic leaving each end along its normal.
+        let n = ((finish.centre - start.centre).norm() / (0.5 * knot_h))
+            .ceil()
+            .max(2.0) as usize;
+        let inner = end_cubic(start, finish, n);
+        pts.splice(1..1, inner);
+    }
+    if (pts[pts.len() - 1] - pts[0]).norm() < 1e-3 {
+        return Err(FitError::NotATube {
+            file: mesh.file.clone(),
+            found: "the two open ends have the same centre".into(),
+        });
+    }
+    Ok(with_ends_past(pts, knot_h))
+}
+
+/// `pts` (end to end, at least two) with one point past each end, along
+/// the end chord, a quarter of `knot_h` (mm) out.
+fn with_ends_past(mut pts: Vec<Point3>, knot_h: f64) -> Vec<Point3> {
+    let n = pts.len();
+    let before = pts[0] + (pts[0] - pts[1]).normalize() * (0.25 * knot_h);
+    let after = pts[n - 1] + (pts[n - 1] - pts[n - 2]).normalize() * (0.25 * knot_h);
+    pts.insert(0, before);
+    pts.push(after);
+    pts
+}
+
+/// `n - 1` points evenly spaced in the parameter of the cubic (Hermite)
+/// from `start`'s centre to `finish`'s, leaving each along its end's normal
+/// with the length that makes it a circular arc when the normals allow one;
+/// the chord's midpoint when the normals are nearly opposed to the chord.
+fn end_cubic(start: &EndRing, finish: &EndRing, n: usize) -> Vec<Point3> {
+    let (p0, p1) = (start.centre, finish.centre);
+    let chord = p1 - p0;
+    let c = chord.norm();
+    let along = |n: &UnitVector3| {
+        let n = n.into_inner();
+        if n.dot(&chord) < 0.0 {
+            -n
+        } else {
+            n
+        }
+    };
+    let (d0, d1) = (along(&start.normal), along(&finish.normal));
+    let turn = d0.angle(&d1);
+    if d0.dot(&chord) < 0.3 * c || d1.dot(&chord) < 0.3 * c || turn > 0.75 * std::f64::consts::PI {
+        return vec![Point3::from((p0.coords + p1.coords) / 2.0)];
+    }
+    // A circular arc of turn θ and chord c: end tangents of length
+    // 4 tan(θ / 4) R with R = c / (2 sin(θ / 2)); c when straight.
+    let m = if turn < 1e-6 {
+        c
+    } else {
+        4.0 * (turn / 4.0).tan() * c / (2.0 * (turn / 2.0).sin())
+    };
+    (1..n)
+        .map(|i| {
+            let u = i as f64 / n as f64;
+            let (u2, u3) = (u * u, u * u * u);
+            let h00 = 2.0 * u3 - 3.0 * u2 + 1.0;
+            let h10 = u3 - 2.0 * u2 + u;
+            let h01 = -2.0 * u3 + 3.0 * u2;
+            let h11 = u3 - u2;
+            Point3::from(p0.coords * h00 + d0 * (m * h10) + p1.coords * h01 + d1 * (m * h11))
+        })
+        .collect()
+}
