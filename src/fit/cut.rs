@@ -23,6 +23,15 @@ use crate::math::{Point3, Vector3};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
+/// Most (station, triangle) pairs [`cut_sections`] lists (dimensionless):
+/// 50 M, 600 MB; a mesh of triangles that each span most of the tube (no
+/// tube a CAD tool exports) gets no section from cuts instead.
+const MAX_CUT_ENTRIES: usize = 50_000_000;
+
+/// Most triangle tests of a [`march`] (dimensionless): 2·10⁸, a few
+/// seconds; 2 000 steps on a 100 k-triangle skin.
+const MAX_MARCH_TESTS: f64 = 2e8;
+
 /// The stations at `frames` (`step` mm apart) from plane cuts of the skins:
 /// per skin, the closed loop around the guide point, resampled, and its
 /// circle. `samples`: the skins' vertices alone, in the skins' order
@@ -54,6 +63,7 @@ pub(super) fn cut_sections(
     // `margin` mm either side (a plane tilted off a guide that is not yet
     // the tube's axis cuts triangles further along).
     let mut cand: Vec<Vec<[u32; 3]>> = vec![Vec::new(); (n + 1) * skins];
+    let mut entries = 0;
     for (k, skin) in surf.skins.iter().enumerate() {
         for &tri in &skin.triangles {
             let tri = mesh.triangles[tri as usize];
@@ -67,6 +77,14 @@ pub(super) fn cut_sections(
             let i1 = ((hi + margin - t0) / step).ceil().min(n as f64);
             if i0 > i1 {
                 continue;
+            }
+            entries += (i1 - i0) as usize + 1;
+            if entries > MAX_CUT_ENTRIES {
+                // Triangles each spanning the tube: no section from cuts.
+                return frames
+                    .iter()
+                    .map(|f| Station::from_fits(f, vec![None; skins], 0, true))
+                    .collect();
             }
             for i in i0 as usize..=i1 as usize {
                 cand[i * skins + k].push(tri);
@@ -152,7 +170,7 @@ pub(super) fn march(
     let mut dir = if side < 0.0 { -n0 } else { n0 };
     let mut pts = vec![start.centre];
     // The tube's length is its skin's area over its circumference: twice
-    // that in steps at most.
+    // that in steps at most, and at most MAX_MARCH_TESTS triangle tests.
     let area: f64 = tris
         .iter()
         .map(|t| {
@@ -161,7 +179,9 @@ pub(super) fn march(
         })
         .sum();
     let r_min = start.radius.min(finish.radius).max(1e-9);
-    let most = (2.0 * area / (std::f64::consts::TAU * r_min) / step).min(1e6) as usize + 8;
+    let most = (2.0 * area / (std::f64::consts::TAU * r_min) / step)
+        .min(MAX_MARCH_TESTS / tris.len().max(1) as f64) as usize
+        + 8;
     for _ in 0..most {
         let last = pts[pts.len() - 1];
         if (finish.centre - last).norm() < 1.5 * step {
@@ -454,5 +474,49 @@ mod tests {
             ..plane
         };
         assert!(section_loop(&aside, &pos, &tris).is_none());
+    }
+
+    #[test]
+    fn a_loop_beside_the_point_is_taken_when_its_centroid_is_near() {
+        // A cylinder of radius 5 along z in one stretch of long triangles
+        // (z from -20 to 20, 40 around), cut by a plane tilted 60 degrees
+        // about x: an ellipse of half-axes 5 (along x) and 10.
+        let n = 40;
+        let mut pos = Vec::new();
+        for z in [-20.0, 20.0] {
+            for j in 0..n {
+                let a = std::f64::consts::TAU * j as f64 / n as f64;
+                pos.push(Point3::new(5.0 * a.cos(), 5.0 * a.sin(), z));
+            }
+        }
+        let mut tris = Vec::new();
+        for j in 0..n as u32 {
+            let k = (j + 1) % n as u32;
+            tris.push([j, k, j + n as u32]);
+            tris.push([k, k + n as u32, j + n as u32]);
+        }
+        let a = 60f64.to_radians();
+        let normal = Vector3::new(0.0, a.sin(), a.cos());
+        let e2 = Vector3::new(0.0, a.cos(), -a.sin());
+        let at = |x: f64| Plane {
+            centre: Point3::new(x, 0.0, 0.0),
+            normal,
+            e1: Vector3::x(),
+            e2,
+        };
+        // Inside: around it. Just outside the ellipse across its short
+        // axis, 6 mm from its centroid (its mean radius is about 7.7 mm):
+        // the same loop, whose centre the refit moves to.
+        for x in [0.0, 6.0] {
+            let pts = section_loop(&at(x), &pos, &tris).expect("a loop");
+            let m = pts.len() as f64;
+            let cx = pts.iter().map(|p| p.x).sum::<f64>() / m;
+            let cy = pts.iter().map(|p| p.y).sum::<f64>() / m;
+            assert!((cx + x).abs() < 0.05 && cy.abs() < 0.05, "x {x}: {cx} {cy}");
+            let long = pts.iter().map(|p| p.y.abs()).fold(0.0, f64::max);
+            assert!((long - 10.0).abs() < 0.05, "x {x}: {long}");
+        }
+        // Further than its mean radius: none.
+        assert!(section_loop(&at(9.0), &pos, &tris).is_none());
     }
 }
