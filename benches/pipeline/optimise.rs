@@ -118,7 +118,8 @@ pub fn plan_at_scale(c: &mut Criterion) {
 /// cells. Goal: the torch-carried planning time per layer within 2× of the
 /// part-carried one. Both cells' plans are timed in the same run, one
 /// cell after the other, and the ratio of their mean times per layer is
-/// printed.
+/// printed; the torch-carried cell also with the positioner's QPs by the
+/// dense interior point ([`PositionerQp::Dense`](waam_slicer::optimise::positioner::PositionerQp)).
 pub fn torch_vs_part_carried(c: &mut Criterion) {
     use std::time::Duration;
     let mut g = c.benchmark_group("torch_vs_part_carried");
@@ -136,19 +137,23 @@ pub fn torch_vs_part_carried(c: &mut Criterion) {
                 )
                 .unwrap()
             });
+            let clarabel = waam_slicer::PlanOptions::default();
+            let mut dense = waam_slicer::PlanOptions::default();
+            dense.optimise.positioner.qp = waam_slicer::optimise::positioner::PositionerQp::Dense;
             // mean optimising time per layer (s) of each cell, over every plan
-            let per_layer = std::cell::RefCell::new([(0.0, 0usize); 2]);
-            for (k, (cell, kind)) in cells.iter().zip(["part", "torch"]).enumerate() {
-                g.bench_function(format!("{part}_{robot}_{kind}_carried"), |b| {
+            let per_layer = std::cell::RefCell::new([(0.0, 0usize); 3]);
+            let runs = [
+                (&cells[0], "part_carried", &clarabel),
+                (&cells[1], "torch_carried", &clarabel),
+                (&cells[1], "torch_carried_dense_qp", &dense),
+            ];
+            for (k, (cell, kind, opts)) in runs.into_iter().enumerate() {
+                g.bench_function(format!("{part}_{robot}_{kind}"), |b| {
                     b.iter_custom(|iters| {
                         let mut total = Duration::ZERO;
                         for _ in 0..iters {
-                            let planned = waam_slicer::plan_part(
-                                black_box(&p),
-                                cell,
-                                &waam_slicer::PlanOptions::default(),
-                            )
-                            .unwrap();
+                            let planned =
+                                waam_slicer::plan_part(black_box(&p), cell, opts).unwrap();
                             let t = planned.times.optimise;
                             let layers = planned.sliced.path.layers.len().max(1);
                             let mut m = per_layer.borrow_mut();
@@ -164,12 +169,16 @@ pub fn torch_vs_part_carried(c: &mut Criterion) {
             let mean = |k: usize| m[k].0 / m[k].1.max(1) as f64;
             eprintln!(
                 "torch_vs_part_carried {part} in {robot}: {:.2} ms a layer torch carried, \
-                 {:.2} ms part carried, ratio {:.2} ({} and {} plans)",
+                 {:.2} ms part carried, ratio {:.2}; dense QPs {:.2} ms, ratio {:.2} \
+                 ({}, {} and {} plans)",
                 1e3 * mean(1),
                 1e3 * mean(0),
                 mean(1) / mean(0),
+                1e3 * mean(2),
+                mean(2) / mean(0),
                 m[1].1,
-                m[0].1
+                m[0].1,
+                m[2].1
             );
         }
     }

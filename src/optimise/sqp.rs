@@ -12,7 +12,7 @@
 use crate::optimise::options::SqpOptions;
 use crate::optimise::parameterisation::Basis;
 use crate::optimise::problem::{Evaluation, LayerProblem, PointFailure};
-use crate::optimise::qp::{solve_qp, unconstrained};
+use crate::optimise::qp::{solve_qp, unconstrained, QpMethod};
 
 /// A step is accepted when the merit falls by at least this fraction of the
 /// model's predicted decrease (unitless, the trust-region ratio).
@@ -247,7 +247,15 @@ impl Run<'_, '_> {
             let rows = self.problem.constraint_rows(&at.e, self.basis, trust);
             n.qp_solves += 1;
             let bound = trust / l1;
-            let Some(qp) = solve_qp(k, &model.p_model, &model.grad, &rows, rho, bound) else {
+            let Some(qp) = solve_qp(
+                k,
+                &model.p_model,
+                &model.grad,
+                &rows,
+                rho,
+                bound,
+                QpMethod::Clarabel,
+            ) else {
                 n.qp_failures += 1;
                 trust *= 0.25;
                 if trust < self.opts.min_trust_rad {

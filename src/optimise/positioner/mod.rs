@@ -65,7 +65,7 @@ mod starts;
 mod tests;
 
 pub use grid::unreachable_point;
-pub use options::{PositionerMode, PositionerOptions};
+pub use options::{PositionerMode, PositionerOptions, PositionerQp};
 pub use outcome::{PositionerBinding, PositionerLaw, PositionerSeed};
 pub use problem::ArmRow;
 pub use rate::required_rotation_rate;

@@ -18,6 +18,23 @@ pub enum PositionerMode {
     Vertical,
 }
 
+/// How the positioner's laws solve their QPs (those whose unconstrained
+/// step breaks a row).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PositionerQp {
+    /// clarabel, as the `R_Z` driver.
+    #[default]
+    Clarabel,
+    /// A dense primal–dual interior point for the laws' few dozen
+    /// coefficients: the law's QP time about a third of clarabel's (its
+    /// set-up per QP, ordering, symbolic factorisation and equilibration,
+    /// cost more than the solve). The same optima to the solvers'
+    /// tolerances, but where a layer's starts end at near-equal objectives
+    /// another start's law may be kept.
+    Dense,
+}
+
 /// Options of the positioner's laws. Plain data.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -37,6 +54,8 @@ pub struct PositionerOptions {
     pub sample_points: usize,
     /// SQP iterations per seed and round. Default 25.
     pub max_iterations: usize,
+    /// How the SQP's QPs are solved. Default clarabel.
+    pub qp: PositionerQp,
 }
 
 impl Default for PositionerOptions {
@@ -48,6 +67,7 @@ impl Default for PositionerOptions {
             arm_length_mm: 1000.0,
             sample_points: 96,
             max_iterations: 25,
+            qp: PositionerQp::Clarabel,
         }
     }
 }

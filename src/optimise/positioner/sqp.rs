@@ -5,8 +5,9 @@
 //! driver's SQP: no secant correction, no ratio test, no polish.
 
 use crate::optimise::parameterisation::Basis;
-use crate::optimise::qp::solve_qp;
+use crate::optimise::qp::{solve_qp, Qp, QpMethod, Row};
 
+use super::options::PositionerQp;
 use super::problem::{build_model, LawProblem, Model};
 
 /// Ridge added to the positioner SQP's Gauss–Newton matrix, relative to its
@@ -42,6 +43,26 @@ pub(super) fn sqp(
     idx: &[usize],
     x0: Vec<f64>,
 ) -> (Vec<f64>, usize, f64) {
+    let method = match pb.opts.qp {
+        PositionerQp::Clarabel => QpMethod::Clarabel,
+        PositionerQp::Dense => QpMethod::Dense,
+    };
+    sqp_using(pb, basis, idx, x0, &mut |p, g, rows, rho, bound| {
+        solve_qp(g.len(), p, g, rows, rho, bound, method)
+    })
+}
+
+/// The elastic QP `(P, g, rows, ρ, box)` of one SQP iteration, solved.
+type QpSolve<'s> = dyn FnMut(&[f64], &[f64], &[Row], f64, f64) -> Option<Qp> + 's;
+
+/// [`sqp`] with its QPs solved by `solve_qp`.
+fn sqp_using(
+    pb: &LawProblem,
+    basis: &Basis,
+    idx: &[usize],
+    x0: Vec<f64>,
+    solve_qp: &mut QpSolve,
+) -> (Vec<f64>, usize, f64) {
     let n = x0.len();
     let rho = 1e2;
     let mut x = x0;
@@ -68,7 +89,7 @@ pub(super) fn sqp(
         for i in 0..n {
             p[i * n + i] += RIDGE_REL * trace.max(RIDGE_TRACE_FLOOR);
         }
-        let Some(qp) = solve_qp(n, &p, &g, &model.rows, rho, bound) else {
+        let Some(qp) = solve_qp(&p, &g, &model.rows, rho, bound) else {
             bound *= 0.25;
             if bound < MIN_TRUST_RAD {
                 break;
@@ -100,4 +121,100 @@ pub(super) fn sqp(
         }
     }
     (x, iterations, model.violation)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::options::PositionerOptions;
+    use super::super::tests::sample_cell;
+    use super::*;
+    use crate::math::{Point3, UnitVector3, Vector3};
+    use crate::optimise::qp::{solve_qp_clarabel, solve_qp_dense};
+    use crate::robot::cell::CellPoint;
+
+    /// `½ xᵀPx + gᵀx + ρt` of a QP's solution, and its largest row
+    /// violation `a·x − t − b` (at most 0 when every row holds).
+    fn qp_value(p: &[f64], g: &[f64], rows: &[Row], rho: f64, qp: &Qp) -> (f64, f64) {
+        let k = g.len();
+        let x = &qp.x;
+        let mut f = rho * qp.t;
+        for i in 0..k {
+            f += g[i] * x[i] + 0.5 * x[i] * (0..k).map(|j| p[i * k + j] * x[j]).sum::<f64>();
+        }
+        let worst = rows
+            .iter()
+            .map(|r| r.a.iter().map(|&(i, v)| v * x[i]).sum::<f64>() - qp.t - r.b)
+            .fold(f64::NEG_INFINITY, f64::max);
+        (f, worst)
+    }
+
+    /// The dense interior point against clarabel on every QP the law's SQP
+    /// meets on a bent layer of the ROBOWAM torch-carried cell: `b` swings
+    /// ±`swing_deg` about the table normal while the cone is 15°, with
+    /// rows binding (the cone, the speeds) and, where the swing is too fast
+    /// for the axes, the elastic variable `t` taking the rest. On each QP,
+    /// with all its rows, both solvers' optima have the same value and keep
+    /// the rows and the box alike (to their tolerances); the SQP follows
+    /// clarabel's steps.
+    #[test]
+    fn the_dense_qp_solves_the_laws_qps_as_clarabel_does() {
+        let cell = sample_cell("robowam_torch_carried.toml");
+        let (mut compared, mut binding, mut elastic) = (0, 0, 0);
+        for (swing_deg, speed) in [(25.0, 6.0), (40.0, 6.0), (60.0, 60.0)] {
+            let n = 160;
+            let points: Vec<CellPoint> = (0..n)
+                .map(|m| {
+                    let v = std::f64::consts::TAU * m as f64 / n as f64;
+                    let a = f64::to_radians(swing_deg) * (3.0 * v).sin();
+                    let b = Vector3::new(a.sin() * v.cos(), a.sin() * v.sin(), a.cos());
+                    CellPoint {
+                        position_mm: Point3::new(80.0 * v.cos(), 50.0 * v.sin(), 30.0),
+                        tool_axis: UnitVector3::new_normalize(b),
+                        build_direction: Some(UnitVector3::new_normalize(b)),
+                        positioner: None,
+                        travel_speed_mm_s: speed,
+                    }
+                })
+                .collect();
+            let opts = PositionerOptions::default();
+            let pb = LawProblem::new(&cell, &points, 0.0, &opts, &[]);
+            let x: Vec<f64> = (0..n).map(|m| m as f64).collect();
+            let basis = Basis::spline(&x, opts.spans);
+            let k = basis.len();
+            let idx: Vec<usize> = (0..n).step_by(2).collect();
+            let mut x0 = vec![0.0; 2 * k];
+            x0[k] = 0.5;
+            sqp_using(&pb, &basis, &idx, x0, &mut |p, g, rows, rho, bound| {
+                let all: Vec<&Row> = rows.iter().collect();
+                let reference = solve_qp_clarabel(g.len(), p, g, &all, rho, bound)?;
+                let dense = solve_qp_dense(g.len(), p, g, &all, rho, bound)
+                    .expect("the dense QP converges where clarabel does");
+                let (fr, vr) = qp_value(p, g, rows, rho, &reference);
+                let (fd, vd) = qp_value(p, g, rows, rho, &dense);
+                let scale = 1.0 + fr.abs();
+                assert!(
+                    (fd - fr).abs() <= 1e-6 * scale,
+                    "objective {fd} against clarabel's {fr}"
+                );
+                assert!(vd <= 1e-7 && vr <= 1e-7, "rows broken by {vd}, {vr}");
+                assert!(dense
+                    .x
+                    .iter()
+                    .all(|v| v.abs() <= bound * (1.0 + 1e-7) + 1e-12));
+                assert!((dense.t - reference.t).abs() <= 1e-6 * (1.0 + reference.t));
+                compared += 1;
+                if vr > -1e-9 {
+                    binding += 1;
+                }
+                if reference.t > 1e-6 {
+                    elastic += 1;
+                }
+                Some(reference)
+            });
+        }
+        // the layers exercise binding rows and the elastic variable
+        assert!(compared >= 20, "{compared} QPs");
+        assert!(binding >= 5, "{binding} QPs with a binding row");
+        assert!(elastic >= 1, "{elastic} QPs with t > 0");
+    }
 }
