@@ -87,6 +87,13 @@ const EDGE_REFITS: usize = 8;
 /// Fewest stations with rings of their own that a radius or thickness law
 /// is fitted to alone, leaving out the widened ones ([`fit_law`]).
 const MIN_OWN_LAW_STATIONS: usize = 3;
+
+/// Largest mesh the fit takes (mm, bounding box's largest side, after the
+/// unit): 10 km, no part of a robot cell; a mesh that big is in another
+/// unit or not a tube, and far past it the guide's splines overflow (the
+/// fuzzer's 1.2e29 mm mesh made parry's projection panic on NaN points).
+const MAX_MESH_SIZE_MM: f64 = 1e7;
+
 /// Fits a tube to `mesh`.
 ///
 /// # Errors
@@ -103,6 +110,22 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
         in_mm = mesh.scaled(opts.units.mm_per_unit());
         &in_mm
     };
+    let size_mm = mesh.bounding_box_size();
+    if !(size_mm <= MAX_MESH_SIZE_MM) {
+        let e = FitError::Stl {
+            file: mesh.file.clone(),
+            reason: format!(
+                "the mesh spans {size_mm:.4e} mm, over the {MAX_MESH_SIZE_MM:.0} mm a part of a robot cell can span"
+            ),
+        };
+        return Err(match warning {
+            Some(hint) => FitError::Units {
+                hint,
+                source: Box::new(e),
+            },
+            None => e,
+        });
+    }
     let repaired = repair::repair(mesh);
     if repaired.mesh.triangles.is_empty() {
         return Err(FitError::Stl {
@@ -220,13 +243,6 @@ fn fit_pass(
                 ),
             });
         }
-        let t = project_all(
-            &spline,
-            range,
-            &samples,
-            hints.as_deref(),
-            PROJECT_PAST_END_RADII * r0,
-        );
         if range.1 - range.0 > DIVERGED_LENGTH_RATIO * first_length {
             return Err(FitError::Degenerate {
                 file: mesh.file.clone(),
@@ -237,6 +253,13 @@ fn fit_pass(
                 ),
             });
         }
+        let t = project_all(
+            &spline,
+            range,
+            &samples,
+            hints.as_deref(),
+            PROJECT_PAST_END_RADII * r0,
+        );
         let stations = if cutting {
             let (step, frames) = station_frames(&spline, range, spacing);
             let mut cuts = cut::cut_sections(mesh, &surf, &samples, &t, &frames, step, 2.0 * r0);

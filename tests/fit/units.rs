@@ -145,3 +145,27 @@ fn cli_units_m_takes_start_in_mm_and_writes_mm() {
     assert!(!done.status.success());
     assert!(String::from_utf8_lossy(&done.stderr).contains("furlong"));
 }
+
+/// A mesh over 10 km across (after its unit) is refused naming the file,
+/// its size and the limit, and the likely unit: the fuzzer's mesh 1.2e29 mm
+/// across had made the guide's spline overflow to NaN and parry's polyline
+/// projection panic.
+#[test]
+fn a_mesh_larger_than_any_cell_is_refused_not_a_panic() {
+    let truth = gen::straight();
+    let (v, f) = gen::mesh(&truth, 1.0, 0.0, 0.0, 6);
+    for scale in [2e5, 1e27] {
+        let huge: Vec<_> = v.iter().map(|p| p * scale).collect();
+        let mesh = TubeMesh::new(huge, f.clone(), "huge.stl").unwrap();
+        let e = Part::from_tube_mesh(&mesh, &FitOptions::default())
+            .err()
+            .unwrap_or_else(|| panic!("{scale}: a mesh that large fitted"));
+        let text = e.to_string();
+        assert!(
+            text.contains("huge.stl")
+                && text.contains("over the 10000000 mm")
+                && text.contains("unit smaller than mm"),
+            "{scale}: {text}"
+        );
+    }
+}
