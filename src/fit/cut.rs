@@ -439,12 +439,11 @@ fn resample(poly: &[[f64; 2]], n: usize) -> Vec<SectionPoint> {
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_cut_cylinder_gives_one_loop_around_its_axis() {
-        // A cylinder of radius 5 along z, 40 around, rings at z = 0, 2.
-        let n = 40;
+    /// A cylinder of radius 5 along z, `n` around, two rings at `zs`, in
+    /// one stretch of two triangles a quad.
+    fn cylinder(n: usize, zs: [f64; 2]) -> (Vec<Point3>, Vec<[u32; 3]>) {
         let mut pos = Vec::new();
-        for z in [0.0, 2.0] {
+        for z in zs {
             for j in 0..n {
                 let a = std::f64::consts::TAU * j as f64 / n as f64;
                 pos.push(Point3::new(5.0 * a.cos(), 5.0 * a.sin(), z));
@@ -456,6 +455,14 @@ mod tests {
             tris.push([j, k, j + n as u32]);
             tris.push([k, k + n as u32, j + n as u32]);
         }
+        (pos, tris)
+    }
+
+    #[test]
+    fn a_cut_cylinder_gives_one_loop_around_its_axis() {
+        // A cylinder of radius 5 along z, 40 around, rings at z = 0, 2.
+        let n = 40;
+        let (pos, tris) = cylinder(n, [0.0, 2.0]);
         let plane = Plane {
             centre: Point3::new(0.0, 0.0, 0.7),
             normal: Vector3::z(),
@@ -482,19 +489,7 @@ mod tests {
         // (z from -20 to 20, 40 around), cut by a plane tilted 60 degrees
         // about x: an ellipse of half-axes 5 (along x) and 10.
         let n = 40;
-        let mut pos = Vec::new();
-        for z in [-20.0, 20.0] {
-            for j in 0..n {
-                let a = std::f64::consts::TAU * j as f64 / n as f64;
-                pos.push(Point3::new(5.0 * a.cos(), 5.0 * a.sin(), z));
-            }
-        }
-        let mut tris = Vec::new();
-        for j in 0..n as u32 {
-            let k = (j + 1) % n as u32;
-            tris.push([j, k, j + n as u32]);
-            tris.push([k, k + n as u32, j + n as u32]);
-        }
+        let (pos, tris) = cylinder(n, [-20.0, 20.0]);
         let a = 60f64.to_radians();
         let normal = Vector3::new(0.0, a.sin(), a.cos());
         let e2 = Vector3::new(0.0, a.cos(), -a.sin());
