@@ -88,6 +88,10 @@ const EDGE_REFITS: usize = 8;
 /// is fitted to alone, leaving out the widened ones ([`fit_law`]).
 const MIN_OWN_LAW_STATIONS: usize = 3;
 
+/// Gap between stations holding rings of their own past which a varying
+/// radius law gets a warning ([`sparse_rings`]), in end radii.
+const SPARSE_RING_GAP_RADII: f64 = 2.0;
+
 /// Largest mesh the fit takes (mm, bounding box's largest side, after the
 /// unit): 10 km, no part of a robot cell; a mesh that big is in another
 /// unit or not a tube, and far past it the guide's splines overflow (the
@@ -337,10 +341,12 @@ fn fit_pass(
     let spread = radius_mm
         .iter()
         .fold((f64::MAX, f64::MIN), |a, &r| (a.0.min(r), a.1.max(r)));
-    if spread.1 - spread.0 < CONSTANT_RADIUS_SPREAD_TOLS * opts.constant_radius_tol_mm {
+    let constant = spread.1 - spread.0 < CONSTANT_RADIUS_SPREAD_TOLS * opts.constant_radius_tol_mm;
+    if constant {
         let mean = radius_mm.iter().sum::<f64>() / radius_mm.len() as f64;
         radius_mm.iter_mut().for_each(|r| *r = mean);
     }
+    let sparse = (!constant).then(|| sparse_rings(&stations, r0)).flatten();
     let thickness_mm = match samples.skins {
         2 => Some(law(&|s| s.thickness)?),
         _ => None,
@@ -392,7 +398,30 @@ fn fit_pass(
     };
     (fit.report, fit.vertex_distance_mm) = report::build(&ctx, &fit);
     fit.report.features = pieces;
+    fit.report.warnings.extend(sparse);
     check_residual(mesh, fit, opts)
+}
+
+/// A warning when the stations holding rings of their own lie more than
+/// [`SPARSE_RING_GAP_RADII`] end radii `r0` (mm) apart somewhere: a coarse
+/// export of a tube whose radius varies, whose radius law is then
+/// interpolated where the mesh does not hold it.
+fn sparse_rings(stations: &[Station], r0: f64) -> Option<String> {
+    let own: Vec<f64> = stations
+        .iter()
+        .filter(|s| !s.widened && s.radius.is_some())
+        .map(|s| s.t)
+        .collect();
+    let (a, b) = own
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))?;
+    (b - a > SPARSE_RING_GAP_RADII * r0).then(|| {
+        format!(
+            "the radius varies, and the mesh holds it only at rings up to {:.1} mm apart (t = {a:.1} to {b:.1} mm): the radius law is interpolated between them",
+            b - a
+        )
+    })
 }
 
 /// The stations' spacing and the guide's knot spacing (mm), from the

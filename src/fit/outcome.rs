@@ -260,7 +260,7 @@ pub struct FitReport {
     /// is in mm.
     pub units: Units,
     /// What the fit noticed but did not refuse (a size suggesting another
-    /// unit).
+    /// unit; a varying radius held by rings of vertices far apart).
     pub warnings: Vec<String>,
     /// Features that are not tube, left out of a trimmed fit
     /// ([`FitOptions::trim`](super::FitOptions::trim)).
