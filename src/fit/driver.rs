@@ -6,9 +6,9 @@
 use super::features;
 use super::first_guide::first_guide;
 use super::options::units_warning;
-use super::outcome::FeatureReport;
 use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
+use super::outcome::{FeatureKind, FeatureReport};
 use super::samples::{self, project_all, Samples};
 use super::section::{fit_circle, fit_plane, plane_basis, station_frames, CircleFit, SectionPoint};
 use super::topology::{self, median_edge, Surfaces};
@@ -80,6 +80,11 @@ const WIDEN_GAP_DEG: f64 = 60.0;
 /// the first guides of a coarse export (level sets a few edges wide) leave
 /// sections that are not yet circles. Otherwise from the second.
 const CHECK_SECTIONS_AFTER: usize = 6;
+/// Refits to the round sections alone (dimensionless count) after the
+/// vertices' pass first fails its check with no feature named, or a lug:
+/// a feature on one side pulls the guide towards it until its sections no
+/// longer steer the guide; then the sections are read for features again.
+const FEATURE_REFITS: usize = 4;
 /// Most refits with the points along a coarse bend's edges (dimensionless
 /// count); then the vertices alone.
 const EDGE_REFITS: usize = 8;
@@ -232,30 +237,37 @@ fn fit_pass(
         let r = tube_range(&guide);
         r.1 - r.0
     };
+    // The vertices' pass's first failed check and its refit, while the
+    // guide is refitted to the round sections alone (FEATURE_REFITS): every
+    // outcome but a feature named then is this failure, as before.
+    let mut postponed: Option<(FitError, usize)> = None;
     while iterations < opts.max_iterations {
         iterations += 1;
-        let spline = spline_of(mesh, &guide)?;
+        let spline = spline_of(mesh, &guide).map_err(|e| postponed.take().map_or(e, |p| p.0))?;
         let range = tube_range(&guide);
         let knots = (range.1 - range.0) / knot_h;
         if knots > MAX_KNOTS {
-            return Err(FitError::Degenerate {
+            return Err(postponed.take().map_or_else(|| FitError::Degenerate {
                 file: mesh.file.clone(),
                 station: 0,
                 reason: format!(
                     "the guide is {:.1} mm long for an end radius of {r0:.3} mm: {knots:.0} knots {knot_h:.2} mm apart, over the limit of {MAX_KNOTS:.0} (a vertex far from the tube? a longer tube fits with a larger knot_spacing_mm)",
                     range.1 - range.0
                 ),
-            });
+            }, |p| p.0));
         }
         if range.1 - range.0 > DIVERGED_LENGTH_RATIO * first_length {
-            return Err(FitError::Degenerate {
-                file: mesh.file.clone(),
-                station: 0,
-                reason: format!(
-                    "the guide diverged ({:.1} mm long, from {first_length:.1} mm)",
-                    range.1 - range.0
-                ),
-            });
+            return Err(postponed.take().map_or_else(
+                || FitError::Degenerate {
+                    file: mesh.file.clone(),
+                    station: 0,
+                    reason: format!(
+                        "the guide diverged ({:.1} mm long, from {first_length:.1} mm)",
+                        range.1 - range.0
+                    ),
+                },
+                |p| p.0,
+            ));
         }
         let t = project_all(
             &spline,
@@ -273,15 +285,49 @@ fn fit_pass(
             sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0)
         };
         if iterations > check_after {
-            if let Some(exit) = failed(&spline, &stations, &samples, &t) {
-                return exit;
+            match (check_sections(mesh, &stations, opts), postponed.take()) {
+                (Ok(()), None) => {}
+                // Round now: the first failure stands (the later passes run
+                // as before).
+                (Ok(()), Some((first, _))) => return Err(first),
+                (Err(e), None) => {
+                    let lug_or_none = pass == Pass::Vertices && {
+                        let cx = (
+                            mesh,
+                            &surf,
+                            &spline,
+                            &stations[..],
+                            &samples,
+                            &t[..],
+                            2.0 * r0,
+                        );
+                        let found = named_features(cx, opts);
+                        found.is_empty() || found.iter().any(|f| f.kind == FeatureKind::Lug)
+                    };
+                    if lug_or_none {
+                        postponed = Some((e, iterations));
+                    } else if let Some(exit) = failed(&spline, &stations, &samples, &t) {
+                        return exit;
+                    }
+                }
+                (Err(_), Some((first, at))) if iterations - at < FEATURE_REFITS => {
+                    postponed = Some((first, at));
+                }
+                (Err(_), Some((first, _))) => {
+                    return match failed(&spline, &stations, &samples, &t) {
+                        Some(Err(FitError::SectionNotCircle { .. })) | None => Err(first),
+                        Some(exit) => exit,
+                    };
+                }
             }
         }
         let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
         slope = fit_law(mesh, &stations, &knots, &|s| s.radius, false)
             .ok()
             .map(|v| (knots.clone(), v));
-        let mut next = refit_guide(mesh, &stations, &knots)?;
+        let round_only = postponed.as_ref().map(|_| opts);
+        let mut next = refit_guide(mesh, &stations, &knots, round_only)
+            .map_err(|e| postponed.take().map_or(e, |p| p.0))?;
         anchor_ends(&mut next, &start, &finish);
         let previous = last_move;
         // The points past the ends are left out: the data barely hold them.
@@ -318,7 +364,7 @@ fn fit_pass(
             break;
         }
     }
-    let spline = spline_of(mesh, &guide)?;
+    let spline = spline_of(mesh, &guide).map_err(|e| postponed.take().map_or(e, |p| p.0))?;
     let knots = chord_knots(&guide);
     let range = tube_range(&guide);
     let samples = samples.vertex_only();
@@ -332,8 +378,12 @@ fn fit_pass(
         PROJECT_PAST_END_RADII * r0,
     );
     let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
-    if let Some(exit) = failed(&spline, &stations, &samples, &t) {
-        return exit;
+    match (failed(&spline, &stations, &samples, &t), postponed) {
+        (Some(Err(FitError::SectionNotCircle { .. })) | None, Some((first, _))) => {
+            return Err(first)
+        }
+        (Some(exit), _) => return exit,
+        (None, None) => {}
     }
     let pieces = separate_pieces(mesh, &surf, &stations, &spline, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick, true);
@@ -775,13 +825,34 @@ fn sections(
         .collect()
 }
 
-/// The guide's new points at `knots`: the smoothing fit of the section centres.
+/// The guide's new points at `knots`: the smoothing fit of the section
+/// centres (of the sections that are circles, when enough are).
 fn refit_guide(
     mesh: &TubeMesh,
     stations: &[Station],
     knots: &[f64],
+    round_only: Option<&FitOptions>,
 ) -> Result<Vec<Point3>, FitError> {
-    let ok: Vec<&Station> = stations.iter().filter(|s| s.centre.is_some()).collect();
+    let mut ok: Vec<&Station> = stations.iter().filter(|s| s.centre.is_some()).collect();
+    // With `round_only`, a section that is not a circle by its check (a lug
+    // on one side pulls its circle's centre towards it) does not steer the
+    // guide while enough others do: the sections' check names it on a
+    // later round. With every section a circle, the refit is as before.
+    if let Some(opts) = round_only {
+        let round: Vec<&Station> = ok
+            .iter()
+            .copied()
+            .filter(|s| {
+                s.fits
+                    .iter()
+                    .flatten()
+                    .all(|f| f.rms <= opts.section_rms_allowed(f.radius))
+            })
+            .collect();
+        if round.len() < ok.len() && round.len() >= 3 && round.len() * 2 >= stations.len() {
+            ok = round;
+        }
+    }
     if ok.len() < 3 || ok.len() * 2 < stations.len() {
         let first_bad = stations
             .iter()
@@ -909,7 +980,7 @@ fn check_sections(
             } else {
                 String::new()
             };
-            let allowed = (opts.max_section_rms_ratio * f.radius).max(opts.max_rms_mm);
+            let allowed = opts.section_rms_allowed(f.radius);
             if f.rms > allowed {
                 return Err(FitError::SectionNotCircle {
                     file: mesh.file.clone(),
@@ -1036,6 +1107,15 @@ fn feature_error(mesh: &TubeMesh, f: &FeatureReport, count: usize) -> FitError {
             }
         ),
     }
+}
+
+/// The features that are not tube that the sections of `cx` show
+/// ([`features::detect`] on the vertices).
+fn named_features(cx: NotTube<'_>, opts: &FitOptions) -> Vec<FeatureReport> {
+    let (_, _, spline, stations, samples, t, _) = cx;
+    let nv = samples.vertices;
+    let pos = &samples.pos[..nv];
+    features::detect(spline, stations, pos, &samples.skin[..nv], &t[..nv], opts).1
 }
 
 /// Sections that failed `error`: features that are not tube refused by

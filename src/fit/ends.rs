@@ -135,7 +135,7 @@ pub(super) fn classify(
                 pts.len()
             )));
         };
-        let allowed = (opts.max_section_rms_ratio * circle.radius).max(opts.max_rms_mm);
+        let allowed = opts.section_rms_allowed(circle.radius);
         let plane_rms =
             (pts.iter().map(|p| (p - c).dot(&n).powi(2)).sum::<f64>() / pts.len() as f64).sqrt();
         if plane_rms > allowed {

@@ -4,9 +4,10 @@
 //! tubular stretches; the stations between them make features, each named
 //! by its shape: a round outline all around is a collar (longer than it is
 //! high) or a flange (higher than long), an outline all around that is not
-//! round a block; a separate piece of the mesh that is not a skin is a tab.
-//! An outline on one side only is not named (a guide off the axis of a
-//! coarse bend gives one too): the sections' failure stands. A cut of the mesh by the guide's normal planes to one
+//! round a block; an outline on one side of an intact wall a lug; a separate
+//! piece of the mesh that is not a skin is a tab. An outline on one side
+//! that is the far side of a shifted wall is not named (a guide off the axis
+//! of a coarse bend gives one): the sections' failure stands. A cut of the mesh by the guide's normal planes to one
 //! tubular stretch (for [`FitOptions::trim`](super::FitOptions::trim)).
 
 use super::outcome::{FeatureKind, FeatureReport, Station};
@@ -24,7 +25,7 @@ fn round(bins: &[Vec<SectionPoint>], opts: &FitOptions) -> Option<f64> {
     let mut r: Option<f64> = None;
     for pts in bins {
         let f = fit_circle(pts, 0.0)?;
-        let allowed = (opts.max_section_rms_ratio * f.radius).max(opts.max_rms_mm);
+        let allowed = opts.section_rms_allowed(f.radius);
         if f.rms > allowed || f.max_gap_rad > opts.max_section_gap_deg.to_radians() {
             return None;
         }
@@ -43,7 +44,7 @@ const SAME_TUBE_RADIUS_FRACTION: f64 = 0.15;
 const RADIUS_JUMP_FRACTION: f64 = 0.05;
 
 /// An outline covering under this share of the directions around the
-/// guide (dimensionless) is on one side: a tab.
+/// guide (dimensionless) is on one side: a lug, when its wall stays a circle.
 const ALL_AROUND_FRACTION: f64 = 0.75;
 
 /// An outline whose distance from the guide varies by more than this
@@ -180,13 +181,20 @@ pub(super) fn detect(
         (t_lo, t_hi) = (t_lo.max(t0), t_hi.min(stations[n - 1].t).max(t_lo.max(t0)));
         let length = t_hi - t_lo;
         let height = (hi - r_tube).max(0.0);
-        // An outline on one side only is what a guide off the tube's axis
-        // gives as well (a coarse bend): not named a feature, the failure
-        // stands.
-        if out.is_empty() || cover < ALL_AROUND_FRACTION {
+        if out.is_empty() {
             continue;
         }
-        let kind = if hi - lo > ROUND_OUTLINE_FRACTION * hi {
+        // An outline on one side only is what a guide off the tube's axis
+        // gives as well (a coarse bend): a lug only when the wall beside it
+        // is the tube's circle and the outline stands beyond that circle,
+        // else not named a feature and the failure stands.
+        let one_side = cover < ALL_AROUND_FRACTION;
+        if one_side && !stands_off_the_wall(&at, (first, last), r_tube, margin, opts) {
+            continue;
+        }
+        let kind = if one_side {
+            FeatureKind::Lug
+        } else if hi - lo > ROUND_OUTLINE_FRACTION * hi {
             FeatureKind::Block
         } else if length >= height {
             FeatureKind::Collar
@@ -207,12 +215,52 @@ pub(super) fn detect(
             } else {
                 [2.0 * lo, 2.0 * hi]
             },
+            around_deg: 360.0 * cover,
             centre_mm: mid.coords.into(),
             triangles: 0,
             box_mm: [0.0; 3],
         });
     }
     (tube, features)
+}
+
+/// The points of stations `first..=last` (`at`: station, guide parameter,
+/// x and y in the station's plane, mm) within `margin` of the tube's wall
+/// (radius `r_tube` about the guide, mm) lie on one circle of about the
+/// tube's radius, and most of the points beyond the wall lie beyond that
+/// circle too: something stands on one side of an intact wall. A guide off
+/// the axis of a coarse bend fails this: the points beyond its wall are the
+/// far side of the same, shifted, circle.
+fn stands_off_the_wall(
+    at: &[(usize, f64, f64, f64)],
+    (first, last): (usize, usize),
+    r_tube: f64,
+    margin: f64,
+    opts: &FitOptions,
+) -> bool {
+    let (mut wall, mut beyond) = (Vec::new(), Vec::new());
+    for &(i, _, x, y) in at {
+        if i < first || i > last {
+            continue;
+        }
+        if x.hypot(y) <= r_tube + margin {
+            wall.push(SectionPoint { x, y, dt: 0.0 });
+        } else {
+            beyond.push((x, y));
+        }
+    }
+    let Some(c) = fit_circle(&wall, 0.0) else {
+        return false;
+    };
+    let allowed = opts.section_rms_allowed(c.radius);
+    if c.rms > allowed || (c.radius - r_tube).abs() > SAME_TUBE_RADIUS_FRACTION * r_tube {
+        return false;
+    }
+    let outside = beyond
+        .iter()
+        .filter(|&&(x, y)| (x - c.centre[0]).hypot(y - c.centre[1]) > c.radius + margin)
+        .count();
+    2 * outside > beyond.len()
 }
 
 /// A separate piece of the mesh (`tris`) as a tab, at the stations its
@@ -261,6 +309,7 @@ pub(super) fn piece(
         length_mm: 0.0,
         height_mm: 0.0,
         across_mm: [0.0; 2],
+        around_deg: 0.0,
         centre_mm: c.coords.into(),
         triangles: tris.len(),
         box_mm: (hi - lo).into(),

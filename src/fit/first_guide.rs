@@ -58,19 +58,13 @@ fn initial_guide(
     }
     let complete = ((far / width).floor() as usize).saturating_sub(1);
     let mut raw = vec![start.centre];
-    for (k, band) in sets.bands.iter().take(complete).enumerate() {
-        if band.pieces >= 2 {
-            return Err(FitError::Branch {
-                file: mesh.file.clone(),
-                station: k,
-                t_mm: (k as f64 + 0.5) * width,
-                x: band.centroid.x,
-                y: band.centroid.y,
-                z: band.centroid.z,
-                found: format!("the level set falls apart in {} rings", band.pieces),
-            });
-        }
-        if band.vertices > 0 {
+    for band in sets.bands.iter().take(complete) {
+        // A level set in several rings on a skin with two open ends is not
+        // a branch (a branch ends in an open end of its own): the distance
+        // reaches a feature on one side apart from the wall beside it (a
+        // lug). Its centroid is pulled towards the feature: no point there,
+        // and the sections decide (a feature is named by them).
+        if band.vertices > 0 && band.pieces < 2 {
             raw.push(band.centroid);
         }
     }

@@ -240,6 +240,13 @@ impl Default for FitOptions {
 }
 
 impl FitOptions {
+    /// The largest RMS (mm) of a section's points from their circle of
+    /// `radius` (mm) that is still a circle: `max_section_rms_ratio` of the
+    /// radius, at least `max_rms_mm`.
+    pub(crate) fn section_rms_allowed(&self, radius: f64) -> f64 {
+        (self.max_section_rms_ratio * radius).max(self.max_rms_mm)
+    }
+
     /// Checks every field; `file` names the mesh in the error.
     ///
     /// # Errors

@@ -355,6 +355,10 @@ pub enum FeatureKind {
     Block,
     /// A separate piece beside the tube (a printing tab).
     Tab,
+    /// A piece on one side of the tube, joined to its wall (a lug, a fin,
+    /// a boss): its outline covers under three quarters of the directions
+    /// around the guide, and the wall beside it stays the tube's circle.
+    Lug,
 }
 
 impl FeatureKind {
@@ -365,6 +369,7 @@ impl FeatureKind {
             FeatureKind::Flange => "flange",
             FeatureKind::Block => "block",
             FeatureKind::Tab => "tab",
+            FeatureKind::Lug => "lug",
         }
     }
 }
@@ -394,6 +399,9 @@ pub struct FeatureReport {
     /// its smallest and largest distance from the guide over the directions
     /// it covers.
     pub across_mm: [f64; 2],
+    /// The share of the directions around the guide its outline covers
+    /// (deg: 360 all around; under 270 for a lug; 0 for a separate piece).
+    pub around_deg: f64,
     /// The guide's point at its middle (mm).
     pub centre_mm: [f64; 3],
     /// For a separate piece: its triangles (0 otherwise).
@@ -409,6 +417,12 @@ impl FeatureReport {
             return format!(
                 "a separate piece of {} triangles, {:.1} x {:.1} x {:.1} mm",
                 self.triangles, self.box_mm[0], self.box_mm[1], self.box_mm[2]
+            );
+        }
+        if self.kind == FeatureKind::Lug {
+            return format!(
+                "{:.1} mm long, reaching {:.1} mm out from the tube's wall on one side, over {:.0} degrees around",
+                self.length_mm, self.height_mm, self.around_deg
             );
         }
         let across = if (self.across_mm[1] - self.across_mm[0]) < 0.05 * self.across_mm[1] {

@@ -263,3 +263,27 @@ fn features_read_from_single_precision_stl_are_named_alike() {
         assert_eq!(named, kind.name(), "{msg}");
     }
 }
+
+/// A lug on one side of a pipe of radius 10 (z = 0 to 80): from z = 34 to
+/// 50, 12 mm out from the wall over 40 degrees around (the vertices within
+/// 20 degrees of +x; a sector of the outline is 5 degrees). Named a lug,
+/// not a branch (the distance along the surface reaches its top apart from
+/// the wall beside it) and not a block (the guide is not pulled towards
+/// it). The longest tubular stretch is 0 to 34.
+#[test]
+fn a_lug_on_one_side_is_named_with_its_place_and_size() {
+    let mesh = gen::lugged_pipe(10.0, 80.0, 22.0, (34.0, 50.0), 20.0, 72, 1.0);
+    refused_then_trimmed(&mesh, "lug.stl", FeatureKind::Lug, (0.0, 34.0), |f, h| {
+        assert!(
+            (f.t_from_mm - 34.0).abs() <= h && (f.t_to_mm - 50.0).abs() <= h,
+            "{f:?}"
+        );
+        assert!((f.height_mm - 12.0).abs() <= 0.2, "{f:?}");
+        assert!((f.around_deg - 40.0).abs() <= 10.0 + 1e-9, "{f:?}");
+    });
+    let msg = fit(&mesh, "lug.stl", false).unwrap_err().to_string();
+    assert!(
+        msg.contains("reaching 12.0 mm out from the tube's wall on one side"),
+        "{msg}"
+    );
+}

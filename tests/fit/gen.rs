@@ -620,6 +620,34 @@ pub fn collared_pipe(
     lofted(&rings)
 }
 
+/// A straight pipe of radius `r` about the z axis from z = 0 to `len` with
+/// a lug on one side from z = `z0` to `z1`: the wall's points within
+/// `half_deg` degrees of the +x axis stand out at radius `outer` there,
+/// joined to the pipe by flat steps at z0 and z1 (the rings' points
+/// outside the lug coincide across the steps; the fit welds them).
+pub fn lugged_pipe(
+    r: f64,
+    len: f64,
+    outer: f64,
+    (z0, z1): (f64, f64),
+    half_deg: f64,
+    around: usize,
+    h: f64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let lug = |z: f64| {
+        ring_of(around, move |a| {
+            let off = a.min(TAU - a).to_degrees() <= half_deg + 1e-9;
+            let rho = if off { outer } else { r };
+            Point3::new(rho * a.cos(), rho * a.sin(), z)
+        })
+    };
+    let mut rings = pipe_rings(around, r, 0.0, z0, h);
+    let n = ((z1 - z0) / h).ceil().max(1.0) as usize;
+    rings.extend((0..=n).map(|i| lug(z0 + (z1 - z0) * i as f64 / n as f64)));
+    rings.extend(pipe_rings(around, r, z1, len, h));
+    lofted(&rings)
+}
+
 /// A straight pipe of radius `r` about the z axis from z = 0 to `len` whose
 /// first `height` mm are a square block of side `side` (its open bottom a
 /// square, a flat step at z = `height` from the square to the pipe).
