@@ -826,33 +826,17 @@ fn sections(
 }
 
 /// The guide's new points at `knots`: the smoothing fit of the section
-/// centres (of the sections that are circles, when enough are).
+/// centres; with `round_only`, the centres of the sections that are not
+/// circles by their check (a lug on one side pulls its circle's centre
+/// towards it) bridged from the round ones beside them
+/// ([`bridge_not_round`]). With every section a circle, as without.
 fn refit_guide(
     mesh: &TubeMesh,
     stations: &[Station],
     knots: &[f64],
     round_only: Option<&FitOptions>,
 ) -> Result<Vec<Point3>, FitError> {
-    let mut ok: Vec<&Station> = stations.iter().filter(|s| s.centre.is_some()).collect();
-    // With `round_only`, a section that is not a circle by its check (a lug
-    // on one side pulls its circle's centre towards it) does not steer the
-    // guide while enough others do: the sections' check names it on a
-    // later round. With every section a circle, the refit is as before.
-    if let Some(opts) = round_only {
-        let round: Vec<&Station> = ok
-            .iter()
-            .copied()
-            .filter(|s| {
-                s.fits
-                    .iter()
-                    .flatten()
-                    .all(|f| f.rms <= opts.section_rms_allowed(f.radius))
-            })
-            .collect();
-        if round.len() < ok.len() && round.len() >= 3 && round.len() * 2 >= stations.len() {
-            ok = round;
-        }
-    }
+    let ok: Vec<&Station> = stations.iter().filter(|s| s.centre.is_some()).collect();
     if ok.len() < 3 || ok.len() * 2 < stations.len() {
         let first_bad = stations
             .iter()
@@ -870,7 +854,20 @@ fn refit_guide(
     }
     let ts: Vec<f64> = ok.iter().map(|s| s.t).collect();
     let w: Vec<f64> = ok.iter().map(|s| s.points as f64).collect();
-    let ys = DMatrix::from_fn(ok.len(), 3, |i, k| ok[i].centre.expect("filtered")[k]);
+    let mut centres: Vec<Point3> = ok.iter().map(|s| s.centre.expect("filtered")).collect();
+    if let Some(opts) = round_only {
+        let round: Vec<bool> = ok
+            .iter()
+            .map(|s| {
+                s.fits
+                    .iter()
+                    .flatten()
+                    .all(|f| f.rms <= opts.section_rms_allowed(f.radius))
+            })
+            .collect();
+        bridge_not_round(&ts, &mut centres, &round);
+    }
+    let ys = DMatrix::from_fn(ok.len(), 3, |i, k| centres[i][k]);
     let sol = smooth::fit(knots, &ts, &ys, &w, 1e-6).ok_or_else(|| FitError::Degenerate {
         file: mesh.file.clone(),
         station: 0,
@@ -887,6 +884,47 @@ fn refit_guide(
         });
     }
     Ok(pts)
+}
+
+/// Replaces the centres (mm, at guide parameters `ts`, mm) of each run of
+/// stations that are not `round` by the cubic (Hermite) between the round
+/// centres either side, leaving each along the direction of the two round
+/// centres behind it with the run's length in `t`: within a bend, close to
+/// its arc. A run at an end, or with fewer than two round stations on a side,
+/// is left as it is.
+fn bridge_not_round(ts: &[f64], centres: &mut [Point3], round: &[bool]) {
+    let n = ts.len();
+    let mut i = 0;
+    while i < n {
+        if round[i] {
+            i += 1;
+            continue;
+        }
+        let first = i;
+        while i < n && !round[i] {
+            i += 1;
+        }
+        // Round stations a - 1, a before the run and b, b + 1 after it.
+        let (Some(a), b) = (first.checked_sub(1), i) else {
+            continue;
+        };
+        if a == 0 || !round[a - 1] || b + 1 >= n || !round[b + 1] {
+            continue;
+        }
+        let span = ts[b] - ts[a];
+        let dir = |p: usize, q: usize| (centres[q] - centres[p]).normalize() * span;
+        let (p0, p1, m0, m1) = (centres[a], centres[b], dir(a - 1, a), dir(b, b + 1));
+        for k in first..b {
+            let s = (ts[k] - ts[a]) / span;
+            let (s2, s3) = (s * s, s * s * s);
+            centres[k] = Point3::from(
+                p0.coords * (2.0 * s3 - 3.0 * s2 + 1.0)
+                    + m0 * (s3 - 2.0 * s2 + s)
+                    + p1.coords * (-2.0 * s3 + 3.0 * s2)
+                    + m1 * (s3 - s2),
+            );
+        }
+    }
 }
 
 /// Slides each end point of the guide along its end chord onto its open

@@ -160,7 +160,11 @@ pub(super) fn detect(
         // The outline: in each direction around the guide, the largest
         // distance of a point beyond the tube's wall; and the span of
         // those points along the guide.
+        // The share of directions it covers is a station's own: the
+        // stations' plane bases turn about the guide from one to the next
+        // along a bend ([`plane_basis`]).
         let mut sector = vec![0.0_f64; SECTORS];
+        let mut covered = vec![0_u128; last + 1 - first];
         let (mut t_lo, mut t_hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for &(i, tv, x, y) in &at {
             let rho = x.hypot(y);
@@ -170,13 +174,15 @@ pub(super) fn detect(
             let a = y.atan2(x).rem_euclid(std::f64::consts::TAU);
             let k = ((a / std::f64::consts::TAU * SECTORS as f64) as usize).min(SECTORS - 1);
             sector[k] = sector[k].max(rho);
+            covered[i - first] |= 1 << k;
             (t_lo, t_hi) = (t_lo.min(tv), t_hi.max(tv));
         }
         let out: Vec<f64> = sector.iter().copied().filter(|&o| o > 0.0).collect();
         let (lo, hi) = out
             .iter()
             .fold((f64::INFINITY, 0.0_f64), |a, &o| (a.0.min(o), a.1.max(o)));
-        let cover = out.len() as f64 / SECTORS as f64;
+        let cover =
+            covered.iter().map(|c| c.count_ones()).max().unwrap_or(0) as f64 / SECTORS as f64;
         // Points past an end project beyond it along the guide.
         (t_lo, t_hi) = (t_lo.max(t0), t_hi.min(stations[n - 1].t).max(t_lo.max(t0)));
         let length = t_hi - t_lo;

@@ -287,3 +287,40 @@ fn a_lug_on_one_side_is_named_with_its_place_and_size() {
         "{msg}"
     );
 }
+
+/// A lug on the bend of the elbow (`gen::elbow`: r 12, R 40, legs of 20 mm)
+/// from 40 to 60 mm along it, on the bend's inner side, 10 mm out over 50
+/// degrees (the vertices within 25 degrees; the stations' plane bases turn
+/// about the guide along the bend, so its share of the directions is each
+/// station's own): named a lug where it is; trimmed, the longest tubular
+/// stretch (from the lug to the far end, 42.8 mm) is fitted.
+#[test]
+fn a_lug_on_a_bend_is_named_with_its_place_and_size() {
+    let elbow = gen::elbow();
+    let mesh = gen::lugged(&elbow, 1.0, 72, (40.0, 60.0), 25.0, 10.0);
+    let e = fit(&mesh, "bend-lug.stl", false).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with("bend-lug.stl: not a tube: a lug at stations"),
+        "{msg}"
+    );
+    let p = fit(&mesh, "bend-lug.stl", true).unwrap_or_else(|e| panic!("{e}"));
+    let r = p.report();
+    let h = 2.0 * spacing(&p);
+    assert_eq!(r.features.len(), 1, "{:?}", r.features);
+    let f = &r.features[0];
+    assert_eq!(f.kind, FeatureKind::Lug, "{f:?}");
+    assert!(
+        (f.t_from_mm - 40.0).abs() <= h && (f.t_to_mm - 60.0).abs() <= h,
+        "{f:?}"
+    );
+    assert!((f.height_mm - 10.0).abs() <= 0.2, "{f:?}");
+    assert!((f.around_deg - 50.0).abs() <= 10.0 + 1e-9, "{f:?}");
+    assert!(
+        (r.length_mm - (elbow.length - 60.0)).abs() <= 2.0 * h,
+        "{}",
+        r.length_mm
+    );
+    assert!(r.start.kind == EndKind::Trimmed && r.end.kind == EndKind::Open);
+    assert!(r.rms_mm < 0.05, "{}", r.rms_mm);
+}

@@ -235,6 +235,33 @@ pub fn mesh_around(
     (v, f)
 }
 
+/// The tube `t` (rings about `h` mm apart, `around` points each) with a
+/// lug on one side between arc lengths `s0` and `s1`: the points within
+/// `half_deg` degrees of the rings' first frame normal stand `height` mm
+/// out from the wall (its sides slope over one ring).
+pub fn lugged(
+    t: &Truth,
+    h: f64,
+    around: usize,
+    (s0, s1): (f64, f64),
+    half_deg: f64,
+    height: f64,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let rings = (t.length / h).ceil() as usize;
+    let all: Vec<Vec<Point3>> = frames(t, rings)
+        .into_iter()
+        .map(|(s, x, ti, n)| {
+            let b = ti.cross(&n);
+            ring_of(around, |a| {
+                let on = (s0..=s1).contains(&s) && a.min(TAU - a).to_degrees() <= half_deg + 1e-9;
+                let rho = (t.radius)(s) + if on { height } else { 0.0 };
+                x + (n * a.cos() + b * a.sin()) * rho
+            })
+        })
+        .collect();
+    lofted(&all)
+}
+
 /// Binary STL bytes (f32), written by hand.
 pub fn binary_stl(v: &[Point3], f: &[[u32; 3]]) -> Vec<u8> {
     let mut out = vec![0u8; 80];
