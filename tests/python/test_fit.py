@@ -152,6 +152,8 @@ def test_trim_fits_the_longest_tubular_stretch_and_names_the_collar(tmp_path):
     assert abs(collar["length_mm"] - 10.0) <= h, collar
     assert abs(collar["height_mm"] - 4.0) <= 0.2, collar
     assert abs(collar["across_mm"][1] - 28.0) <= 0.4, collar
+    # All around the pipe (a lug, on one side, covers under 270 degrees).
+    assert 270.0 <= collar["around_deg"] <= 360.0, collar
     files = part.write_fit(tmp_path / "module")
     written = read_json(files[1])
     assert written["features"] == report["features"]
