@@ -324,10 +324,18 @@ pub struct FitArgs {
     /// Refuse a start end further than this from the --substrate mesh (mm).
     #[arg(long, value_name = "MM", default_value_t = 1.0)]
     pub substrate_tolerance: f64,
-    /// A mesh with features that are not tube (collars, flanges, blocks, tabs): fit its
+    /// A mesh with features that are not tube (collars, flanges, blocks, lugs, tabs): fit its
     /// longest tubular stretch and name the features in fit.json, instead of refusing it.
     #[arg(long)]
     pub trim: bool,
+    /// The guide's knot spacing (mm; default from the end radius, 4 to 12 mm). A coarse coil
+    /// whose rings of vertices lie far apart fits smooth between them with knots 1.5 times
+    /// the rings' distance apart (fit.json warns with the value).
+    #[arg(long, value_name = "MM")]
+    pub knot_spacing: Option<f64>,
+    /// The stations' spacing along the guide (mm; default from the mesh's median edge).
+    #[arg(long, value_name = "MM")]
+    pub station_spacing: Option<f64>,
 }
 
 fn parse_units(s: &str) -> Result<waam_slicer::fit::Units, String> {

@@ -13,6 +13,8 @@ pub fn run(a: &FitArgs, quiet: bool) -> Result<(), String> {
         substrate: a.substrate.clone(),
         substrate_tolerance_mm: a.substrate_tolerance,
         trim: a.trim,
+        knot_spacing_mm: a.knot_spacing,
+        station_spacing_mm: a.station_spacing,
         ..FitOptions::default()
     };
     let fitted = Part::from_mesh(&a.mesh, &opts).map_err(|e| e.to_string())?;

@@ -80,6 +80,13 @@ const WIDEN_GAP_DEG: f64 = 60.0;
 /// the first guides of a coarse export (level sets a few edges wide) leave
 /// sections that are not yet circles. Otherwise from the second.
 const CHECK_SECTIONS_AFTER: usize = 6;
+/// Knots closer than this many times a coarse export's distance between
+/// its rings of vertices (dimensionless) get a warning ([`fit_in_mm`]): a
+/// coil in rings 12 mm apart, fitted with knots 4 mm apart, lies 0.14 mm
+/// RMS off its true surface (0.38 mm at most) with its vertices fitted
+/// within hundredths; with knots 18 mm apart, 0.002 mm. A bend in a few
+/// stretches needs its closer knots: the choice is the user's.
+const KNOT_RING_GAPS: f64 = 1.5;
 /// Refits to the round sections alone (dimensionless count) after the
 /// vertices' pass first fails its check with no feature named, or a lug:
 /// a feature on one side pulls the guide towards it until its sections no
@@ -176,11 +183,48 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
 /// a circle, too few), it runs again with points along the edges of a
 /// coarse bend too ([`samples::with_bend_edges`]), and the first failure stands when
 /// that fails as well: a mesh that fits on its vertices is fitted as before.
+///
+/// A coarse export whose rings of vertices lie further apart along the
+/// guide than 1 / [`KNOT_RING_GAPS`] of its knot spacing gets a warning
+/// (unless [`FitOptions::knot_spacing_mm`] is set): between its rings no
+/// vertex holds the guide, which then follows the facets' chords, inside a
+/// curved tube.
 fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFit, FitError> {
-    match fit_pass(mesh, opts, trimmed, Pass::Vertices) {
+    let mut coarse = Coarseness::default();
+    let mut fit = fit_passes(mesh, opts, trimmed, &mut coarse)?;
+    let wide = KNOT_RING_GAPS * coarse.ring_gap;
+    if opts.knot_spacing_mm.is_none() && coarse.ring_gap > 0.0 && coarse.knot_h < wide {
+        fit.report.warnings.push(format!(
+            "a coarse export: its rings of vertices lie about {:.1} mm apart along the guide, its knots {:.1} mm apart: between the rings the guide follows the facets' chords, inside a curved tube; on a gently curved tube (a coil) knots {wide:.0} mm apart or more (--knot-spacing, FitOptions::knot_spacing_mm) run it smooth between them",
+            coarse.ring_gap, coarse.knot_h
+        ));
+    }
+    Ok(fit)
+}
+
+/// What a fit learnt of a mesh's coarseness along the guide (mm): the
+/// distance between its rings of vertices ([`rings_apart`]; 0 when every
+/// station holds its own ring) and the knot spacing it used.
+#[derive(Debug, Clone, Copy, Default)]
+struct Coarseness {
+    ring_gap: f64,
+    knot_h: f64,
+}
+
+/// The passes of [`fit_in_mm`] with the options' knots: the vertices, then
+/// (where their sections fail) a coarse bend's edges, then plane cuts; the
+/// first failure stands. `coarse` is the first pass's.
+fn fit_passes(
+    mesh: &TubeMesh,
+    opts: &FitOptions,
+    trimmed: bool,
+    coarse: &mut Coarseness,
+) -> Result<TubeFit, FitError> {
+    match fit_pass(mesh, opts, trimmed, Pass::Vertices, coarse) {
         Err(e @ (FitError::SectionNotCircle { .. } | FitError::Degenerate { .. })) => {
-            fit_pass(mesh, opts, trimmed, Pass::BendEdges)
-                .or_else(|_| fit_pass(mesh, opts, trimmed, Pass::Cuts))
+            let mut other = Coarseness::default();
+            fit_pass(mesh, opts, trimmed, Pass::BendEdges, &mut other)
+                .or_else(|_| fit_pass(mesh, opts, trimmed, Pass::Cuts, &mut other))
                 .map_err(|_| e)
         }
         fitted => fitted,
@@ -211,6 +255,7 @@ fn fit_pass(
     opts: &FitOptions,
     trimmed: bool,
     pass: Pass,
+    coarse: &mut Coarseness,
 ) -> Result<TubeFit, FitError> {
     let surf = topology::surfaces(mesh, opts)?;
     let ends = end_rings(mesh, &surf)?;
@@ -218,6 +263,7 @@ fn fit_pass(
     let edge = median_edge(mesh, &surf.skins[0].triangles);
     let r0 = start.radius.min(finish.radius);
     let (spacing, knot_h) = spacings(opts, edge, r0);
+    coarse.knot_h = knot_h;
     let march = pass == Pass::Cuts;
     let mut guide = first_guide(mesh, &surf, [&start, &finish], edge, knot_h, march)?;
     let later = pass != Pass::Vertices;
@@ -284,6 +330,9 @@ fn fit_pass(
         } else {
             sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0)
         };
+        if iterations == 1 && pass == Pass::Vertices {
+            coarse.ring_gap = rings_apart(&stations);
+        }
         if iterations > check_after {
             match (check_sections(mesh, &stations, opts), postponed.take()) {
                 (Ok(()), None) => {}
@@ -385,6 +434,9 @@ fn fit_pass(
         (Some(exit), _) => return exit,
         (None, None) => {}
     }
+    if pass == Pass::Vertices {
+        coarse.ring_gap = rings_apart(&stations);
+    }
     let pieces = separate_pieces(mesh, &surf, &stations, &spline, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick, true);
     let mut radius_mm = law(&|s| s.radius)?;
@@ -450,6 +502,44 @@ fn fit_pass(
     fit.report.features = pieces;
     fit.report.warnings.extend(sparse);
     check_residual(mesh, fit, opts)
+}
+
+/// The typical distance (mm) along the guide between the rings of vertices
+/// of a coarse export: the median gap between the runs of stations holding
+/// rings of their own, where some stations hold none (they took their
+/// neighbours' points); 0 when every station holds its own ring.
+fn rings_apart(stations: &[Station]) -> f64 {
+    if stations.iter().all(|s| !s.widened) {
+        return 0.0;
+    }
+    let mut centres: Vec<f64> = Vec::new();
+    let mut run: Vec<f64> = Vec::new();
+    for s in stations {
+        if !s.widened && s.centre.is_some() {
+            run.push(s.t);
+        } else if !run.is_empty() {
+            centres.push(run.iter().sum::<f64>() / run.len() as f64);
+            run.clear();
+        }
+    }
+    if !run.is_empty() {
+        centres.push(run.iter().sum::<f64>() / run.len() as f64);
+    }
+    // A ring whose vertices fall either side of a station is one ring.
+    let step = stations.get(1).map_or(0.0, |s| s.t - stations[0].t);
+    centres.dedup_by(|b, a| {
+        let near = *b - *a <= 2.5 * step;
+        if near {
+            *a = 0.5 * (*a + *b);
+        }
+        near
+    });
+    let mut gaps: Vec<f64> = centres.windows(2).map(|w| w[1] - w[0]).collect();
+    if gaps.is_empty() {
+        return 0.0;
+    }
+    let k = gaps.len() / 2;
+    *gaps.select_nth_unstable_by(k, f64::total_cmp).1
 }
 
 /// A warning when the stations holding rings of their own lie more than

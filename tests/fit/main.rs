@@ -679,3 +679,45 @@ fn coarse_s_bend_and_helix_exports_fit_through_plane_cuts() {
         }
     }
 }
+
+/// A coarse export of a coil (`gen::helix`: radius 40, 60 mm a turn,
+/// r 8, three quarters of a turn; rings of 24 vertices 12 and 16 mm apart
+/// along it, facets up to 0.43 and 0.76 mm inside its curve between the
+/// rings). With the knots of a fine mesh (4 mm here) the guide follows the
+/// facets' chords between the rings: 0.1 mm RMS off the true surface or
+/// more (12 mm; fit.json warns, naming the rings' distance and the knots to
+/// take), or refused (16 mm). With knots 1.5 times the rings' distance
+/// apart its surface lies within 0.02 mm RMS and 0.08 mm at most of the
+/// true one.
+#[test]
+fn a_coarse_coil_fits_smooth_between_its_rings_with_wider_knots() {
+    let truth = gen::helix();
+    for g in [12.0, 16.0] {
+        let (v, f) = gen::mesh_around(&truth, g, 24, 0.0, 0.0, 0);
+        match fit_mesh(v.clone(), f.clone(), "coil.stl", &FitOptions::default()) {
+            Ok(p) => {
+                let (rms, _) = surface_errors(&truth, &p);
+                assert!(rms > 0.05, "{g}: {rms}");
+                let w = &p.report().warnings;
+                assert!(
+                    w.iter()
+                        .any(|w| w.starts_with("a coarse export: its rings of vertices")
+                            && w.contains("mm apart or more (--knot-spacing")),
+                    "{g}: {w:?}"
+                );
+            }
+            Err(e) => assert!(g > 12.0, "{g}: {e}"),
+        }
+        let wide = FitOptions {
+            knot_spacing_mm: Some(1.5 * g),
+            ..FitOptions::default()
+        };
+        let p = fit_mesh(v, f, "coil.stl", &wide).unwrap_or_else(|e| panic!("{g}: {e}"));
+        let (rms, max) = surface_errors(&truth, &p);
+        eprintln!(
+            "rings {g} mm apart, knots {}: surface {rms:.4} / {max:.4} mm",
+            1.5 * g
+        );
+        assert!(rms < 0.02 && max < 0.08, "{g}: {rms} {max}");
+    }
+}
