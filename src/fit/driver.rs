@@ -501,6 +501,12 @@ fn fit_pass(
     (fit.report, fit.vertex_distance_mm) = report::build(&ctx, &fit);
     fit.report.features = pieces;
     fit.report.warnings.extend(sparse);
+    if !converged {
+        fit.report.warnings.push(format!(
+            "the guide did not settle in {iterations} refits: its last refit moved it by up to {last_move:.3} mm (tolerance {:.3} mm); the residuals above are those of its last place",
+            opts.tolerance_mm
+        ));
+    }
     check_residual(mesh, fit, opts)
 }
 

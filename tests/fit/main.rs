@@ -721,3 +721,30 @@ fn a_coarse_coil_fits_smooth_between_its_rings_with_wider_knots() {
         assert!(rms < 0.02 && max < 0.08, "{g}: {rms} {max}");
     }
 }
+
+/// A fit stopped before its guide settled (here after 2 refits) says so in
+/// fit.json's warnings, with its last move; the same mesh given its refits
+/// settles and has no such warning.
+#[test]
+fn a_guide_that_did_not_settle_is_a_warning() {
+    let (v, f) = gen::mesh(&gen::elbow(), 1.0, 0.0, 0.0, 0);
+    let short = FitOptions {
+        max_iterations: 2,
+        ..FitOptions::default()
+    };
+    let p = fit_mesh(v.clone(), f.clone(), "elbow.stl", &short).unwrap();
+    let r = p.report();
+    assert!(!r.converged);
+    let said = |r: &waam_slicer::fit::FitReport| {
+        r.warnings
+            .iter()
+            .any(|w| w.starts_with("the guide did not settle in"))
+    };
+    assert!(said(r), "{:?}", r.warnings);
+    let p = fit_mesh(v, f, "elbow.stl", &FitOptions::default()).unwrap();
+    assert!(
+        p.report().converged && !said(p.report()),
+        "{:?}",
+        p.report().warnings
+    );
+}
