@@ -51,6 +51,9 @@ const ALL_AROUND_FRACTION: f64 = 0.75;
 /// fraction of its largest (dimensionless) is not round: a block.
 const ROUND_OUTLINE_FRACTION: f64 = 0.1;
 
+/// A feature spans at most this share of the tube's length (dimensionless).
+const MAX_FEATURE_SHARE: f64 = 0.5;
+
 /// Directions around the guide in which the outline is measured.
 const SECTORS: usize = 72;
 
@@ -187,7 +190,15 @@ pub(super) fn detect(
         (t_lo, t_hi) = (t_lo.max(t0), t_hi.min(stations[n - 1].t).max(t_lo.max(t0)));
         let length = t_hi - t_lo;
         let height = (hi - r_tube).max(0.0);
-        if out.is_empty() {
+        // Longer than the tube's longest tubular stretch, or over half the
+        // tube, is not a feature on it: the tube itself fails (a coil whose
+        // radius tapers by a third, its sections read against one radius),
+        // and its failure stands.
+        let longest = stations[main.1].t - stations[main.0].t;
+        if out.is_empty()
+            || length > longest
+            || length > MAX_FEATURE_SHARE * (stations[n - 1].t - t0)
+        {
             continue;
         }
         // An outline on one side only is what a guide off the tube's axis

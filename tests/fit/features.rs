@@ -324,3 +324,19 @@ fn a_lug_on_a_bend_is_named_with_its_place_and_size() {
     assert!(r.start.kind == EndKind::Trimmed && r.end.kind == EndKind::Open);
     assert!(r.rms_mm < 0.05, "{}", r.rms_mm);
 }
+
+/// A "feature" longer than the tube's longest tubular stretch, or over half
+/// the tube, is the tube failing, not a feature on it (a coil whose radius
+/// tapers by a third was named a lug, a block or a collar over 600 to 2 000
+/// mm of its length): a sleeve of radius 14 over z = 20 to 70 of the pipe
+/// of radius 10 (0 to 80) is refused as sections that are not circles,
+/// where the collar of 10 mm is named.
+#[test]
+fn a_feature_over_most_of_the_tube_is_the_tube_failing() {
+    let mesh = gen::collared_pipe(10.0, 80.0, 14.0, 20.0, 70.0, 64, 1.0);
+    let e = fit(&mesh, "sleeve.stl", false).unwrap_err();
+    assert!(
+        matches!(e, Error::Fit(FitError::SectionNotCircle { .. })),
+        "{e}"
+    );
+}
