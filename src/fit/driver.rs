@@ -87,6 +87,10 @@ const CHECK_SECTIONS_AFTER: usize = 6;
 /// within hundredths; with knots 18 mm apart, 0.002 mm. A bend in a few
 /// stretches needs its closer knots: the choice is the user's.
 const KNOT_RING_GAPS: f64 = 1.5;
+/// ... when the facets' chords between the rings lie more than this inside
+/// the fitted guide's curve (mm): half the slices' RMS goal (a straight
+/// written as one strip of long triangles gets none).
+const WARN_SAG_MM: f64 = 0.05;
 /// Refits to the round sections alone (dimensionless count) after the
 /// vertices' pass first fails its check with no feature named, or a lug:
 /// a feature on one side pulls the guide towards it until its sections no
@@ -193,10 +197,14 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFi
     let mut coarse = Coarseness::default();
     let mut fit = fit_passes(mesh, opts, trimmed, &mut coarse)?;
     let wide = KNOT_RING_GAPS * coarse.ring_gap;
-    if opts.knot_spacing_mm.is_none() && coarse.ring_gap > 0.0 && coarse.knot_h < wide {
+    if opts.knot_spacing_mm.is_none()
+        && coarse.ring_gap > 0.0
+        && coarse.knot_h < wide
+        && coarse.sag > WARN_SAG_MM
+    {
         fit.report.warnings.push(format!(
-            "a coarse export: its rings of vertices lie about {:.1} mm apart along the guide, its knots {:.1} mm apart: between the rings the guide follows the facets' chords, inside a curved tube; on a gently curved tube (a coil) knots {wide:.0} mm apart or more (--knot-spacing, FitOptions::knot_spacing_mm) run it smooth between them",
-            coarse.ring_gap, coarse.knot_h
+            "a coarse export: its rings of vertices lie about {:.1} mm apart along the guide, its knots {:.1} mm apart: between the rings the guide follows the facets' chords, up to {:.2} mm inside the curved tube; on a gently curved tube (a coil) knots {wide:.0} mm apart or more (--knot-spacing, FitOptions::knot_spacing_mm) run it smooth between them",
+            coarse.ring_gap, coarse.knot_h, coarse.sag
         ));
     }
     Ok(fit)
@@ -209,11 +217,15 @@ fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFi
 struct Coarseness {
     ring_gap: f64,
     knot_h: f64,
+    /// How far the facets' chords between rings lie inside the fitted
+    /// guide's curve at most: its largest curvature times the rings'
+    /// distance squared over 8 (mm).
+    sag: f64,
 }
 
 /// The passes of [`fit_in_mm`] with the options' knots: the vertices, then
 /// (where their sections fail) a coarse bend's edges, then plane cuts; the
-/// first failure stands. `coarse` is the first pass's.
+/// first failure stands. `coarse` is the fitting pass's.
 fn fit_passes(
     mesh: &TubeMesh,
     opts: &FitOptions,
@@ -222,9 +234,8 @@ fn fit_passes(
 ) -> Result<TubeFit, FitError> {
     match fit_pass(mesh, opts, trimmed, Pass::Vertices, coarse) {
         Err(e @ (FitError::SectionNotCircle { .. } | FitError::Degenerate { .. })) => {
-            let mut other = Coarseness::default();
-            fit_pass(mesh, opts, trimmed, Pass::BendEdges, &mut other)
-                .or_else(|_| fit_pass(mesh, opts, trimmed, Pass::Cuts, &mut other))
+            fit_pass(mesh, opts, trimmed, Pass::BendEdges, coarse)
+                .or_else(|_| fit_pass(mesh, opts, trimmed, Pass::Cuts, coarse))
                 .map_err(|_| e)
         }
         fitted => fitted,
@@ -328,11 +339,14 @@ fn fit_pass(
             cut::hold_ends(&mut cuts, [&start, &finish]);
             cuts
         } else {
-            sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0)
+            let mut st = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
+            fill_from_cuts(
+                (mesh, &surf, &samples, &t),
+                (&spline, range, spacing, r0),
+                &mut st,
+            );
+            st
         };
-        if iterations == 1 && pass == Pass::Vertices {
-            coarse.ring_gap = rings_apart(&stations);
-        }
         if iterations > check_after {
             match (check_sections(mesh, &stations, opts), postponed.take()) {
                 (Ok(()), None) => {}
@@ -426,7 +440,12 @@ fn fit_pass(
             .map(|h| &h[..samples.vertices.min(h.len())]),
         PROJECT_PAST_END_RADII * r0,
     );
-    let stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
+    let mut stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
+    fill_from_cuts(
+        (mesh, &surf, &samples, &t),
+        (&spline, range, spacing, r0),
+        &mut stations,
+    );
     match (failed(&spline, &stations, &samples, &t), postponed) {
         (Some(Err(FitError::SectionNotCircle { .. })) | None, Some((first, _))) => {
             return Err(first)
@@ -434,8 +453,14 @@ fn fit_pass(
         (Some(exit), _) => return exit,
         (None, None) => {}
     }
-    if pass == Pass::Vertices {
+    {
         coarse.ring_gap = rings_apart(&stations);
+        let curvature = |t: f64| {
+            let (d1, d2) = (spline.d1(t), spline.d2(t));
+            d1.cross(&d2).norm() / d1.norm().powi(3).max(1e-12)
+        };
+        let most = stations.iter().map(|s| curvature(s.t)).fold(0.0, f64::max);
+        coarse.sag = most * coarse.ring_gap * coarse.ring_gap / 8.0;
     }
     let pieces = separate_pieces(mesh, &surf, &stations, &spline, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick, true);
@@ -919,6 +944,34 @@ fn sections(
             station
         })
         .collect()
+}
+
+/// When under half the stations' vertices give a circle (the guide's refit
+/// needs half), those without take their section from plane cuts of the
+/// skins at the same frames ([`cut::cut_sections`]), their own
+/// (a cut of the surface at the station, not its neighbours' points; the
+/// facets lie up to r (1 - cos(pi / n)) inside an n-gon's circle): a
+/// straight written as one strip of long triangles has no vertex between
+/// its end rings, further apart than the stations borrow. `data`: the mesh, its surfaces, the samples (the skins' vertices
+/// first) and their guide parameters; `at`: the guide, its range, the
+/// stations' spacing and the end radius (mm). Stations with circles are
+/// left as they are.
+fn fill_from_cuts(
+    (mesh, surf, samples, t): (&TubeMesh, &Surfaces, &Samples, &[f64]),
+    (spline, range, spacing, r0): (&CubicSpline, (f64, f64), f64, f64),
+    stations: &mut [Station],
+) {
+    let held = stations.iter().filter(|s| s.centre.is_some()).count();
+    if held * 2 >= stations.len() {
+        return;
+    }
+    let (step, frames) = station_frames(spline, range, spacing);
+    let cuts = cut::cut_sections(mesh, surf, samples, t, &frames, step, 2.0 * r0);
+    for (s, c) in stations.iter_mut().zip(cuts) {
+        if s.centre.is_none() && c.centre.is_some() {
+            *s = c;
+        }
+    }
 }
 
 /// The guide's new points at `knots`: the smoothing fit of the section

@@ -748,3 +748,45 @@ fn a_guide_that_did_not_settle_is_a_warning() {
         p.report().warnings
     );
 }
+
+/// A straight written as CAD tools write it: one strip of long triangles
+/// with vertices only at its two end rings (here 200 mm long, radius 10, 32
+/// around; and between two finely meshed stubs of 20 mm). The stations
+/// between the rings hold no vertex and borrow none (their rings are 20 r
+/// apart): they take their sections from plane cuts of the facets. Fits the
+/// pipe's length and end centres within 0.01 mm and its radius within 0.05
+/// mm (the 32-gon's facets lie up to r (1 - cos(pi / 32)) = 0.048 mm inside
+/// the circle), and warns of nothing coarse (a straight's facets lie on it
+/// along the guide).
+#[test]
+fn a_straight_written_as_one_strip_of_long_triangles_fits() {
+    let strip = vec![gen::circle_z(32, 10.0, 0.0), gen::circle_z(32, 10.0, 200.0)];
+    let mut stubs = gen::pipe_rings(32, 10.0, 0.0, 20.0, 1.0);
+    stubs.extend(gen::pipe_rings(32, 10.0, 180.0, 200.0, 1.0));
+    for (name, rings) in [("strip", strip), ("stubs", stubs)] {
+        let (v, f) = gen::lofted(&rings);
+        let p = fit_mesh(v, f, "strip.stl", &FitOptions::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let r = p.report();
+        assert!(
+            (r.length_mm - 200.0).abs() < 0.01,
+            "{name}: {}",
+            r.length_mm
+        );
+        assert!(
+            (r.radius_min_mm - 10.0).abs() < 0.05 && (r.radius_max_mm - 10.0).abs() < 0.05,
+            "{name}: {} {}",
+            r.radius_min_mm,
+            r.radius_max_mm
+        );
+        for e in [&r.start, &r.end] {
+            let c = e.centre_mm;
+            assert!(c[0].hypot(c[1]) < 0.01, "{name}: {c:?}");
+        }
+        assert!(
+            !r.warnings.iter().any(|w| w.starts_with("a coarse export")),
+            "{name}: {:?}",
+            r.warnings
+        );
+    }
+}
