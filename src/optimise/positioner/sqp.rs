@@ -1,8 +1,12 @@
 //! **Stage 6a — the positioner's laws: their SQP.** Gauss–Newton steps on
 //! the law's spline coefficients (rad per unit basis value) within a trust
 //! region, each an elastic QP of the `R_Z` driver's (so an infeasible law
-//! ends at its least violation), accepted on an l∞ merit. Not the `R_Z`
-//! driver's SQP: no secant correction, no ratio test, no polish.
+//! ends at its least violation), accepted on an l∞ merit by the ratio of
+//! its actual to its predicted decrease, which also sizes the trust region
+//! (as the `R_Z` driver's). Stops where the model predicts no decrease
+//! worth a step, the step or the gain is below tolerance, or an infeasible
+//! run's violation no longer falls. Not the `R_Z` driver's SQP: no secant
+//! correction, no polish.
 
 use crate::optimise::parameterisation::Basis;
 use crate::optimise::qp::{solve_qp, Qp, QpMethod, Row};
@@ -18,17 +22,31 @@ const RIDGE_TRACE_FLOOR: f64 = 1e-12;
 /// Trust bound on the positioner joints' coefficients (rad) below which the
 /// SQP stops.
 const MIN_TRUST_RAD: f64 = 1e-9;
-/// Largest coefficient change (rad) of a refused step below which the SQP
-/// stops: shrinking the trust region further changes nothing.
-const MIN_STEP_RAD: f64 = 1e-10;
-/// A trial is accepted when it lowers the merit by more than this fraction of
-/// it (relative): more than rounding.
-const ACCEPT_GAIN_REL: f64 = 1e-14;
-/// An accepted gain below this fraction of the merit (relative) is flat: the
-/// SQP stops.
+/// A QP step whose largest coefficient change is below this (rad; a spline's
+/// weights sum to 1, so no axis moves more) ends the SQP: converged.
+const MIN_STEP_RAD: f64 = 1e-7;
+/// A trial is accepted when the merit falls by at least this fraction of the
+/// model's predicted decrease (unitless, the trust-region ratio).
+const ACCEPT_RATIO: f64 = 1e-4;
+/// The SQP stops when the model predicts a decrease of the merit below this
+/// fraction of `1 + merit` (as the `R_Z` driver's relative tolerance; the
+/// laws' merits are 1e-6–1e-2 rad², so about an absolute 1e-9 rad²):
+/// converged, feasible or at the least violation. Measured on the elbow
+/// in the ROBOWAM torch-carried cell: the law of a straight leg's layer,
+/// where the turn is nearly free, otherwise wanders along the turn for
+/// gains of 1e-9 of a merit of 1e-6.
+const PREDICTED_REL: f64 = 1e-9;
+/// An accepted gain below this fraction of `1 + merit` is flat: the SQP
+/// stops.
 const FLAT_GAIN_REL: f64 = 1e-9;
-/// Floor of the merit the two relative gains above scale with (merit units).
-const MERIT_FLOOR: f64 = 1e-12;
+/// Iterations over which an infeasible run must lower its violation by
+/// [`STALL_FALL`], or stop at its least violation.
+const STALL_WINDOW: usize = 5;
+/// Relative fall of the violation an infeasible run must make every
+/// [`STALL_WINDOW`] iterations (unitless).
+const STALL_FALL: f64 = 0.1;
+/// Weight of the violation in the l∞ merit (merit units per constraint unit).
+const RHO: f64 = 1e2;
 
 fn merit(model: &Model, rho: f64) -> f64 {
     0.5 * model.r.iter().map(|v| v * v).sum::<f64>() + rho * model.violation
@@ -64,13 +82,15 @@ fn sqp_using(
     solve_qp: &mut QpSolve,
 ) -> (Vec<f64>, usize, f64) {
     let n = x0.len();
-    let rho = 1e2;
+    let rho = RHO;
     let mut x = x0;
     let mut model = build_model(pb, basis, idx, &x, true);
     let mut cur = merit(&model, rho);
     let mut bound = 0.3 / basis.row_l1_bound();
     let mut iterations = 0;
-    for _ in 0..pb.opts.max_iterations {
+    // the violation at the last check of an infeasible run's progress
+    let mut checked_violation = model.violation;
+    for it in 0..pb.opts.max_iterations {
         iterations += 1;
         // P = JᵀJ (+ a small ridge), g = Jᵀr
         // (over each row's non-zero entries: the zero ones add nothing)
@@ -96,28 +116,58 @@ fn sqp_using(
             }
             continue;
         };
+        // the model's decrease of the merit: −(gᵀδ + ½δᵀPδ) + ρ(v − t)
+        let mut quad = 0.0;
+        for i in 0..n {
+            quad += g[i] * qp.x[i]
+                + 0.5 * qp.x[i] * (0..n).map(|j| p[i * n + j] * qp.x[j]).sum::<f64>();
+        }
+        // (the step's own linearised violation, not the QP's `t`: an
+        // interior point leaves `t` a hair above 0 where every row holds)
+        let left = model
+            .rows
+            .iter()
+            .zip(&model.merit_slack)
+            .map(|(r, s)| r.a.iter().map(|&(i, v)| v * qp.x[i]).sum::<f64>() - r.b - s)
+            .fold(0.0f64, f64::max);
+        let predicted = -quad + rho * (model.violation - left);
+        let step = qp.x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let scale = 1.0 + cur.abs();
+        if !(predicted > PREDICTED_REL * scale) || step < MIN_STEP_RAD {
+            break;
+        }
         let trial: Vec<f64> = x.iter().zip(&qp.x).map(|(a, d)| a + d).collect();
         let tm = build_model(pb, basis, idx, &trial, true);
         let new = merit(&tm, rho);
-        let step = qp.x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        if new.is_finite() && new < cur - ACCEPT_GAIN_REL * cur.abs().max(MERIT_FLOOR) {
+        let ratio = (cur - new) / predicted;
+        if new.is_finite() && ratio >= ACCEPT_RATIO {
             let gain = cur - new;
             x = trial;
             model = tm;
             cur = new;
-            if step > 0.9 * bound {
+            if ratio > 0.75 && step > 0.9 * bound {
                 bound *= 2.0;
+            } else if ratio < 0.25 {
+                bound = 0.5 * step;
             }
             // flat: a relative gain this small moves no axis by a
             // measurable amount (feasible or at the least violation)
-            if gain < FLAT_GAIN_REL * cur.abs().max(MERIT_FLOOR) {
+            if gain < FLAT_GAIN_REL * (1.0 + cur.abs()) {
                 break;
             }
         } else {
-            bound *= 0.25;
-            if bound < MIN_TRUST_RAD || step < MIN_STEP_RAD {
+            bound = 0.25 * step.min(bound);
+            if bound < MIN_TRUST_RAD {
                 break;
             }
+        }
+        // an infeasible run whose violation no longer falls: stuck at its
+        // least violation (the samples' law is kept as it is)
+        if (it + 1) % STALL_WINDOW == 0 {
+            if model.violation > 0.0 && model.violation > (1.0 - STALL_FALL) * checked_violation {
+                break;
+            }
+            checked_violation = model.violation;
         }
     }
     (x, iterations, model.violation)
