@@ -45,6 +45,8 @@ const STALL_WINDOW: usize = 5;
 /// Relative fall of the violation an infeasible run must make every
 /// [`STALL_WINDOW`] iterations (unitless).
 const STALL_FALL: f64 = 0.1;
+/// Floor of the merit the QP is scaled by (merit units).
+const QP_SCALE_FLOOR: f64 = 1e-12;
 /// Weight of the violation in the l∞ merit (merit units per constraint unit).
 const RHO: f64 = 1e2;
 
@@ -109,7 +111,17 @@ fn sqp_using(
         for i in 0..n {
             p[i * n + i] += RIDGE_REL * trace.max(RIDGE_TRACE_FLOOR);
         }
-        let Some(qp) = solve_qp(&p, &g, &model.rows, rho, bound) else {
+        // the QP scaled to a merit of 1: its solvers' tolerances are
+        // absolute in part (clarabel's duality gap 1e-8), and the laws'
+        // merits are 1e-6–1e-2 rad², where a gap of 1e-8 left clarabel's
+        // step at half the model's decrease (the general tube's first
+        // layer in the ROBOWAM cell)
+        let s = 1.0 / cur.max(QP_SCALE_FLOOR);
+        let (ps, gs): (Vec<f64>, Vec<f64>) = (
+            p.iter().map(|v| v * s).collect(),
+            g.iter().map(|v| v * s).collect(),
+        );
+        let Some(qp) = solve_qp(&ps, &gs, &model.rows, s * rho, bound) else {
             bound *= 0.25;
             if bound < MIN_TRUST_RAD {
                 break;

@@ -34,8 +34,13 @@ const SAME_LAW_RAD: f64 = 1e-6;
 const ARM_TIE_RAD: f64 = 1e-4;
 
 /// Feasible laws whose objectives are within this fraction of the lowest
-/// are a tie (relative), kept in the order solved ([`kept`]).
+/// (relative), plus [`OBJECTIVE_TIE_ABS`], are a tie, kept in the order
+/// solved ([`kept`]).
 const OBJECTIVE_TIE_REL: f64 = 1e-3;
+/// The absolute part of a tie (objective units, rad²): the laws of a
+/// straight leg's layer end at 1e-11–1e-6, where the starts differ by
+/// nothing an axis could show.
+const OBJECTIVE_TIE_ABS: f64 = 1e-9;
 
 /// The thesis's positioner joints turning every point's `b` exactly
 /// vertical, the turn continued from `q8_hint` (rad); `None` where a point
@@ -274,7 +279,7 @@ fn kept(laws: &[Solved], arm: bool) -> usize {
         .filter(|s| candidate(s))
         .map(|s| s.objective)
         .fold(f64::INFINITY, f64::min);
-    let tie = lowest + OBJECTIVE_TIE_REL * lowest.abs() + ZERO_OBJECTIVE;
+    let tie = lowest + OBJECTIVE_TIE_REL * lowest.abs() + OBJECTIVE_TIE_ABS;
     laws.iter()
         .position(|s| candidate(s) && s.objective <= tie)
         .unwrap_or(0)
