@@ -193,6 +193,10 @@ impl LawProblem<'_> {
     }
 }
 
+/// Share of the cone (unitless) from which the SQP's merit counts a
+/// violation of a cone row (aimed at 99 %, [`LawProblem::cos_cone`]).
+const CONE_MERIT_SHARE: f64 = 0.995;
+
 /// The laws' value and the linear model at `x = [c7; c8]` on samples `idx`.
 pub(super) struct Model {
     /// Residuals (the objective is `½|r|²`).
@@ -200,7 +204,16 @@ pub(super) struct Model {
     /// Jacobian rows, one per residual, their non-zero entries only.
     pub(super) jac: SparseRows,
     pub(super) rows: Vec<Row>,
-    /// Largest violation of a linearised row at `δ = 0` (its own units).
+    /// Per row, how far past it the merit counts no violation (its own
+    /// units): the cone's rows aim at 99 % of the cone, and the merit
+    /// counts from 99.5 % (the rest is a margin the check keeps), so that
+    /// a step along the cone's curved edge, which its linearisation leaves
+    /// a hair outside, is not refused (the Maratos effect); 0 for the
+    /// linear rows (travel, stroke, speeds, the arm's), which a step keeps
+    /// exactly.
+    pub(super) merit_slack: Vec<f64>,
+    /// Largest violation of a row at `δ = 0` past its merit slack (its own
+    /// units).
     pub(super) violation: f64,
 }
 
@@ -316,9 +329,12 @@ pub(super) fn build_model(
     let mut violation: f64 = 0.0;
     let n_all = basis.points().max(1) as f64;
     let cone_target = pb.cos_cone;
-    let mut push_row = |rows: &mut Vec<Row>, a: Vec<(usize, f64)>, b: f64| {
-        violation = violation.max(-b);
+    let cone_slack = cone_target - (CONE_MERIT_SHARE * pb.cone).cos();
+    let mut merit_slack = Vec::with_capacity(9 * idx.len() + pb.arm.len());
+    let mut push_row = |rows: &mut Vec<Row>, a: Vec<(usize, f64)>, b: f64, slack: f64| {
+        violation = violation.max(-b - slack);
         rows.push(Row { a, b });
+        merit_slack.push(slack);
     };
     let mut g = Gradient::new(if jacobian { k } else { 0 });
     // a residual's value and its Jacobian row `g` (emptied)
@@ -361,24 +377,24 @@ pub(super) fn build_model(
         }
         // cone: b_z >= cos(cone)
         grad(&mut g, w.b[1].z, w.b[2].z);
-        push_row(&mut rows, g.drain(-1.0), w.b[0].z - cone_target);
+        push_row(&mut rows, g.drain(-1.0), w.b[0].z - cone_target, cone_slack);
         // travel
         for a in 0..2 {
             let (a7, a8) = if a == 0 { (1.0, 0.0) } else { (0.0, 1.0) };
             if pb.upper[a].is_finite() {
                 grad(&mut g, a7, a8);
-                push_row(&mut rows, g.drain(1.0), pb.upper[a] - q[a]);
+                push_row(&mut rows, g.drain(1.0), pb.upper[a] - q[a], 0.0);
             }
             if pb.lower[a].is_finite() {
                 grad(&mut g, a7, a8);
-                push_row(&mut rows, g.drain(-1.0), q[a] - pb.lower[a]);
+                push_row(&mut rows, g.drain(-1.0), q[a] - pb.lower[a], 0.0);
             }
         }
         // the arm's rows at this point: grad·(q + δ − q0) ≤ slack
         for a in pb.arm.iter().filter(|a| a.point == m) {
             grad(&mut g, a.grad[0], a.grad[1]);
             let at = a.grad[0] * (q[0] - a.q0[0]) + a.grad[1] * (q[1] - a.q0[1]);
-            push_row(&mut rows, g.drain(1.0), a.slack_rad - at);
+            push_row(&mut rows, g.drain(1.0), a.slack_rad - at, 0.0);
         }
         if let Some((mp, wp)) = &prev {
             let gap = (m - mp) as f64;
@@ -426,9 +442,9 @@ pub(super) fn build_model(
                     let cap = 0.98 * pb.max_speed[a] * time;
                     let (a7, a8) = if a == 0 { (1.0, 0.0) } else { (0.0, 1.0) };
                     diff(&mut g, a7, a8, a7, a8);
-                    push_row(&mut rows, g.drain(1.0), cap - dq[a]);
+                    push_row(&mut rows, g.drain(1.0), cap - dq[a], 0.0);
                     diff(&mut g, a7, a8, a7, a8);
-                    push_row(&mut rows, g.drain(-1.0), cap + dq[a]);
+                    push_row(&mut rows, g.drain(-1.0), cap + dq[a], 0.0);
                 }
             }
         }
@@ -439,6 +455,7 @@ pub(super) fn build_model(
         r,
         jac,
         rows,
+        merit_slack,
         violation,
     }
 }

@@ -33,6 +33,15 @@ const SAME_LAW_RAD: f64 = 1e-6;
 /// ranked by their objective (rad).
 const ARM_TIE_RAD: f64 = 1e-4;
 
+/// Feasible laws whose objectives are within this fraction of the lowest
+/// (relative), plus [`OBJECTIVE_TIE_ABS`], are a tie, kept in the order
+/// solved ([`kept`]).
+const OBJECTIVE_TIE_REL: f64 = 1e-3;
+/// The absolute part of a tie (objective units, rad²): the laws of a
+/// straight leg's layer end at 1e-11–1e-6, where the starts differ by
+/// nothing an axis could show.
+const OBJECTIVE_TIE_ABS: f64 = 1e-9;
+
 /// The thesis's positioner joints turning every point's `b` exactly
 /// vertical, the turn continued from `q8_hint` (rad); `None` where a point
 /// cannot be turned vertical.
@@ -191,18 +200,12 @@ pub(super) fn solve_bases(
     if !all.iter().any(|s| s.feasible) {
         all.extend(vertical.take());
     }
-    let mut best = 0;
-    for (i, s) in all.iter().enumerate() {
-        if s.better_than(&all[best]) {
-            best = i;
-        }
-    }
-    let best = all.swap_remove(best);
-    // the other feasible laws, best first, each once
+    let best = all.remove(kept(&all, true));
+    // the other feasible laws, best first (ties in the order solved), each once
     all.retain(|s| s.feasible);
-    all.sort_by(|a, b| a.objective.total_cmp(&b.objective));
     let mut others: Vec<Solved> = Vec::new();
-    for s in all {
+    while !all.is_empty() {
+        let s = all.remove(kept(&all, false));
         let same = |o: &Solved| {
             o.joints.iter().zip(&s.joints).all(|(a, b)| {
                 (a[0] - b[0]).abs() <= SAME_LAW_RAD && (a[1] - b[1]).abs() <= SAME_LAW_RAD
@@ -245,18 +248,41 @@ impl Solved {
             joints,
         }
     }
+}
 
-    /// Feasible beats infeasible; then the one that breaks the arm's rows
-    /// less, then the lower objective; or the lower violation.
-    fn better_than(&self, other: &Solved) -> bool {
-        match (self.feasible, other.feasible) {
-            (true, false) => true,
-            (false, true) => false,
-            (true, true) if (self.arm - other.arm).abs() > ARM_TIE_RAD => self.arm < other.arm,
-            (true, true) => self.objective < other.objective,
-            (false, false) => self.violation < other.violation,
+/// The law kept of `laws` (in the order solved; not empty): the feasible
+/// ones first, of those the ones that break the arm's rows least (within
+/// [`ARM_TIE_RAD`], where `arm`), of those the lowest objective, a tie
+/// within [`OBJECTIVE_TIE_REL`] going to the one solved first; with no
+/// feasible law, the least violation. Laws at near-equal objectives are
+/// alike to the axes, and which one comes out lowest is up to the QPs'
+/// tolerances: the fixed rule keeps the same one whichever solver.
+fn kept(laws: &[Solved], arm: bool) -> usize {
+    let feasible = laws.iter().any(|s| s.feasible);
+    if !feasible {
+        let mut best = 0;
+        for (i, s) in laws.iter().enumerate() {
+            if s.violation < laws[best].violation {
+                best = i;
+            }
         }
+        return best;
     }
+    let least_arm = laws
+        .iter()
+        .filter(|s| s.feasible)
+        .map(|s| s.arm)
+        .fold(f64::INFINITY, f64::min);
+    let candidate = |s: &Solved| s.feasible && (!arm || s.arm <= least_arm + ARM_TIE_RAD);
+    let lowest = laws
+        .iter()
+        .filter(|s| candidate(s))
+        .map(|s| s.objective)
+        .fold(f64::INFINITY, f64::min);
+    let tie = lowest + OBJECTIVE_TIE_REL * lowest.abs() + OBJECTIVE_TIE_ABS;
+    laws.iter()
+        .position(|s| candidate(s) && s.objective <= tie)
+        .unwrap_or(0)
 }
 
 /// The starts of [`positioner_law`](super::positioner_law) (the exact vertical `follow` fitted,
