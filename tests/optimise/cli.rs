@@ -277,47 +277,53 @@ fn a_layer_without_joints_exits_2_with_its_summary_and_report() {
 }
 
 /// Arc-off transits that one joint move would take through the deposited
-/// wall go through via points (issue 45): the elbow's layer 55 → 56 in the
-/// KUKA torch-carried cell and the S-bend's layer 111 → 112 in the ABB one
-/// exited 2 ("passes through the deposited wall ... even with the retract
-/// and approach points raised up to 160 mm"). Now both plan (exit 0),
-/// summary.json names the vias on the bead they leave, and `waam check`
-/// reads the programs (KUKA `PTP`, ABB `MoveAbsJ` to each via) back clean,
-/// its transit check included. FANUC: no sample part needs a via in the
-/// ROBOWAM torch-carried cell, so the quarter torus is planned there with
-/// the retract and approach points at 10 mm, raised at most to 20: its
-/// transits after layer 9 then go through vias (`J P[..]`), read back
-/// clean too.
+/// wall go through via points (issue 45): summary.json names the vias on
+/// the bead they leave, and `waam check` reads the programs (KUKA `PTP`,
+/// ABB `MoveAbsJ`, FANUC `J P[..]` to each via) back clean, its transit
+/// check included. The quarter torus is planned in each torch-carried cell
+/// with the retract and approach points at 10 mm, raised at most to 20: its
+/// transits from layer 5 (KUKA), 10 (ABB) and 14 (ROBOWAM) on need vias.
+/// (The elbow's layer 55 → 56 in the KUKA cell and the S-bend's 111 → 112 in
+/// the ABB one needed them at the sample clearances until the positioner's
+/// laws converged and turned the table less from one layer to the next.)
 #[test]
 fn transits_through_via_points_plan_and_check_clean() {
     let dir = tempfile::tempdir().unwrap();
-    let low = dir.path().join("robowam_torch_carried_low_clearance.toml");
-    let text = std::fs::read_to_string(part_path("cells/robowam_torch_carried.toml")).unwrap();
-    assert!(text.contains("\ntransit_max_clearance_mm = 160.0\n"));
-    std::fs::write(
-        &low,
-        text.replace(
-            "\ntransit_max_clearance_mm = 160.0\n",
-            "\nclearance_mm = 10.0\ntransit_max_clearance_mm = 20.0\n",
-        ),
-    )
-    .unwrap();
+    // The sample cells with the retract and approach points held low.
+    let low = |cell: &str| {
+        let path = dir.path().join(format!("{cell}_low_clearance.toml"));
+        let text = std::fs::read_to_string(part_path(&format!("cells/{cell}.toml"))).unwrap();
+        assert!(text.contains("\ntransit_max_clearance_mm = 160.0\n"));
+        std::fs::write(
+            &path,
+            text.replace(
+                "\ntransit_max_clearance_mm = 160.0\n",
+                "\nclearance_mm = 10.0\ntransit_max_clearance_mm = 20.0\n",
+            ),
+        )
+        .unwrap();
+        path
+    };
+    // The quarter torus, all 17 layers, in each torch-carried cell held
+    // low, and the first layer that leaves through vias. (The elbow in the
+    // KUKA cell and the S-bend in the ABB cell left through vias at their
+    // sample clearances until the positioner's laws converged.)
     for (part, cell, layers, leaving) in [
         (
-            "elbow.toml",
-            part_path("cells/kuka_kr16_2_torch_carried.toml"),
-            57,
-            55,
+            "quarter-torus.toml",
+            low("kuka_kr16_2_torch_carried"),
+            17,
+            5,
         ),
         (
-            "s-bend.toml",
-            part_path("cells/abb_irb2600_torch_carried.toml"),
-            113,
-            111,
+            "quarter-torus.toml",
+            low("abb_irb2600_torch_carried"),
+            17,
+            10,
         ),
-        ("quarter-torus.toml", low.clone(), 17, 9),
+        ("quarter-torus.toml", low("robowam_torch_carried"), 17, 14),
     ] {
-        let out = dir.path().join(part);
+        let out = dir.path().join(cell.file_stem().unwrap()).join(part);
         let o = waam()
             .args(["--quiet", "plan"])
             .arg(part_path(part))
