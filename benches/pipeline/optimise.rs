@@ -118,8 +118,9 @@ pub fn plan_at_scale(c: &mut Criterion) {
 /// cells. Goal: the torch-carried planning time per layer within 2× of the
 /// part-carried one. Both cells' plans are timed in the same run, one
 /// cell after the other, and the ratio of their mean times per layer is
-/// printed; the torch-carried cell also with the positioner's QPs by the
-/// dense interior point ([`PositionerQp::Dense`](waam_slicer::optimise::positioner::PositionerQp)).
+/// printed; the torch-carried cell with the positioner's QPs by the dense
+/// interior point (the default) and by clarabel
+/// ([`PositionerQp`](waam_slicer::optimise::positioner::PositionerQp)).
 pub fn torch_vs_part_carried(c: &mut Criterion) {
     use std::time::Duration;
     let mut g = c.benchmark_group("torch_vs_part_carried");
@@ -137,15 +138,16 @@ pub fn torch_vs_part_carried(c: &mut Criterion) {
                 )
                 .unwrap()
             });
-            let clarabel = waam_slicer::PlanOptions::default();
-            let mut dense = waam_slicer::PlanOptions::default();
-            dense.optimise.positioner.qp = waam_slicer::optimise::positioner::PositionerQp::Dense;
+            let dense = waam_slicer::PlanOptions::default();
+            let mut clarabel = waam_slicer::PlanOptions::default();
+            clarabel.optimise.positioner.qp =
+                waam_slicer::optimise::positioner::PositionerQp::Clarabel;
             // mean optimising time per layer (s) of each cell, over every plan
             let per_layer = std::cell::RefCell::new([(0.0, 0usize); 3]);
             let runs = [
-                (&cells[0], "part_carried", &clarabel),
-                (&cells[1], "torch_carried", &clarabel),
-                (&cells[1], "torch_carried_dense_qp", &dense),
+                (&cells[0], "part_carried", &dense),
+                (&cells[1], "torch_carried", &dense),
+                (&cells[1], "torch_carried_clarabel_qp", &clarabel),
             ];
             for (k, (cell, kind, opts)) in runs.into_iter().enumerate() {
                 g.bench_function(format!("{part}_{robot}_{kind}"), |b| {
@@ -169,7 +171,7 @@ pub fn torch_vs_part_carried(c: &mut Criterion) {
             let mean = |k: usize| m[k].0 / m[k].1.max(1) as f64;
             eprintln!(
                 "torch_vs_part_carried {part} in {robot}: {:.2} ms a layer torch carried, \
-                 {:.2} ms part carried, ratio {:.2}; dense QPs {:.2} ms, ratio {:.2} \
+                 {:.2} ms part carried, ratio {:.2}; clarabel QPs {:.2} ms, ratio {:.2} \
                  ({}, {} and {} plans)",
                 1e3 * mean(1),
                 1e3 * mean(0),

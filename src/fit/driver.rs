@@ -3,6 +3,7 @@
 //! a smooth refit of the guide, until the guide stops moving; a final pass
 //! fits the radius law (and wall thickness) and measures the residuals.
 
+use super::coarse::{bridge_not_round, fill_from_cuts, sparse_rings, Coarseness};
 use super::features;
 use super::first_guide::first_guide;
 use super::options::units_warning;
@@ -80,17 +81,6 @@ const WIDEN_GAP_DEG: f64 = 60.0;
 /// the first guides of a coarse export (level sets a few edges wide) leave
 /// sections that are not yet circles. Otherwise from the second.
 const CHECK_SECTIONS_AFTER: usize = 6;
-/// Knots closer than this many times a coarse export's distance between
-/// its rings of vertices (dimensionless) get a warning ([`fit_in_mm`]): a
-/// coil in rings 12 mm apart, fitted with knots 4 mm apart, lies 0.14 mm
-/// RMS off its true surface (0.38 mm at most) with its vertices fitted
-/// within hundredths; with knots 18 mm apart, 0.002 mm. A bend in a few
-/// stretches needs its closer knots: the choice is the user's.
-const KNOT_RING_GAPS: f64 = 1.5;
-/// ... when the facets' chords between the rings lie more than this inside
-/// the fitted guide's curve (mm): half the slices' RMS goal (a straight
-/// written as one strip of long triangles gets none).
-const WARN_SAG_MM: f64 = 0.05;
 /// Refits to the round sections alone (dimensionless count) after the
 /// vertices' pass first fails its check with no feature named, or a lug:
 /// a feature on one side pulls the guide towards it until its sections no
@@ -103,10 +93,6 @@ const EDGE_REFITS: usize = 8;
 /// Fewest stations with rings of their own that a radius or thickness law
 /// is fitted to alone, leaving out the widened ones ([`fit_law`]).
 const MIN_OWN_LAW_STATIONS: usize = 3;
-
-/// Gap between stations holding rings of their own past which a varying
-/// radius law gets a warning ([`sparse_rings`]), in end radii.
-const SPARSE_RING_GAP_RADII: f64 = 2.0;
 
 /// Largest mesh the fit takes (mm, bounding box's largest side, after the
 /// unit): 10 km, no part of a robot cell; a mesh that big is in another
@@ -189,38 +175,17 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
 /// that fails as well: a mesh that fits on its vertices is fitted as before.
 ///
 /// A coarse export whose rings of vertices lie further apart along the
-/// guide than 1 / [`KNOT_RING_GAPS`] of its knot spacing gets a warning
+/// guide than its knots allow gets a warning ([`Coarseness::warning`])
 /// (unless [`FitOptions::knot_spacing_mm`] is set): between its rings no
 /// vertex holds the guide, which then follows the facets' chords, inside a
 /// curved tube.
 fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFit, FitError> {
     let mut coarse = Coarseness::default();
     let mut fit = fit_passes(mesh, opts, trimmed, &mut coarse)?;
-    let wide = KNOT_RING_GAPS * coarse.ring_gap;
-    if opts.knot_spacing_mm.is_none()
-        && coarse.ring_gap > 0.0
-        && coarse.knot_h < wide
-        && coarse.sag > WARN_SAG_MM
-    {
-        fit.report.warnings.push(format!(
-            "a coarse export: its rings of vertices lie about {:.1} mm apart along the guide, its knots {:.1} mm apart: between the rings the guide follows the facets' chords, up to {:.2} mm inside the curved tube; on a gently curved tube (a coil) knots {wide:.0} mm apart or more (--knot-spacing, FitOptions::knot_spacing_mm) run it smooth between them",
-            coarse.ring_gap, coarse.knot_h, coarse.sag
-        ));
+    if opts.knot_spacing_mm.is_none() {
+        fit.report.warnings.extend(coarse.warning());
     }
     Ok(fit)
-}
-
-/// What a fit learnt of a mesh's coarseness along the guide (mm): the
-/// distance between its rings of vertices ([`rings_apart`]; 0 when every
-/// station holds its own ring) and the knot spacing it used.
-#[derive(Debug, Clone, Copy, Default)]
-struct Coarseness {
-    ring_gap: f64,
-    knot_h: f64,
-    /// How far the facets' chords between rings lie inside the fitted
-    /// guide's curve at most: its largest curvature times the rings'
-    /// distance squared over 8 (mm).
-    sag: f64,
 }
 
 /// The passes of [`fit_in_mm`] with the options' knots: the vertices, then
@@ -453,15 +418,7 @@ fn fit_pass(
         (Some(exit), _) => return exit,
         (None, None) => {}
     }
-    {
-        coarse.ring_gap = rings_apart(&stations);
-        let curvature = |t: f64| {
-            let (d1, d2) = (spline.d1(t), spline.d2(t));
-            d1.cross(&d2).norm() / d1.norm().powi(3).max(1e-12)
-        };
-        let most = stations.iter().map(|s| curvature(s.t)).fold(0.0, f64::max);
-        coarse.sag = most * coarse.ring_gap * coarse.ring_gap / 8.0;
-    }
+    coarse.measure(&stations, &spline);
     let pieces = separate_pieces(mesh, &surf, &stations, &spline, opts)?;
     let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick, true);
     let mut radius_mm = law(&|s| s.radius)?;
@@ -533,66 +490,6 @@ fn fit_pass(
         ));
     }
     check_residual(mesh, fit, opts)
-}
-
-/// The typical distance (mm) along the guide between the rings of vertices
-/// of a coarse export: the median gap between the runs of stations holding
-/// rings of their own, where some stations hold none (they took their
-/// neighbours' points); 0 when every station holds its own ring.
-fn rings_apart(stations: &[Station]) -> f64 {
-    if stations.iter().all(|s| !s.widened) {
-        return 0.0;
-    }
-    let mut centres: Vec<f64> = Vec::new();
-    let mut run: Vec<f64> = Vec::new();
-    for s in stations {
-        if !s.widened && s.centre.is_some() {
-            run.push(s.t);
-        } else if !run.is_empty() {
-            centres.push(run.iter().sum::<f64>() / run.len() as f64);
-            run.clear();
-        }
-    }
-    if !run.is_empty() {
-        centres.push(run.iter().sum::<f64>() / run.len() as f64);
-    }
-    // A ring whose vertices fall either side of a station is one ring.
-    let step = stations.get(1).map_or(0.0, |s| s.t - stations[0].t);
-    centres.dedup_by(|b, a| {
-        let near = *b - *a <= 2.5 * step;
-        if near {
-            *a = 0.5 * (*a + *b);
-        }
-        near
-    });
-    let mut gaps: Vec<f64> = centres.windows(2).map(|w| w[1] - w[0]).collect();
-    if gaps.is_empty() {
-        return 0.0;
-    }
-    let k = gaps.len() / 2;
-    *gaps.select_nth_unstable_by(k, f64::total_cmp).1
-}
-
-/// A warning when the stations holding rings of their own lie more than
-/// [`SPARSE_RING_GAP_RADII`] end radii `r0` (mm) apart somewhere: a coarse
-/// export of a tube whose radius varies, whose radius law is then
-/// interpolated where the mesh does not hold it.
-fn sparse_rings(stations: &[Station], r0: f64) -> Option<String> {
-    let own: Vec<f64> = stations
-        .iter()
-        .filter(|s| !s.widened && s.radius.is_some())
-        .map(|s| s.t)
-        .collect();
-    let (a, b) = own
-        .windows(2)
-        .map(|w| (w[0], w[1]))
-        .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))?;
-    (b - a > SPARSE_RING_GAP_RADII * r0).then(|| {
-        format!(
-            "the radius varies, and the mesh holds it only at rings up to {:.1} mm apart (t = {a:.1} to {b:.1} mm): the radius law is interpolated between them",
-            b - a
-        )
-    })
 }
 
 /// The stations' spacing and the guide's knot spacing (mm), from the
@@ -946,34 +843,6 @@ fn sections(
         .collect()
 }
 
-/// When under half the stations' vertices give a circle (the guide's refit
-/// needs half), those without take their section from plane cuts of the
-/// skins at the same frames ([`cut::cut_sections`]), their own
-/// (a cut of the surface at the station, not its neighbours' points; the
-/// facets lie up to r (1 - cos(pi / n)) inside an n-gon's circle): a
-/// straight written as one strip of long triangles has no vertex between
-/// its end rings, further apart than the stations borrow. `data`: the mesh, its surfaces, the samples (the skins' vertices
-/// first) and their guide parameters; `at`: the guide, its range, the
-/// stations' spacing and the end radius (mm). Stations with circles are
-/// left as they are.
-fn fill_from_cuts(
-    (mesh, surf, samples, t): (&TubeMesh, &Surfaces, &Samples, &[f64]),
-    (spline, range, spacing, r0): (&CubicSpline, (f64, f64), f64, f64),
-    stations: &mut [Station],
-) {
-    let held = stations.iter().filter(|s| s.centre.is_some()).count();
-    if held * 2 >= stations.len() {
-        return;
-    }
-    let (step, frames) = station_frames(spline, range, spacing);
-    let cuts = cut::cut_sections(mesh, surf, samples, t, &frames, step, 2.0 * r0);
-    for (s, c) in stations.iter_mut().zip(cuts) {
-        if s.centre.is_none() && c.centre.is_some() {
-            *s = c;
-        }
-    }
-}
-
 /// The guide's new points at `knots`: the smoothing fit of the section
 /// centres; with `round_only`, the centres of the sections that are not
 /// circles by their check (a lug on one side pulls its circle's centre
@@ -1033,47 +902,6 @@ fn refit_guide(
         });
     }
     Ok(pts)
-}
-
-/// Replaces the centres (mm, at guide parameters `ts`, mm) of each run of
-/// stations that are not `round` by the cubic (Hermite) between the round
-/// centres either side, leaving each along the direction of the two round
-/// centres behind it with the run's length in `t`: within a bend, close to
-/// its arc. A run at an end, or with fewer than two round stations on a side,
-/// is left as it is.
-fn bridge_not_round(ts: &[f64], centres: &mut [Point3], round: &[bool]) {
-    let n = ts.len();
-    let mut i = 0;
-    while i < n {
-        if round[i] {
-            i += 1;
-            continue;
-        }
-        let first = i;
-        while i < n && !round[i] {
-            i += 1;
-        }
-        // Round stations a - 1, a before the run and b, b + 1 after it.
-        let (Some(a), b) = (first.checked_sub(1), i) else {
-            continue;
-        };
-        if a == 0 || !round[a - 1] || b + 1 >= n || !round[b + 1] {
-            continue;
-        }
-        let span = ts[b] - ts[a];
-        let dir = |p: usize, q: usize| (centres[q] - centres[p]).normalize() * span;
-        let (p0, p1, m0, m1) = (centres[a], centres[b], dir(a - 1, a), dir(b, b + 1));
-        for k in first..b {
-            let s = (ts[k] - ts[a]) / span;
-            let (s2, s3) = (s * s, s * s * s);
-            centres[k] = Point3::from(
-                p0.coords * (2.0 * s3 - 3.0 * s2 + 1.0)
-                    + m0 * (s3 - 2.0 * s2 + s)
-                    + p1.coords * (-2.0 * s3 + 3.0 * s2)
-                    + m1 * (s3 - s2),
-            );
-        }
-    }
 }
 
 /// Slides each end point of the guide along its end chord onto its open

@@ -31,6 +31,7 @@
 //! section far from a circle, a residual over [`FitOptions::max_rms_mm`]) is
 //! refused with a [`FitError`] naming the file, the station and what was found.
 
+mod coarse;
 mod cut;
 mod driver;
 pub mod ends;

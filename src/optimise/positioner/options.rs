@@ -24,18 +24,19 @@ pub enum PositionerMode {
 #[serde(rename_all = "snake_case")]
 pub enum PositionerQp {
     /// clarabel, as the `R_Z` driver.
-    #[default]
     Clarabel,
     /// A dense primal–dual interior point for the laws' few dozen
-    /// coefficients: the law's QP time about a third of clarabel's (its
-    /// set-up per QP, ordering, symbolic factorisation and equilibration,
-    /// cost more than the solve). The same optima to the solvers'
-    /// tolerances; on the 27 torch-carried sample pairs (2097 beads) the
-    /// plans' joints agree with clarabel's within 0.01° on all but 37 beads
-    /// and within 1° on all but 12: layers whose objective is flat along
-    /// the turn (a straight leg's, the elbow's layer 15), or whose starts
-    /// end in different local minima (the S-bend's layer 80 in the ROBOWAM
-    /// cell: no smooth law with clarabel, the hold start's with this one).
+    /// coefficients (the default): the law's QP time about a third of
+    /// clarabel's (its set-up per QP, ordering, symbolic factorisation and
+    /// equilibration, cost more than the solve). The same optima to the
+    /// solvers' tolerances; on the 27 torch-carried sample pairs (2097
+    /// beads) the plans' joints agree with clarabel's within 0.01° on all
+    /// but 37 beads and within 1° on all but 12: layers whose objective is
+    /// flat along the turn (a straight leg's, the elbow's layer 15), or
+    /// whose starts end in different local minima of near-equal objective
+    /// (the S-bend's layer 80 in the ROBOWAM cell: no smooth law with
+    /// clarabel, the hold start's with this one).
+    #[default]
     Dense,
 }
 
@@ -58,7 +59,7 @@ pub struct PositionerOptions {
     pub sample_points: usize,
     /// SQP iterations per seed and round. Default 25.
     pub max_iterations: usize,
-    /// How the SQP's QPs are solved. Default clarabel.
+    /// How the SQP's QPs are solved. Default dense.
     pub qp: PositionerQp,
 }
 
@@ -71,7 +72,7 @@ impl Default for PositionerOptions {
             arm_length_mm: 1000.0,
             sample_points: 96,
             max_iterations: 25,
-            qp: PositionerQp::Clarabel,
+            qp: PositionerQp::Dense,
         }
     }
 }
