@@ -9,6 +9,7 @@
 //! refitted without them.
 
 use super::cut;
+use super::features::runs_of_false;
 use super::outcome::Station;
 use super::samples::Samples;
 use super::section::station_frames;
@@ -171,16 +172,8 @@ pub(super) fn fill_from_cuts(
 /// is left as it is.
 pub(super) fn bridge_not_round(ts: &[f64], centres: &mut [Point3], round: &[bool]) {
     let n = ts.len();
-    let mut i = 0;
-    while i < n {
-        if round[i] {
-            i += 1;
-            continue;
-        }
-        let first = i;
-        while i < n && !round[i] {
-            i += 1;
-        }
+    for run in runs_of_false(round) {
+        let (first, i) = (run.start, run.end);
         // Round stations a - 1, a before the run and b, b + 1 after it.
         let (Some(a), b) = (first.checked_sub(1), i) else {
             continue;

@@ -137,17 +137,8 @@ pub(super) fn detect(
         return (tube, Vec::new());
     }
     let mut features = Vec::new();
-    let mut i = 0;
-    while i < n {
-        if in_tube[i] {
-            i += 1;
-            continue;
-        }
-        let first = i;
-        while i < n && !in_tube[i] {
-            i += 1;
-        }
-        let last = i - 1;
+    for run in runs_of_false(&in_tube) {
+        let (first, last) = (run.start, run.end - 1);
         // The tube's radius beside it: its neighbours', else the main run's.
         let beside: Vec<f64> = [first.checked_sub(1), Some(last + 1).filter(|&j| j < n)]
             .into_iter()
@@ -239,6 +230,24 @@ pub(super) fn detect(
         });
     }
     (tube, features)
+}
+
+/// The maximal runs of `false` in `flags` (index ranges, in order).
+pub(super) fn runs_of_false(flags: &[bool]) -> Vec<std::ops::Range<usize>> {
+    let mut runs = Vec::new();
+    let mut i = 0;
+    while i < flags.len() {
+        if flags[i] {
+            i += 1;
+            continue;
+        }
+        let first = i;
+        while i < flags.len() && !flags[i] {
+            i += 1;
+        }
+        runs.push(first..i);
+    }
+    runs
 }
 
 /// The points of stations `first..=last` (`at`: station, guide parameter,
