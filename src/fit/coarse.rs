@@ -12,11 +12,11 @@ use super::cut;
 use super::features::runs_of_false;
 use super::outcome::Station;
 use super::samples::Samples;
-use super::section::station_frames;
+use super::section::{fit_circle, fit_plane, plane_basis, station_frames, SectionPoint};
 use super::topology::Surfaces;
-use super::TubeMesh;
+use super::{FitOptions, TubeMesh};
 use crate::geometry::guide::{CubicSpline, GuideCurve};
-use crate::math::Point3;
+use crate::math::{Point3, Vector3};
 
 /// Knots closer than this many times a coarse export's distance between
 /// its rings of vertices (dimensionless) get a warning ([`Coarseness::warning`]): a
@@ -30,6 +30,170 @@ const KNOT_RING_GAPS: f64 = 1.5;
 /// the fitted guide's curve (mm): half the slices' RMS goal (a straight
 /// written as one strip of long triangles gets none).
 const WARN_SAG_MM: f64 = 0.05;
+
+/// Runs of vertices along the guide further apart than this many station
+/// spacings are separate rings ([`vertex_rings`]); within a ring the
+/// vertices lie a ring's tilt to the guide apart at most.
+const RING_APART_STEPS: f64 = 0.5;
+
+/// Fewest vertices of each skin in a ring of a coarse export
+/// ([`vertex_rings`]): a hexagon.
+const MIN_RING_POINTS: usize = 6;
+
+/// One ring of vertices of a coarse export (mesh frame, mm): a flat closed
+/// ring of vertices with none nearby along the guide, as a sweep exporter
+/// writes one section of the tube. Its plane is the tube's normal plane
+/// there, its centre on the tube's axis.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct VertexRing {
+    /// Mean guide parameter of its vertices (mm).
+    pub t: f64,
+    /// Centre of its circle (the skins' mean).
+    pub centre: Point3,
+    /// Unit normal of its plane, along the guide's direction.
+    pub normal: Vector3,
+    /// Its vertices.
+    pub points: usize,
+}
+
+/// The runs of the skins' vertices (the first `samples.vertices`, at guide
+/// parameters `t`, mm) along the guide, apart by more than
+/// [`RING_APART_STEPS`] station `step`s (mm), in order; each a ring of a
+/// coarse export when it is flat (RMS) within
+/// [`FitOptions::section_rms_allowed`] of its radius and a closed circle (gaps under `max_gap_deg`) of at least
+/// [`MIN_RING_POINTS`] per skin, `None` when not (a stretch of a fine mesh,
+/// a cap, two rings that the guide's tilt runs together).
+pub(super) fn vertex_rings(
+    samples: &Samples,
+    t: &[f64],
+    spline: &CubicSpline,
+    step: f64,
+    max_gap_deg: f64,
+    opts: &FitOptions,
+) -> Vec<Option<VertexRing>> {
+    let n = samples.vertices.min(t.len());
+    let mut order: Vec<usize> = (0..n).filter(|&i| t[i].is_finite()).collect();
+    order.sort_by(|&a, &b| t[a].total_cmp(&t[b]));
+    let mut runs: Vec<&[usize]> = Vec::new();
+    let mut start = 0;
+    for k in 1..=order.len() {
+        if k == order.len() || t[order[k]] - t[order[k - 1]] > RING_APART_STEPS * step {
+            runs.push(&order[start..k]);
+            start = k;
+        }
+    }
+    runs.into_iter()
+        .map(|run| ring_of(run, samples, t, spline, max_gap_deg, opts))
+        .collect()
+}
+
+/// The ring of vertices `run` (indices into `samples`), when it is one
+/// ([`vertex_rings`]).
+fn ring_of(
+    run: &[usize],
+    samples: &Samples,
+    t: &[f64],
+    spline: &CubicSpline,
+    max_gap_deg: f64,
+    opts: &FitOptions,
+) -> Option<VertexRing> {
+    let pts: Vec<Point3> = run.iter().map(|&i| samples.pos[i]).collect();
+    let (c, normal, _) = fit_plane(&pts)?;
+    let flat = (pts
+        .iter()
+        .map(|p| (p - c).dot(&normal).powi(2))
+        .sum::<f64>()
+        / pts.len() as f64)
+        .sqrt();
+    let (e1, e2) = plane_basis(&normal);
+    let mut centre = Vector3::zeros();
+    for skin in 0..samples.skins {
+        let sp: Vec<SectionPoint> = run
+            .iter()
+            .filter(|&&i| samples.skin[i] as usize == skin)
+            .map(|&i| {
+                let d = samples.pos[i] - c;
+                SectionPoint {
+                    x: d.dot(&e1),
+                    y: d.dot(&e2),
+                    dt: 0.0,
+                }
+            })
+            .collect();
+        if sp.len() < MIN_RING_POINTS {
+            return None;
+        }
+        let f = fit_circle(&sp, 0.0)?;
+        let allowed = opts.section_rms_allowed(f.radius);
+        if f.rms > allowed || flat > allowed || f.max_gap_rad > max_gap_deg.to_radians() {
+            return None;
+        }
+        centre += c.coords + e1 * f.centre[0] + e2 * f.centre[1];
+    }
+    let tm = run.iter().map(|&i| t[i]).sum::<f64>() / run.len() as f64;
+    let along = spline.d1(tm);
+    let normal = if normal.dot(&along) < 0.0 {
+        -normal.into_inner()
+    } else {
+        normal.into_inner()
+    };
+    Some(VertexRing {
+        t: tm,
+        centre: Point3::from(centre / samples.skins as f64),
+        normal,
+        points: run.len(),
+    })
+}
+
+/// Sets the centres (mm) of the stations between two consecutive runs of
+/// vertices that are both rings of a coarse export ([`vertex_rings`]) and
+/// hold no ring of their own to the cubic
+/// (Hermite) from one ring's centre to the next, leaving each along its
+/// ring's normal: the facets between the rings are chords, inside a curved
+/// tube, and the stations there hold only their neighbours' points (a
+/// widened ring) or none, which keep the guide where it lies; the rings'
+/// centres and planes are the exporter's own
+/// samples of the tube's axis and tangent. The tangents' length makes the
+/// cubic an arc's when the rings are a circular arc's (two normals at
+/// `theta`: chord x 2 tan(theta / 4) / sin(theta / 2)); parallel normals
+/// give a straight. The bridged stations weigh as their rings' mean.
+/// Returns how many stations it set.
+pub(super) fn bridge_between_rings(
+    stations: &mut [Station],
+    rings: &[Option<VertexRing>],
+) -> usize {
+    let mut set = 0;
+    for w in rings.windows(2) {
+        let [Some(a), Some(b)] = w else { continue };
+        let chord = (b.centre - a.centre).norm();
+        let theta = a.normal.angle(&b.normal);
+        let scale = if theta < 1e-6 {
+            chord
+        } else {
+            chord * 2.0 * (theta / 4.0).tan() / (theta / 2.0).sin()
+        };
+        let (m0, m1) = (a.normal * scale, b.normal * scale);
+        let weight = (a.points + b.points) / 2;
+        for s in stations.iter_mut() {
+            let own = !s.widened && s.centre.is_some();
+            if own || s.t <= a.t || s.t >= b.t {
+                continue;
+            }
+            let u = (s.t - a.t) / (b.t - a.t);
+            let (u2, u3) = (u * u, u * u * u);
+            s.centre = Some(Point3::from(
+                a.centre.coords * (2.0 * u3 - 3.0 * u2 + 1.0)
+                    + m0 * (u3 - 2.0 * u2 + u)
+                    + b.centre.coords * (-2.0 * u3 + 3.0 * u2)
+                    + m1 * (u3 - u2),
+            ));
+            s.points = weight;
+            s.bridged = true;
+            set += 1;
+        }
+    }
+    set
+}
 
 /// Gap between stations holding rings of their own past which a varying
 /// radius law gets a warning ([`sparse_rings`]), in end radii.
@@ -46,6 +210,10 @@ pub(super) struct Coarseness {
     /// guide's curve at most: its largest curvature times the rings'
     /// distance squared over 8 (mm).
     pub sag: f64,
+    /// Stations bridged between rings of vertices
+    /// ([`bridge_between_rings`]): the guide there follows the rings, not
+    /// the chords, and no warning is due.
+    pub bridged: usize,
 }
 
 impl Coarseness {
@@ -67,7 +235,8 @@ impl Coarseness {
     /// guide's curve.
     pub(super) fn warning(&self) -> Option<String> {
         let wide = KNOT_RING_GAPS * self.ring_gap;
-        (self.ring_gap > 0.0 && self.knot_h < wide && self.sag > WARN_SAG_MM).then(|| {
+        let chords = self.ring_gap > 0.0 && self.bridged == 0;
+        (chords && self.knot_h < wide && self.sag > WARN_SAG_MM).then(|| {
             format!(
                 "a coarse export: its rings of vertices lie about {:.1} mm apart along the guide, its knots {:.1} mm apart: between the rings the guide follows the facets' chords, up to {:.2} mm inside the curved tube; on a gently curved tube (a coil) knots {wide:.0} mm apart or more (--knot-spacing, FitOptions::knot_spacing_mm) run it smooth between them",
                 self.ring_gap, self.knot_h, self.sag
@@ -194,5 +363,77 @@ pub(super) fn bridge_not_round(ts: &[f64], centres: &mut [Point3], round: &[bool
                     + m1 * (s3 - s2),
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A station at `t` (mm) holding no ring of its own.
+    fn borrowed(t: f64) -> Station {
+        let frame = (t, Point3::origin(), Vector3::z(), Vector3::x(), Vector3::y());
+        let mut s = Station::from_fits(&frame, vec![None], 0, false);
+        s.widened = true;
+        s
+    }
+
+    fn ring(t: f64, centre: Point3, normal: Vector3) -> Option<VertexRing> {
+        Some(VertexRing {
+            t,
+            centre,
+            normal,
+            points: 16,
+        })
+    }
+
+    /// Two rings 40 degrees apart on an arc of radius 50 mm: the bridge
+    /// between them lies on the arc (the cubic's closed-form error there is
+    /// about 2e-6 of the radius); a ring between them of its own is kept.
+    #[test]
+    fn the_bridge_between_two_rings_of_an_arc_lies_on_the_arc() {
+        let (radius, theta) = (50.0, 40f64.to_radians());
+        let at = |a: f64| Point3::new(radius * a.cos(), radius * a.sin(), 0.0);
+        let along = |a: f64| Vector3::new(-a.sin(), a.cos(), 0.0);
+        let rings = [
+            ring(0.0, at(0.0), along(0.0)),
+            ring(radius * theta, at(theta), along(theta)),
+        ];
+        let mut stations: Vec<Station> = (1..20)
+            .map(|i| borrowed(radius * theta * i as f64 / 20.0))
+            .collect();
+        stations[9].widened = false;
+        stations[9].centre = Some(Point3::new(1.0, 2.0, 3.0));
+        assert_eq!(bridge_between_rings(&mut stations, &rings), 18);
+        for s in &stations {
+            let c = s.centre.expect("a centre");
+            if s.bridged {
+                let off = (c.coords.norm() - radius).abs();
+                assert!(off < 2e-4, "t {}: {off} mm off the arc", s.t);
+                assert_eq!(s.points, 16);
+            } else {
+                assert_eq!(c, Point3::new(1.0, 2.0, 3.0));
+            }
+        }
+    }
+
+    /// Two parallel rings on one axis: the bridge is the straight between
+    /// them; a run of vertices that is no ring (`None`) stops the bridge.
+    #[test]
+    fn the_bridge_between_two_parallel_rings_is_straight() {
+        let z = Vector3::z();
+        let rings = [
+            ring(0.0, Point3::new(1.0, 2.0, 0.0), z),
+            ring(30.0, Point3::new(1.0, 2.0, 30.0), z),
+            None,
+            ring(60.0, Point3::new(1.0, 2.0, 60.0), z),
+        ];
+        let mut stations: Vec<Station> = (1..60).map(|i| borrowed(i as f64)).collect();
+        assert_eq!(bridge_between_rings(&mut stations, &rings), 29);
+        for s in stations.iter().filter(|s| s.bridged) {
+            let c = s.centre.expect("a centre");
+            assert!((c - Point3::new(1.0, 2.0, s.t)).norm() < 1e-9, "{c:?}");
+        }
+        assert!(stations.iter().filter(|s| s.t > 30.0).all(|s| !s.bridged));
     }
 }

@@ -3,6 +3,7 @@
 //! a smooth refit of the guide, until the guide stops moving; a final pass
 //! fits the radius law (and wall thickness) and measures the residuals.
 
+use super::coarse::{bridge_between_rings, vertex_rings};
 use super::coarse::{bridge_not_round, fill_from_cuts, sparse_rings, Coarseness};
 use super::features;
 use super::first_guide::first_guide;
@@ -298,7 +299,7 @@ fn fit_pass(
             hints.as_deref(),
             PROJECT_PAST_END_RADII * r0,
         );
-        let stations = if cutting {
+        let mut stations = if cutting {
             let (step, frames) = station_frames(&spline, range, spacing);
             let mut cuts = cut::cut_sections(mesh, &surf, &samples, &t, &frames, step, 2.0 * r0);
             cut::hold_ends(&mut cuts, [&start, &finish]);
@@ -312,6 +313,8 @@ fn fit_pass(
             );
             st
         };
+        let rings = vertex_rings(&samples, &t, &spline, spacing, WIDEN_GAP_DEG, opts);
+        bridge_between_rings(&mut stations, &rings);
         if iterations > check_after {
             match (check_sections(mesh, &stations, opts), postponed.take()) {
                 (Ok(()), None) => {}
@@ -350,7 +353,9 @@ fn fit_pass(
             }
         }
         let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
-        slope = fit_law(mesh, &stations, &knots, &|s| s.radius, false)
+        // A bridged station's radius is borrowed across its rings: left out.
+        let own_radius = |s: &Station| s.radius.filter(|_| !s.bridged);
+        slope = fit_law(mesh, &stations, &knots, &own_radius, false)
             .ok()
             .map(|v| (knots.clone(), v));
         let round_only = postponed.as_ref().map(|_| opts);
@@ -366,7 +371,7 @@ fn fit_pass(
             .take(knots.len() - 2)
             .map(|(&k, p)| (spline.point(k) - p).norm())
             .fold(0.0, f64::max);
-        hints = Some(t);
+        hints = Some(carry_hints(t, &knots, &chord_knots(&next)));
         guide = next;
         // Converged, or stalled at the level of the mesh's noise (a quarter
         // of the sections' typical scatter: vertices changing station make
@@ -411,6 +416,8 @@ fn fit_pass(
         (&spline, range, spacing, r0),
         &mut stations,
     );
+    let rings = vertex_rings(&samples, &t, &spline, spacing, WIDEN_GAP_DEG, opts);
+    coarse.bridged = bridge_between_rings(&mut stations, &rings);
     match (failed(&spline, &stations, &samples, &t), postponed) {
         (Some(Err(FitError::SectionNotCircle { .. })) | None, Some((first, _))) => {
             return Err(first)
@@ -539,10 +546,12 @@ fn pass_samples(
 }
 
 /// The median RMS of the stations' circle fits (mm; 0 with none): the
-/// level of the mesh's noise.
+/// level of the mesh's noise. A bridged station's borrowed section is left
+/// out: its scatter is the guide's error at the rings it borrowed from.
 fn median_section_rms(stations: &[Station]) -> f64 {
     let mut scatter: Vec<f64> = stations
         .iter()
+        .filter(|s| !s.bridged)
         .flat_map(|s| s.fits.iter().flatten().map(|f| f.rms))
         .collect();
     if scatter.is_empty() {
@@ -619,6 +628,29 @@ fn coupling_gap(law: Option<&(Vec<f64>, Vec<f64>)>) -> f64 {
         }
     }
     1.2 * std::f64::consts::PI * worst
+}
+
+/// The guide parameters `t` (mm) of the samples on the guide that the
+/// refit replaced, carried onto the new guide: the refit's point `j` lies at
+/// `from[j]` on the old guide and at `to[j]` on the new one (its chord
+/// lengths), linear between and past the ends. Newton's search from an
+/// uncarried parameter lands on the wrong stretch when the refit
+/// lengthens the guide (a coil's first guide, 13 % short, put the vertices
+/// of its far turns at its start).
+fn carry_hints(mut t: Vec<f64>, from: &[f64], to: &[f64]) -> Vec<f64> {
+    let n = from.len().min(to.len());
+    if n < 2 {
+        return t;
+    }
+    for x in &mut t {
+        let j = from[..n].partition_point(|&k| k <= *x).clamp(1, n - 1);
+        let (a, b) = (j - 1, j);
+        let span = from[b] - from[a];
+        if span > 0.0 {
+            *x = to[a] + (*x - from[a]) * (to[b] - to[a]) / span;
+        }
+    }
+    t
 }
 
 /// Cumulative chord lengths of `points` (mm): the spline guide's `t`.
@@ -989,7 +1021,9 @@ fn check_sections(
     for (i, s) in stations.iter().enumerate() {
         let mut open = None;
         for (k, f) in s.fits.iter().enumerate() {
-            let Some(f) = f else { continue };
+            let Some(f) = f.filter(|_| !s.bridged) else {
+                continue;
+            };
             let skin = if s.fits.len() == 2 {
                 format!("skin {k}: ")
             } else {

@@ -98,6 +98,10 @@ pub(super) struct Station {
     /// Whether its rings took its neighbours' points (a coarse mesh): its
     /// radius then leans on the radius law's slope across them.
     pub widened: bool,
+    /// Whether its centre is the bridge between two rings of vertices of a
+    /// coarse export ([`bridge_between_rings`](super::coarse::bridge_between_rings)):
+    /// it holds no section of its own, and its borrowed one is not checked.
+    pub bridged: bool,
 }
 
 impl Station {
@@ -135,6 +139,7 @@ impl Station {
             thickness,
             points,
             widened: false,
+            bridged: false,
         }
     }
 }
