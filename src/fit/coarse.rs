@@ -372,7 +372,13 @@ mod tests {
 
     /// A station at `t` (mm) holding no ring of its own.
     fn borrowed(t: f64) -> Station {
-        let frame = (t, Point3::origin(), Vector3::z(), Vector3::x(), Vector3::y());
+        let frame = (
+            t,
+            Point3::origin(),
+            Vector3::z(),
+            Vector3::x(),
+            Vector3::y(),
+        );
         let mut s = Station::from_fits(&frame, vec![None], 0, false);
         s.widened = true;
         s

@@ -11,7 +11,7 @@ use super::options::units_warning;
 use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
 use super::outcome::{FeatureKind, FeatureReport};
-use super::samples::{self, project_all, Samples};
+use super::samples::{self, carry_hints, project_all, Samples};
 use super::section::{fit_circle, fit_plane, plane_basis, station_frames, CircleFit, SectionPoint};
 use super::topology::{self, median_edge, Surfaces};
 use super::{cut, ends, repair, report};
@@ -364,12 +364,20 @@ fn fit_pass(
         anchor_ends(&mut next, &start, &finish);
         let previous = last_move;
         // The points past the ends are left out: the data barely hold them.
+        // A move along the guide is its parameter's, not its shape's (the
+        // chord lengths from the point past the start shift every knot's
+        // place along the guide a little): left out.
+        let across = |k: f64, p: &Point3| {
+            let d = spline.point(k) - p;
+            let along = spline.d1(k).normalize();
+            (d - along * d.dot(&along)).norm()
+        };
         last_move = knots
             .iter()
             .zip(&next)
             .skip(1)
             .take(knots.len() - 2)
-            .map(|(&k, p)| (spline.point(k) - p).norm())
+            .map(|(&k, p)| across(k, p))
             .fold(0.0, f64::max);
         hints = Some(carry_hints(t, &knots, &chord_knots(&next)));
         guide = next;
@@ -628,29 +636,6 @@ fn coupling_gap(law: Option<&(Vec<f64>, Vec<f64>)>) -> f64 {
         }
     }
     1.2 * std::f64::consts::PI * worst
-}
-
-/// The guide parameters `t` (mm) of the samples on the guide that the
-/// refit replaced, carried onto the new guide: the refit's point `j` lies at
-/// `from[j]` on the old guide and at `to[j]` on the new one (its chord
-/// lengths), linear between and past the ends. Newton's search from an
-/// uncarried parameter lands on the wrong stretch when the refit
-/// lengthens the guide (a coil's first guide, 13 % short, put the vertices
-/// of its far turns at its start).
-fn carry_hints(mut t: Vec<f64>, from: &[f64], to: &[f64]) -> Vec<f64> {
-    let n = from.len().min(to.len());
-    if n < 2 {
-        return t;
-    }
-    for x in &mut t {
-        let j = from[..n].partition_point(|&k| k <= *x).clamp(1, n - 1);
-        let (a, b) = (j - 1, j);
-        let span = from[b] - from[a];
-        if span > 0.0 {
-            *x = to[a] + (*x - from[a]) * (to[b] - to[a]) / span;
-        }
-    }
-    t
 }
 
 /// Cumulative chord lengths of `points` (mm): the spline guide's `t`.

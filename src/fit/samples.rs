@@ -182,6 +182,29 @@ pub(super) fn project_all(
         .collect()
 }
 
+/// The guide parameters `t` (mm) of the samples on the guide that the
+/// refit replaced, carried onto the new guide: the refit's point `j` lies at
+/// `from[j]` on the old guide and at `to[j]` on the new one (its chord
+/// lengths), linear between and past the ends. Newton's search from an
+/// uncarried parameter lands on the wrong stretch when the refit
+/// lengthens the guide (a coil's first guide, 13 % short, put the vertices
+/// of its far turns at its start).
+pub(super) fn carry_hints(mut t: Vec<f64>, from: &[f64], to: &[f64]) -> Vec<f64> {
+    let n = from.len().min(to.len());
+    if n < 2 {
+        return t;
+    }
+    for x in &mut t {
+        let j = from[..n].partition_point(|&k| k <= *x).clamp(1, n - 1);
+        let (a, b) = (j - 1, j);
+        let span = from[b] - from[a];
+        if span > 0.0 {
+            *x = to[a] + (*x - from[a]) * (to[b] - to[a]) / span;
+        }
+    }
+    t
+}
+
 /// Nearest-point parameter by Newton on `(C(t) - p) · C'(t) = 0` in `[lo, hi]`.
 fn newton(spline: &CubicSpline, p: &Point3, mut t: f64, lo: f64, hi: f64) -> Option<f64> {
     for _ in 0..12 {

@@ -714,6 +714,41 @@ fn a_coarse_coil_fits_smooth_between_its_rings() {
     }
 }
 
+/// A coarse export of the coil whose rings are not flat (each vertex but
+/// the end rings' 0.6 mm along the tube either side of its ring, in turn,
+/// over the 0.5 mm a ring's plane allows; rings 12 mm apart) has no rings
+/// to bridge: between them the guide
+/// follows the facets' chords, and fit.json warns, naming the rings'
+/// distance and the knots to take. The same rings flat get no warning
+/// (`a_coarse_coil_fits_smooth_between_its_rings`).
+#[test]
+fn a_coarse_export_without_flat_rings_warns_of_its_chords() {
+    // mm along the tube, either side of the ring: 0.6 mm RMS off its plane.
+    const AMP: f64 = 0.6;
+    let truth = gen::helix();
+    let around = 24;
+    let (mut v, f) = gen::mesh_around(&truth, 12.0, around, 0.0, 0.0, 0);
+    let last = v.len() / around - 1;
+    let gap = truth.length / last as f64;
+    for (k, p) in v.iter_mut().enumerate() {
+        let ring = k / around;
+        if ring == 0 || ring == last {
+            continue;
+        }
+        let s = ring as f64 * gap;
+        let along = ((truth.centre)(s + 0.01) - (truth.centre)(s - 0.01)).normalize();
+        *p += along * if k % 2 == 0 { AMP } else { -AMP };
+    }
+    let p = fit_mesh(v, f, "coil.stl", &FitOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let w = &p.report().warnings;
+    assert!(
+        w.iter()
+            .any(|w| w.starts_with("a coarse export: its rings of vertices")
+                && w.contains("mm apart or more (--knot-spacing")),
+        "{w:?}"
+    );
+}
+
 /// A fit stopped before its guide settled (here after 2 refits) says so in
 /// fit.json's warnings, with its last move; the same mesh given its refits
 /// settles and has no such warning.
