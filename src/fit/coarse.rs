@@ -156,8 +156,10 @@ fn ring_of(
 /// samples of the tube's axis and tangent. The tangents' length makes the
 /// cubic an arc's when the rings are a circular arc's (two normals at
 /// `theta`: chord x 2 tan(theta / 4) / sin(theta / 2)); parallel normals
-/// give a straight. The bridged stations weigh as their rings' mean.
-/// Returns how many stations it set.
+/// give a straight. The bridged stations weigh as their rings' mean and
+/// hold no radius (nor wall thickness): the radius law interpolates the
+/// rings' own (the facets between them lie up to r (1 - cos(pi / n))
+/// inside an n-gon's circle). Returns how many stations it set.
 pub(super) fn bridge_between_rings(
     stations: &mut [Station],
     rings: &[Option<VertexRing>],
@@ -187,6 +189,9 @@ pub(super) fn bridge_between_rings(
                     + b.centre.coords * (-2.0 * u3 + 3.0 * u2)
                     + m1 * (u3 - u2),
             ));
+            // Its borrowed radius leans on the radius law's slope across
+            // the rings: the law interpolates the rings' own instead.
+            (s.radius, s.thickness) = (None, None);
             s.points = weight;
             s.bridged = true;
             set += 1;

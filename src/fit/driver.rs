@@ -305,16 +305,14 @@ fn fit_pass(
             cut::hold_ends(&mut cuts, [&start, &finish]);
             cuts
         } else {
-            let mut st = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
-            fill_from_cuts(
-                (mesh, &surf, &samples, &t),
-                (&spline, range, spacing, r0),
-                &mut st,
-            );
-            st
+            sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0)
         };
-        let rings = vertex_rings(&samples, &t, &spline, spacing, WIDEN_GAP_DEG, opts);
-        bridge_between_rings(&mut stations, &rings);
+        bridge_then_cut(
+            (mesh, &surf, &samples, &t),
+            (&spline, range, spacing, r0),
+            &mut stations,
+            opts,
+        );
         if iterations > check_after {
             match (check_sections(mesh, &stations, opts), postponed.take()) {
                 (Ok(()), None) => {}
@@ -353,9 +351,7 @@ fn fit_pass(
             }
         }
         let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
-        // A bridged station's radius is borrowed across its rings: left out.
-        let own_radius = |s: &Station| s.radius.filter(|_| !s.bridged);
-        slope = fit_law(mesh, &stations, &knots, &own_radius, false)
+        slope = fit_law(mesh, &stations, &knots, &|s| s.radius, false)
             .ok()
             .map(|v| (knots.clone(), v));
         let round_only = postponed.as_ref().map(|_| opts);
@@ -419,13 +415,12 @@ fn fit_pass(
         PROJECT_PAST_END_RADII * r0,
     );
     let mut stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
-    fill_from_cuts(
+    coarse.bridged = bridge_then_cut(
         (mesh, &surf, &samples, &t),
         (&spline, range, spacing, r0),
         &mut stations,
+        opts,
     );
-    let rings = vertex_rings(&samples, &t, &spline, spacing, WIDEN_GAP_DEG, opts);
-    coarse.bridged = bridge_between_rings(&mut stations, &rings);
     match (failed(&spline, &stations, &samples, &t), postponed) {
         (Some(Err(FitError::SectionNotCircle { .. })) | None, Some((first, _))) => {
             return Err(first)
@@ -505,6 +500,27 @@ fn fit_pass(
         ));
     }
     check_residual(mesh, fit, opts)
+}
+
+/// Completes a refit's `stations`: those between two rings of vertices of
+/// a coarse export that hold no ring of their own are bridged between the
+/// rings ([`bridge_between_rings`]), then, when under half the stations
+/// hold a section, those without one take plane cuts ([`fill_from_cuts`]).
+/// `data`: the mesh, its surfaces, the samples and their guide parameters;
+/// `at`: the guide, its range, the stations' spacing and the end radius
+/// (mm). Returns how many stations it bridged.
+fn bridge_then_cut(
+    data: (&TubeMesh, &Surfaces, &Samples, &[f64]),
+    at: (&CubicSpline, (f64, f64), f64, f64),
+    stations: &mut [Station],
+    opts: &FitOptions,
+) -> usize {
+    let (_, _, samples, t) = data;
+    let (spline, _, spacing, _) = at;
+    let rings = vertex_rings(samples, t, spline, spacing, WIDEN_GAP_DEG, opts);
+    let bridged = bridge_between_rings(stations, &rings);
+    fill_from_cuts(data, at, stations);
+    bridged
 }
 
 /// The stations' spacing and the guide's knot spacing (mm), from the
@@ -944,8 +960,10 @@ fn anchor_ends(points: &mut [Point3], start: &EndRing, finish: &EndRing) {
 /// when at least [`MIN_OWN_LAW_STATIONS`] have a value: a widened station's
 /// value (a coarse mesh) leans on the refits' slope across the points it
 /// borrowed, tens of mm away, and swung the law by ±2 mm between the rings
-/// of a coarse export. The refits' slope law takes every station (its knot
-/// spacing, [`coupling_gap`], keeps the guide of a coarse bend smooth).
+/// of a coarse export (a bridged one holds none,
+/// [`bridge_between_rings`]). The refits' slope law takes every station
+/// (its knot spacing, [`coupling_gap`], keeps the guide of a coarse bend
+/// smooth).
 fn fit_law(
     mesh: &TubeMesh,
     stations: &[Station],
