@@ -156,10 +156,12 @@ fn ring_of(
 /// samples of the tube's axis and tangent. The tangents' length makes the
 /// cubic an arc's when the rings are a circular arc's (two normals at
 /// `theta`: chord x 2 tan(theta / 4) / sin(theta / 2)); parallel normals
-/// give a straight. The bridged stations weigh as their rings' mean and
-/// hold no radius (nor wall thickness): the radius law interpolates the
-/// rings' own (the facets between them lie up to r (1 - cos(pi / n))
-/// inside an n-gon's circle). Returns how many stations it set.
+/// give a straight. The bridged stations weigh as their rings' mean. A station between the rings whose section
+/// is a plane cut ([`fill_from_cuts`]) keeps its centre (a straight's
+/// facets lie on it). Neither holds a radius (nor wall thickness) then:
+/// the radius law interpolates the rings' own (the facets lie up to
+/// r (1 - cos(pi / n)) inside an n-gon's circle). Returns how many
+/// stations it bridged.
 pub(super) fn bridge_between_rings(
     stations: &mut [Station],
     rings: &[Option<VertexRing>],
@@ -178,7 +180,14 @@ pub(super) fn bridge_between_rings(
         let weight = (a.points + b.points) / 2;
         for s in stations.iter_mut() {
             let own = !s.widened && s.centre.is_some();
-            if own || s.t <= a.t || s.t >= b.t {
+            if (own && !s.cut) || s.t <= a.t || s.t >= b.t {
+                continue;
+            }
+            // Its borrowed radius leans on the radius law's slope across
+            // the rings, its cut one reads the facets: the law interpolates
+            // the rings' own instead.
+            (s.radius, s.thickness) = (None, None);
+            if s.cut {
                 continue;
             }
             let u = (s.t - a.t) / (b.t - a.t);
@@ -189,9 +198,6 @@ pub(super) fn bridge_between_rings(
                     + b.centre.coords * (-2.0 * u3 + 3.0 * u2)
                     + m1 * (u3 - u2),
             ));
-            // Its borrowed radius leans on the radius law's slope across
-            // the rings: the law interpolates the rings' own instead.
-            (s.radius, s.thickness) = (None, None);
             s.points = weight;
             s.bridged = true;
             set += 1;
@@ -334,6 +340,7 @@ pub(super) fn fill_from_cuts(
     for (s, c) in stations.iter_mut().zip(cuts) {
         if s.centre.is_none() && c.centre.is_some() {
             *s = c;
+            s.cut = true;
         }
     }
 }
@@ -446,5 +453,27 @@ mod tests {
             assert!((c - Point3::new(1.0, 2.0, s.t)).norm() < 1e-9, "{c:?}");
         }
         assert!(stations.iter().filter(|s| s.t > 30.0).all(|s| !s.bridged));
+    }
+
+    /// A station between two rings whose section is a plane cut of the
+    /// facets keeps its centre (a straight's facets lie on it) but not its
+    /// radius (the facets read inside the circle): the law takes the rings'.
+    #[test]
+    fn a_cut_between_two_rings_keeps_its_centre_not_its_radius() {
+        let z = Vector3::z();
+        let rings = [
+            ring(0.0, Point3::origin(), z),
+            ring(30.0, Point3::new(0.0, 0.0, 30.0), z),
+        ];
+        let mut cut = borrowed(15.0);
+        (cut.widened, cut.cut) = (false, true);
+        cut.centre = Some(Point3::new(0.0, 0.0, 15.0));
+        cut.radius = Some(9.95);
+        let mut stations = vec![cut];
+        assert_eq!(bridge_between_rings(&mut stations, &rings), 0);
+        let s = &stations[0];
+        assert_eq!(s.centre, Some(Point3::new(0.0, 0.0, 15.0)));
+        assert_eq!(s.radius, None);
+        assert!(!s.bridged);
     }
 }

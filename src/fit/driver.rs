@@ -502,10 +502,15 @@ fn fit_pass(
     check_residual(mesh, fit, opts)
 }
 
-/// Completes a refit's `stations`: those between two rings of vertices of
-/// a coarse export that hold no ring of their own are bridged between the
-/// rings ([`bridge_between_rings`]), then, when under half the stations
-/// hold a section, those without one take plane cuts ([`fill_from_cuts`]).
+/// Completes a refit's `stations`: when under half the stations hold a
+/// section, those without one take plane cuts ([`fill_from_cuts`]); then
+/// those between two rings of vertices of a coarse export that hold no ring
+/// of their own are bridged between the rings ([`bridge_between_rings`]).
+/// The cuts go first: the facets of a straight written as one strip lie on
+/// it, where the rings at its ends may be tilted (an exporter that takes a
+/// ring's tangent from its neighbours' centres tilts it at a join with a
+/// bend, and a cubic along those tilts bulged a pipe network's straights
+/// by 0.1 mm).
 /// `data`: the mesh, its surfaces, the samples and their guide parameters;
 /// `at`: the guide, its range, the stations' spacing and the end radius
 /// (mm). Returns how many stations it bridged.
@@ -518,9 +523,8 @@ fn bridge_then_cut(
     let (_, _, samples, t) = data;
     let (spline, _, spacing, _) = at;
     let rings = vertex_rings(samples, t, spline, spacing, WIDEN_GAP_DEG, opts);
-    let bridged = bridge_between_rings(stations, &rings);
     fill_from_cuts(data, at, stations);
-    bridged
+    bridge_between_rings(stations, &rings)
 }
 
 /// The stations' spacing and the guide's knot spacing (mm), from the

@@ -102,6 +102,9 @@ pub(super) struct Station {
     /// coarse export ([`bridge_between_rings`](super::coarse::bridge_between_rings)):
     /// it holds no section of its own, and its borrowed one is not checked.
     pub bridged: bool,
+    /// Whether its section is a plane cut of the facets, taken for want of
+    /// vertices ([`fill_from_cuts`](super::coarse::fill_from_cuts)).
+    pub cut: bool,
 }
 
 impl Station {
@@ -140,6 +143,7 @@ impl Station {
             points,
             widened: false,
             bridged: false,
+            cut: false,
         }
     }
 }
