@@ -522,8 +522,16 @@ fn bridge_then_cut(
 ) -> usize {
     let (_, _, samples, t) = data;
     let (spline, _, spacing, _) = at;
-    let rings = vertex_rings(samples, t, spline, spacing, WIDEN_GAP_DEG, opts);
     fill_from_cuts(data, at, stations);
+    // Every station holding a ring of its own (a fine mesh): nothing to
+    // bridge, and no runs of vertices to sort.
+    if stations
+        .iter()
+        .all(|s| !s.widened && !s.cut && s.centre.is_some())
+    {
+        return 0;
+    }
+    let rings = vertex_rings(samples, t, spline, spacing, WIDEN_GAP_DEG, opts);
     bridge_between_rings(stations, &rings)
 }
 
