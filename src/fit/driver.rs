@@ -7,6 +7,7 @@ use super::coarse::{bridge_between_rings, vertex_rings};
 use super::coarse::{bridge_not_round, fill_from_cuts, sparse_rings, Coarseness};
 use super::features;
 use super::first_guide::first_guide;
+use super::laws::{coupling_gap, fit_law, outer_skin};
 use super::options::units_warning;
 use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
@@ -90,10 +91,6 @@ const FEATURE_REFITS: usize = 4;
 /// Most refits with the points along a coarse bend's edges (dimensionless
 /// count); then the vertices alone.
 const EDGE_REFITS: usize = 8;
-
-/// Fewest stations with rings of their own that a radius or thickness law
-/// is fitted to alone, leaving out the widened ones ([`fit_law`]).
-const MIN_OWN_LAW_STATIONS: usize = 3;
 
 /// Largest mesh the fit takes (mm, bounding box's largest side, after the
 /// unit): 10 km, no part of a robot cell; a mesh that big is in another
@@ -647,25 +644,6 @@ fn fit_knots(range: (f64, f64), knot_h: f64, spacing: f64) -> Vec<f64> {
     k
 }
 
-/// Shortest knot interval (mm) that keeps the refit stable on a tube whose
-/// radius changes: a guide tilted by `alpha` moves a section's centre by
-/// about `A' A alpha` (the points of one side come from a wider part), so a
-/// wiggle of wavelength `2 h` grows unless `h > pi |A'| A`; 20 % margin.
-fn coupling_gap(law: Option<&(Vec<f64>, Vec<f64>)>) -> f64 {
-    let Some((k, v)) = law else { return 0.0 };
-    let m = smooth::natural_second_derivatives(k, v);
-    let mut worst = 0.0_f64;
-    for w in k.windows(2) {
-        for f in [0.0, 0.5, 1.0] {
-            let t = w[0] + f * (w[1] - w[0]);
-            let h = 1e-3 * (w[1] - w[0]);
-            let d = (smooth::eval(k, v, &m, t + h) - smooth::eval(k, v, &m, t - h)) / (2.0 * h);
-            worst = worst.max(d.abs() * smooth::eval(k, v, &m, t));
-        }
-    }
-    1.2 * std::f64::consts::PI * worst
-}
-
 /// Cumulative chord lengths of `points` (mm): the spline guide's `t`.
 pub(super) fn chord_knots(points: &[Point3]) -> Vec<f64> {
     let mut k = vec![0.0];
@@ -965,63 +943,6 @@ fn anchor_ends(points: &mut [Point3], start: &EndRing, finish: &EndRing) {
             }
         }
     }
-}
-
-/// A law over `knots` fitted to the stations' values. With `own_rings`
-/// (the final laws), to those of the stations whose rings are their own
-/// when at least [`MIN_OWN_LAW_STATIONS`] have a value: a widened station's
-/// value (a coarse mesh) leans on the refits' slope across the points it
-/// borrowed, tens of mm away, and swung the law by ±2 mm between the rings
-/// of a coarse export (a bridged one holds none,
-/// [`bridge_between_rings`]). The refits' slope law takes every station
-/// (its knot spacing, [`coupling_gap`], keeps the guide of a coarse bend
-/// smooth).
-fn fit_law(
-    mesh: &TubeMesh,
-    stations: &[Station],
-    knots: &[f64],
-    pick: &dyn Fn(&Station) -> Option<f64>,
-    own_rings: bool,
-) -> Result<Vec<f64>, FitError> {
-    let own = stations
-        .iter()
-        .filter(|s| !s.widened && pick(s).is_some())
-        .count();
-    let all = !own_rings || own < MIN_OWN_LAW_STATIONS;
-    let ok: Vec<(f64, f64, f64)> = stations
-        .iter()
-        .filter(|s| all || !s.widened)
-        .filter_map(|s| pick(s).map(|v| (s.t, v, s.points as f64)))
-        .collect();
-    let ts: Vec<f64> = ok.iter().map(|x| x.0).collect();
-    let w: Vec<f64> = ok.iter().map(|x| x.2).collect();
-    let ys = DMatrix::from_fn(ok.len(), 1, |i, _| ok[i].1);
-    let sol = smooth::fit(knots, &ts, &ys, &w, 1e-6).ok_or_else(|| FitError::Degenerate {
-        file: mesh.file.clone(),
-        station: 0,
-        reason: "the radius law's least-squares system is singular".into(),
-    })?;
-    let v: Vec<f64> = sol.column(0).iter().copied().collect();
-    if let Some(j) = v.iter().position(|&r| !(r > 0.0)) {
-        return Err(FitError::Degenerate {
-            file: mesh.file.clone(),
-            station: j,
-            reason: format!("the fitted law is not positive at t = {:.2} mm", knots[j]),
-        });
-    }
-    Ok(v)
-}
-
-/// Index of the outer skin (larger mean radius), when two.
-fn outer_skin(stations: &[Station]) -> usize {
-    let mean = |k: usize| {
-        let v: Vec<f64> = stations
-            .iter()
-            .filter_map(|s| s.fits.get(k).copied().flatten().map(|f| f.radius))
-            .collect();
-        v.iter().sum::<f64>() / v.len().max(1) as f64
-    };
-    usize::from(stations.first().is_some_and(|s| s.fits.len() == 2) && mean(1) > mean(0))
 }
 
 /// Refuses a section far from a circle, or a run of three sections that are

@@ -37,6 +37,7 @@ mod driver;
 pub mod ends;
 pub mod features;
 mod first_guide;
+mod laws;
 mod mesh;
 mod options;
 mod outcome;

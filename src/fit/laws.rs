@@ -1,0 +1,101 @@
+//! **Stage 0a — a tube from a mesh: its laws** (mesh frame, mm). The radius
+//! and wall-thickness laws fitted to the stations' sections along the
+//! guide (a smoothing cubic over the knots), the knot spacing that keeps
+//! the guide's refit stable where the radius changes, and which of two
+//! skins is the outer one.
+
+use super::outcome::Station;
+use super::{smooth, FitError, TubeMesh};
+use nalgebra::DMatrix;
+
+/// Fewest stations with rings of their own that a radius or thickness law
+/// is fitted to alone, leaving out the widened ones ([`fit_law`]).
+const MIN_OWN_LAW_STATIONS: usize = 3;
+
+/// Shortest knot interval (mm) that keeps the refit stable on a tube whose
+/// radius changes: a guide tilted by `alpha` moves a section's centre by
+/// about `A' A alpha` (the points of one side come from a wider part), so a
+/// wiggle of wavelength `2 h` grows unless `h > pi |A'| A`; 20 % margin.
+pub(super) fn coupling_gap(law: Option<&(Vec<f64>, Vec<f64>)>) -> f64 {
+    let Some((k, v)) = law else { return 0.0 };
+    let m = smooth::natural_second_derivatives(k, v);
+    let mut worst = 0.0_f64;
+    for w in k.windows(2) {
+        for f in [0.0, 0.5, 1.0] {
+            let t = w[0] + f * (w[1] - w[0]);
+            let h = 1e-3 * (w[1] - w[0]);
+            let d = (smooth::eval(k, v, &m, t + h) - smooth::eval(k, v, &m, t - h)) / (2.0 * h);
+            worst = worst.max(d.abs() * smooth::eval(k, v, &m, t));
+        }
+    }
+    1.2 * std::f64::consts::PI * worst
+}
+
+/// A law over `knots` fitted to the stations' values. With `own_rings`
+/// (the final laws), to those of the stations whose rings are their own
+/// when at least [`MIN_OWN_LAW_STATIONS`] have a value: a widened station's
+/// value (a coarse mesh) leans on the refits' slope across the points it
+/// borrowed, tens of mm away, and swung the law by ±2 mm between the rings
+/// of a coarse export (a bridged one holds none,
+/// [`bridge_between_rings`](super::coarse::bridge_between_rings)). The refits' slope law takes every station
+/// (its knot spacing, [`coupling_gap`], keeps the guide of a coarse bend
+/// smooth).
+pub(super) fn fit_law(
+    mesh: &TubeMesh,
+    stations: &[Station],
+    knots: &[f64],
+    pick: &dyn Fn(&Station) -> Option<f64>,
+    own_rings: bool,
+) -> Result<Vec<f64>, FitError> {
+    let own = stations
+        .iter()
+        .filter(|s| !s.widened && pick(s).is_some())
+        .count();
+    let all = !own_rings || own < MIN_OWN_LAW_STATIONS;
+    let ok: Vec<(f64, f64, f64)> = stations
+        .iter()
+        .filter(|s| all || !s.widened)
+        .filter_map(|s| pick(s).map(|v| (s.t, v, s.points as f64)))
+        .collect();
+    let ts: Vec<f64> = ok.iter().map(|x| x.0).collect();
+    let w: Vec<f64> = ok.iter().map(|x| x.2).collect();
+    let ys = DMatrix::from_fn(ok.len(), 1, |i, _| ok[i].1);
+    let sol = smooth::fit(knots, &ts, &ys, &w, 1e-6).ok_or_else(|| FitError::Degenerate {
+        file: mesh.file.clone(),
+        station: 0,
+        reason: "the radius law's least-squares system is singular".into(),
+    })?;
+    let v: Vec<f64> = sol.column(0).iter().copied().collect();
+    if let Some(j) = v.iter().position(|&r| !(r > 0.0)) {
+        let at = knots[j];
+        let station = stations
+            .iter()
+            .enumerate()
+            .min_by(|a, b| (a.1.t - at).abs().total_cmp(&(b.1.t - at).abs()))
+            .map_or(0, |(i, _)| i);
+        let (lo, hi) = ok
+            .iter()
+            .fold((f64::MAX, f64::MIN), |m, x| (m.0.min(x.1), m.1.max(x.1)));
+        return Err(FitError::Degenerate {
+            file: mesh.file.clone(),
+            station,
+            reason: format!(
+                "the law fitted to {} sections' values ({lo:.3} to {hi:.3} mm) is not positive at t = {at:.2} mm: the value changes faster along the guide than the sections hold it (a cone or a cap, not a tube?)",
+                ok.len()
+            ),
+        });
+    }
+    Ok(v)
+}
+
+/// Index of the outer skin (larger mean radius), when two.
+pub(super) fn outer_skin(stations: &[Station]) -> usize {
+    let mean = |k: usize| {
+        let v: Vec<f64> = stations
+            .iter()
+            .filter_map(|s| s.fits.get(k).copied().flatten().map(|f| f.radius))
+            .collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    usize::from(stations.first().is_some_and(|s| s.fits.len() == 2) && mean(1) > mean(0))
+}
