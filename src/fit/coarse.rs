@@ -1,12 +1,14 @@
 //! **Stage 0a — a tube from a mesh: what a coarse export needs** (mesh
 //! frame, mm). A coarse export (rings of vertices far apart along the tube,
 //! straights written as one strip of long triangles) leaves stations with
-//! no ring of their own: how far apart its rings lie and how far its
-//! facets' chords sag inside a curved guide between them (a warning naming
-//! the knots to take), plane cuts for stations that hold no vertex, a
-//! warning when a varying radius is held only at rings far apart, and the
-//! bridge over sections that are not circles (a lug) when the guide is
-//! refitted without them.
+//! no ring of their own: its flat rings of vertices (the exporter's own
+//! samples of the axis and the tangent) and the cubic that bridges the
+//! guide between two of them, plane cuts for stations that hold no vertex,
+//! how far apart its rings lie and how far its facets' chords sag inside a
+//! curved guide between them where no ring bridges them (a warning naming
+//! the knots to take), a warning when a varying radius is held only at
+//! rings far apart, and the bridge over sections that are not circles (a
+//! lug) when the guide is refitted without them.
 
 use super::cut;
 use super::features::runs_of_false;
