@@ -108,6 +108,22 @@ pub fn helix() -> Truth {
     }
 }
 
+/// A coil of `coil_r` mm about Z rising `pitch` mm a turn over `turns`
+/// turns, tube radius `r` mm (VesselMeshGenerator's helical mode).
+pub fn coil(coil_r: f64, pitch: f64, turns: f64, r: f64) -> Truth {
+    let b = pitch / TAU;
+    let k = (coil_r * coil_r + b * b).sqrt();
+    Truth {
+        name: "coil",
+        length: turns * TAU * k,
+        centre: Box::new(move |s| {
+            let th = s / k;
+            Point3::new(coil_r * th.cos(), coil_r * th.sin(), b * th)
+        }),
+        radius: Box::new(move |_| r),
+    }
+}
+
 pub fn swelling() -> Truth {
     let len = 90.0;
     Truth {
