@@ -14,7 +14,8 @@ use super::cut;
 use super::features::runs_of_false;
 use super::outcome::Station;
 use super::samples::Samples;
-use super::section::{fit_circle, fit_plane, plane_basis, station_frames, SectionPoint};
+use super::section::{circle_in_plane, fit_plane, station_frames};
+use super::smooth::{arc_tangent_length, hermite};
 use super::topology::Surfaces;
 use super::{FitOptions, TubeMesh};
 use crate::geometry::guide::{CubicSpline, GuideCurve};
@@ -107,30 +108,22 @@ fn ring_of(
         .sum::<f64>()
         / pts.len() as f64)
         .sqrt();
-    let (e1, e2) = plane_basis(&normal);
     let mut centre = Vector3::zeros();
     for skin in 0..samples.skins {
-        let sp: Vec<SectionPoint> = run
+        let pts: Vec<Point3> = run
             .iter()
             .filter(|&&i| samples.skin[i] as usize == skin)
-            .map(|&i| {
-                let d = samples.pos[i] - c;
-                SectionPoint {
-                    x: d.dot(&e1),
-                    y: d.dot(&e2),
-                    dt: 0.0,
-                }
-            })
+            .map(|&i| samples.pos[i])
             .collect();
-        if sp.len() < MIN_RING_POINTS {
+        if pts.len() < MIN_RING_POINTS {
             return None;
         }
-        let f = fit_circle(&sp, 0.0)?;
+        let (at, f) = circle_in_plane(&pts, &c, &normal)?;
         let allowed = opts.section_rms_allowed(f.radius);
         if f.rms > allowed || flat > allowed || f.max_gap_rad > max_gap_deg.to_radians() {
             return None;
         }
-        centre += c.coords + e1 * f.centre[0] + e2 * f.centre[1];
+        centre += at.coords;
     }
     let tm = run.iter().map(|&i| t[i]).sum::<f64>() / run.len() as f64;
     let along = spline.d1(tm);
@@ -171,14 +164,8 @@ pub(super) fn bridge_between_rings(
     let mut set = 0;
     for w in rings.windows(2) {
         let [Some(a), Some(b)] = w else { continue };
-        let chord = (b.centre - a.centre).norm();
-        let theta = a.normal.angle(&b.normal);
-        let scale = if theta < 1e-6 {
-            chord
-        } else {
-            chord * 2.0 * (theta / 4.0).tan() / (theta / 2.0).sin()
-        };
-        let (m0, m1) = (a.normal * scale, b.normal * scale);
+        let m = arc_tangent_length((b.centre - a.centre).norm(), a.normal.angle(&b.normal));
+        let (m0, m1) = (a.normal * m, b.normal * m);
         let weight = (a.points + b.points) / 2;
         for s in stations.iter_mut() {
             let own = !s.widened && s.centre.is_some();
@@ -193,13 +180,7 @@ pub(super) fn bridge_between_rings(
                 continue;
             }
             let u = (s.t - a.t) / (b.t - a.t);
-            let (u2, u3) = (u * u, u * u * u);
-            s.centre = Some(Point3::from(
-                a.centre.coords * (2.0 * u3 - 3.0 * u2 + 1.0)
-                    + m0 * (u3 - 2.0 * u2 + u)
-                    + b.centre.coords * (-2.0 * u3 + 3.0 * u2)
-                    + m1 * (u3 - u2),
-            ));
+            s.centre = Some(hermite(&a.centre, &m0, &b.centre, &m1, u));
             s.points = weight;
             s.bridged = true;
             set += 1;
@@ -368,14 +349,7 @@ pub(super) fn bridge_not_round(ts: &[f64], centres: &mut [Point3], round: &[bool
         let dir = |p: usize, q: usize| (centres[q] - centres[p]).normalize() * span;
         let (p0, p1, m0, m1) = (centres[a], centres[b], dir(a - 1, a), dir(b, b + 1));
         for k in first..b {
-            let s = (ts[k] - ts[a]) / span;
-            let (s2, s3) = (s * s, s * s * s);
-            centres[k] = Point3::from(
-                p0.coords * (2.0 * s3 - 3.0 * s2 + 1.0)
-                    + m0 * (s3 - 2.0 * s2 + s)
-                    + p1.coords * (-2.0 * s3 + 3.0 * s2)
-                    + m1 * (s3 - s2),
-            );
+            centres[k] = hermite(&p0, &m0, &p1, &m1, (ts[k] - ts[a]) / span);
         }
     }
 }

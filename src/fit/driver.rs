@@ -13,7 +13,9 @@ use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
 use super::outcome::{FeatureKind, FeatureReport};
 use super::samples::{self, carry_hints, project_all, Samples};
-use super::section::{fit_circle, fit_plane, plane_basis, station_frames, CircleFit, SectionPoint};
+use super::section::{
+    circle_in_plane, fit_circle, fit_plane, station_frames, CircleFit, SectionPoint,
+};
 use super::topology::{self, median_edge, Surfaces};
 use super::{cut, ends, repair, report};
 use super::{smooth, FitError, FitOptions, StartEnd, TubeMesh, Units};
@@ -173,10 +175,11 @@ pub fn fit_tube(mesh: &TubeMesh, opts: &FitOptions) -> Result<TubeFit, FitError>
 /// that fails as well: a mesh that fits on its vertices is fitted as before.
 ///
 /// A coarse export whose rings of vertices lie further apart along the
-/// guide than its knots allow gets a warning ([`Coarseness::warning`])
-/// (unless [`FitOptions::knot_spacing_mm`] is set): between its rings no
-/// vertex holds the guide, which then follows the facets' chords, inside a
-/// curved tube.
+/// guide than its knots allow, and are not flat rings that bridge the guide
+/// between them ([`bridge_between_rings`]), gets a warning
+/// ([`Coarseness::warning`]) (unless [`FitOptions::knot_spacing_mm`] is
+/// set): between its rings no vertex holds the guide, which then follows
+/// the facets' chords, inside a curved tube.
 fn fit_in_mm(mesh: &TubeMesh, opts: &FitOptions, trimmed: bool) -> Result<TubeFit, FitError> {
     let mut coarse = Coarseness::default();
     let mut fit = fit_passes(mesh, opts, trimmed, &mut coarse)?;
@@ -304,7 +307,7 @@ fn fit_pass(
         } else {
             sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0)
         };
-        bridge_then_cut(
+        cut_then_bridge(
             (mesh, &surf, &samples, &t),
             (&spline, range, spacing, r0),
             &mut stations,
@@ -412,7 +415,7 @@ fn fit_pass(
         PROJECT_PAST_END_RADII * r0,
     );
     let mut stations = sections(&spline, range, spacing, &samples, &t, slope.as_ref(), r0);
-    coarse.bridged = bridge_then_cut(
+    coarse.bridged = cut_then_bridge(
         (mesh, &surf, &samples, &t),
         (&spline, range, spacing, r0),
         &mut stations,
@@ -511,7 +514,7 @@ fn fit_pass(
 /// `data`: the mesh, its surfaces, the samples and their guide parameters;
 /// `at`: the guide, its range, the stations' spacing and the end radius
 /// (mm). Returns how many stations it bridged.
-fn bridge_then_cut(
+fn cut_then_bridge(
     data: (&TubeMesh, &Surfaces, &Samples, &[f64]),
     at: (&CubicSpline, (f64, f64), f64, f64),
     stations: &mut [Station],
@@ -660,17 +663,8 @@ fn ring(mesh: &TubeMesh, vertices: &[u32]) -> Option<(Point3, UnitVector3, f64)>
         .map(|&v| mesh.vertices[v as usize])
         .collect();
     let (c, n, _) = fit_plane(&pts)?;
-    let (e1, e2) = plane_basis(&n);
-    let sp: Vec<SectionPoint> = pts
-        .iter()
-        .map(|p| SectionPoint {
-            x: (p - c).dot(&e1),
-            y: (p - c).dot(&e2),
-            dt: 0.0,
-        })
-        .collect();
-    let f = fit_circle(&sp, 0.0)?;
-    Some((c + e1 * f.centre[0] + e2 * f.centre[1], n, f.radius))
+    let (centre, f) = circle_in_plane(&pts, &c, &n)?;
+    Some((centre, n, f.radius))
 }
 
 /// The two open ends, each averaged over the skins (loops paired by nearest centre).

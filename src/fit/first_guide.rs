@@ -7,6 +7,7 @@
 
 use super::cut;
 use super::outcome::EndRing;
+use super::smooth::{arc_tangent_length, hermite};
 use super::topology::{self, Surfaces};
 use super::{FitError, TubeMesh};
 use crate::math::{Point3, UnitVector3};
@@ -127,22 +128,9 @@ fn end_cubic(start: &EndRing, finish: &EndRing, n: usize) -> Vec<Point3> {
     if d0.dot(&chord) < 0.3 * c || d1.dot(&chord) < 0.3 * c || turn > 0.75 * std::f64::consts::PI {
         return vec![Point3::from((p0.coords + p1.coords) / 2.0)];
     }
-    // A circular arc of turn θ and chord c: end tangents of length
-    // 4 tan(θ / 4) R with R = c / (2 sin(θ / 2)); c when straight.
-    let m = if turn < 1e-6 {
-        c
-    } else {
-        4.0 * (turn / 4.0).tan() * c / (2.0 * (turn / 2.0).sin())
-    };
+    let m = arc_tangent_length(c, turn);
+    let (m0, m1) = (d0 * m, d1 * m);
     (1..n)
-        .map(|i| {
-            let u = i as f64 / n as f64;
-            let (u2, u3) = (u * u, u * u * u);
-            let h00 = 2.0 * u3 - 3.0 * u2 + 1.0;
-            let h10 = u3 - 2.0 * u2 + u;
-            let h01 = -2.0 * u3 + 3.0 * u2;
-            let h11 = u3 - u2;
-            Point3::from(p0.coords * h00 + d0 * (m * h10) + p1.coords * h01 + d1 * (m * h11))
-        })
+        .map(|i| hermite(&p0, &m0, &p1, &m1, i as f64 / n as f64))
         .collect()
 }

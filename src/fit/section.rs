@@ -154,6 +154,27 @@ pub fn fit_plane(points: &[Point3]) -> Option<(Point3, UnitVector3, f64)> {
     max.is_finite().then_some((Point3::from(c), normal, max))
 }
 
+/// The least-squares circle of `pts` seen in the plane through `origin`
+/// with unit `normal` (mm, slope 0): its centre (mesh frame, mm) and the
+/// fit. `None` as [`fit_circle`].
+pub fn circle_in_plane(
+    pts: &[Point3],
+    origin: &Point3,
+    normal: &UnitVector3,
+) -> Option<(Point3, CircleFit)> {
+    let (e1, e2) = plane_basis(normal);
+    let sp: Vec<SectionPoint> = pts
+        .iter()
+        .map(|p| SectionPoint {
+            x: (p - origin).dot(&e1),
+            y: (p - origin).dot(&e2),
+            dt: 0.0,
+        })
+        .collect();
+    let f = fit_circle(&sp, 0.0)?;
+    Some((origin + e1 * f.centre[0] + e2 * f.centre[1], f))
+}
+
 /// Two unit vectors completing `normal` to a right-handed orthonormal basis.
 pub fn plane_basis(normal: &UnitVector3) -> (Vector3, Vector3) {
     let pick = if normal.x.abs() < 0.6 {

@@ -6,6 +6,7 @@
 //! the second differences keeps knot intervals without data determined.
 //! Solved by nalgebra's Cholesky factorisation of the normal equations.
 
+use crate::math::{Point3, Vector3};
 use nalgebra::{DMatrix, DVector};
 
 /// Second derivatives of the natural cubic spline through `(knots, values)`.
@@ -171,6 +172,30 @@ pub fn graded_knots(length: f64, spacing: f64, min_gap: f64) -> Vec<f64> {
     let last = knots.len() - 1;
     knots[last] = length;
     knots
+}
+
+/// The cubic Hermite from `p0` to `p1` with end tangents `m0`, `m1` (mm
+/// per unit of `u`) at `u` in [0, 1] (mm, the points' frame).
+pub(super) fn hermite(p0: &Point3, m0: &Vector3, p1: &Point3, m1: &Vector3, u: f64) -> Point3 {
+    let (u2, u3) = (u * u, u * u * u);
+    Point3::from(
+        p0.coords * (2.0 * u3 - 3.0 * u2 + 1.0)
+            + m0 * (u3 - 2.0 * u2 + u)
+            + p1.coords * (-2.0 * u3 + 3.0 * u2)
+            + m1 * (u3 - u2),
+    )
+}
+
+/// The end tangents' length (mm) that makes [`hermite`] between two points
+/// `chord` mm apart a circular arc when its unit end directions turn by
+/// `turn` (rad): 4 tan(turn / 4) R with R = chord / (2 sin(turn / 2));
+/// the chord when straight.
+pub(super) fn arc_tangent_length(chord: f64, turn: f64) -> f64 {
+    if turn < 1e-6 {
+        chord
+    } else {
+        4.0 * (turn / 4.0).tan() * chord / (2.0 * (turn / 2.0).sin())
+    }
 }
 
 #[cfg(test)]
