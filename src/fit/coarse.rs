@@ -332,19 +332,35 @@ pub(super) fn fill_from_cuts(
 /// stations that are not `round` by the cubic (Hermite) between the round
 /// centres either side, leaving each along the direction of the two round
 /// centres behind it with the run's length in `t`: within a bend, close to
-/// its arc. A run at an end, or with fewer than two round stations on a side,
-/// is left as it is.
+/// its arc. A run at an end (a flange or a block holding the open end) is
+/// the straight line on from the two round centres beside it. A run with
+/// fewer than two round stations on a side is left as it is.
 pub(super) fn bridge_not_round(ts: &[f64], centres: &mut [Point3], round: &[bool]) {
     let n = ts.len();
     for run in runs_of_false(round) {
-        let (first, i) = (run.start, run.end);
+        let (first, b) = (run.start, run.end);
         // Round stations a - 1, a before the run and b, b + 1 after it.
-        let (Some(a), b) = (first.checked_sub(1), i) else {
-            continue;
+        let before = first.checked_sub(1).filter(|&a| a > 0 && round[a - 1]);
+        let after = (b + 1 < n && round[b + 1]).then_some(b);
+        let (a, b) = match (before, after, first == 0, b == n) {
+            (Some(a), Some(b), _, _) => (a, b),
+            // At an end: on along the line of the two round centres.
+            (None, Some(b), true, false) => {
+                let d = (centres[b + 1] - centres[b]) / (ts[b + 1] - ts[b]);
+                for k in first..b {
+                    centres[k] = centres[b] + d * (ts[k] - ts[b]);
+                }
+                continue;
+            }
+            (Some(a), None, false, true) => {
+                let d = (centres[a] - centres[a - 1]) / (ts[a] - ts[a - 1]);
+                for k in run {
+                    centres[k] = centres[a] + d * (ts[k] - ts[a]);
+                }
+                continue;
+            }
+            _ => continue,
         };
-        if a == 0 || !round[a - 1] || b + 1 >= n || !round[b + 1] {
-            continue;
-        }
         let span = ts[b] - ts[a];
         let dir = |p: usize, q: usize| (centres[q] - centres[p]).normalize() * span;
         let (p0, p1, m0, m1) = (centres[a], centres[b], dir(a - 1, a), dir(b, b + 1));
@@ -451,5 +467,37 @@ mod tests {
         assert_eq!(s.centre, Some(Point3::new(0.0, 0.0, 15.0)));
         assert_eq!(s.radius, None);
         assert!(!s.bridged);
+    }
+
+    /// Runs not round at both ends (a flange on each) go on along the line
+    /// of the two round centres beside them; a run between them takes the
+    /// cubic, here on the same line; a run with one round centre beside it
+    /// stays.
+    #[test]
+    fn runs_not_round_at_the_ends_go_on_straight() {
+        let line = |t: f64| Point3::new(1.0 + 0.6 * t, -2.0, 0.8 * t);
+        let ts: Vec<f64> = (0..10).map(f64::from).collect();
+        let round = [
+            false, false, true, true, false, true, true, true, false, false,
+        ];
+        let pulled = Vector3::new(4.0, 0.0, 0.0);
+        let mut centres: Vec<Point3> = ts
+            .iter()
+            .zip(&round)
+            .map(|(&t, &r)| if r { line(t) } else { line(t) + pulled })
+            .collect();
+        bridge_not_round(&ts, &mut centres, &round);
+        for (c, &t) in centres.iter().zip(&ts) {
+            assert!(
+                (c - line(t)).norm() < 1e-12,
+                "t {t}: {c} against {}",
+                line(t)
+            );
+        }
+        let round = [true, false, true, true, true];
+        let mut centres: Vec<Point3> = (0..5).map(|i| line(f64::from(i)) + pulled).collect();
+        let before = centres.clone();
+        bridge_not_round(&ts[..5], &mut centres, &round);
+        assert_eq!(centres, before);
     }
 }

@@ -9,9 +9,9 @@ use super::features;
 use super::first_guide::first_guide;
 use super::laws::{coupling_gap, fit_law, outer_skin};
 use super::options::units_warning;
+use super::outcome::FeatureReport;
 use super::outcome::RepairReport;
 use super::outcome::{EndRing, FitReport, Station, TubeFit};
-use super::outcome::{FeatureKind, FeatureReport};
 use super::samples::{self, carry_hints, project_all, Samples};
 use super::section::{
     circle_in_plane, fit_circle, fit_plane, station_frames, CircleFit, SectionPoint,
@@ -86,10 +86,15 @@ const WIDEN_GAP_DEG: f64 = 60.0;
 /// sections that are not yet circles. Otherwise from the second.
 const CHECK_SECTIONS_AFTER: usize = 6;
 /// Refits to the round sections alone (dimensionless count) after the
-/// vertices' pass first fails its check with no feature named, or a lug:
-/// a feature on one side pulls the guide towards it until its sections no
-/// longer steer the guide; then the sections are read for features again.
+/// vertices' pass first fails its check: a feature pulls the guide towards
+/// it (a lug on one side, a flange holding an open end) until its sections
+/// no longer steer the guide; then the sections are read for features.
 const FEATURE_REFITS: usize = 4;
+/// With [`FitOptions::trim`], the tube is cut this far (in tube radii) past
+/// the extent of a feature beside it along the guide: the guide's normal
+/// plane there clears the feature's side (a flange's face) on a guide a
+/// little off its axis.
+const TRIM_MARGIN_RADII: f64 = 0.05;
 /// Most refits with the points along a coarse bend's edges (dimensionless
 /// count); then the vertices alone.
 const EDGE_REFITS: usize = 8;
@@ -320,20 +325,7 @@ fn fit_pass(
                 // as before).
                 (Ok(()), Some((first, _))) => return Err(first),
                 (Err(e), None) => {
-                    let lug_or_none = pass == Pass::Vertices && {
-                        let cx = (
-                            mesh,
-                            &surf,
-                            &spline,
-                            &stations[..],
-                            &samples,
-                            &t[..],
-                            2.0 * r0,
-                        );
-                        let found = named_features(cx, opts);
-                        found.is_empty() || found.iter().any(|f| f.kind == FeatureKind::Lug)
-                    };
-                    if lug_or_none {
+                    if pass == Pass::Vertices {
                         postponed = Some((e, iterations));
                     } else if let Some(exit) = failed(&spline, &stations, &samples, &t) {
                         return exit;
@@ -1088,15 +1080,6 @@ fn feature_error(mesh: &TubeMesh, f: &FeatureReport, count: usize) -> FitError {
     }
 }
 
-/// The features that are not tube that the sections of `cx` show
-/// ([`features::detect`] on the vertices).
-fn named_features(cx: NotTube<'_>, opts: &FitOptions) -> Vec<FeatureReport> {
-    let (_, _, spline, stations, samples, t, _) = cx;
-    let nv = samples.vertices;
-    let pos = &samples.pos[..nv];
-    features::detect(spline, stations, pos, &samples.skin[..nv], &t[..nv], opts).1
-}
-
 /// Sections that failed `error`: features that are not tube refused by
 /// name, or with [`FitOptions::trim`] the longest tubular stretch cut out
 /// and fitted (once: `trimmed`); `error` itself when no feature is found.
@@ -1137,8 +1120,21 @@ fn not_tube(
     }) else {
         return Err(feature_error(mesh, first, found.len()));
     };
-    let t_lo = (a > 0).then(|| stations[a].t);
-    let t_hi = (b + 1 < n).then(|| stations[b].t);
+    // Cut a little past the features beside the stretch (their points'
+    // extent along the guide), not at its first round station: the stretch
+    // keeps the tube up to the feature.
+    let t0 = stations[0].t;
+    let margin = TRIM_MARGIN_RADII * 0.5 * reach;
+    let t_lo = (a > 0).then(|| {
+        let edge = found.iter().filter(|f| f.last_station < a);
+        edge.fold(stations[a - 1].t, |x, f| x.max(t0 + f.t_to_mm + margin))
+            .min(stations[a].t)
+    });
+    let t_hi = (b + 1 < n).then(|| {
+        let edge = found.iter().filter(|f| f.first_station > b);
+        edge.fold(stations[b + 1].t, |x, f| x.min(t0 + f.t_from_mm - margin))
+            .max(stations[b].t)
+    });
     let mut t_of = vec![None; mesh.vertices.len()];
     let skin_vertices = surf.skins.iter().flat_map(|s| s.vertices.iter());
     for (&v, &tv) in skin_vertices.zip(t) {

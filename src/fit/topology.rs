@@ -195,7 +195,8 @@ pub fn surfaces(mesh: &TubeMesh, opts: &FitOptions) -> Result<Surfaces, FitError
         if loops.len() >= 3 {
             return Err(branch_error(mesh, &comp, &loops));
         }
-        if let Ok(pair) = <[Vec<u32>; 2]>::try_from(loops) {
+        if loops.len() == 2 && !concentric(mesh, &loops) {
+            let pair = <[Vec<u32>; 2]>::try_from(loops).expect("two loops");
             out.skins.push(Skin {
                 vertices: vertices_of(mesh, &comp),
                 triangles: comp,
@@ -206,27 +207,20 @@ pub fn surfaces(mesh: &TubeMesh, opts: &FitOptions) -> Result<Surfaces, FitError
         let faces = pieces(mesh, &comp, |a, b| {
             normals[a as usize].dot(&normals[b as usize]).abs() >= cos_crease
         });
+        let flat: Vec<Option<Cap>> = faces.iter().map(|f| flat_face(mesh, f)).collect();
         let small_face = (comp.len() / 200).max(1);
-        for face in faces {
-            let vertices = vertices_of(mesh, &face);
-            let pts: Vec<Point3> = vertices
-                .iter()
-                .map(|&v| mesh.vertices[v as usize])
-                .collect();
-            if let Some((centroid, normal, dev)) = fit_plane(&pts) {
-                let extent = pts
-                    .iter()
-                    .map(|p| (p - centroid).norm())
-                    .fold(0.0, f64::max);
-                if dev <= 1e-4 * extent + 1e-3 {
-                    out.caps.push(Cap {
-                        vertices,
-                        centroid,
-                        normal,
-                    });
+        for group in steps_joined(mesh, &faces, &flat) {
+            if let [i] = group[..] {
+                if let Some(cap) = &flat[i] {
+                    out.caps.push(cap.clone());
                     continue;
                 }
             }
+            let face: Vec<u32> = group
+                .iter()
+                .flat_map(|&i| faces[i].iter().copied())
+                .collect();
+            let vertices = vertices_of(mesh, &face);
             if face.len() < small_face {
                 out.ignored_triangles += face.len();
                 continue;
@@ -268,6 +262,101 @@ pub fn surfaces(mesh: &TubeMesh, opts: &FitOptions) -> Result<Surfaces, FitError
         });
     }
     Ok(out)
+}
+
+/// Two open ends about one centre (within a twentieth of the smaller's
+/// mean radius): the two skins of a wall opened at one end (a wall trimmed
+/// at a feature), not one skin from end to end.
+fn concentric(mesh: &TubeMesh, loops: &[Vec<u32>]) -> bool {
+    let ring = |l: &[u32]| {
+        let pts: Vec<Point3> = l.iter().map(|&v| mesh.vertices[v as usize]).collect();
+        let c = Point3::from(
+            pts.iter()
+                .fold(crate::math::Vector3::zeros(), |a, p| a + p.coords)
+                / pts.len() as f64,
+        );
+        let r = pts.iter().map(|p| (p - c).norm()).sum::<f64>() / pts.len() as f64;
+        (c, r)
+    };
+    let ((c0, r0), (c1, r1)) = (ring(&loops[0]), ring(&loops[1]));
+    (c1 - c0).norm() < 0.05 * r0.min(r1)
+}
+
+/// `face` as a flat face (its vertices within 1e-4 of its size plus 1 µm
+/// of a plane), else `None`.
+fn flat_face(mesh: &TubeMesh, face: &[u32]) -> Option<Cap> {
+    let vertices = vertices_of(mesh, face);
+    let pts: Vec<Point3> = vertices
+        .iter()
+        .map(|&v| mesh.vertices[v as usize])
+        .collect();
+    let (centroid, normal, dev) = fit_plane(&pts)?;
+    let extent = pts
+        .iter()
+        .map(|p| (p - centroid).norm())
+        .fold(0.0, f64::max);
+    (dev <= 1e-4 * extent + 1e-3).then_some(Cap {
+        vertices,
+        centroid,
+        normal,
+    })
+}
+
+/// The faces of a closed piece (`faces`, `flat` their flat-face fits)
+/// grouped into surfaces: a flat face whose neighbouring faces lie on both
+/// sides of its plane is a step on one skin (a flange's or a collar's
+/// side, a block's top), joined with them; a flat face whose neighbours
+/// all lie on one side closes an end (a cap). Groups of face indices.
+fn steps_joined(mesh: &TubeMesh, faces: &[Vec<u32>], flat: &[Option<Cap>]) -> Vec<Vec<usize>> {
+    let face_of: HashMap<u32, usize> = faces
+        .iter()
+        .enumerate()
+        .flat_map(|(i, f)| f.iter().map(move |&t| (t, i)))
+        .collect();
+    let all: Vec<u32> = faces.iter().flatten().copied().collect();
+    let mut next: Vec<Vec<usize>> = vec![Vec::new(); faces.len()];
+    for group in edges(mesh, &all).chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)) {
+        for w in group.windows(2) {
+            let (a, b) = (face_of[&w[0].2], face_of[&w[1].2]);
+            if a != b {
+                next[a].push(b);
+                next[b].push(a);
+            }
+        }
+    }
+    let mut uf = UnionFind::new(faces.len());
+    for (i, cap) in flat.iter().enumerate() {
+        let Some(cap) = cap else { continue };
+        next[i].sort_unstable();
+        next[i].dedup();
+        let extent = cap
+            .vertices
+            .iter()
+            .map(|&v| (mesh.vertices[v as usize] - cap.centroid).norm())
+            .fold(0.0, f64::max);
+        let tol = 1e-4 * extent + 1e-3;
+        let (mut above, mut below) = (false, false);
+        for &j in &next[i] {
+            let (lo, hi) = vertices_of(mesh, &faces[j])
+                .iter()
+                .map(|&v| (mesh.vertices[v as usize] - cap.centroid).dot(&cap.normal))
+                .fold((0.0_f64, 0.0_f64), |a, x| (a.0.min(x), a.1.max(x)));
+            above |= hi > tol && lo >= -tol;
+            below |= lo < -tol && hi <= tol;
+        }
+        if above && below {
+            for &j in &next[i] {
+                uf.union(i as u32, j as u32);
+            }
+        }
+    }
+    let mut by_root: HashMap<u32, Vec<usize>> = HashMap::new();
+    for i in 0..faces.len() {
+        by_root.entry(uf.find(i as u32)).or_default().push(i);
+    }
+    let mut out: Vec<Vec<usize>> = by_root.into_values().collect();
+    out.sort_unstable();
+    out
 }
 
 /// The branch error of a piece with three open ends or more: names the first

@@ -171,6 +171,127 @@ fn a_separate_tab_is_named_with_its_place_and_size() {
     assert!(r.start.kind == EndKind::Open && r.end.kind == EndKind::Open);
 }
 
+/// The pipe's features named, each a flange of `z` (mm along the axis),
+/// 15 mm high and 50 mm across: within a station spacing `h` along the
+/// guide, 0.2 mm in height and 0.4 mm across (the flange tests above).
+fn flanges_named(fs: &[FeatureReport], z: &[(f64, f64)], h: f64) {
+    assert_eq!(fs.len(), z.len(), "{fs:?}");
+    for (f, &(z0, z1)) in fs.iter().zip(z) {
+        assert_eq!(f.kind, FeatureKind::Flange, "{f:?}");
+        assert!(
+            (f.centre_mm[2] - 0.5 * (z0 + z1)).abs() <= h
+                && (f.length_mm - (z1 - z0)).abs() <= h
+                && (f.height_mm - 15.0).abs() <= 0.2
+                && (f.across_mm[1] - 50.0).abs() <= 0.4,
+            "{f:?}"
+        );
+    }
+}
+
+/// The fitted stretch's ends along the axis (z, mm), lowest first.
+fn kept(p: &FittedPart) -> (f64, f64) {
+    let r = p.report();
+    let (a, b) = (r.start.centre_mm[2], r.end.centre_mm[2]);
+    (a.min(b), a.max(b))
+}
+
+/// A pipe wall exported as a solid (bore r 8, outer skin r 10, z = 0 to 80,
+/// ring faces at both ends) with a flange of radius 25 from z = 37 to 40.
+/// Split at its creases, the flange's flat sides were caps and its rim a
+/// skin of its own: "4 tube surfaces" refused it. The flange's sides stand
+/// between skins on both sides of their plane: a step on the outer skin.
+/// Refused naming the flange; trimmed, the longer stretch (40 to 80) keeps
+/// its ring-capped end and its wall: mid-surface radius 9, 2 mm thick.
+#[test]
+fn a_solid_wall_with_a_flange_is_named_with_its_place_and_size() {
+    let mesh = gen::flanged_wall(8.0, 10.0, 80.0, &[(37.0, 40.0, 25.0)], 64);
+    let e = fit(&mesh, "flanged.stl", false).unwrap_err();
+    let msg = e.to_string();
+    let Error::Fit(FitError::Feature { kind, .. }) = e else {
+        panic!("{msg}")
+    };
+    assert_eq!(kind, "flange", "{msg}");
+    let p = fit(&mesh, "flanged.stl", true).unwrap();
+    let r = p.report();
+    flanges_named(&r.features, &[(37.0, 40.0)], spacing(&p));
+    let (lo, hi) = kept(&p);
+    assert!(
+        (40.0..=41.5).contains(&lo) && (hi - 80.0).abs() < 1e-6,
+        "{lo} {hi}"
+    );
+    let kinds = [r.start.kind, r.end.kind];
+    assert!(
+        kinds.contains(&EndKind::Trimmed) && kinds.contains(&EndKind::RingCapped),
+        "{kinds:?}"
+    );
+    let wall = r.wall.as_ref().expect("two skins");
+    assert!((wall.mean_mm - 2.0).abs() < 0.01, "{wall:?}");
+    assert!(
+        (r.radius_min_mm - 9.0).abs() < 0.01 && (r.radius_max_mm - 9.0).abs() < 0.01,
+        "{} {}",
+        r.radius_min_mm,
+        r.radius_max_mm
+    );
+    assert!(r.rms_mm < 0.01, "{}", r.rms_mm);
+}
+
+/// A spool: flanges of radius 25, 3 mm thick, at both ends of a pipe of
+/// radius 10 from z = 0 to 80 (the feature holds the open end), as a solid
+/// wall (bore r 8), as one skin with the flanges' faces back to the pipe's
+/// radius, and as one skin open at the flanges' rims. Before, the guide
+/// bent towards the flange at the start (its sections were left as they
+/// were in the refits to the round ones) and the flange there went unnamed
+/// or was named a lug or a block, and the rims' spool was refused. Now both
+/// flanges are named; trimmed, the tube between them is kept: cut within
+/// 1.5 mm of each flange (never into it).
+#[test]
+fn a_spool_flanged_at_both_ends_keeps_the_tube_between_its_flanges() {
+    let flanges = [(0.0, 3.0, 25.0), (77.0, 80.0, 25.0)];
+    let skin = |faces: bool| {
+        let mut rings = Vec::new();
+        if faces {
+            rings.push(gen::circle_z(64, 10.0, 0.0));
+        }
+        rings.extend(gen::pipe_rings(64, 25.0, 0.0, 3.0, 1.0));
+        rings.extend(gen::pipe_rings(64, 10.0, 3.0, 77.0, 1.0));
+        rings.extend(gen::pipe_rings(64, 25.0, 77.0, 80.0, 1.0));
+        if faces {
+            rings.push(gen::circle_z(64, 10.0, 80.0));
+        }
+        gen::lofted(&rings)
+    };
+    for (name, mesh) in [
+        (
+            "solid.stl",
+            gen::flanged_wall(8.0, 10.0, 80.0, &flanges, 64),
+        ),
+        ("faces.stl", skin(true)),
+        ("rims.stl", skin(false)),
+    ] {
+        let msg = fit(&mesh, name, false).unwrap_err().to_string();
+        assert!(
+            msg.starts_with(&format!("{name}: not a tube: a flange at stations 0 to"))
+                && msg.contains("(and 1 more)"),
+            "{msg}"
+        );
+        let p = fit(&mesh, name, true).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let r = p.report();
+        flanges_named(&r.features, &[(0.0, 3.0), (77.0, 80.0)], 2.0 * spacing(&p));
+        let (lo, hi) = kept(&p);
+        assert!(
+            (3.0..=4.5).contains(&lo) && (75.5..=77.0).contains(&hi),
+            "{name}: kept {lo} to {hi}"
+        );
+        assert!(
+            r.start.kind == EndKind::Trimmed && r.end.kind == EndKind::Trimmed,
+            "{name}: {:?} {:?}",
+            r.start.kind,
+            r.end.kind
+        );
+        assert!(r.rms_mm < 0.01, "{name}: {}", r.rms_mm);
+    }
+}
+
 /// A tube that fits is the same with `trim`.
 #[test]
 fn trim_leaves_a_tube_without_features_as_it_is() {

@@ -663,6 +663,38 @@ pub fn collared_pipe(
     lofted(&rings)
 }
 
+/// A pipe wall exported as a solid: watertight, two skins about the z axis
+/// from z = 0 to `len`, the bore of radius `r_in` and the outer skin of
+/// radius `r_out` except on each of `flanges` (`z0`, `z1`, radius: sorted,
+/// apart), where it stands out to the flange's radius, joined by flat steps;
+/// flat ring faces close both ends, from the bore to the outer skin there.
+/// Rings 1 mm apart, `around` points each; the seam ring where the start's
+/// face meets the outer skin is written twice (the fit welds it).
+pub fn flanged_wall(
+    r_in: f64,
+    r_out: f64,
+    len: f64,
+    flanges: &[(f64, f64, f64)],
+    around: usize,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let mut rings = Vec::new();
+    let mut z = 0.0;
+    for &(z0, z1, r) in flanges {
+        if z0 > z {
+            rings.extend(pipe_rings(around, r_out, z, z0, 1.0));
+        }
+        rings.extend(pipe_rings(around, r, z0, z1, 1.0));
+        z = z1;
+    }
+    if z < len {
+        rings.extend(pipe_rings(around, r_out, z, len, 1.0));
+    }
+    let start = rings[0].clone();
+    rings.extend(pipe_rings(around, r_in, 0.0, len, 1.0).into_iter().rev());
+    rings.push(start);
+    lofted(&rings)
+}
+
 /// A straight pipe of radius `r` about the z axis from z = 0 to `len` with
 /// a lug on one side from z = `z0` to `z1`: the wall's points within
 /// `half_deg` degrees of the +x axis stand out at radius `outer` there,
