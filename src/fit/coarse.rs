@@ -328,44 +328,53 @@ pub(super) fn fill_from_cuts(
     }
 }
 
+/// An end of the tube for [`bridge_not_round`]: its guide parameter (mm),
+/// its ring's centre (mesh frame, mm) and unit normal (either sense).
+pub(super) type EndAnchor = (f64, Point3, Vector3);
+
 /// Replaces the centres (mm, at guide parameters `ts`, mm) of each run of
 /// stations that are not `round` by the cubic (Hermite) between the round
 /// centres either side, leaving each along the direction of the two round
 /// centres behind it with the run's length in `t`: within a bend, close to
-/// its arc. A run at an end (a flange or a block holding the open end) is
-/// the straight line on from the two round centres beside it. A run with
-/// fewer than two round stations on a side is left as it is.
-pub(super) fn bridge_not_round(ts: &[f64], centres: &mut [Point3], round: &[bool]) {
+/// its arc. A run at an end (a flange or a block holding it) runs to that
+/// end's centre, arriving along its normal: `ends`, the start's and the
+/// finish's guide parameter (mm), centre (mesh frame, mm) and unit normal
+/// (either sense). A run with fewer than two round stations on a side
+/// within the tube is left as it is.
+pub(super) fn bridge_not_round(
+    ts: &[f64],
+    centres: &mut [Point3],
+    round: &[bool],
+    ends: [EndAnchor; 2],
+) {
     let n = ts.len();
     for run in runs_of_false(round) {
-        let (first, b) = (run.start, run.end);
-        // Round stations a - 1, a before the run and b, b + 1 after it.
-        let before = first.checked_sub(1).filter(|&a| a > 0 && round[a - 1]);
-        let after = (b + 1 < n && round[b + 1]).then_some(b);
-        let (a, b) = match (before, after, first == 0, b == n) {
-            (Some(a), Some(b), _, _) => (a, b),
-            // At an end: on along the line of the two round centres.
-            (None, Some(b), true, false) => {
-                let d = (centres[b + 1] - centres[b]) / (ts[b + 1] - ts[b]);
-                for k in first..b {
-                    centres[k] = centres[b] + d * (ts[k] - ts[b]);
-                }
-                continue;
-            }
-            (Some(a), None, false, true) => {
-                let d = (centres[a] - centres[a - 1]) / (ts[a] - ts[a - 1]);
-                for k in run {
-                    centres[k] = centres[a] + d * (ts[k] - ts[a]);
-                }
-                continue;
+        let unit = |p: usize, q: usize| (centres[q] - centres[p]).normalize();
+        // Each side: (guide parameter, point, unit direction along the guide).
+        let from = match run.start.checked_sub(1) {
+            Some(a) if a > 0 && round[a - 1] => (ts[a], centres[a], unit(a - 1, a)),
+            None if run.end < n => {
+                let (t, c, normal) = ends[0];
+                (t, c, normal * normal.dot(&(centres[run.end] - c)).signum())
             }
             _ => continue,
         };
-        let span = ts[b] - ts[a];
-        let dir = |p: usize, q: usize| (centres[q] - centres[p]).normalize() * span;
-        let (p0, p1, m0, m1) = (centres[a], centres[b], dir(a - 1, a), dir(b, b + 1));
-        for k in first..b {
-            centres[k] = hermite(&p0, &m0, &p1, &m1, (ts[k] - ts[a]) / span);
+        let b = run.end;
+        let to = if b + 1 < n && round[b + 1] {
+            (ts[b], centres[b], unit(b, b + 1))
+        } else if b == n && run.start > 0 {
+            let (t, c, normal) = ends[1];
+            (t, c, normal * normal.dot(&(c - from.1)).signum())
+        } else {
+            continue;
+        };
+        let span = to.0 - from.0;
+        if span <= 0.0 {
+            continue;
+        }
+        let (m0, m1) = (from.2 * span, to.2 * span);
+        for k in run {
+            centres[k] = hermite(&from.1, &m0, &to.1, &m1, (ts[k] - from.0) / span);
         }
     }
 }
@@ -469,10 +478,10 @@ mod tests {
         assert!(!s.bridged);
     }
 
-    /// Runs not round at both ends (a flange on each) go on along the line
-    /// of the two round centres beside them; a run between them takes the
-    /// cubic, here on the same line; a run with one round centre beside it
-    /// stays.
+    /// Runs not round at both ends (a flange on each) run to the ends'
+    /// centres, here on the line of the round centres; a run between them
+    /// takes the cubic, on the same line; a run with one round centre
+    /// beside it stays.
     #[test]
     fn runs_not_round_at_the_ends_go_on_straight() {
         let line = |t: f64| Point3::new(1.0 + 0.6 * t, -2.0, 0.8 * t);
@@ -486,7 +495,9 @@ mod tests {
             .zip(&round)
             .map(|(&t, &r)| if r { line(t) } else { line(t) + pulled })
             .collect();
-        bridge_not_round(&ts, &mut centres, &round);
+        let u = Vector3::new(0.6, 0.0, 0.8);
+        let ends = [(-1.0, line(-1.0), -u), (10.0, line(10.0), u)];
+        bridge_not_round(&ts, &mut centres, &round, ends);
         for (c, &t) in centres.iter().zip(&ts) {
             assert!(
                 (c - line(t)).norm() < 1e-12,
@@ -497,7 +508,7 @@ mod tests {
         let round = [true, false, true, true, true];
         let mut centres: Vec<Point3> = (0..5).map(|i| line(f64::from(i)) + pulled).collect();
         let before = centres.clone();
-        bridge_not_round(&ts[..5], &mut centres, &round);
+        bridge_not_round(&ts[..5], &mut centres, &round, ends);
         assert_eq!(centres, before);
     }
 }

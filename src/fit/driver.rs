@@ -4,7 +4,7 @@
 //! fits the radius law (and wall thickness) and measures the residuals.
 
 use super::coarse::{bridge_between_rings, vertex_rings};
-use super::coarse::{bridge_not_round, fill_from_cuts, sparse_rings, Coarseness};
+use super::coarse::{bridge_not_round, fill_from_cuts, sparse_rings, Coarseness, EndAnchor};
 use super::features;
 use super::first_guide::first_guide;
 use super::laws::{coupling_gap, fit_law, outer_skin};
@@ -346,7 +346,8 @@ fn fit_pass(
         slope = fit_law(mesh, &stations, &knots, &|s| s.radius, false)
             .ok()
             .map(|v| (knots.clone(), v));
-        let round_only = postponed.as_ref().map(|_| opts);
+        let ends = [(range.0, &start), (range.1, &finish)].map(|(t, e)| (t, e.centre, *e.normal));
+        let round_only = postponed.as_ref().map(|_| (opts, ends));
         let mut next = refit_guide(mesh, &stations, &knots, round_only)
             .map_err(|e| postponed.take().map_or(e, |p| p.0))?;
         anchor_ends(&mut next, &start, &finish);
@@ -852,16 +853,27 @@ fn sections(
         .collect()
 }
 
+/// A station's sections are circles by their check (RMS within the
+/// allowance of [`FitOptions::section_rms_allowed`]).
+fn round(s: &Station, opts: &FitOptions) -> bool {
+    s.fits
+        .iter()
+        .flatten()
+        .all(|f| f.rms <= opts.section_rms_allowed(f.radius))
+}
+
 /// The guide's new points at `knots`: the smoothing fit of the section
 /// centres; with `round_only`, the centres of the sections that are not
 /// circles by their check (a lug on one side pulls its circle's centre
-/// towards it) bridged from the round ones beside them
-/// ([`bridge_not_round`]). With every section a circle, as without.
+/// towards it) bridged from the round ones beside them, or from an end's
+/// ring (its guide parameter, centre and normal, start and finish) beside
+/// a run at that end ([`bridge_not_round`]). With every section a circle,
+/// as without.
 fn refit_guide(
     mesh: &TubeMesh,
     stations: &[Station],
     knots: &[f64],
-    round_only: Option<&FitOptions>,
+    round_only: Option<(&FitOptions, [EndAnchor; 2])>,
 ) -> Result<Vec<Point3>, FitError> {
     let ok: Vec<&Station> = stations.iter().filter(|s| s.centre.is_some()).collect();
     if ok.len() < 3 || ok.len() * 2 < stations.len() {
@@ -882,17 +894,9 @@ fn refit_guide(
     let ts: Vec<f64> = ok.iter().map(|s| s.t).collect();
     let w: Vec<f64> = ok.iter().map(|s| s.points as f64).collect();
     let mut centres: Vec<Point3> = ok.iter().map(|s| s.centre.expect("filtered")).collect();
-    if let Some(opts) = round_only {
-        let round: Vec<bool> = ok
-            .iter()
-            .map(|s| {
-                s.fits
-                    .iter()
-                    .flatten()
-                    .all(|f| f.rms <= opts.section_rms_allowed(f.radius))
-            })
-            .collect();
-        bridge_not_round(&ts, &mut centres, &round);
+    if let Some((opts, ends)) = round_only {
+        let round: Vec<bool> = ok.iter().map(|s| round(s, opts)).collect();
+        bridge_not_round(&ts, &mut centres, &round, ends);
     }
     let ys = DMatrix::from_fn(ok.len(), 3, |i, k| centres[i][k]);
     let sol = smooth::fit(knots, &ts, &ys, &w, 1e-6).ok_or_else(|| FitError::Degenerate {

@@ -154,29 +154,39 @@ pub(super) fn detect(
         // The outline: in each direction around the guide, the largest
         // distance of a point beyond the tube's wall; and the span of
         // those points along the guide.
-        // The share of directions it covers is a station's own: the
-        // stations' plane bases turn about the guide from one to the next
-        // along a bend ([`plane_basis`]).
+        // Directions are measured from the first station's basis carried
+        // along the feature (the stations' own plane bases turn about the
+        // guide from one to the next along a bend, [`plane_basis`]): the
+        // share they cover is the feature's, whichever station its points
+        // project to (a flange's ring splits between two).
+        let e1_first = frames[first].1;
+        let turn: Vec<f64> = (first..=last)
+            .map(|i| {
+                let (_, e1, e2) = &frames[i];
+                let tan = spline.d1(stations[i].t).normalize();
+                let e = e1_first - tan * e1_first.dot(&tan);
+                e.dot(e2).atan2(e.dot(e1))
+            })
+            .collect();
         let mut sector = vec![0.0_f64; SECTORS];
-        let mut covered = vec![0_u128; last + 1 - first];
+        let mut covered = 0_u128;
         let (mut t_lo, mut t_hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for &(i, tv, x, y) in &at {
             let rho = x.hypot(y);
             if i < first || i > last || rho <= r_tube + margin {
                 continue;
             }
-            let a = y.atan2(x).rem_euclid(std::f64::consts::TAU);
+            let a = (y.atan2(x) - turn[i - first]).rem_euclid(std::f64::consts::TAU);
             let k = ((a / std::f64::consts::TAU * SECTORS as f64) as usize).min(SECTORS - 1);
             sector[k] = sector[k].max(rho);
-            covered[i - first] |= 1 << k;
+            covered |= 1 << k;
             (t_lo, t_hi) = (t_lo.min(tv), t_hi.max(tv));
         }
         let out: Vec<f64> = sector.iter().copied().filter(|&o| o > 0.0).collect();
         let (lo, hi) = out
             .iter()
             .fold((f64::INFINITY, 0.0_f64), |a, &o| (a.0.min(o), a.1.max(o)));
-        let cover =
-            covered.iter().map(|c| c.count_ones()).max().unwrap_or(0) as f64 / SECTORS as f64;
+        let cover = covered.count_ones() as f64 / SECTORS as f64;
         // Points past an end project beyond it along the guide.
         (t_lo, t_hi) = (t_lo.max(t0), t_hi.min(stations[n - 1].t).max(t_lo.max(t0)));
         let length = t_hi - t_lo;

@@ -23,7 +23,7 @@ pub(super) fn first_guide(
     knot_h: f64,
     march: bool,
 ) -> Result<Vec<Point3>, FitError> {
-    let tris = &surf.skins[0].triangles;
+    let tris = &surf.skins[guide_skin(mesh, surf)].triangles;
     march
         .then(|| cut::march(mesh, tris, start, finish, 0.5 * knot_h))
         .flatten()
@@ -31,6 +31,25 @@ pub(super) fn first_guide(
             || initial_guide(mesh, surf, start, finish, edge, knot_h),
             |g| Ok(with_ends_past(g, knot_h)),
         )
+}
+
+/// The skin the first guide follows: of a wall's two skins the one of
+/// the smaller area, the bore (a flange, a collar or a block stands on the
+/// outer skin, and on a bend the distance along it across the feature's
+/// steps breaks the level sets apart); else the only one.
+fn guide_skin(mesh: &TubeMesh, surf: &Surfaces) -> usize {
+    let area = |tris: &[u32]| -> f64 {
+        tris.iter()
+            .map(|&t| {
+                let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.vertices[i as usize]);
+                (b - a).cross(&(c - a)).norm()
+            })
+            .sum()
+    };
+    match &surf.skins[..] {
+        [outer, inner] if area(&inner.triangles) < area(&outer.triangles) => 1,
+        _ => 0,
+    }
 }
 
 /// First guide: the start end's centre, the centroids of the level sets of
@@ -44,10 +63,11 @@ fn initial_guide(
     edge: f64,
     knot_h: f64,
 ) -> Result<Vec<Point3>, FitError> {
-    let skin = &surf.skins[0];
+    let k = guide_skin(mesh, surf);
+    let skin = &surf.skins[k];
     let width = (3.0 * edge).max(start.radius / 3.0);
-    let sets = topology::level_sets(mesh, &skin.triangles, &skin.loops[start.loops[0]], width);
-    let far = skin.loops[finish.loops[0]]
+    let sets = topology::level_sets(mesh, &skin.triangles, &skin.loops[start.loops[k]], width);
+    let far = skin.loops[finish.loops[k]]
         .iter()
         .map(|&v| sets.distance[v as usize])
         .fold(f64::INFINITY, f64::min);

@@ -171,21 +171,27 @@ fn a_separate_tab_is_named_with_its_place_and_size() {
     assert!(r.start.kind == EndKind::Open && r.end.kind == EndKind::Open);
 }
 
-/// The pipe's features named, each a flange of `z` (mm along the axis),
-/// 15 mm high and 50 mm across: within a station spacing `h` along the
-/// guide, 0.2 mm in height and 0.4 mm across (the flange tests above).
-fn flanges_named(fs: &[FeatureReport], z: &[(f64, f64)], h: f64) {
-    assert_eq!(fs.len(), z.len(), "{fs:?}");
-    for (f, &(z0, z1)) in fs.iter().zip(z) {
+/// The pipe's features named, each a flange `length` mm long about the
+/// point `at` (mesh frame, mm) within `h` mm, standing `size.0` mm out from
+/// the wall and `size.1` mm across within `tol` and twice `tol` (mm).
+fn flanges_named(fs: &[FeatureReport], at: &[Point3], h: f64, size: (f64, f64, f64), tol: f64) {
+    assert_eq!(fs.len(), at.len(), "{fs:?}");
+    let (length, height, across) = size;
+    for (f, c) in fs.iter().zip(at) {
         assert_eq!(f.kind, FeatureKind::Flange, "{f:?}");
         assert!(
-            (f.centre_mm[2] - 0.5 * (z0 + z1)).abs() <= h
-                && (f.length_mm - (z1 - z0)).abs() <= h
-                && (f.height_mm - 15.0).abs() <= 0.2
-                && (f.across_mm[1] - 50.0).abs() <= 0.4,
-            "{f:?}"
+            (Point3::from(f.centre_mm) - c).norm() <= h
+                && (f.length_mm - length).abs() <= h
+                && (f.height_mm - height).abs() <= tol
+                && (f.across_mm[1] - across).abs() <= 2.0 * tol,
+            "{f:?} against {c}"
         );
     }
+}
+
+/// The point `z` mm up the z axis.
+fn on_z(z: f64) -> Point3 {
+    Point3::new(0.0, 0.0, z)
 }
 
 /// The fitted stretch's ends along the axis (z, mm), lowest first.
@@ -204,7 +210,7 @@ fn kept(p: &FittedPart) -> (f64, f64) {
 /// its ring-capped end and its wall: mid-surface radius 9, 2 mm thick.
 #[test]
 fn a_solid_wall_with_a_flange_is_named_with_its_place_and_size() {
-    let mesh = gen::flanged_wall(8.0, 10.0, 80.0, &[(37.0, 40.0, 25.0)], 64);
+    let mesh = gen::flanged_wall(&gen::along_z(80.0, 9.0), 1.0, &[(37.0, 40.0, 25.0)], 64);
     let e = fit(&mesh, "flanged.stl", false).unwrap_err();
     let msg = e.to_string();
     let Error::Fit(FitError::Feature { kind, .. }) = e else {
@@ -213,7 +219,13 @@ fn a_solid_wall_with_a_flange_is_named_with_its_place_and_size() {
     assert_eq!(kind, "flange", "{msg}");
     let p = fit(&mesh, "flanged.stl", true).unwrap();
     let r = p.report();
-    flanges_named(&r.features, &[(37.0, 40.0)], spacing(&p));
+    flanges_named(
+        &r.features,
+        &[on_z(38.5)],
+        spacing(&p),
+        (3.0, 15.0, 50.0),
+        0.2,
+    );
     let (lo, hi) = kept(&p);
     assert!(
         (40.0..=41.5).contains(&lo) && (hi - 80.0).abs() < 1e-6,
@@ -263,7 +275,7 @@ fn a_spool_flanged_at_both_ends_keeps_the_tube_between_its_flanges() {
     for (name, mesh) in [
         (
             "solid.stl",
-            gen::flanged_wall(8.0, 10.0, 80.0, &flanges, 64),
+            gen::flanged_wall(&gen::along_z(80.0, 9.0), 1.0, &flanges, 64),
         ),
         ("faces.stl", skin(true)),
         ("rims.stl", skin(false)),
@@ -276,7 +288,13 @@ fn a_spool_flanged_at_both_ends_keeps_the_tube_between_its_flanges() {
         );
         let p = fit(&mesh, name, true).unwrap_or_else(|e| panic!("{name}: {e}"));
         let r = p.report();
-        flanges_named(&r.features, &[(0.0, 3.0), (77.0, 80.0)], 2.0 * spacing(&p));
+        flanges_named(
+            &r.features,
+            &[on_z(1.5), on_z(78.5)],
+            2.0 * spacing(&p),
+            (3.0, 15.0, 50.0),
+            0.2,
+        );
         let (lo, hi) = kept(&p);
         assert!(
             (3.0..=4.5).contains(&lo) && (75.5..=77.0).contains(&hi),
@@ -289,6 +307,61 @@ fn a_spool_flanged_at_both_ends_keeps_the_tube_between_its_flanges() {
             r.end.kind
         );
         assert!(r.rms_mm < 0.01, "{name}: {}", r.rms_mm);
+    }
+}
+
+/// A flanged elbow as a solid: the generator's elbow (legs of 20 mm, a
+/// 90 degree bend of radius 40) as a wall of mid-surface radius 11, 2 mm
+/// thick, with flanges of radius 30, 3 mm thick, at both ends, or one on
+/// the bend 40 to 43 mm along it. The first guide followed the outer skin,
+/// where the distance from the start end across a flange's steps on a bend
+/// breaks the level sets apart (the bend's inner side reaches the steps
+/// first): the guide on the bend ran 6 km long and the fit was refused
+/// naming its knots. It follows the bore now. Each flange is named about
+/// its place (within two station spacings), 18 mm out and 60 across
+/// (within 1 and 2 mm; measured 18.6 and 59.0 to 61.1 on the spool's, 18.0
+/// and 59.9 to 60.1 on the bend's); trimmed, the fitted surface lies on
+/// the true mid-surface within 0.01 mm RMS and 0.05 mm (measured 0.004 /
+/// 0.016), 2 mm thick, and at most 2 mm of tube is lost at each cut
+/// (measured 3.4 mm in all on the spool, 0.5 mm on the bend). The far
+/// flange's place along the guide (t_from_mm, 94.6 mm) is 5 mm short of
+/// the true 99.8: it is read on the guide of the first refits, not settled.
+#[test]
+fn a_flanged_elbow_as_a_solid_is_named_and_trimmed() {
+    let truth = gen::Truth {
+        name: "elbow wall",
+        length: 40.0 + 40.0 * std::f64::consts::FRAC_PI_2,
+        centre: Box::new(gen::elbow_centre(20.0, 40.0)),
+        radius: Box::new(|_| 11.0),
+    };
+    let l = truth.length;
+    for (name, flanges, keep) in [
+        ("spool.stl", vec![(0.0, 3.0), (l - 3.0, l)], l - 6.0),
+        ("bend.stl", vec![(40.0, 43.0)], l - 43.0),
+    ] {
+        let with_r: Vec<(f64, f64, f64)> = flanges.iter().map(|&(a, b)| (a, b, 30.0)).collect();
+        let mesh = gen::flanged_wall(&truth, 1.0, &with_r, 64);
+        let msg = fit(&mesh, name, false).unwrap_err().to_string();
+        assert!(
+            msg.starts_with(&format!("{name}: not a tube: a flange at stations")),
+            "{msg}"
+        );
+        let p = fit(&mesh, name, true).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let r = p.report();
+        let at: Vec<Point3> = flanges
+            .iter()
+            .map(|&(a, b)| (truth.centre)(0.5 * (a + b)))
+            .collect();
+        flanges_named(&r.features, &at, 2.0 * spacing(&p), (3.0, 18.0, 60.0), 1.0);
+        assert!(
+            r.length_mm <= keep && r.length_mm >= keep - 2.0 * flanges.len() as f64,
+            "{name}: kept {} of {keep} mm",
+            r.length_mm
+        );
+        let (rms, max) = crate::surface_errors(&truth, &p);
+        assert!(rms < 0.01 && max < 0.05, "{name}: surface {rms} / {max} mm");
+        let wall = r.wall.as_ref().expect("two skins");
+        assert!((wall.mean_mm - 2.0).abs() < 0.01, "{name}: {wall:?}");
     }
 }
 

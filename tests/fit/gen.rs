@@ -663,36 +663,62 @@ pub fn collared_pipe(
     lofted(&rings)
 }
 
-/// A pipe wall exported as a solid: watertight, two skins about the z axis
-/// from z = 0 to `len`, the bore of radius `r_in` and the outer skin of
-/// radius `r_out` except on each of `flanges` (`z0`, `z1`, radius: sorted,
-/// apart), where it stands out to the flange's radius, joined by flat steps;
-/// flat ring faces close both ends, from the bore to the outer skin there.
-/// Rings 1 mm apart, `around` points each; the seam ring where the start's
-/// face meets the outer skin is written twice (the fit welds it).
+/// A straight tube about the z axis from z = 0 to `length` (mm) of radius
+/// `r` (mm).
+pub fn along_z(length: f64, r: f64) -> Truth {
+    Truth {
+        name: "straight along z",
+        length,
+        centre: Box::new(|s| Point3::new(0.0, 0.0, s)),
+        radius: Box::new(move |_| r),
+    }
+}
+
+/// A pipe wall exported as a solid along the tube `t` (its radius the
+/// wall's mid-surface): watertight, two skins, the outer at `t`'s radius
+/// plus `half` (mm), the bore at it minus `half`, except on each of
+/// `flanges` (from arc length `s0` to `s1`, radius: sorted, apart, mm),
+/// where the outer skin stands out to the flange's radius, joined by flat
+/// steps; flat ring faces close both ends, from the bore to the outer skin
+/// there. Rings about 1 mm apart in the normal planes (a flange's edges on
+/// the nearest), `around` points each; the start's outer ring is written
+/// twice (the fit welds it).
 pub fn flanged_wall(
-    r_in: f64,
-    r_out: f64,
-    len: f64,
+    t: &Truth,
+    half: f64,
     flanges: &[(f64, f64, f64)],
     around: usize,
 ) -> (Vec<Point3>, Vec<[u32; 3]>) {
-    let mut rings = Vec::new();
-    let mut z = 0.0;
-    for &(z0, z1, r) in flanges {
-        if z0 > z {
-            rings.extend(pipe_rings(around, r_out, z, z0, 1.0));
+    let rings = t.length.ceil() as usize;
+    let fr = frames(t, rings);
+    let ring = |i: usize, rho: f64| {
+        let (_, x, ti, n) = fr[i];
+        let b = ti.cross(&n);
+        ring_of(around, |a| x + (n * a.cos() + b * a.sin()) * rho)
+    };
+    let at = |s: f64| (s / t.length * rings as f64).round() as usize;
+    let flanges: Vec<(usize, usize, f64)> = flanges
+        .iter()
+        .map(|&(s0, s1, r)| (at(s0), at(s1), r))
+        .collect();
+    let mut out = Vec::new();
+    for (i, frame) in fr.iter().enumerate() {
+        let tube = (t.radius)(frame.0) + half;
+        match flanges.iter().find(|f| (f.0..=f.1).contains(&i)) {
+            Some(f) if f.0 == i && i > 0 => out.extend([ring(i, tube), ring(i, f.2)]),
+            Some(f) if f.1 == i && i < rings => out.extend([ring(i, f.2), ring(i, tube)]),
+            Some(f) => out.push(ring(i, f.2)),
+            None => out.push(ring(i, tube)),
         }
-        rings.extend(pipe_rings(around, r, z0, z1, 1.0));
-        z = z1;
     }
-    if z < len {
-        rings.extend(pipe_rings(around, r_out, z, len, 1.0));
-    }
-    let start = rings[0].clone();
-    rings.extend(pipe_rings(around, r_in, 0.0, len, 1.0).into_iter().rev());
-    rings.push(start);
-    lofted(&rings)
+    let start = out[0].clone();
+    out.extend(
+        (0..=rings)
+            .rev()
+            .map(|i| ring(i, (t.radius)(fr[i].0) - half)),
+    );
+    out.push(start);
+    lofted(&out)
 }
 
 /// A straight pipe of radius `r` about the z axis from z = 0 to `len` with
