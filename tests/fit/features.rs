@@ -365,6 +365,78 @@ fn a_flanged_elbow_as_a_solid_is_named_and_trimmed() {
     }
 }
 
+/// Solid walls (bore r 8, outer r 10, z = 0 to 80) with a square stop
+/// block of side 40 from z = 0 to 15 around the bore (the ear tube
+/// as a solid: the block's flat sides and top join the outer skin, its
+/// bottom is the start's end face), or a collar of radius 14 from z = 30 to
+/// 40: each named with its place and size as on one skin (the block 18.3 mm
+/// out, 40 to 56.6 mm across; the collar 4 mm out, 28 across); trimmed, the
+/// longest stretch keeps its ring-capped end and its 2 mm wall.
+#[test]
+fn a_stop_block_and_a_collar_on_solid_walls_are_named_and_trimmed() {
+    let a = 20.0;
+    let mut block: Vec<Vec<Point3>> = (0..=15)
+        .map(|i| {
+            gen::ring_of(64, |t| {
+                let s = a / t.cos().abs().max(t.sin().abs());
+                Point3::new(s * t.cos(), s * t.sin(), f64::from(i))
+            })
+        })
+        .collect();
+    let start = block[0].clone();
+    block.extend(gen::pipe_rings(64, 10.0, 15.0, 80.0, 1.0));
+    block.extend(gen::pipe_rings(64, 8.0, 0.0, 80.0, 1.0).into_iter().rev());
+    block.push(start);
+    let d = 20.0 * 2f64.sqrt();
+    for (name, mesh, kind, (z0, z1), (out, across)) in [
+        (
+            "stop.stl",
+            gen::lofted(&block),
+            FeatureKind::Block,
+            (0.0, 15.0),
+            (d - 10.0, [40.0, 2.0 * d]),
+        ),
+        (
+            "collar.stl",
+            gen::flanged_wall(&gen::along_z(80.0, 9.0), 1.0, &[(30.0, 40.0, 14.0)], 64),
+            FeatureKind::Collar,
+            (30.0, 40.0),
+            (4.0, [28.0, 28.0]),
+        ),
+    ] {
+        let e = fit(&mesh, name, false).unwrap_err();
+        let msg = e.to_string();
+        let Error::Fit(FitError::Feature { kind: named, .. }) = e else {
+            panic!("{msg}")
+        };
+        assert_eq!(named, kind.name(), "{msg}");
+        let p = fit(&mesh, name, true).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let r = p.report();
+        let h = spacing(&p);
+        let [f] = &r.features[..] else {
+            panic!("{:?}", r.features)
+        };
+        assert!(
+            f.kind == kind
+                && (f.t_from_mm - z0).abs() <= h
+                && (f.t_to_mm - z1).abs() <= h
+                && (f.height_mm - out).abs() <= 0.2
+                && (f.across_mm[0] - across[0]).abs() <= 0.4
+                && (f.across_mm[1] - across[1]).abs() <= 0.4,
+            "{name}: {f:?}"
+        );
+        let (lo, hi) = kept(&p);
+        assert!(
+            (z1..=z1 + 1.5).contains(&lo) && (hi - 80.0).abs() < 1e-6,
+            "{name}: kept {lo} to {hi}"
+        );
+        assert_eq!(r.end.kind, EndKind::RingCapped, "{name}");
+        let wall = r.wall.as_ref().expect("two skins");
+        assert!((wall.mean_mm - 2.0).abs() < 0.01, "{name}: {wall:?}");
+        assert!(r.rms_mm < 0.01, "{name}: {}", r.rms_mm);
+    }
+}
+
 /// A tube that fits is the same with `trim`.
 #[test]
 fn trim_leaves_a_tube_without_features_as_it_is() {
