@@ -209,9 +209,10 @@ pub struct FitOptions {
     /// refused ([`FitError::SubstrateFar`]).
     pub substrate_tolerance_mm: f64,
     /// Fit the longest tubular stretch of a mesh that carries features that
-    /// are not tube (collars, flanges, blocks, tabs), cut at the guide's
-    /// normal planes next to them, and name the features in the report;
-    /// `false` (the default): such a mesh is refused, naming the feature.
+    /// are not tube (collars, flanges, blocks, lugs, tabs; on one skin or on
+    /// a solid wall, holding an end or not), cut at the guide's normal
+    /// planes just past them, and name the features in the report; `false`
+    /// (the default): such a mesh is refused, naming the feature.
     pub trim: bool,
 }
 
