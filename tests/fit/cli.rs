@@ -158,3 +158,80 @@ fn fit_trim_names_the_feature_left_out() {
     assert_eq!(report["features"][0]["kind"], "flange", "{report}");
     assert_eq!(report["start"]["kind"], "trimmed", "{report}");
 }
+
+/// A flanged elbow exported as a solid (the generator's elbow as a wall of
+/// mid-surface radius 11, 2 mm thick, flanges of radius 30 and 3 mm at both
+/// ends), end to end: `fit --trim` names both flanges left out and writes
+/// the tube between them with its wall, which `slice` slices and `plan`
+/// plans in the torch-carried cell (planned or refused by the cell, exit 0
+/// or 2, never bad input).
+#[test]
+fn a_flanged_solid_elbow_is_trimmed_sliced_and_planned() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = gen::Truth {
+        name: "elbow wall",
+        length: 40.0 + 40.0 * std::f64::consts::FRAC_PI_2,
+        centre: Box::new(gen::elbow_centre(20.0, 40.0)),
+        radius: Box::new(|_| 11.0),
+    };
+    let l = truth.length;
+    let (v, f) = gen::flanged_wall(&truth, 1.0, &[(0.0, 3.0, 30.0), (l - 3.0, l, 30.0)], 64);
+    let stl = dir.path().join("spool.stl");
+    std::fs::write(&stl, gen::binary_stl(&v, &f)).unwrap();
+    let out = dir.path().join("fit");
+    let done = waam()
+        .arg("fit")
+        .arg(&stl)
+        .arg("--trim")
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&done.stdout);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert_eq!(
+        text.matches("left out    a flange from").count(),
+        2,
+        "{text}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
+    assert_eq!(report["start"]["kind"], "trimmed", "{report}");
+    assert_eq!(report["end"]["kind"], "trimmed", "{report}");
+    let wall = report["wall"]["mean_mm"].as_f64().unwrap();
+    assert!((wall - 2.0).abs() < 0.01, "{report}");
+    let sliced = dir.path().join("sliced");
+    let done = waam()
+        .args(["--quiet", "slice"])
+        .arg(out.join("part.toml"))
+        .args(["--points", "60", "--out"])
+        .arg(&sliced)
+        .output()
+        .unwrap();
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(sliced.join("path.csv").exists());
+    let planned = dir.path().join("planned");
+    let done = waam()
+        .args(["--quiet", "plan"])
+        .arg(out.join("part.toml"))
+        .arg("--cell")
+        .arg(crate::common::part_path("cells/robowam_torch_carried.toml"))
+        .args(["--points", "40", "--delta", "6", "--out"])
+        .arg(&planned)
+        .output()
+        .unwrap();
+    assert!(
+        matches!(done.status.code(), Some(0 | 2)),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(planned.join("summary.json").exists());
+}
