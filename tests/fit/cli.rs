@@ -34,11 +34,20 @@ fn fit_writes_a_part_that_slices() {
         text.contains("kind = \"spline\"") && text.contains("name = \"s-bend\""),
         "{text}"
     );
-    let sliced = dir.path().join("sliced");
+    slices_and_plans(dir.path(), &out.join("part.toml"), &["--no-wall"], "part");
+}
+
+/// `slice` slices the fitted `part` (with `flags`) and `plan` takes it as
+/// it is in the `carried`-carried RoboWAM cell: planned (exit 0) or refused
+/// by the cell (exit 2), never bad input (exit 1).
+fn slices_and_plans(dir: &std::path::Path, part: &std::path::Path, flags: &[&str], carried: &str) {
+    let sliced = dir.join("sliced");
     let done = waam()
         .args(["--quiet", "slice"])
-        .arg(out.join("part.toml"))
-        .args(["--points", "60", "--no-wall", "--out"])
+        .arg(part)
+        .args(["--points", "60"])
+        .args(flags)
+        .arg("--out")
         .arg(&sliced)
         .output()
         .unwrap();
@@ -48,14 +57,14 @@ fn fit_writes_a_part_that_slices() {
         String::from_utf8_lossy(&done.stderr)
     );
     assert!(sliced.join("path.csv").exists());
-    // plan takes it as it is: planned (exit 0) or refused by the cell (exit
-    // 2), never bad input (exit 1).
-    let planned = dir.path().join("planned");
+    let planned = dir.join("planned");
     let done = waam()
         .args(["--quiet", "plan"])
-        .arg(out.join("part.toml"))
+        .arg(part)
         .arg("--cell")
-        .arg(crate::common::part_path("cells/robowam_part_carried.toml"))
+        .arg(crate::common::part_path(&format!(
+            "cells/robowam_{carried}_carried.toml"
+        )))
         .args(["--points", "40", "--delta", "6", "--out"])
         .arg(&planned)
         .output()
@@ -168,12 +177,7 @@ fn fit_trim_names_the_feature_left_out() {
 #[test]
 fn a_flanged_solid_elbow_is_trimmed_sliced_and_planned() {
     let dir = tempfile::tempdir().unwrap();
-    let truth = gen::Truth {
-        name: "elbow wall",
-        length: 40.0 + 40.0 * std::f64::consts::FRAC_PI_2,
-        centre: Box::new(gen::elbow_centre(20.0, 40.0)),
-        radius: Box::new(|_| 11.0),
-    };
+    let truth = gen::elbow_wall();
     let l = truth.length;
     let (v, f) = gen::flanged_wall(&truth, 1.0, &[(0.0, 3.0, 30.0), (l - 3.0, l, 30.0)], 64);
     let stl = dir.path().join("spool.stl");
@@ -204,34 +208,5 @@ fn a_flanged_solid_elbow_is_trimmed_sliced_and_planned() {
     assert_eq!(report["end"]["kind"], "trimmed", "{report}");
     let wall = report["wall"]["mean_mm"].as_f64().unwrap();
     assert!((wall - 2.0).abs() < 0.01, "{report}");
-    let sliced = dir.path().join("sliced");
-    let done = waam()
-        .args(["--quiet", "slice"])
-        .arg(out.join("part.toml"))
-        .args(["--points", "60", "--out"])
-        .arg(&sliced)
-        .output()
-        .unwrap();
-    assert!(
-        done.status.success(),
-        "{}",
-        String::from_utf8_lossy(&done.stderr)
-    );
-    assert!(sliced.join("path.csv").exists());
-    let planned = dir.path().join("planned");
-    let done = waam()
-        .args(["--quiet", "plan"])
-        .arg(out.join("part.toml"))
-        .arg("--cell")
-        .arg(crate::common::part_path("cells/robowam_torch_carried.toml"))
-        .args(["--points", "40", "--delta", "6", "--out"])
-        .arg(&planned)
-        .output()
-        .unwrap();
-    assert!(
-        matches!(done.status.code(), Some(0 | 2)),
-        "{}",
-        String::from_utf8_lossy(&done.stderr)
-    );
-    assert!(planned.join("summary.json").exists());
+    slices_and_plans(dir.path(), &out.join("part.toml"), &[], "torch");
 }

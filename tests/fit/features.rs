@@ -328,12 +328,7 @@ fn a_spool_flanged_at_both_ends_keeps_the_tube_between_its_flanges() {
 /// the true 99.8: it is read on the guide of the first refits, not settled.
 #[test]
 fn a_flanged_elbow_as_a_solid_is_named_and_trimmed() {
-    let truth = gen::Truth {
-        name: "elbow wall",
-        length: 40.0 + 40.0 * std::f64::consts::FRAC_PI_2,
-        centre: Box::new(gen::elbow_centre(20.0, 40.0)),
-        radius: Box::new(|_| 11.0),
-    };
+    let truth = gen::elbow_wall();
     let l = truth.length;
     for (name, flanges, keep) in [
         ("spool.stl", vec![(0.0, 3.0), (l - 3.0, l)], l - 6.0),

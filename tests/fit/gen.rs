@@ -61,6 +61,18 @@ pub fn elbow_centre(leg: f64, r: f64) -> impl Fn(f64) -> Point3 + Sync {
     }
 }
 
+/// The elbow's centre line (legs of 20 mm, a 90 degree bend of radius 40)
+/// with the mid-surface radius 11 of a 2 mm wall about it (skins 10 and
+/// 12: [`flanged_wall`] with `half` 1).
+pub fn elbow_wall() -> Truth {
+    Truth {
+        name: "elbow wall",
+        length: 40.0 + 40.0 * FRAC_PI_2,
+        centre: Box::new(elbow_centre(20.0, 40.0)),
+        radius: Box::new(|_| 11.0),
+    }
+}
+
 pub fn elbow() -> Truth {
     let (leg, r) = (20.0, 40.0);
     Truth {
