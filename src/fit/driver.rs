@@ -1125,19 +1125,19 @@ fn not_tube(
         return Err(feature_error(mesh, first, found.len()));
     };
     // Cut a little past the features beside the stretch (their points'
-    // extent along the guide), not at its first round station: the stretch
-    // keeps the tube up to the feature.
+    // extent along the guide), between its first round station and the one
+    // before; at its first round station when no feature is named before.
     let t0 = stations[0].t;
     let margin = TRIM_MARGIN_RADII * 0.5 * reach;
     let t_lo = (a > 0).then(|| {
-        let edge = found.iter().filter(|f| f.last_station < a);
-        edge.fold(stations[a - 1].t, |x, f| x.max(t0 + f.t_to_mm + margin))
-            .min(stations[a].t)
+        let past = found.iter().filter(|f| f.last_station < a);
+        let past = past.map(|f| t0 + f.t_to_mm + margin).reduce(f64::max);
+        past.map_or(stations[a].t, |t| t.clamp(stations[a - 1].t, stations[a].t))
     });
     let t_hi = (b + 1 < n).then(|| {
-        let edge = found.iter().filter(|f| f.first_station > b);
-        edge.fold(stations[b + 1].t, |x, f| x.min(t0 + f.t_from_mm - margin))
-            .max(stations[b].t)
+        let before = found.iter().filter(|f| f.first_station > b);
+        let before = before.map(|f| t0 + f.t_from_mm - margin).reduce(f64::min);
+        before.map_or(stations[b].t, |t| t.clamp(stations[b].t, stations[b + 1].t))
     });
     let mut t_of = vec![None; mesh.vertices.len()];
     let skin_vertices = surf.skins.iter().flat_map(|s| s.vertices.iter());

@@ -207,11 +207,11 @@ pub fn surfaces(mesh: &TubeMesh, opts: &FitOptions) -> Result<Surfaces, FitError
         let faces = pieces(mesh, &comp, |a, b| {
             normals[a as usize].dot(&normals[b as usize]).abs() >= cos_crease
         });
-        let flat: Vec<Option<Cap>> = faces.iter().map(|f| flat_face(mesh, f)).collect();
+        let flat: Vec<Option<(Cap, f64)>> = faces.iter().map(|f| flat_face(mesh, f)).collect();
         let small_face = (comp.len() / 200).max(1);
         for group in steps_joined(mesh, &faces, &flat) {
             if let [i] = group[..] {
-                if let Some(cap) = &flat[i] {
+                if let Some((cap, _)) = &flat[i] {
                     out.caps.push(cap.clone());
                     continue;
                 }
@@ -283,8 +283,8 @@ fn concentric(mesh: &TubeMesh, loops: &[Vec<u32>]) -> bool {
 }
 
 /// `face` as a flat face (its vertices within 1e-4 of its size plus 1 µm
-/// of a plane), else `None`.
-fn flat_face(mesh: &TubeMesh, face: &[u32]) -> Option<Cap> {
+/// of a plane) and that tolerance (mm), else `None`.
+fn flat_face(mesh: &TubeMesh, face: &[u32]) -> Option<(Cap, f64)> {
     let vertices = vertices_of(mesh, face);
     let pts: Vec<Point3> = vertices
         .iter()
@@ -295,19 +295,26 @@ fn flat_face(mesh: &TubeMesh, face: &[u32]) -> Option<Cap> {
         .iter()
         .map(|p| (p - centroid).norm())
         .fold(0.0, f64::max);
-    (dev <= 1e-4 * extent + 1e-3).then_some(Cap {
+    let tol = 1e-4 * extent + 1e-3;
+    let cap = Cap {
         vertices,
         centroid,
         normal,
-    })
+    };
+    (dev <= tol).then_some((cap, tol))
 }
 
-/// The faces of a closed piece (`faces`, `flat` their flat-face fits)
+/// The faces of a closed piece (`faces`, `flat` their flat-face fits and
+/// tolerances)
 /// grouped into surfaces: a flat face whose neighbouring faces lie on both
 /// sides of its plane is a step on one skin (a flange's or a collar's
 /// side, a block's top), joined with them; a flat face whose neighbours
 /// all lie on one side closes an end (a cap). Groups of face indices.
-fn steps_joined(mesh: &TubeMesh, faces: &[Vec<u32>], flat: &[Option<Cap>]) -> Vec<Vec<usize>> {
+fn steps_joined(
+    mesh: &TubeMesh,
+    faces: &[Vec<u32>],
+    flat: &[Option<(Cap, f64)>],
+) -> Vec<Vec<usize>> {
     let face_of: HashMap<u32, usize> = faces
         .iter()
         .enumerate()
@@ -326,23 +333,17 @@ fn steps_joined(mesh: &TubeMesh, faces: &[Vec<u32>], flat: &[Option<Cap>]) -> Ve
     }
     let mut uf = UnionFind::new(faces.len());
     for (i, cap) in flat.iter().enumerate() {
-        let Some(cap) = cap else { continue };
+        let Some((cap, tol)) = cap else { continue };
         next[i].sort_unstable();
         next[i].dedup();
-        let extent = cap
-            .vertices
-            .iter()
-            .map(|&v| (mesh.vertices[v as usize] - cap.centroid).norm())
-            .fold(0.0, f64::max);
-        let tol = 1e-4 * extent + 1e-3;
         let (mut above, mut below) = (false, false);
         for &j in &next[i] {
             let (lo, hi) = vertices_of(mesh, &faces[j])
                 .iter()
                 .map(|&v| (mesh.vertices[v as usize] - cap.centroid).dot(&cap.normal))
                 .fold((0.0_f64, 0.0_f64), |a, x| (a.0.min(x), a.1.max(x)));
-            above |= hi > tol && lo >= -tol;
-            below |= lo < -tol && hi <= tol;
+            above |= hi > *tol && lo >= -tol;
+            below |= lo < -tol && hi <= *tol;
         }
         if above && below {
             for &j in &next[i] {
