@@ -44,7 +44,9 @@ const SAME_TUBE_RADIUS_FRACTION: f64 = 0.15;
 const RADIUS_JUMP_FRACTION: f64 = 0.05;
 
 /// An outline covering under this share of the directions around the
-/// guide (dimensionless) is on one side: a lug, when its wall stays a circle.
+/// guide (dimensionless, all but the largest gap between its points'
+/// directions: [`share_around`]) is on one side: a lug, when its wall stays
+/// a circle.
 const ALL_AROUND_FRACTION: f64 = 0.75;
 
 /// An outline whose distance from the guide varies by more than this
@@ -101,19 +103,34 @@ pub(super) fn detect(
         at.push((i, tv, x, y));
     }
     let radius: Vec<Option<f64>> = bins.iter().map(|b| round(b, opts)).collect();
-    // Runs of round stations of a continuous radius.
+    // Runs of round stations of a continuous radius. A station without
+    // points (between the rings of a coarse export) carries the run on:
+    // it says nothing against the tube.
+    let empty: Vec<bool> = bins.iter().map(|b| b.iter().all(Vec::is_empty)).collect();
     let mut runs: Vec<(usize, usize)> = Vec::new();
+    let mut last_r = f64::NAN;
     for i in 0..n {
-        let Some(r) = radius[i] else { continue };
+        let Some(r) = radius[i] else {
+            match runs.last_mut() {
+                Some(run) if empty[i] && run.1 + 1 == i => run.1 = i,
+                _ => {}
+            }
+            continue;
+        };
         match runs.last_mut() {
             Some(run)
-                if run.1 + 1 == i
-                    && radius[run.1]
-                        .is_some_and(|q| (q - r).abs() <= RADIUS_JUMP_FRACTION * q.max(r)) =>
+                if run.1 + 1 == i && (last_r - r).abs() <= RADIUS_JUMP_FRACTION * last_r.max(r) =>
             {
                 run.1 = i
             }
             _ => runs.push((i, i)),
+        }
+        last_r = r;
+    }
+    // And back over the stations without points before it.
+    for run in &mut runs {
+        while run.0 > 0 && empty[run.0 - 1] {
+            run.0 -= 1;
         }
     }
     let median = |run: &(usize, usize)| {
@@ -169,7 +186,7 @@ pub(super) fn detect(
             })
             .collect();
         let mut sector = vec![0.0_f64; SECTORS];
-        let mut covered = 0_u128;
+        let mut angles: Vec<f64> = Vec::new();
         let (mut t_lo, mut t_hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for &(i, tv, x, y) in &at {
             let rho = x.hypot(y);
@@ -179,14 +196,14 @@ pub(super) fn detect(
             let a = (y.atan2(x) - turn[i - first]).rem_euclid(std::f64::consts::TAU);
             let k = ((a / std::f64::consts::TAU * SECTORS as f64) as usize).min(SECTORS - 1);
             sector[k] = sector[k].max(rho);
-            covered |= 1 << k;
+            angles.push(a);
             (t_lo, t_hi) = (t_lo.min(tv), t_hi.max(tv));
         }
         let out: Vec<f64> = sector.iter().copied().filter(|&o| o > 0.0).collect();
         let (lo, hi) = out
             .iter()
             .fold((f64::INFINITY, 0.0_f64), |a, &o| (a.0.min(o), a.1.max(o)));
-        let cover = covered.count_ones() as f64 / SECTORS as f64;
+        let cover = share_around(&mut angles);
         // Points past an end project beyond it along the guide.
         (t_lo, t_hi) = (t_lo.max(t0), t_hi.min(stations[n - 1].t).max(t_lo.max(t0)));
         let length = t_hi - t_lo;
@@ -240,6 +257,21 @@ pub(super) fn detect(
         });
     }
     (tube, features)
+}
+
+/// The share of the directions around the guide (dimensionless, 0 to 1)
+/// that the directions `angles` (rad, from a common basis) span: all but
+/// their largest gap. A ring of 32 points spans 31/32; a lug over 40
+/// degrees, a ninth. Sorts `angles`.
+fn share_around(angles: &mut [f64]) -> f64 {
+    use std::f64::consts::TAU;
+    if angles.len() < 2 {
+        return 0.0;
+    }
+    angles.sort_unstable_by(f64::total_cmp);
+    let wrap = angles[0] + TAU - angles[angles.len() - 1];
+    let gap = angles.windows(2).map(|w| w[1] - w[0]).fold(wrap, f64::max);
+    (TAU - gap) / TAU
 }
 
 /// The maximal runs of `false` in `flags` (index ranges, in order).
@@ -419,4 +451,26 @@ pub(super) fn clip(
         out.triangles = tris;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::share_around;
+    use std::f64::consts::TAU;
+
+    /// A ring of n points spans all but one n-th; points from -20 to +20
+    /// degrees (wrapping through zero) span 40 degrees; one point, none.
+    #[test]
+    fn the_share_around_is_all_but_the_largest_gap() {
+        for n in [8, 32, 64] {
+            let mut a: Vec<f64> = (0..n).map(|k| TAU * k as f64 / n as f64).collect();
+            let want = (n - 1) as f64 / n as f64;
+            assert!((share_around(&mut a) - want).abs() < 1e-12, "{n}");
+        }
+        let mut lug: Vec<f64> = (-20..=20)
+            .map(|d| f64::from(d).to_radians().rem_euclid(TAU))
+            .collect();
+        assert!((share_around(&mut lug) - 40.0 / 360.0).abs() < 1e-12);
+        assert_eq!(share_around(&mut [1.0]), 0.0);
+    }
 }

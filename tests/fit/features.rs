@@ -432,6 +432,60 @@ fn a_stop_block_and_a_collar_on_solid_walls_are_named_and_trimmed() {
     }
 }
 
+/// A flanged solid wall as a CAD tool writes it: rings only where the
+/// shape changes (bore r 8 and outer skin r 10 from z = 0 to 80 in one
+/// stretch of long triangles each side of a flange of radius 25 from z = 37
+/// to 40), 32 and 64 points around. The stations between the rings hold no
+/// points, and they broke the tubular runs: no run was long enough to be
+/// the tube, and the fit was refused as a section not near a circle. Now
+/// they carry a run on. The 32 points of a ring covered under 0.75 of 72
+/// sectors, so the flange read as a lug; now a ring spans all but its
+/// largest gap. Named as the flange (3 / 15 / 50 mm within 0.2 / 0.4);
+/// trimmed, 40 to 41 up to the ring-capped end at 80, wall 2 mm within
+/// 0.02 (the facets of a 32-gon read 0.5 % inside).
+#[test]
+fn a_coarse_solid_as_cad_writes_it_names_its_flange() {
+    for around in [32, 64] {
+        let ring = |r: f64, z: f64| gen::circle_z(around, r, z);
+        let rings = [
+            ring(10.0, 0.0),
+            ring(10.0, 37.0),
+            ring(25.0, 37.0),
+            ring(25.0, 40.0),
+            ring(10.0, 40.0),
+            ring(10.0, 80.0),
+            ring(8.0, 80.0),
+            ring(8.0, 0.0),
+            ring(10.0, 0.0),
+        ];
+        let mesh = gen::lofted(&rings);
+        let name = format!("cad-{around}.stl");
+        let e = fit(&mesh, &name, false).unwrap_err();
+        let msg = e.to_string();
+        let Error::Fit(FitError::Feature { kind, .. }) = e else {
+            panic!("{msg}")
+        };
+        assert_eq!(kind, "flange", "{msg}");
+        let p = fit(&mesh, &name, true).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let r = p.report();
+        flanges_named(
+            &r.features,
+            &[on_z(38.5)],
+            spacing(&p),
+            (3.0, 15.0, 50.0),
+            0.2,
+        );
+        let (lo, hi) = kept(&p);
+        assert!(
+            (40.0..=41.0).contains(&lo) && (hi - 80.0).abs() < 1e-6,
+            "{name}: {lo} {hi}"
+        );
+        assert_eq!(r.end.kind, EndKind::RingCapped, "{name}");
+        let wall = r.wall.as_ref().expect("two skins");
+        assert!((wall.mean_mm - 2.0).abs() < 0.02, "{name}: {wall:?}");
+    }
+}
+
 /// A tube that fits is the same with `trim`.
 #[test]
 fn trim_leaves_a_tube_without_features_as_it_is() {
