@@ -151,9 +151,9 @@ fn ring_of(
 /// samples of the tube's axis and tangent. The tangents' length makes the
 /// cubic an arc's when the rings are a circular arc's (two normals at
 /// `theta`: chord x 2 tan(theta / 4) / sin(theta / 2)); parallel normals
-/// give a straight. The bridged stations weigh as their rings' mean. A station between the rings whose section
-/// is a plane cut ([`fill_from_cuts`]) keeps its centre (a straight's
-/// facets lie on it). Neither holds a radius (nor wall thickness) then:
+/// give a straight. The bridged stations weigh as their rings' mean. A
+/// station between the rings whose section is a plane cut
+/// ([`fill_from_cuts`]) keeps its centre (a straight's facets lie on it). Neither holds a radius (nor wall thickness) then:
 /// the radius law interpolates the rings' own (the facets lie up to
 /// r (1 - cos(pi / n)) inside an n-gon's circle). Returns how many
 /// stations it bridged.
@@ -483,7 +483,7 @@ mod tests {
     /// takes the cubic, on the same line; a run with one round centre
     /// beside it stays.
     #[test]
-    fn runs_not_round_at_the_ends_go_on_straight() {
+    fn runs_not_round_at_the_ends_run_to_the_end_rings() {
         let line = |t: f64| Point3::new(1.0 + 0.6 * t, -2.0, 0.8 * t);
         let ts: Vec<f64> = (0..10).map(f64::from).collect();
         let round = [

@@ -13,8 +13,9 @@ use super::{FitError, TubeMesh};
 use crate::math::{Point3, UnitVector3};
 
 /// The first guide of a pass (points, one past each end): marched through
-/// plane cuts of the first skin with `march` ([`cut::march`]), else
-/// (or when the march is lost) through the level sets ([`initial_guide`]).
+/// plane cuts of the skin it follows ([`guide_skin`]) with `march`
+/// ([`cut::march`]), else (or when the march is lost) through the level
+/// sets ([`initial_guide`]).
 pub(super) fn first_guide(
     mesh: &TubeMesh,
     surf: &Surfaces,
@@ -23,12 +24,12 @@ pub(super) fn first_guide(
     knot_h: f64,
     march: bool,
 ) -> Result<Vec<Point3>, FitError> {
-    let tris = &surf.skins[guide_skin(mesh, surf)].triangles;
+    let k = guide_skin(mesh, surf);
     march
-        .then(|| cut::march(mesh, tris, start, finish, 0.5 * knot_h))
+        .then(|| cut::march(mesh, &surf.skins[k].triangles, start, finish, 0.5 * knot_h))
         .flatten()
         .map_or_else(
-            || initial_guide(mesh, surf, start, finish, edge, knot_h),
+            || initial_guide(mesh, surf, k, start, finish, edge, knot_h),
             |g| Ok(with_ends_past(g, knot_h)),
         )
 }
@@ -54,16 +55,17 @@ fn guide_skin(mesh: &TubeMesh, surf: &Surfaces) -> usize {
 
 /// First guide: the start end's centre, the centroids of the level sets of
 /// the geodesic distance from the start end (those before the far end), the
-/// far end's centre; thinned to points `knot_h / 2` apart.
+/// far end's centre; thinned to points `knot_h / 2` apart. On skin `k`
+/// ([`guide_skin`]).
 fn initial_guide(
     mesh: &TubeMesh,
     surf: &Surfaces,
+    k: usize,
     start: &EndRing,
     finish: &EndRing,
     edge: f64,
     knot_h: f64,
 ) -> Result<Vec<Point3>, FitError> {
-    let k = guide_skin(mesh, surf);
     let skin = &surf.skins[k];
     let width = (3.0 * edge).max(start.radius / 3.0);
     let sets = topology::level_sets(mesh, &skin.triangles, &skin.loops[start.loops[k]], width);
