@@ -343,9 +343,15 @@ fn fit_pass(
             }
         }
         let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
-        slope = fit_law(mesh, &stations, &knots, &|s| s.radius, false)
-            .ok()
-            .map(|v| (knots.clone(), v));
+        slope = fit_law(
+            mesh,
+            &stations,
+            &knots,
+            &|s| s.radius.map(|r| (s.t, r)),
+            false,
+        )
+        .ok()
+        .map(|v| (knots.clone(), v));
         let ends = [(range.0, &start), (range.1, &finish)].map(|(t, e)| (t, e.centre, *e.normal));
         let round_only = postponed.as_ref().map(|_| (opts, ends));
         let mut next = refit_guide(mesh, &stations, &knots, round_only)
@@ -423,8 +429,10 @@ fn fit_pass(
     }
     coarse.measure(&stations, &spline);
     let pieces = separate_pieces(mesh, &surf, &stations, &spline, opts)?;
-    let law = |pick: &dyn Fn(&Station) -> Option<f64>| fit_law(mesh, &stations, &knots, pick, true);
-    let mut radius_mm = law(&|s| s.radius)?;
+    let law = |pick: &dyn Fn(&Station) -> Option<(f64, f64)>| {
+        fit_law(mesh, &stations, &knots, pick, true)
+    };
+    let mut radius_mm = law(&Station::radius_read)?;
     let spread = radius_mm
         .iter()
         .fold((f64::MAX, f64::MIN), |a, &r| (a.0.min(r), a.1.max(r)));
@@ -435,7 +443,7 @@ fn fit_pass(
     }
     let sparse = (!constant).then(|| sparse_rings(&stations, r0)).flatten();
     let thickness_mm = match samples.skins {
-        2 => Some(law(&|s| s.thickness)?),
+        2 => Some(law(&|s| s.thickness.map(|e| (s.t, e)))?),
         _ => None,
     };
     let outer = outer_skin(&stations);
@@ -481,7 +489,7 @@ fn fit_pass(
         iterations,
         converged,
         last_move_mm: last_move,
-        check_surface: opts.check_surface,
+        check_surface: opts.check_surface.then_some(opts.max_rms_mm),
     };
     (fit.report, fit.vertex_distance_mm) = report::build(&ctx, &fit);
     fit.report.features = pieces;

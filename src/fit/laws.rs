@@ -39,12 +39,14 @@ pub(super) fn coupling_gap(law: Option<&(Vec<f64>, Vec<f64>)>) -> f64 {
 /// of a coarse export (a bridged one holds none,
 /// [`bridge_between_rings`](super::coarse::bridge_between_rings)). The refits' slope law takes every station
 /// (its knot spacing, [`coupling_gap`], keeps the guide of a coarse bend
-/// smooth).
+/// smooth). `pick`: a station's value (mm) and the guide parameter (mm)
+/// where it is read. A law that is not positive is fitted again, straight
+/// between the sections where they leave it free ([`straight_between`]).
 pub(super) fn fit_law(
     mesh: &TubeMesh,
     stations: &[Station],
     knots: &[f64],
-    pick: &dyn Fn(&Station) -> Option<f64>,
+    pick: &dyn Fn(&Station) -> Option<(f64, f64)>,
     own_rings: bool,
 ) -> Result<Vec<f64>, FitError> {
     let own = stations
@@ -52,20 +54,29 @@ pub(super) fn fit_law(
         .filter(|s| !s.widened && pick(s).is_some())
         .count();
     let all = !own_rings || own < MIN_OWN_LAW_STATIONS;
-    let ok: Vec<(f64, f64, f64)> = stations
+    let mut ok: Vec<(f64, f64, f64)> = stations
         .iter()
         .filter(|s| all || !s.widened)
-        .filter_map(|s| pick(s).map(|v| (s.t, v, s.points as f64)))
+        .filter_map(|s| pick(s).map(|(t, v)| (t, v, s.points as f64)))
         .collect();
-    let ts: Vec<f64> = ok.iter().map(|x| x.0).collect();
-    let w: Vec<f64> = ok.iter().map(|x| x.2).collect();
-    let ys = DMatrix::from_fn(ok.len(), 1, |i, _| ok[i].1);
-    let sol = smooth::fit(knots, &ts, &ys, &w, 1e-6).ok_or_else(|| FitError::Degenerate {
-        file: mesh.file.clone(),
-        station: 0,
-        reason: "the radius law's least-squares system is singular".into(),
-    })?;
-    let v: Vec<f64> = sol.column(0).iter().copied().collect();
+    ok.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let held = ok;
+    let solve = |data: &[(f64, f64, f64)]| {
+        let ts: Vec<f64> = data.iter().map(|x| x.0).collect();
+        let w: Vec<f64> = data.iter().map(|x| x.2).collect();
+        let ys = DMatrix::from_fn(data.len(), 1, |i, _| data[i].1);
+        smooth::fit(knots, &ts, &ys, &w, 1e-6)
+            .map(|sol| sol.column(0).iter().copied().collect::<Vec<f64>>())
+            .ok_or_else(|| FitError::Degenerate {
+                file: mesh.file.clone(),
+                station: 0,
+                reason: "the radius law's least-squares system is singular".into(),
+            })
+    };
+    let mut v = solve(&held)?;
+    if v.iter().any(|&r| !(r > 0.0)) {
+        v = solve(&[held.clone(), straight_between(stations, &held)].concat())?;
+    }
     if let Some(j) = v.iter().position(|&r| !(r > 0.0)) {
         let at = knots[j];
         let station = stations
@@ -73,7 +84,7 @@ pub(super) fn fit_law(
             .enumerate()
             .min_by(|a, b| (a.1.t - at).abs().total_cmp(&(b.1.t - at).abs()))
             .map_or(0, |(i, _)| i);
-        let (lo, hi) = ok
+        let (lo, hi) = held
             .iter()
             .fold((f64::MAX, f64::MIN), |m, x| (m.0.min(x.1), m.1.max(x.1)));
         return Err(FitError::Degenerate {
@@ -81,11 +92,45 @@ pub(super) fn fit_law(
             station,
             reason: format!(
                 "the law fitted to {} sections' values ({lo:.3} to {hi:.3} mm) is not positive at t = {at:.2} mm: the value changes faster along the guide than the sections hold it (a cone or a cap, not a tube?)",
-                ok.len()
+                held.len()
             ),
         });
     }
     Ok(v)
+}
+
+/// Weight of a station's straight-line value ([`straight_between`]) as a
+/// fraction of the least weight of the sections' own values: enough to hold
+/// a law the sections leave free (the curvature penalty is ~1e-6 of the
+/// data), too little to move it where they hold it (a bias under 1e-3).
+const STRAIGHT_WEIGHT_FRACTION: f64 = 1e-3;
+
+/// Values for the stations between two `held` sections (guide parameter,
+/// value, weight; sorted along the guide) that hold none: on the straight
+/// line between those two, at [`STRAIGHT_WEIGHT_FRACTION`] of their weight.
+/// Taken only when the law through the sections alone is not positive: a
+/// coarse export written as rings only where its profile bends (a reducer:
+/// pipe, cone, pipe) leaves tens of knots between two rings, where the
+/// least-curvature law through a step of the radius bowed below zero. Its
+/// facets between the rings are straight, and so is the law there then.
+/// Elsewhere the smooth law stays: a swelling written as a few rings is
+/// nearer its author's shape smooth than straight between them.
+fn straight_between(stations: &[Station], held: &[(f64, f64, f64)]) -> Vec<(f64, f64, f64)> {
+    let least = held.iter().map(|x| x.2).fold(f64::INFINITY, f64::min);
+    let weight = STRAIGHT_WEIGHT_FRACTION * least;
+    stations
+        .iter()
+        .filter_map(|s| {
+            // The held sections either side of the station (none past the
+            // first or the last; none at the station itself).
+            let b = held.partition_point(|h| h.0 < s.t);
+            let (a, b) = (held.get(b.checked_sub(1)?)?, held.get(b)?);
+            (b.0 > s.t && b.0 > a.0).then(|| {
+                let u = (s.t - a.0) / (b.0 - a.0);
+                (s.t, a.1 + u * (b.1 - a.1), weight)
+            })
+        })
+        .collect()
 }
 
 /// Index of the outer skin (larger mean radius), when two.

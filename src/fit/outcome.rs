@@ -105,9 +105,23 @@ pub(super) struct Station {
     /// Whether its section is a plane cut of the facets, taken for want of
     /// vertices ([`fill_from_cuts`](super::coarse::fill_from_cuts)).
     pub cut: bool,
+    /// Where along the guide its points lie on average, from the station
+    /// (mm), and its radius there less its radius at the station (mm): its
+    /// circles' mean `dt` and the slope across it ([`Station::radius_read`]).
+    pub read_shift: (f64, f64),
 }
 
 impl Station {
+    /// Its radius (mm) at the guide parameter where its points lie on
+    /// average (mm), when it holds one: the radius its points read with no
+    /// slope. A ring of a coarse export a few mm off its station is read at
+    /// the ring's own place; a smoothed slope across a kink of the profile
+    /// (a reducer's cone meeting its pipe) carried it 3 mm off.
+    pub(super) fn radius_read(&self) -> Option<(f64, f64)> {
+        let (dt, dr) = self.read_shift;
+        self.radius.map(|r| (self.t + dt, r + dr))
+    }
+
     /// The station at `frame` from its circle per skin (`fits`) over `points`
     /// samples: its centre (the circles' mean) and radius and, with two skins,
     /// its wall thickness, when every skin has a circle and the ring is `full`.
@@ -123,16 +137,18 @@ impl Station {
         } else {
             None
         };
-        let (centre, radius, thickness) = match all {
+        let (centre, radius, thickness, read_shift) = match all {
             Some(f) => {
                 let m = f.len() as f64;
+                let dt = f.iter().map(|f| f.mean_dt).sum::<f64>() / m;
+                let dr = f.iter().map(|f| f.slope * f.mean_dt).sum::<f64>() / m;
                 let cx = f.iter().map(|f| f.centre[0]).sum::<f64>() / m;
                 let cy = f.iter().map(|f| f.centre[1]).sum::<f64>() / m;
                 let r = f.iter().map(|f| f.radius).sum::<f64>() / m;
                 let e = (f.len() == 2).then(|| (f[0].radius - f[1].radius).abs());
-                (Some(c + e1 * cx + e2 * cy), Some(r), e)
+                (Some(c + e1 * cx + e2 * cy), Some(r), e, (dt, dr))
             }
-            None => (None, None, None),
+            None => (None, None, None, (0.0, 0.0)),
         };
         Station {
             t: *ti,
@@ -144,6 +160,7 @@ impl Station {
             widened: false,
             bridged: false,
             cut: false,
+            read_shift,
         }
     }
 }

@@ -42,6 +42,9 @@ pub struct CircleFit {
     pub max_gap_rad: f64,
     /// Number of points.
     pub points: usize,
+    /// Mean of the points' `dt` (mm along the guide from the station): the
+    /// radius read without the slope is the radius at `dt` = this.
+    pub mean_dt: f64,
 }
 
 /// Fewest points a section needs.
@@ -123,6 +126,7 @@ pub fn fit_circle(points: &[SectionPoint], slope: f64) -> Option<CircleFit> {
         radius: r0,
         slope,
         rms: (ss / n).sqrt(),
+        mean_dt: points.iter().map(|p| p.dt).sum::<f64>() / n,
         max_dev,
         max_gap_rad: gap,
         points: points.len(),
