@@ -40,15 +40,17 @@ pub(super) fn coupling_gap(law: Option<&(Vec<f64>, Vec<f64>)>) -> f64 {
 /// [`bridge_between_rings`](super::coarse::bridge_between_rings)). The refits' slope law takes every station
 /// (its knot spacing, [`coupling_gap`], keeps the guide of a coarse bend
 /// smooth). `pick`: a station's value (mm) and the guide parameter (mm)
-/// where it is read. A law that is not positive is fitted again, straight
-/// between the sections where they leave it free ([`straight_between`]).
+/// where it is read. A law that is not positive, or any law when
+/// `straight`, is fitted again straight between the sections where they
+/// leave it free ([`straight_between`]).
 pub(super) fn fit_law(
     mesh: &TubeMesh,
     stations: &[Station],
     knots: &[f64],
     pick: &dyn Fn(&Station) -> Option<(f64, f64)>,
     own_rings: bool,
-) -> Result<Vec<f64>, FitError> {
+    straight: bool,
+) -> Result<Law, FitError> {
     let own = stations
         .iter()
         .filter(|s| !s.widened && pick(s).is_some())
@@ -74,8 +76,10 @@ pub(super) fn fit_law(
             })
     };
     let mut v = solve(&held)?;
-    if v.iter().any(|&r| !(r > 0.0)) {
-        v = solve(&[held.clone(), straight_between(stations, &held)].concat())?;
+    let straight = straight || v.iter().any(|&r| !(r > 0.0));
+    if straight {
+        let at = stations.iter().map(|s| s.t).chain(knots.iter().copied());
+        v = solve(&[held.clone(), straight_between(at, &held)].concat())?;
     }
     if let Some(j) = v.iter().position(|&r| !(r > 0.0)) {
         let at = knots[j];
@@ -96,7 +100,32 @@ pub(super) fn fit_law(
             ),
         });
     }
-    Ok(v)
+    let kinks = if straight { kinks(&held) } else { Vec::new() };
+    Ok(Law { values: v, kinks })
+}
+
+/// A law of [`fit_law`]: its values at the knots (mm) and, when it runs
+/// straight between sections far apart, the guide parameters (mm) of the
+/// sections where its slope turns by over [`KINK_SLOPE_TURN`].
+pub(super) struct Law {
+    pub values: Vec<f64>,
+    pub kinks: Vec<f64>,
+}
+
+/// Change of a straight law's slope (mm per mm) at a section past which it
+/// is a kink of the profile ([`Law::kinks`]): a reducer's cone meeting its
+/// pipe turns by its flare's tangent (1.7 at 60 degrees).
+const KINK_SLOPE_TURN: f64 = 0.05;
+
+/// The guide parameters of the `held` sections (guide parameter, value,
+/// weight; sorted) where the straight line through them turns by over
+/// [`KINK_SLOPE_TURN`].
+fn kinks(held: &[(f64, f64, f64)]) -> Vec<f64> {
+    let slope = |a: &(f64, f64, f64), b: &(f64, f64, f64)| (b.1 - a.1) / (b.0 - a.0).max(1e-9);
+    held.windows(3)
+        .filter(|w| (slope(&w[1], &w[2]) - slope(&w[0], &w[1])).abs() > KINK_SLOPE_TURN)
+        .map(|w| w[1].0)
+        .collect()
 }
 
 /// Weight of a station's straight-line value ([`straight_between`]) as a
@@ -105,9 +134,10 @@ pub(super) fn fit_law(
 /// data), too little to move it where they hold it (a bias under 1e-3).
 const STRAIGHT_WEIGHT_FRACTION: f64 = 1e-3;
 
-/// Values for the stations between two `held` sections (guide parameter,
-/// value, weight; sorted along the guide) that hold none: on the straight
-/// line between those two, at [`STRAIGHT_WEIGHT_FRACTION`] of their weight.
+/// Values at the guide parameters `at` (mm: the stations' and the knots')
+/// between two `held` sections (guide parameter, value, weight; sorted
+/// along the guide): on the straight line between those two, at
+/// [`STRAIGHT_WEIGHT_FRACTION`] of their weight.
 /// Taken only when the law through the sections alone is not positive: a
 /// coarse export written as rings only where its profile bends (a reducer:
 /// pipe, cone, pipe) leaves tens of knots between two rings, where the
@@ -115,22 +145,23 @@ const STRAIGHT_WEIGHT_FRACTION: f64 = 1e-3;
 /// facets between the rings are straight, and so is the law there then.
 /// Elsewhere the smooth law stays: a swelling written as a few rings is
 /// nearer its author's shape smooth than straight between them.
-fn straight_between(stations: &[Station], held: &[(f64, f64, f64)]) -> Vec<(f64, f64, f64)> {
+fn straight_between(
+    at: impl Iterator<Item = f64>,
+    held: &[(f64, f64, f64)],
+) -> Vec<(f64, f64, f64)> {
     let least = held.iter().map(|x| x.2).fold(f64::INFINITY, f64::min);
     let weight = STRAIGHT_WEIGHT_FRACTION * least;
-    stations
-        .iter()
-        .filter_map(|s| {
-            // The held sections either side of the station (none past the
-            // first or the last; none at the station itself).
-            let b = held.partition_point(|h| h.0 < s.t);
-            let (a, b) = (held.get(b.checked_sub(1)?)?, held.get(b)?);
-            (b.0 > s.t && b.0 > a.0).then(|| {
-                let u = (s.t - a.0) / (b.0 - a.0);
-                (s.t, a.1 + u * (b.1 - a.1), weight)
-            })
+    at.filter_map(|t| {
+        // The held sections either side of `t` (none past the first or the
+        // last; none at `t` itself).
+        let b = held.partition_point(|h| h.0 < t);
+        let (a, b) = (held.get(b.checked_sub(1)?)?, held.get(b)?);
+        (b.0 > t && b.0 > a.0).then(|| {
+            let u = (t - a.0) / (b.0 - a.0);
+            (t, a.1 + u * (b.1 - a.1), weight)
         })
-        .collect()
+    })
+    .collect()
 }
 
 /// Index of the outer skin (larger mean radius), when two.

@@ -191,8 +191,7 @@ pub struct FitOptions {
     pub constant_radius_tol_mm: f64,
     /// Measure the distance of the fitted surface to the mesh as well (a
     /// parry3d BVH query per sample of the fitted tube): finds a fitted tube
-    /// running past the mesh, with a warning naming the station where it
-    /// lies over `max_rms_mm` from it.
+    /// running past the mesh.
     pub check_surface: bool,
     /// A part file whose `[slicing]`, `[tool_axis]` and `[process]` tables
     /// the written part takes; `None`: constant-distance slicing with

@@ -30,9 +30,7 @@ pub(super) struct Context<'a> {
     pub iterations: usize,
     pub converged: bool,
     pub last_move_mm: f64,
-    /// Measure the fitted surface's distance to the mesh, and warn past
-    /// this (mm); `None`: not measured.
-    pub check_surface: Option<f64>,
+    pub check_surface: bool,
 }
 
 fn end(e: &EndRing) -> EndReport {
@@ -137,14 +135,8 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> (FitReport, Vec<Option<f
     });
     let surface = cx
         .check_surface
-        .and_then(|limit| Some((limit, surface_to_mesh(cx, &guide, &stations, &skin_radius)?)));
-    let warnings = match surface {
-        Some((limit, (d, i))) if d > limit => vec![format!(
-            "the fitted surface lies up to {d:.3} mm from the mesh, at station {i} (t = {:.2} mm), over max_rms_mm = {limit} mm: the mesh's rings there hold a shape the smooth guide and radius law cannot follow (a kink of the profile between rings far apart?)",
-            stations[i].t_mm
-        )],
-        _ => Vec::new(),
-    };
+        .then(|| surface_to_mesh(cx, &guide, &stations, &skin_radius))
+        .flatten();
     let report = FitReport {
         file: cx.mesh.file.clone(),
         triangles: cx.mesh.triangles.len(),
@@ -175,27 +167,26 @@ pub(super) fn build(cx: &Context<'_>, fit: &TubeFit) -> (FitReport, Vec<Option<f
             .samples_pos
             .get(imax)
             .map_or([0.0; 3], |p| p.coords.into()),
-        surface_to_mesh_max_mm: surface.map(|(_, (d, _))| d),
+        surface_to_mesh_max_mm: surface,
         substrate_distance_mm: None,
         wall,
         stations,
         repair: Default::default(),
         units: Default::default(),
-        warnings,
+        warnings: Vec::new(),
         features: Vec::new(),
     };
     (report, per_vertex)
 }
 
 /// Largest distance (parry3d) from samples of the fitted surface (every
-/// station, 36 profile angles, each skin) to the mesh, and the index of
-/// the station where it is.
+/// station, 36 profile angles, each skin) to the mesh.
 fn surface_to_mesh(
     cx: &Context<'_>,
     guide: &crate::geometry::guide::CubicSpline,
     stations: &[StationReport],
     skin_radius: &(dyn Fn(u8, f64) -> f64 + Sync),
-) -> Option<(f64, usize)> {
+) -> Option<f64> {
     let trimesh = TriMesh::new(cx.mesh.vertices.clone(), cx.mesh.triangles.clone()).ok()?;
     let skins = cx.surfaces.skins.len() as u8;
     let samples: Vec<Point3> = stations
@@ -212,11 +203,9 @@ fn surface_to_mesh(
             })
         })
         .collect();
-    let per_station = 36 * skins as usize;
-    let (d, at) = samples
+    let d = samples
         .par_iter()
-        .enumerate()
-        .map(|(k, p)| (trimesh.distance_to_local_point(p, false), k / per_station))
-        .reduce(|| (0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
-    d.is_finite().then_some((d, at))
+        .map(|p| trimesh.distance_to_local_point(p, false))
+        .reduce(|| 0.0, f64::max);
+    d.is_finite().then_some(d)
 }
