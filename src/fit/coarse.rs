@@ -406,6 +406,49 @@ mod tests {
         })
     }
 
+    /// Rings 12 mm apart, knots 4 mm apart and chords 0.2 mm inside the
+    /// curve: the warning names the rings' and the knots' spacing, the sag
+    /// and the knots to take (18 mm); no warning once bridged, with chords
+    /// under 0.05 mm inside, or with knots as wide as 1.5 ring gaps.
+    #[test]
+    fn the_chords_warning_names_the_rings_and_the_knots() {
+        let coarse = Coarseness {
+            ring_gap: 12.0,
+            knot_h: 4.0,
+            sag: 0.2,
+            bridged: 0,
+        };
+        let w = coarse.warning().expect("a warning");
+        for part in [
+            "12.0 mm apart",
+            "knots 4.0 mm apart",
+            "up to 0.20 mm inside",
+            "knots 18 mm apart or more",
+        ] {
+            assert!(w.contains(part), "{part}: {w}");
+        }
+        for quiet in [
+            Coarseness {
+                bridged: 3,
+                ..coarse
+            },
+            Coarseness {
+                sag: 0.04,
+                ..coarse
+            },
+            Coarseness {
+                knot_h: 18.5,
+                ..coarse
+            },
+            Coarseness {
+                ring_gap: 0.0,
+                ..coarse
+            },
+        ] {
+            assert_eq!(quiet.warning(), None, "{quiet:?}");
+        }
+    }
+
     /// Two rings 40 degrees apart on an arc of radius 50 mm: the bridge
     /// between them lies on the arc (the cubic's closed-form error there is
     /// about 2e-6 of the radius); a ring between them of its own is kept.

@@ -324,10 +324,10 @@ fn fit_pass(
         );
         if iterations > check_after {
             match (check_sections(mesh, &stations, opts), postponed.take()) {
-                (Ok(()), None) => {}
-                // Round now: the first failure stands (the later passes run
-                // as before).
-                (Ok(()), Some((first, _))) => return Err(first),
+                // Round now (with a failure postponed: the refits to the
+                // round sections brought the rest round too, an early guide
+                // that cut a tight bend short): on as if it had not failed.
+                (Ok(()), _) => {}
                 (Err(e), None) => {
                     if pass == Pass::Vertices {
                         postponed = Some((e, iterations));

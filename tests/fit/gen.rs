@@ -900,3 +900,67 @@ pub fn coarse_bend(
     let (v, f) = lofted(&rings);
     (truth, v, f)
 }
+
+/// A sine tube: centre line x = `a` sin(2 pi z / `l`), y = 0, z from 0 to
+/// `l` (mm), radius `r` (mm); the arc length from a table 0.01 mm fine.
+pub fn sine(a: f64, l: f64, r: f64) -> Truth {
+    let n = (l / 0.01).ceil() as usize;
+    let at = move |z: f64| Point3::new(a * (TAU * z / l).sin(), 0.0, z);
+    let mut table = vec![(0.0, 0.0)];
+    for i in 1..=n {
+        let (z0, z1) = (l * (i - 1) as f64 / n as f64, l * i as f64 / n as f64);
+        let s = table[i - 1].0 + (at(z1) - at(z0)).norm();
+        table.push((s, z1));
+    }
+    let length = table[n].0;
+    Truth {
+        name: "sine tube",
+        length,
+        centre: Box::new(move |s| {
+            let i = table.partition_point(|x| x.0 < s).clamp(1, n);
+            let ((s0, z0), (s1, z1)) = (table[i - 1], table[i]);
+            at(z0 + (z1 - z0) * ((s - s0) / (s1 - s0)).clamp(0.0, 1.0))
+        }),
+        radius: Box::new(move |_| r),
+    }
+}
+
+/// The sine tube of [`sine`] as an exporter that frames each ring by its
+/// tangent crossed with z writes it (ib565/colabdesign-stl's sweep):
+/// `rings` rings evenly in z, `around` points each, the tangent by central
+/// differences. Where x' changes sign (the crests) the frame turns by half
+/// a turn between two rings, and the band of triangles between them twists
+/// through the axis.
+pub fn flipped_sine(
+    a: f64,
+    l: f64,
+    r: f64,
+    rings: usize,
+    around: usize,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let c: Vec<Point3> = (0..rings)
+        .map(|i| {
+            let z = l * i as f64 / (rings - 1) as f64;
+            Point3::new(a * (TAU * z / l).sin(), 0.0, z)
+        })
+        .collect();
+    let mut v = Vec::new();
+    for i in 0..rings {
+        let t = (c[(i + 1).min(rings - 1)] - c[i.saturating_sub(1)]).normalize();
+        let n = t.cross(&Vector3::z()).normalize();
+        let b = t.cross(&n);
+        v.extend((0..around).map(|j| {
+            let u = TAU * j as f64 / around as f64;
+            c[i] + (n * u.cos() + b * u.sin()) * r
+        }));
+    }
+    let id = |i: usize, j: usize| (i * around + j % around) as u32;
+    let mut f = Vec::new();
+    for i in 0..rings - 1 {
+        for j in 0..around {
+            f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            f.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    (v, f)
+}
