@@ -267,7 +267,8 @@ fn fit_pass(
     };
     // The vertices' pass's first failed check and its refit, while the
     // guide is refitted to the round sections alone (FEATURE_REFITS): every
-    // outcome but a feature named then is this failure, as before.
+    // outcome but a feature named, or every section round again, is then
+    // this failure.
     let mut postponed: Option<(FitError, usize)> = None;
     // The last refit's sections (where the final radius law turns), and
     // its knots on the guide before and after it (carry_hints).

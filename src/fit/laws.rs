@@ -56,13 +56,12 @@ pub(super) fn fit_law(
         .filter(|s| !s.widened && pick(s).is_some())
         .count();
     let all = !own_rings || own < MIN_OWN_LAW_STATIONS;
-    let mut ok: Vec<(f64, f64, f64)> = stations
+    let mut held: Vec<(f64, f64, f64)> = stations
         .iter()
         .filter(|s| all || !s.widened)
         .filter_map(|s| pick(s).map(|(t, v)| (t, v, s.points as f64)))
         .collect();
-    ok.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let held = ok;
+    held.sort_by(|a, b| a.0.total_cmp(&b.0));
     let solve = |data: &[(f64, f64, f64)]| {
         let ts: Vec<f64> = data.iter().map(|x| x.0).collect();
         let w: Vec<f64> = data.iter().map(|x| x.2).collect();
@@ -138,7 +137,8 @@ const STRAIGHT_WEIGHT_FRACTION: f64 = 1e-3;
 /// between two `held` sections (guide parameter, value, weight; sorted
 /// along the guide): on the straight line between those two, at
 /// [`STRAIGHT_WEIGHT_FRACTION`] of their weight.
-/// Taken only when the law through the sections alone is not positive: a
+/// Taken when the law through the sections alone is not positive (on the
+/// last refit's sections: the final law then follows, [`Law::kinks`]): a
 /// coarse export written as rings only where its profile bends (a reducer:
 /// pipe, cone, pipe) leaves tens of knots between two rings, where the
 /// least-curvature law through a step of the radius bowed below zero. Its
