@@ -348,6 +348,10 @@ fn fit_pass(
             }
         }
         let knots = fit_knots(range, knot_h, spacing.max(coupling_gap(slope.as_ref())));
+        // Each station's radius at the station: read at its points' place
+        // (Station::radius_read, the final law's), the widened stations'
+        // moved this slope law and broke the refits of coarse coils and
+        // bends.
         slope = fit_law(
             mesh,
             &stations,
@@ -380,8 +384,9 @@ fn fit_pass(
             .take(knots.len() - 2)
             .map(|(&k, p)| across(k, p))
             .fold(0.0, f64::max);
-        hints = Some(carry_hints(t, &knots, &chord_knots(&next)));
-        last_carry = (knots, chord_knots(&next));
+        let next_knots = chord_knots(&next);
+        hints = Some(carry_hints(t, &knots, &next_knots));
+        last_carry = (knots, next_knots);
         guide = next;
         // Converged, or stalled at the level of the mesh's noise (a quarter
         // of the sections' typical scatter: vertices changing station make
@@ -408,15 +413,24 @@ fn fit_pass(
             break;
         }
     }
-    let kinks = fit_law(
-        mesh,
-        &last_stations,
-        &last_carry.0,
-        &Station::radius_read,
-        true,
-        false,
-    )
-    .map_or_else(|_| Vec::new(), |law| law.kinks);
+    // Kinks of a profile held by rings far apart; a radius held at every
+    // station (a fine mesh) needs no trial law.
+    let rings_apart = last_stations
+        .iter()
+        .any(|s| s.widened || s.radius.is_none());
+    let kinks = if rings_apart {
+        fit_law(
+            mesh,
+            &last_stations,
+            &last_carry.0,
+            &Station::radius_read,
+            true,
+            false,
+        )
+        .map_or_else(|_| Vec::new(), |law| law.kinks)
+    } else {
+        Vec::new()
+    };
     let kinks = carry_hints(kinks, &last_carry.0, &last_carry.1);
     let guide = kinked_guide(mesh, guide, &kinks, knot_h)
         .map_err(|e| postponed.take().map_or(e, |p| p.0))?;
