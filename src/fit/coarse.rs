@@ -3,7 +3,8 @@
 //! straights written as one strip of long triangles) leaves stations with
 //! no ring of their own: its flat rings of vertices (the exporter's own
 //! samples of the axis and the tangent) and the cubic that bridges the
-//! guide between two of them, plane cuts for stations that hold no vertex,
+//! guide between two of them (straight along a straight leg, leaving a
+//! leg along it), plane cuts for stations that hold no vertex,
 //! how far apart its rings lie and how far its facets' chords sag inside a
 //! curved guide between them where no ring bridges them (a warning naming
 //! the knots to take), a warning when a varying radius is held only at
@@ -140,32 +141,109 @@ fn ring_of(
     })
 }
 
+/// Two consecutive stretches between rings whose chords turn by less than
+/// this (degrees) are straight ([`straight_stretches`]): a bend's chords
+/// turn by its stretches' angle; an arc in stretches of 0.5 degrees sags
+/// under 0.0011 of a stretch inside its chord.
+const STRAIGHT_TURN_DEG: f64 = 0.5;
+
+/// A stretch between rings that holds plane cuts and is longer than this
+/// many times each stretch beside it is straight ([`straight_stretches`]):
+/// an exporter writes a straight leg as one strip of long triangles, and a
+/// curve in stretches of a few lengths each (their chords sag alike, by the
+/// exporter's tolerance).
+const STRAIGHT_LENGTH_RATIO: f64 = 2.0;
+
+/// Which stretches between consecutive `rings` (`rings.len() - 1` of them)
+/// are straight, from the rings' centres: its chord and a neighbour's turn
+/// by under [`STRAIGHT_TURN_DEG`], or it holds a station's plane cut
+/// (`cut`, per stretch: too long for its stations to borrow its rings'
+/// vertices) and is over [`STRAIGHT_LENGTH_RATIO`] times as long as each
+/// neighbour. `None` for a stretch with a missing ring or no neighbour to
+/// tell it by.
+fn straight_stretches(rings: &[Option<VertexRing>], cut: &[bool]) -> Vec<Option<bool>> {
+    let chords: Vec<Option<Vector3>> = rings
+        .windows(2)
+        .map(|w| match w {
+            [Some(a), Some(b)] => Some(b.centre - a.centre),
+            _ => None,
+        })
+        .collect();
+    (0..chords.len())
+        .map(|i| {
+            let d = chords[i]?;
+            let beside: Vec<Vector3> = [i.checked_sub(1), Some(i + 1)]
+                .into_iter()
+                .flatten()
+                .filter_map(|j| chords.get(j).copied().flatten())
+                .collect();
+            (!beside.is_empty()).then(|| {
+                beside
+                    .iter()
+                    .any(|e| d.angle(e) < STRAIGHT_TURN_DEG.to_radians())
+                    || (cut[i]
+                        && beside
+                            .iter()
+                            .all(|e| d.norm() > STRAIGHT_LENGTH_RATIO * e.norm()))
+            })
+        })
+        .collect()
+}
+
 /// Sets the centres (mm) of the stations between two consecutive runs of
 /// vertices that are both rings of a coarse export ([`vertex_rings`]) and
-/// hold no ring of their own to the cubic
-/// (Hermite) from one ring's centre to the next, leaving each along its
-/// ring's normal: the facets between the rings are chords, inside a curved
+/// hold no ring of their own to the cubic (Hermite) from one ring's centre
+/// to the next: the facets between the rings are chords, inside a curved
 /// tube, and the stations there hold only their neighbours' points (a
-/// widened ring) or none, which keep the guide where it lies; the rings'
-/// centres and planes are the exporter's own
-/// samples of the tube's axis and tangent. The tangents' length makes the
-/// cubic an arc's when the rings are a circular arc's (two normals at
-/// `theta`: chord x 2 tan(theta / 4) / sin(theta / 2)); parallel normals
-/// give a straight. The bridged stations weigh as their rings' mean. A
-/// station between the rings whose section is a plane cut
-/// ([`fill_from_cuts`]) keeps its centre (a straight's facets lie on it). Neither holds a radius (nor wall thickness) then:
-/// the radius law interpolates the rings' own (the facets lie up to
-/// r (1 - cos(pi / n)) inside an n-gon's circle). Returns how many
-/// stations it bridged.
+/// widened ring), none, or a plane cut of those chords. The rings' centres
+/// are the exporter's own samples of the tube's axis. The cubic leaves a
+/// ring along the tube's tangent there: along a straight stretch
+/// ([`straight_stretches`]) its chord, from a straight stretch into a
+/// curved one the straight's chord (a straight meets a bend at a tangent),
+/// else the ring's normal. An exporter that takes a ring's normal from its
+/// neighbours' centres leans the ring where a straight meets a bend (a
+/// cubic along it left a pipe network's straight by 0.36 mm 19 mm before
+/// its bend at 10 times scale); on a bend's arc that normal is its tangent.
+/// The tangents' length makes the cubic an arc's when the rings are a
+/// circular arc's (two tangents at `theta`: chord x 2 tan(theta / 4) /
+/// sin(theta / 2)); parallel tangents give a straight. The bridged stations
+/// weigh as their rings' mean. A station whose section is a plane cut
+/// ([`fill_from_cuts`]) keeps its centre where its stretch is not told
+/// curved (a straight's facets lie on it); on a curved stretch it is
+/// bridged too. None of them holds a radius (nor wall thickness) then: the
+/// radius law interpolates the rings' own (the facets lie up to
+/// r (1 - cos(pi / n)) inside an n-gon's circle). Returns how many stations
+/// it bridged.
 pub(super) fn bridge_between_rings(
     stations: &mut [Station],
     rings: &[Option<VertexRing>],
 ) -> usize {
+    let cut: Vec<bool> = rings
+        .windows(2)
+        .map(|w| match w {
+            [Some(a), Some(b)] => stations.iter().any(|s| s.cut && s.t > a.t && s.t < b.t),
+            _ => false,
+        })
+        .collect();
+    let straight = straight_stretches(rings, &cut);
+    // The unit chord of stretch `j` when it is straight.
+    let straight_chord = |j: usize| match (straight.get(j), rings.get(j), rings.get(j + 1)) {
+        (Some(Some(true)), Some(Some(p)), Some(Some(q))) => Some((q.centre - p.centre).normalize()),
+        _ => None,
+    };
     let mut set = 0;
-    for w in rings.windows(2) {
+    for (i, w) in rings.windows(2).enumerate() {
         let [Some(a), Some(b)] = w else { continue };
-        let m = arc_tangent_length((b.centre - a.centre).norm(), a.normal.angle(&b.normal));
-        let (m0, m1) = (a.normal * m, b.normal * m);
+        let chord = b.centre - a.centre;
+        let ta = straight_chord(i)
+            .or_else(|| i.checked_sub(1).and_then(straight_chord))
+            .unwrap_or(a.normal);
+        let tb = straight_chord(i)
+            .or_else(|| straight_chord(i + 1))
+            .unwrap_or(b.normal);
+        let curved = straight[i] == Some(false);
+        let m = arc_tangent_length(chord.norm(), ta.angle(&tb));
+        let (m0, m1) = (ta * m, tb * m);
         let weight = (a.points + b.points) / 2;
         for s in stations.iter_mut() {
             let own = !s.widened && s.centre.is_some();
@@ -176,13 +254,14 @@ pub(super) fn bridge_between_rings(
             // the rings, its cut one reads the facets: the law interpolates
             // the rings' own instead.
             (s.radius, s.thickness) = (None, None);
-            if s.cut {
+            if s.cut && !curved {
                 continue;
             }
             let u = (s.t - a.t) / (b.t - a.t);
             s.centre = Some(hermite(&a.centre, &m0, &b.centre, &m1, u));
             s.points = weight;
             s.bridged = true;
+            s.cut = false;
             set += 1;
         }
     }
@@ -382,6 +461,7 @@ pub(super) fn bridge_not_round(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
     /// A station at `t` (mm) holding no ring of its own.
     fn borrowed(t: f64) -> Station {
@@ -497,6 +577,83 @@ mod tests {
             assert!((c - Point3::new(1.0, 2.0, s.t)).norm() < 1e-9, "{c:?}");
         }
         assert!(stations.iter().filter(|s| s.t > 30.0).all(|s| !s.bridged));
+    }
+
+    /// A leg 200 mm long meets an arc of radius 40 mm in two stretches of
+    /// 45 degrees, then a second leg; each ring's normal is taken from its
+    /// neighbours' centres, so the rings at the joins lean 2.94 degrees
+    /// toward the arc. The legs (their stations hold plane cuts) are
+    /// straight, the arc's stretches not, though one holds a cut of its
+    /// chords. The bridge stays on each leg's axis up to its ring, and runs
+    /// on the arc between the joins, the cut on the arc bridged too.
+    #[test]
+    fn a_leaning_ring_where_a_leg_meets_an_arc_bridges_both_true() {
+        let radius = 40.0;
+        let arc = |a: f64| Point3::new(radius * (1.0 - a.cos()), 0.0, 200.0 + radius * a.sin());
+        let c = [
+            Point3::origin(),
+            arc(0.0),
+            arc(FRAC_PI_4),
+            arc(FRAC_PI_2),
+            arc(FRAC_PI_2) + Vector3::x() * 200.0,
+        ];
+        let ts = [
+            0.0,
+            200.0,
+            200.0 + radius * FRAC_PI_4,
+            200.0 + radius * FRAC_PI_2,
+        ];
+        let ts = [ts[0], ts[1], ts[2], ts[3], ts[3] + 200.0];
+        let rings: Vec<Option<VertexRing>> = (0..5_usize)
+            .map(|i| {
+                let (p, q) = (c[i.saturating_sub(1)], c[(i + 1).min(4)]);
+                ring(ts[i], c[i], (q - p).normalize())
+            })
+            .collect();
+        let lean = rings[1].expect("a ring").normal.angle(&Vector3::z());
+        assert!((lean.to_degrees() - 2.94).abs() < 0.01, "{lean}");
+        let on_leg = |t: f64| t < ts[1] || t > ts[3];
+        let mut stations: Vec<Station> = (0..231).map(|i| borrowed(2.0 * i as f64 + 1.0)).collect();
+        for s in stations.iter_mut() {
+            let leg_cut = (s.t > 20.0 && s.t < 180.0) || (s.t > 282.0 && s.t < 442.0);
+            if leg_cut || (s.t - 215.0).abs() < 1.0 {
+                (s.widened, s.cut) = (false, true);
+                // A leg's cut lies on its axis, the arc's on its chord.
+                s.centre = Some(if s.t < ts[1] {
+                    Point3::new(0.0, 0.0, s.t)
+                } else if s.t > ts[3] {
+                    c[3] + Vector3::x() * (s.t - ts[3])
+                } else {
+                    c[1] + (c[2] - c[1]) * ((s.t - ts[1]) / (ts[2] - ts[1]))
+                });
+            }
+        }
+        let cut: Vec<bool> = vec![true, true, false, true];
+        assert_eq!(
+            straight_stretches(&rings, &cut),
+            vec![Some(true), Some(false), Some(false), Some(true)]
+        );
+        bridge_between_rings(&mut stations, &rings);
+        for s in &stations {
+            let p = s.centre.expect("a centre");
+            let off = if on_leg(s.t) {
+                let axis = if s.t < ts[1] {
+                    p.coords.xy().norm()
+                } else {
+                    (p.z - 240.0).abs() + p.y.abs()
+                };
+                assert!(
+                    !s.bridged || axis < 1e-9,
+                    "t {}: {axis} mm off the leg",
+                    s.t
+                );
+                axis
+            } else {
+                assert!(s.bridged, "t {}", s.t);
+                ((p - Point3::new(radius, 0.0, 200.0)).norm() - radius).abs()
+            };
+            assert!(off < 2e-4 * radius, "t {}: {off} mm off", s.t);
+        }
     }
 
     /// A station between two rings whose section is a plane cut of the

@@ -542,10 +542,8 @@ fn fit_pass(
 /// those between two rings of vertices of a coarse export that hold no ring
 /// of their own are bridged between the rings ([`bridge_between_rings`]).
 /// The cuts go first: the facets of a straight written as one strip lie on
-/// it, where the rings at its ends may be tilted (an exporter that takes a
-/// ring's tangent from its neighbours' centres tilts it at a join with a
-/// bend, and a cubic along those tilts bulged a pipe network's straights
-/// by 0.1 mm).
+/// it, and they tell the bridge which stretches between rings are long
+/// enough to be a straight leg.
 /// `data`: the mesh, its surfaces, the samples and their guide parameters;
 /// `at`: the guide, its range, the stations' spacing and the end radius
 /// (mm). Returns how many stations it bridged.

@@ -878,16 +878,55 @@ pub fn coarse_bend(
         centre: Box::new(elbow_centre(leg, bend_r)),
         radius: Box::new(move |_| r),
     };
-    let bend = bend_r * FRAC_PI_2;
+    let (v, f) = coarse_bend_rings(&truth, r, leg, segments, around, false);
+    (truth, v, f)
+}
+
+/// [`coarse_bend`] as an exporter that takes each ring's plane from its
+/// neighbours' centres writes it (pipe_network.py's sweep): a ring's normal
+/// is the direction from the centre before it to the centre after it (from
+/// the one beside it at the ends), so the rings where a leg joins the bend
+/// lean toward the bend, by more the longer the leg.
+pub fn coarse_bend_central(
+    r: f64,
+    bend_r: f64,
+    leg: f64,
+    segments: usize,
+    around: usize,
+) -> (Truth, Vec<Point3>, Vec<[u32; 3]>) {
+    let (truth, _, _) = coarse_bend(r, bend_r, leg, 1, 3);
+    let (v, f) = coarse_bend_rings(&truth, r, leg, segments, around, true);
+    (truth, v, f)
+}
+
+/// The rings of [`coarse_bend`] on `truth`, normal to its centre line or
+/// (`central`) to the chord between the neighbouring rings' centres.
+fn coarse_bend_rings(
+    truth: &Truth,
+    r: f64,
+    leg: f64,
+    segments: usize,
+    around: usize,
+    central: bool,
+) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let bend = truth.length - 2.0 * leg;
     let mut at: Vec<f64> = vec![0.0];
     at.extend((0..=segments).map(|i| leg + bend * i as f64 / segments as f64));
     at.push(2.0 * leg + bend);
     let m = (truth.length / 0.05).ceil() as usize;
-    let fr = frames(&truth, m);
-    let rings: Vec<Vec<Point3>> = at
-        .iter()
-        .map(|&s| {
-            let (_, x, ti, n) = fr[((s / truth.length) * m as f64).round() as usize];
+    let fr = frames(truth, m);
+    let frame = |s: f64| fr[((s / truth.length) * m as f64).round() as usize];
+    let rings: Vec<Vec<Point3>> = (0..at.len())
+        .map(|i| {
+            let (_, x, mut ti, mut n) = frame(at[i]);
+            if central {
+                let (before, after) = (
+                    frame(at[i.saturating_sub(1)]).1,
+                    frame(at[(i + 1).min(at.len() - 1)]).1,
+                );
+                ti = (after - before).normalize();
+                n = (n - ti * n.dot(&ti)).normalize();
+            }
             let b = ti.cross(&n);
             (0..around)
                 .map(|j| {
@@ -897,8 +936,7 @@ pub fn coarse_bend(
                 .collect()
         })
         .collect();
-    let (v, f) = lofted(&rings);
-    (truth, v, f)
+    lofted(&rings)
 }
 
 /// A sine tube: centre line x = `a` sin(2 pi z / `l`), y = 0, z from 0 to
