@@ -16,10 +16,11 @@
 
 use super::outcome::{EndRing, Station};
 use super::samples::Samples;
-use super::section::{fit_circle, Frame, SectionPoint};
+use super::section::{fit_circle, plane_basis, Frame, SectionPoint};
 use super::topology::Surfaces;
 use super::TubeMesh;
-use crate::math::{Point3, Vector3};
+use crate::geometry::guide::{CubicSpline, GuideCurve};
+use crate::math::{Point3, UnitVector3, Vector3};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -46,6 +47,67 @@ pub(super) fn cut_sections(
     step: f64,
     margin: f64,
 ) -> Vec<Station> {
+    cut_loops(mesh, surf, samples, t, frames, step, margin)
+        .into_iter()
+        .zip(frames)
+        .map(|(loops, frame)| {
+            let points = loops.iter().flatten().map(Vec::len).sum();
+            let fits = loops
+                .iter()
+                .map(|l| l.as_deref().and_then(|l| fit_circle(l, 0.0)))
+                .collect();
+            Station::from_fits(frame, fits, points, true)
+        })
+        .collect()
+}
+
+/// The points of the stations' plane cuts as samples: each loop's points
+/// of [`cut_loops`] (mesh frame, mm) with its skin and its station's guide
+/// parameter (mm), at the stations' `ts` (mm) on `spline`; `samples`, `t`
+/// and `margin` as for [`cut_sections`]. A solid as a CAD tool writes it
+/// has vertices only where its shape changes (a flange's edges); its tube's
+/// sections are the cuts.
+pub(super) fn cut_points(
+    (mesh, surf, samples, t): (&TubeMesh, &Surfaces, &Samples, &[f64]),
+    spline: &CubicSpline,
+    ts: &[f64],
+    margin: f64,
+) -> (Vec<Point3>, Vec<u8>, Vec<f64>) {
+    let frames: Vec<Frame> = ts
+        .iter()
+        .map(|&ti| {
+            let tan = UnitVector3::new_normalize(spline.d1(ti));
+            let (e1, e2) = plane_basis(&tan);
+            (ti, spline.point(ti), tan.into_inner(), e1, e2)
+        })
+        .collect();
+    let step = (ts[ts.len() - 1] - ts[0]) / (ts.len() - 1).max(1) as f64;
+    let (mut pos, mut skin, mut at) = (Vec::new(), Vec::new(), Vec::new());
+    let loops = cut_loops(mesh, surf, samples, t, &frames, step, margin);
+    for (per_skin, (ti, c, _, e1, e2)) in loops.into_iter().zip(&frames) {
+        for (k, pts) in per_skin.into_iter().enumerate() {
+            for q in pts.into_iter().flatten() {
+                pos.push(c + e1 * q.x + e2 * q.y);
+                skin.push(k as u8);
+                at.push(*ti);
+            }
+        }
+    }
+    (pos, skin, at)
+}
+
+/// Per station at `frames` (`step` mm apart) and per skin, the closed loop
+/// of [`section_loop`] cut from the skin's triangles near the station;
+/// `samples`, `t` and `margin` as for [`cut_sections`].
+fn cut_loops(
+    mesh: &TubeMesh,
+    surf: &Surfaces,
+    samples: &Samples,
+    t: &[f64],
+    frames: &[Frame],
+    step: f64,
+    margin: f64,
+) -> Vec<Vec<Option<Vec<SectionPoint>>>> {
     let skins = surf.skins.len();
     let n = frames.len() - 1;
     let t0 = frames[0].0;
@@ -81,10 +143,7 @@ pub(super) fn cut_sections(
             entries += (i1 - i0) as usize + 1;
             if entries > MAX_CUT_ENTRIES {
                 // Triangles each spanning the tube: no section from cuts.
-                return frames
-                    .iter()
-                    .map(|f| Station::from_fits(f, vec![None; skins], 0, true))
-                    .collect();
+                return vec![vec![None; skins]; frames.len()];
             }
             for i in i0 as usize..=i1 as usize {
                 cand[i * skins + k].push(tri);
@@ -102,15 +161,9 @@ pub(super) fn cut_sections(
                 e1,
                 e2,
             };
-            let loops: Vec<Option<Vec<SectionPoint>>> = (0..skins)
+            (0..skins)
                 .map(|k| section_loop(&plane, &mesh.vertices, &cand[i * skins + k]))
-                .collect();
-            let points = loops.iter().flatten().map(Vec::len).sum();
-            let fits = loops
-                .iter()
-                .map(|l| l.as_deref().and_then(|l| fit_circle(l, 0.0)))
-                .collect();
-            Station::from_fits(frame, fits, points, true)
+                .collect()
         })
         .collect()
 }

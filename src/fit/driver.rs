@@ -1170,14 +1170,20 @@ fn not_tube(
 ) -> Result<TubeFit, FitError> {
     let (mesh, surf, spline, stations, samples, t, reach) = cx;
     let nv = samples.vertices;
-    let (tube, found) = features::detect(
-        spline,
-        stations,
-        &samples.pos[..nv],
-        &samples.skin[..nv],
-        &t[..nv],
-        opts,
-    );
+    let (mut pos, mut skin) = (samples.pos[..nv].to_vec(), samples.skin[..nv].to_vec());
+    let mut at = t[..nv].to_vec();
+    let (mut tube, mut found) = features::detect(spline, stations, &pos, &skin, &at, opts);
+    // Stations without a vertex (a solid as a CAD tool writes it, vertices
+    // only where its shape changes: a spool whose flanges hold every ring)
+    // take the points of their plane cuts too.
+    if found.is_empty() && stations.iter().any(|s| s.points == 0) {
+        let ts: Vec<f64> = stations.iter().map(|s| s.t).collect();
+        let cuts = cut::cut_points((mesh, surf, samples, &t[..nv]), spline, &ts, reach);
+        pos.extend(cuts.0);
+        skin.extend(cuts.1);
+        at.extend(cuts.2);
+        (tube, found) = features::detect(spline, stations, &pos, &skin, &at, opts);
+    }
     let Some(first) = found.first() else {
         return Err(error);
     };
