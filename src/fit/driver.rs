@@ -206,8 +206,14 @@ fn fit_passes(
     match fit_pass(mesh, opts, trimmed, Pass::Vertices, coarse) {
         Err(e @ (FitError::SectionNotCircle { .. } | FitError::Degenerate { .. })) => {
             fit_pass(mesh, opts, trimmed, Pass::BendEdges, coarse)
-                .or_else(|_| fit_pass(mesh, opts, trimmed, Pass::Cuts, coarse))
-                .map_err(|_| e)
+                .or_else(|x| {
+                    eprintln!("PROBE bendedges: {x}");
+                    fit_pass(mesh, opts, trimmed, Pass::Cuts, coarse)
+                })
+                .map_err(|x| {
+                    eprintln!("PROBE cuts: {x}");
+                    e
+                })
         }
         fitted => fitted,
     }
@@ -247,7 +253,8 @@ fn fit_pass(
     let (spacing, knot_h) = spacings(opts, edge, r0);
     coarse.knot_h = knot_h;
     let march = pass == Pass::Cuts;
-    let mut guide = first_guide(mesh, &surf, [&start, &finish], edge, knot_h, march)?;
+    let sizes = (edge, knot_h, opts.section_rms_allowed(r0));
+    let mut guide = first_guide(mesh, &surf, [&start, &finish], sizes, march)?;
     let later = pass != Pass::Vertices;
     let mut samples = pass_samples(mesh, &surf, &guide, spacing, r0, pass)?;
     let check_after = if later { CHECK_SECTIONS_AFTER } else { 1 };
@@ -1098,7 +1105,7 @@ fn separate_pieces(
         .map(|p| features::piece(mesh, p, stations, spline))
         .collect();
     match (pieces.first(), opts.trim) {
-        (Some(f), false) => Err(feature_error(mesh, f, pieces.len())),
+        (Some(f), false) => Err(features::refusal(mesh, f, pieces.len())),
         _ => Ok(pieces),
     }
 }
@@ -1135,30 +1142,6 @@ fn failed_sections(
     })
 }
 
-/// The refusal of a feature that is not tube.
-fn feature_error(mesh: &TubeMesh, f: &FeatureReport, count: usize) -> FitError {
-    let c = f.centre_mm;
-    FitError::Feature {
-        file: mesh.file.clone(),
-        kind: f.kind.name(),
-        station: f.first_station,
-        last_station: f.last_station,
-        t_mm: f.t_from_mm,
-        t_end_mm: f.t_to_mm,
-        size: format!(
-            "{}, near ({:.1}, {:.1}, {:.1}) mm{}; with --trim (FitOptions::trim) the longest tubular stretch is fitted and the rest named in fit.json",
-            f.size(),
-            c[0],
-            c[1],
-            c[2],
-            match count {
-                1 => String::new(),
-                n => format!(" (and {} more)", n - 1),
-            }
-        ),
-    }
-}
-
 /// Sections that failed `error`: features that are not tube refused by
 /// name, or with [`FitOptions::trim`] the longest tubular stretch cut out
 /// and fitted (once: `trimmed`); `error` itself when no feature is found.
@@ -1188,7 +1171,7 @@ fn not_tube(
         return Err(error);
     };
     if !opts.trim || trimmed {
-        return Err(feature_error(mesh, first, found.len()));
+        return Err(features::refusal(mesh, first, found.len()));
     }
     // Tubular runs that touch make one stretch; the longest is fitted.
     let mut stretches: Vec<(usize, usize)> = Vec::new();
@@ -1203,7 +1186,7 @@ fn not_tube(
         let len = |s: &(usize, usize)| stations[s.1].t - stations[s.0].t;
         len(x).total_cmp(&len(y))
     }) else {
-        return Err(feature_error(mesh, first, found.len()));
+        return Err(features::refusal(mesh, first, found.len()));
     };
     // Cut a little past the features beside the stretch (their points'
     // extent along the guide), between its first round station and the one

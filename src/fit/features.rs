@@ -12,7 +12,7 @@
 
 use super::outcome::{FeatureKind, FeatureReport, Station};
 use super::section::{fit_circle, plane_basis, SectionPoint};
-use super::{FitOptions, TubeMesh};
+use super::{FitError, FitOptions, TubeMesh};
 use crate::geometry::guide::{CubicSpline, GuideCurve};
 use crate::math::{Point3, UnitVector3, Vector3};
 use std::collections::HashMap;
@@ -257,6 +257,30 @@ pub(super) fn detect(
         });
     }
     (tube, features)
+}
+
+/// The refusal of a feature that is not tube: `f`, the first of `count`.
+pub(super) fn refusal(mesh: &TubeMesh, f: &FeatureReport, count: usize) -> FitError {
+    let c = f.centre_mm;
+    FitError::Feature {
+        file: mesh.file.clone(),
+        kind: f.kind.name(),
+        station: f.first_station,
+        last_station: f.last_station,
+        t_mm: f.t_from_mm,
+        t_end_mm: f.t_to_mm,
+        size: format!(
+            "{}, near ({:.1}, {:.1}, {:.1}) mm{}; with --trim (FitOptions::trim) the longest tubular stretch is fitted and the rest named in fit.json",
+            f.size(),
+            c[0],
+            c[1],
+            c[2],
+            match count {
+                1 => String::new(),
+                n => format!(" (and {} more)", n - 1),
+            }
+        ),
+    }
 }
 
 /// The share of the directions around the guide (dimensionless, 0 to 1)

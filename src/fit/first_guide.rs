@@ -2,7 +2,8 @@
 //! refits start from, end to end through the tube, with one point past
 //! each end. Through the centroids of the level sets of the geodesic
 //! distance from the start end, or the cubic leaving each end along its
-//! normal when the mesh is too coarse for level sets; on the plane-cut pass,
+//! normal when the mesh is too coarse for level sets, or through a swept
+//! export's rings where the level sets leave them; on the plane-cut pass,
 //! marched through plane cuts of the skin ([`cut::march`]). Mesh frame, mm.
 
 use super::cut;
@@ -15,13 +16,13 @@ use crate::math::{Point3, UnitVector3};
 /// The first guide of a pass (points, one past each end): marched through
 /// plane cuts of the skin it follows ([`guide_skin`]) with `march`
 /// ([`cut::march`]), else (or when the march is lost) through the level
-/// sets ([`initial_guide`]).
+/// sets ([`initial_guide`]). The sizes: the median edge, the knot spacing
+/// and the RMS a flat ring may have (mm).
 pub(super) fn first_guide(
     mesh: &TubeMesh,
     surf: &Surfaces,
     [start, finish]: [&EndRing; 2],
-    edge: f64,
-    knot_h: f64,
+    (edge, knot_h, flat_mm): (f64, f64, f64),
     march: bool,
 ) -> Result<Vec<Point3>, FitError> {
     let k = guide_skin(mesh, surf);
@@ -29,7 +30,7 @@ pub(super) fn first_guide(
         .then(|| cut::march(mesh, &surf.skins[k].triangles, start, finish, 0.5 * knot_h))
         .flatten()
         .map_or_else(
-            || initial_guide(mesh, surf, k, start, finish, edge, knot_h),
+            || initial_guide(mesh, surf, k, [start, finish], (edge, knot_h, flat_mm)),
             |g| Ok(with_ends_past(g, knot_h)),
         )
 }
@@ -56,15 +57,15 @@ fn guide_skin(mesh: &TubeMesh, surf: &Surfaces) -> usize {
 /// First guide: the start end's centre, the centroids of the level sets of
 /// the geodesic distance from the start end (those before the far end), the
 /// far end's centre; thinned to points `knot_h / 2` apart. On skin `k`
-/// ([`guide_skin`]).
+/// ([`guide_skin`]); `edge` its median edge (mm). A swept export's rings
+/// (flat within `flat_mm` RMS, [`topology::swept_rings`]) that lie over
+/// [`SWEPT_RINGS_OFF_RADII`] end radii from that guide take their place.
 fn initial_guide(
     mesh: &TubeMesh,
     surf: &Surfaces,
     k: usize,
-    start: &EndRing,
-    finish: &EndRing,
-    edge: f64,
-    knot_h: f64,
+    [start, finish]: [&EndRing; 2],
+    (edge, knot_h, flat_mm): (f64, f64, f64),
 ) -> Result<Vec<Point3>, FitError> {
     let skin = &surf.skins[k];
     let width = (3.0 * edge).max(start.radius / 3.0);
@@ -100,6 +101,27 @@ fn initial_guide(
         }
     }
     pts.push(finish.centre);
+    // A swept export whose rings the level sets leave (they shear across
+    // a coarse coil's turn): through its rings instead.
+    let ends = [start, finish].map(|e| &skin.loops[e.loops[k]][..]);
+    if let Some(rings) = topology::swept_rings(mesh, &skin.triangles, ends, flat_mm) {
+        let off = rings
+            .iter()
+            .map(|c| distance_to_polyline(c, &pts))
+            .fold(0.0, f64::max);
+        if off > SWEPT_RINGS_OFF_RADII * start.radius.min(finish.radius) {
+            let mut through = vec![start.centre];
+            for p in &rings[1..rings.len() - 1] {
+                if (p - through[through.len() - 1]).norm() >= 0.5 * knot_h
+                    && (finish.centre - p).norm() >= 0.5 * knot_h
+                {
+                    through.push(*p);
+                }
+            }
+            through.push(finish.centre);
+            return Ok(with_ends_past(through, knot_h));
+        }
+    }
     if pts.len() == 2 {
         // No level set between the ends (a coarse mesh, whose bands are
         // wide): the cubic leaving each end along its normal.
@@ -116,6 +138,22 @@ fn initial_guide(
         });
     }
     Ok(with_ends_past(pts, knot_h))
+}
+
+/// A swept export's ring further than this many end radii from the guide
+/// through the level sets takes the guide through its rings
+/// ([`topology::swept_rings`]).
+const SWEPT_RINGS_OFF_RADII: f64 = 0.5;
+
+/// Distance (mm) from `p` to the polyline through `pts` (at least one).
+fn distance_to_polyline(p: &Point3, pts: &[Point3]) -> f64 {
+    pts.windows(2)
+        .map(|w| {
+            let d = w[1] - w[0];
+            let u = ((p - w[0]).dot(&d) / d.norm_squared().max(1e-300)).clamp(0.0, 1.0);
+            (p - (w[0] + d * u)).norm()
+        })
+        .fold((p - pts[0]).norm(), f64::min)
 }
 
 /// `pts` (end to end, at least two) with one point past each end, along

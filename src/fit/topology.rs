@@ -604,10 +604,9 @@ pub struct LevelSets {
 /// coordinates give about 1e-6 of the band width).
 const ONE_DISTANCE_BANDS: f64 = 1e-3;
 
-/// Dijkstra over the edges of `tris` from `sources`, then bands of `width` mm.
-pub fn level_sets(mesh: &TubeMesh, tris: &[u32], sources: &[u32], width: f64) -> LevelSets {
-    let n = mesh.vertices.len();
-    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n];
+/// Each mesh vertex's neighbours along the edges of `tris` (repeats kept).
+fn adjacency(mesh: &TubeMesh, tris: &[u32]) -> Vec<Vec<u32>> {
+    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); mesh.vertices.len()];
     for &t in tris {
         let v = mesh.triangles[t as usize];
         for k in 0..3 {
@@ -615,6 +614,66 @@ pub fn level_sets(mesh: &TubeMesh, tris: &[u32], sources: &[u32], width: f64) ->
             adj[v[(k + 1) % 3] as usize].push(v[k]);
         }
     }
+    adj
+}
+
+/// The rings of a swept export (mm, mesh frame): when the vertices of
+/// `tris` one edge, two edges, ... away from the loop `start` each number
+/// as many as `start`, lie in a plane (within `flat_mm` RMS) and the last
+/// of them is the loop `finish`, the exporter wrote the tube as flat rings
+/// joined by strips, and these are its rings: the centroid of each, from
+/// `start`'s to `finish`'s. `None` for any other mesh. Its rings are the
+/// exporter's samples of the tube's axis, however far apart (a coil in
+/// rings 3 tube radii apart, where the level sets of the distance along its
+/// surface shear across its turn).
+pub fn swept_rings(
+    mesh: &TubeMesh,
+    tris: &[u32],
+    [start, finish]: [&[u32]; 2],
+    flat_mm: f64,
+) -> Option<Vec<Point3>> {
+    let adj = adjacency(mesh, tris);
+    let mut hops = vec![usize::MAX; mesh.vertices.len()];
+    let mut layer: Vec<u32> = start.to_vec();
+    layer.iter().for_each(|&v| hops[v as usize] = 0);
+    let mut rings = Vec::new();
+    while !layer.is_empty() {
+        if layer.len() != start.len() {
+            return None;
+        }
+        let pts: Vec<Point3> = layer.iter().map(|&v| mesh.vertices[v as usize]).collect();
+        let (centroid, normal, _) = fit_plane(&pts)?;
+        let off2 = pts
+            .iter()
+            .map(|p| (p - centroid).dot(&normal).powi(2))
+            .sum::<f64>();
+        if (off2 / pts.len() as f64).sqrt() > flat_mm {
+            return None;
+        }
+        rings.push(centroid);
+        let hop = rings.len();
+        let mut next = Vec::new();
+        for &v in &layer {
+            for &w in &adj[v as usize] {
+                if hops[w as usize] == usize::MAX {
+                    hops[w as usize] = hop;
+                    next.push(w);
+                }
+            }
+        }
+        if next.is_empty() {
+            let last: std::collections::HashSet<u32> = layer.iter().copied().collect();
+            return (rings.len() > 2 && finish.iter().all(|v| last.contains(v))).then_some(rings);
+        }
+        layer = next;
+    }
+    None
+}
+
+/// Dijkstra over the edges of `tris` from `sources`, then bands of `width` mm.
+pub fn level_sets(mesh: &TubeMesh, tris: &[u32], sources: &[u32], width: f64) -> LevelSets {
+    let n = mesh.vertices.len();
+    let adj = adjacency(mesh, tris);
     let mut dist = vec![f64::INFINITY; n];
     let mut heap = BinaryHeap::new();
     for &s in sources {
