@@ -16,11 +16,11 @@
 
 use super::outcome::{EndRing, Station};
 use super::samples::Samples;
-use super::section::{fit_circle, plane_basis, Frame, SectionPoint};
+use super::section::{fit_circle, frame_at, Frame, SectionPoint};
 use super::topology::Surfaces;
 use super::TubeMesh;
-use crate::geometry::guide::{CubicSpline, GuideCurve};
-use crate::math::{Point3, UnitVector3, Vector3};
+use crate::geometry::guide::CubicSpline;
+use crate::math::{Point3, Vector3};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -73,14 +73,7 @@ pub(super) fn cut_points(
     ts: &[f64],
     margin: f64,
 ) -> (Vec<Point3>, Vec<u8>, Vec<f64>) {
-    let frames: Vec<Frame> = ts
-        .iter()
-        .map(|&ti| {
-            let tan = UnitVector3::new_normalize(spline.d1(ti));
-            let (e1, e2) = plane_basis(&tan);
-            (ti, spline.point(ti), tan.into_inner(), e1, e2)
-        })
-        .collect();
+    let frames: Vec<Frame> = ts.iter().map(|&ti| frame_at(spline, ti)).collect();
     let step = (ts[ts.len() - 1] - ts[0]) / (ts.len() - 1).max(1) as f64;
     let (mut pos, mut skin, mut at) = (Vec::new(), Vec::new(), Vec::new());
     let loops = cut_loops(mesh, surf, samples, t, &frames, step, margin);

@@ -202,14 +202,17 @@ pub fn station_frames(spline: &CubicSpline, range: (f64, f64), spacing: f64) -> 
     let n = ((len / spacing).ceil() as usize).max(2);
     let step = len / n as f64;
     let frames = (0..=n)
-        .map(|i| {
-            let ti = range.0 + i as f64 * step;
-            let tan = UnitVector3::new_normalize(spline.d1(ti));
-            let (e1, e2) = plane_basis(&tan);
-            (ti, spline.point(ti), tan.into_inner(), e1, e2)
-        })
+        .map(|i| frame_at(spline, range.0 + i as f64 * step))
         .collect();
     (step, frames)
+}
+
+/// The station frame at guide parameter `ti` (mm): the guide's point, its
+/// unit tangent and the plane's basis ([`plane_basis`]).
+pub fn frame_at(spline: &CubicSpline, ti: f64) -> Frame {
+    let tan = UnitVector3::new_normalize(spline.d1(ti));
+    let (e1, e2) = plane_basis(&tan);
+    (ti, spline.point(ti), tan.into_inner(), e1, e2)
 }
 
 #[cfg(test)]

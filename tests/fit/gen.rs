@@ -872,14 +872,19 @@ pub fn coarse_bend(
     segments: usize,
     around: usize,
 ) -> (Truth, Vec<Point3>, Vec<[u32; 3]>) {
-    let truth = Truth {
+    let truth = coarse_bend_truth(r, bend_r, leg);
+    let (v, f) = coarse_bend_rings(&truth, r, leg, segments, around, false);
+    (truth, v, f)
+}
+
+/// The tube of [`coarse_bend`].
+fn coarse_bend_truth(r: f64, bend_r: f64, leg: f64) -> Truth {
+    Truth {
         name: "coarse bend",
         length: 2.0 * leg + bend_r * FRAC_PI_2,
         centre: Box::new(elbow_centre(leg, bend_r)),
         radius: Box::new(move |_| r),
-    };
-    let (v, f) = coarse_bend_rings(&truth, r, leg, segments, around, false);
-    (truth, v, f)
+    }
 }
 
 /// [`coarse_bend`] as an exporter that takes each ring's plane from its
@@ -894,7 +899,7 @@ pub fn coarse_bend_central(
     segments: usize,
     around: usize,
 ) -> (Truth, Vec<Point3>, Vec<[u32; 3]>) {
-    let (truth, _, _) = coarse_bend(r, bend_r, leg, 1, 3);
+    let truth = coarse_bend_truth(r, bend_r, leg);
     let (v, f) = coarse_bend_rings(&truth, r, leg, segments, around, true);
     (truth, v, f)
 }
