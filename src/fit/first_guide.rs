@@ -57,9 +57,10 @@ fn guide_skin(mesh: &TubeMesh, surf: &Surfaces) -> usize {
 /// First guide: the start end's centre, the centroids of the level sets of
 /// the geodesic distance from the start end (those before the far end), the
 /// far end's centre; thinned to points `knot_h / 2` apart. On skin `k`
-/// ([`guide_skin`]); `edge` its median edge (mm). A swept export's rings
-/// (flat within `flat_mm` RMS, [`topology::swept_rings`]) that lie over
-/// [`SWEPT_RINGS_OFF_RADII`] end radii from that guide take their place.
+/// ([`guide_skin`]); `edge` its median edge (mm). When the level sets are
+/// wider than the tube, a swept export's rings (flat within `flat_mm` RMS,
+/// [`topology::swept_rings`]) that lie over [`SWEPT_RINGS_OFF_RADII`] end
+/// radii from that guide take their place.
 fn initial_guide(
     mesh: &TubeMesh,
     surf: &Surfaces,
@@ -101,15 +102,19 @@ fn initial_guide(
         }
     }
     pts.push(finish.centre);
-    // A swept export whose rings the level sets leave (they shear across
-    // a coarse coil's turn): through its rings instead.
+    // A swept export whose rings the level sets leave (bands wider than
+    // the tube shear across a coarse coil's turn): through its rings.
+    let r0 = start.radius.min(finish.radius);
     let ends = [start, finish].map(|e| &skin.loops[e.loops[k]][..]);
-    if let Some(rings) = topology::swept_rings(mesh, &skin.triangles, ends, flat_mm) {
+    let swept = (width > 2.0 * r0)
+        .then(|| topology::swept_rings(mesh, &skin.triangles, ends, flat_mm))
+        .flatten();
+    if let Some(rings) = swept {
         let off = rings
             .iter()
             .map(|c| distance_to_polyline(c, &pts))
             .fold(0.0, f64::max);
-        if off > SWEPT_RINGS_OFF_RADII * start.radius.min(finish.radius) {
+        if off > SWEPT_RINGS_OFF_RADII * r0 {
             let mut through = vec![start.centre];
             for p in &rings[1..rings.len() - 1] {
                 if (p - through[through.len() - 1]).norm() >= 0.5 * knot_h
