@@ -206,14 +206,8 @@ fn fit_passes(
     match fit_pass(mesh, opts, trimmed, Pass::Vertices, coarse) {
         Err(e @ (FitError::SectionNotCircle { .. } | FitError::Degenerate { .. })) => {
             fit_pass(mesh, opts, trimmed, Pass::BendEdges, coarse)
-                .or_else(|x| {
-                    eprintln!("PROBE bendedges: {x}");
-                    fit_pass(mesh, opts, trimmed, Pass::Cuts, coarse)
-                })
-                .map_err(|x| {
-                    eprintln!("PROBE cuts: {x}");
-                    e
-                })
+                .or_else(|_| fit_pass(mesh, opts, trimmed, Pass::Cuts, coarse))
+                .map_err(|_| e)
         }
         fitted => fitted,
     }
