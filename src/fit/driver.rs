@@ -275,33 +275,30 @@ fn fit_pass(
     // its knots on the guide before and after it (carry_hints).
     let mut last_stations: Vec<Station> = Vec::new();
     let mut last_carry: (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
+    // Every refit's guide, and the last: one too long for its knots, or
+    // diverged from the first guide's length, goes no further.
+    let too_long = |range: (f64, f64)| {
+        let len = range.1 - range.0;
+        let knots = len / knot_h;
+        let reason = if knots > MAX_KNOTS {
+            format!("the guide is {len:.1} mm long for an end radius of {r0:.3} mm: {knots:.0} knots {knot_h:.2} mm apart, over the limit of {MAX_KNOTS:.0} (a vertex far from the tube? a longer tube fits with a larger knot_spacing_mm)")
+        } else if len > DIVERGED_LENGTH_RATIO * first_length {
+            format!("the guide diverged ({len:.1} mm long, from {first_length:.1} mm)")
+        } else {
+            return None;
+        };
+        Some(FitError::Degenerate {
+            file: mesh.file.clone(),
+            station: 0,
+            reason,
+        })
+    };
     while iterations < opts.max_iterations {
         iterations += 1;
         let spline = spline_of(mesh, &guide).map_err(|e| postponed.take().map_or(e, |p| p.0))?;
         let range = tube_range(&guide);
-        let knots = (range.1 - range.0) / knot_h;
-        if knots > MAX_KNOTS {
-            return Err(postponed.take().map_or_else(|| FitError::Degenerate {
-                file: mesh.file.clone(),
-                station: 0,
-                reason: format!(
-                    "the guide is {:.1} mm long for an end radius of {r0:.3} mm: {knots:.0} knots {knot_h:.2} mm apart, over the limit of {MAX_KNOTS:.0} (a vertex far from the tube? a longer tube fits with a larger knot_spacing_mm)",
-                    range.1 - range.0
-                ),
-            }, |p| p.0));
-        }
-        if range.1 - range.0 > DIVERGED_LENGTH_RATIO * first_length {
-            return Err(postponed.take().map_or_else(
-                || FitError::Degenerate {
-                    file: mesh.file.clone(),
-                    station: 0,
-                    reason: format!(
-                        "the guide diverged ({:.1} mm long, from {first_length:.1} mm)",
-                        range.1 - range.0
-                    ),
-                },
-                |p| p.0,
-            ));
+        if let Some(e) = too_long(range) {
+            return Err(postponed.take().map_or(e, |p| p.0));
         }
         let t = project_all(
             &spline,
@@ -438,6 +435,9 @@ fn fit_pass(
     let spline = spline_of(mesh, &guide).map_err(|e| postponed.take().map_or(e, |p| p.0))?;
     let knots = chord_knots(&guide);
     let range = tube_range(&guide);
+    if let Some(e) = too_long(range) {
+        return Err(postponed.take().map_or(e, |p| p.0));
+    }
     let samples = samples.vertex_only();
     let t = project_all(
         &spline,

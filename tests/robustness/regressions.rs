@@ -6,11 +6,11 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
+use waam_slicer::fit::{fit_tube, FitOptions, TubeMesh};
 use waam_slicer::geometry::guide::{Expression, Line};
 use waam_slicer::geometry::{FrameMethod, GeometryError, ProfileLaw, Tube, TubeRange};
 use waam_slicer::math::{Point3, Vector3};
 
-#[allow(dead_code)]
 fn regression_file(name: &str) -> Vec<u8> {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/robustness/regressions")
@@ -203,4 +203,31 @@ fn program_readers_answer_large_inputs() {
     if let Err(e) = parse_mod(&m.replacen(&target, &target.repeat(20_000), 1), "many.mod") {
         names_file(e.to_string(), "many.mod");
     }
+}
+
+/// Fuzz `fit_stl` (its artifact oom-1edf5395, less the units byte): with 4
+/// refits, the guide of the last one had diverged and the final sections
+/// were taken on it unchecked, 186 M station frames (a 7.4 GB allocation;
+/// libFuzzer's 4 GB limit stopped it). The last refit's guide now gets the
+/// length checks every refit's gets: refused naming the file, the process
+/// peaking under 1 GB (read from /proc: the allocation itself is what
+/// failed).
+#[test]
+fn a_fit_whose_last_refit_diverged_is_refused_not_sectioned() {
+    let bytes = regression_file("fit-last-refit-diverged.stl");
+    let mesh = TubeMesh::from_stl_bytes(&bytes, "fuzz.stl").expect("an STL");
+    let opts = FitOptions {
+        max_iterations: 4,
+        check_surface: false,
+        ..FitOptions::default()
+    };
+    let e = fit_tube(&mesh, &opts).unwrap_err();
+    assert!(e.to_string().starts_with("fuzz.stl: "), "{e}");
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let peak_kb: u64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .unwrap_or(0);
+    assert!(peak_kb < 1_000_000, "peak {peak_kb} kB");
 }
