@@ -602,8 +602,8 @@ mod tests {
             200.0,
             200.0 + radius * FRAC_PI_4,
             200.0 + radius * FRAC_PI_2,
+            400.0 + radius * FRAC_PI_2,
         ];
-        let ts = [ts[0], ts[1], ts[2], ts[3], ts[3] + 200.0];
         let rings: Vec<Option<VertexRing>> = (0..5_usize)
             .map(|i| {
                 let (p, q) = (c[i.saturating_sub(1)], c[(i + 1).min(4)]);
