@@ -15,7 +15,7 @@ use super::cut;
 use super::features::runs_of_false;
 use super::outcome::Station;
 use super::samples::Samples;
-use super::section::{circle_in_plane, fit_plane, station_frames};
+use super::section::{circle_in_plane, fit_plane, plane_rms, station_frames};
 use super::smooth::{arc_tangent_length, hermite};
 use super::topology::Surfaces;
 use super::{FitOptions, TubeMesh};
@@ -103,12 +103,7 @@ fn ring_of(
 ) -> Option<VertexRing> {
     let pts: Vec<Point3> = run.iter().map(|&i| samples.pos[i]).collect();
     let (c, normal, _) = fit_plane(&pts)?;
-    let flat = (pts
-        .iter()
-        .map(|p| (p - c).dot(&normal).powi(2))
-        .sum::<f64>()
-        / pts.len() as f64)
-        .sqrt();
+    let flat = plane_rms(&pts, &c, &normal);
     let mut centre = Vector3::zeros();
     for skin in 0..samples.skins {
         let pts: Vec<Point3> = run

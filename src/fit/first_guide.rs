@@ -82,7 +82,7 @@ fn initial_guide(
         });
     }
     let complete = ((far / width).floor() as usize).saturating_sub(1);
-    let mut raw = vec![start.centre];
+    let mut raw = Vec::new();
     for band in sets.bands.iter().take(complete) {
         // A level set in several rings on a skin with two open ends is not
         // a branch (a branch ends in an open end of its own): the distance
@@ -93,15 +93,7 @@ fn initial_guide(
             raw.push(band.centroid);
         }
     }
-    let mut pts = vec![start.centre];
-    for p in raw.into_iter().skip(1) {
-        if (p - pts[pts.len() - 1]).norm() >= 0.5 * knot_h
-            && (finish.centre - p).norm() >= 0.5 * knot_h
-        {
-            pts.push(p);
-        }
-    }
-    pts.push(finish.centre);
+    let mut pts = thinned(start, &raw, finish, knot_h);
     // A swept export whose rings the level sets leave (bands wider than
     // the tube shear across a coarse coil's turn): through its rings.
     let r0 = start.radius.min(finish.radius);
@@ -115,15 +107,7 @@ fn initial_guide(
             .map(|c| distance_to_polyline(c, &pts))
             .fold(0.0, f64::max);
         if off > SWEPT_RINGS_OFF_RADII * r0 {
-            let mut through = vec![start.centre];
-            for p in &rings[1..rings.len() - 1] {
-                if (p - through[through.len() - 1]).norm() >= 0.5 * knot_h
-                    && (finish.centre - p).norm() >= 0.5 * knot_h
-                {
-                    through.push(*p);
-                }
-            }
-            through.push(finish.centre);
+            let through = thinned(start, &rings[1..rings.len() - 1], finish, knot_h);
             return Ok(with_ends_past(through, knot_h));
         }
     }
@@ -143,6 +127,22 @@ fn initial_guide(
         });
     }
     Ok(with_ends_past(pts, knot_h))
+}
+
+/// The start end's centre, the points `between` (mm, in order) at least
+/// `knot_h / 2` from the point kept before them and from the far end's
+/// centre, and the far end's centre.
+fn thinned(start: &EndRing, between: &[Point3], finish: &EndRing, knot_h: f64) -> Vec<Point3> {
+    let mut pts = vec![start.centre];
+    for p in between {
+        if (p - pts[pts.len() - 1]).norm() >= 0.5 * knot_h
+            && (finish.centre - p).norm() >= 0.5 * knot_h
+        {
+            pts.push(*p);
+        }
+    }
+    pts.push(finish.centre);
+    pts
 }
 
 /// A swept export's ring further than this many end radii from the guide

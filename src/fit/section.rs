@@ -158,6 +158,16 @@ pub fn fit_plane(points: &[Point3]) -> Option<(Point3, UnitVector3, f64)> {
     max.is_finite().then_some((Point3::from(c), normal, max))
 }
 
+/// RMS distance (mm) of `points` from the plane through `centre` with unit
+/// `normal` (mesh frame, mm).
+pub fn plane_rms(points: &[Point3], centre: &Point3, normal: &Vector3) -> f64 {
+    let sum: f64 = points
+        .iter()
+        .map(|p| (p - centre).dot(normal).powi(2))
+        .sum();
+    (sum / points.len().max(1) as f64).sqrt()
+}
+
 /// The least-squares circle of `pts` seen in the plane through `origin`
 /// with unit `normal` (mm, slope 0): its centre (mesh frame, mm) and the
 /// fit. `None` as [`fit_circle`].

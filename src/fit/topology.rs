@@ -4,7 +4,7 @@
 //! branches). Mesh frame, mm.
 
 use super::outcome::FeatureKind;
-use super::section::fit_plane;
+use super::section::{fit_plane, plane_rms};
 use super::{FitError, FitOptions, TubeMesh};
 use crate::math::{Point3, UnitVector3};
 use std::cmp::Reverse;
@@ -633,9 +633,9 @@ pub fn swept_rings(
     flat_mm: f64,
 ) -> Option<Vec<Point3>> {
     let adj = adjacency(mesh, tris);
-    let mut hops = vec![usize::MAX; mesh.vertices.len()];
+    let mut seen = vec![false; mesh.vertices.len()];
     let mut layer: Vec<u32> = start.to_vec();
-    layer.iter().for_each(|&v| hops[v as usize] = 0);
+    layer.iter().for_each(|&v| seen[v as usize] = true);
     let mut rings = Vec::new();
     while !layer.is_empty() {
         if layer.len() != start.len() {
@@ -643,20 +643,14 @@ pub fn swept_rings(
         }
         let pts: Vec<Point3> = layer.iter().map(|&v| mesh.vertices[v as usize]).collect();
         let (centroid, normal, _) = fit_plane(&pts)?;
-        let off2 = pts
-            .iter()
-            .map(|p| (p - centroid).dot(&normal).powi(2))
-            .sum::<f64>();
-        if (off2 / pts.len() as f64).sqrt() > flat_mm {
+        if plane_rms(&pts, &centroid, &normal) > flat_mm {
             return None;
         }
         rings.push(centroid);
-        let hop = rings.len();
         let mut next = Vec::new();
         for &v in &layer {
             for &w in &adj[v as usize] {
-                if hops[w as usize] == usize::MAX {
-                    hops[w as usize] = hop;
+                if !std::mem::replace(&mut seen[w as usize], true) {
                     next.push(w);
                 }
             }

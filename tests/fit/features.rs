@@ -536,7 +536,7 @@ fn a_block_around_a_bore_is_a_feature_not_a_branch() {
 #[test]
 fn a_coarse_bend_is_not_named_a_feature() {
     for around in [16, 32] {
-        let (_, v, f) = gen::coarse_bend(10.0, 30.0, 20.0, 5, around);
+        let (_, v, f) = gen::coarse_bend(10.0, 30.0, 20.0, 5, around, false);
         if let Err(e) = fit(&(v, f), "bend.stl", false) {
             assert!(
                 !matches!(e, Error::Fit(FitError::Feature { .. })),

@@ -864,62 +864,32 @@ pub fn sleeved_pipe(
 /// A coarse export of a bend: straight legs of `leg` mm (one stretch each),
 /// a 90° bend of centre-line radius `bend_r` toward +x in `segments`
 /// stretches, tube radius `r`, `around` points per ring (rings on the true
-/// surface, normal to the centre line).
+/// surface, normal to the centre line). With `central`, as an exporter that
+/// takes each ring's plane from its neighbours' centres writes it
+/// (pipe_network.py's sweep): a ring's normal is the direction from the
+/// centre before it to the centre after it (from the one beside it at the
+/// ends), so the rings where a leg joins the bend lean toward the bend, by
+/// more the longer the leg.
 pub fn coarse_bend(
     r: f64,
     bend_r: f64,
     leg: f64,
     segments: usize,
     around: usize,
+    central: bool,
 ) -> (Truth, Vec<Point3>, Vec<[u32; 3]>) {
-    let truth = coarse_bend_truth(r, bend_r, leg);
-    let (v, f) = coarse_bend_rings(&truth, r, leg, segments, around, false);
-    (truth, v, f)
-}
-
-/// The tube of [`coarse_bend`].
-fn coarse_bend_truth(r: f64, bend_r: f64, leg: f64) -> Truth {
-    Truth {
+    let truth = Truth {
         name: "coarse bend",
         length: 2.0 * leg + bend_r * FRAC_PI_2,
         centre: Box::new(elbow_centre(leg, bend_r)),
         radius: Box::new(move |_| r),
-    }
-}
-
-/// [`coarse_bend`] as an exporter that takes each ring's plane from its
-/// neighbours' centres writes it (pipe_network.py's sweep): a ring's normal
-/// is the direction from the centre before it to the centre after it (from
-/// the one beside it at the ends), so the rings where a leg joins the bend
-/// lean toward the bend, by more the longer the leg.
-pub fn coarse_bend_central(
-    r: f64,
-    bend_r: f64,
-    leg: f64,
-    segments: usize,
-    around: usize,
-) -> (Truth, Vec<Point3>, Vec<[u32; 3]>) {
-    let truth = coarse_bend_truth(r, bend_r, leg);
-    let (v, f) = coarse_bend_rings(&truth, r, leg, segments, around, true);
-    (truth, v, f)
-}
-
-/// The rings of [`coarse_bend`] on `truth`, normal to its centre line or
-/// (`central`) to the chord between the neighbouring rings' centres.
-fn coarse_bend_rings(
-    truth: &Truth,
-    r: f64,
-    leg: f64,
-    segments: usize,
-    around: usize,
-    central: bool,
-) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    };
     let bend = truth.length - 2.0 * leg;
     let mut at: Vec<f64> = vec![0.0];
     at.extend((0..=segments).map(|i| leg + bend * i as f64 / segments as f64));
     at.push(2.0 * leg + bend);
     let m = (truth.length / 0.05).ceil() as usize;
-    let fr = frames(truth, m);
+    let fr = frames(&truth, m);
     let frame = |s: f64| fr[((s / truth.length) * m as f64).round() as usize];
     let rings: Vec<Vec<Point3>> = (0..at.len())
         .map(|i| {
@@ -941,7 +911,8 @@ fn coarse_bend_rings(
                 .collect()
         })
         .collect();
-    lofted(&rings)
+    let (v, f) = lofted(&rings);
+    (truth, v, f)
 }
 
 /// A sine tube: centre line x = `a` sin(2 pi z / `l`), y = 0, z from 0 to

@@ -268,7 +268,8 @@ fn coarse_bends_fit_against_the_generators_tube() {
     for ratio in [2.0, 3.0, 4.0] {
         for stretches in [3, 4, 5, 6, 8] {
             for around in [16, 32] {
-                let (truth, v, f) = gen::coarse_bend(10.0, 10.0 * ratio, 20.0, stretches, around);
+                let (truth, v, f) =
+                    gen::coarse_bend(10.0, 10.0 * ratio, 20.0, stretches, around, false);
                 let name = format!("R/r {ratio}, {stretches} stretches, {around} around");
                 cases.push((name, stretches, truth, v, f));
             }
@@ -308,7 +309,7 @@ fn coarse_bends_fit_against_the_generators_tube() {
 }
 
 /// A coarse bend between long legs written in one stretch each, its rings'
-/// planes taken from their neighbours' centres (`gen::coarse_bend_central`,
+/// planes taken from their neighbours' centres (`gen::coarse_bend`, `central`,
 /// as a pipe network's exporter writes them; unseen exports, issue 47): the
 /// ring where a leg joins the bend leans toward the bend, by up to 4
 /// degrees here. Between two rings the guide runs on the cubic from one
@@ -327,7 +328,7 @@ fn coarse_bends_fit_against_the_generators_tube() {
 fn a_coarse_bend_with_long_legs_and_leaning_joins_fits() {
     for ratio in [3.0, 4.0, 6.0] {
         for stretches in [2, 3, 4, 6] {
-            let (truth, v, f) = gen::coarse_bend_central(10.0, 10.0 * ratio, 200.0, stretches, 24);
+            let (truth, v, f) = gen::coarse_bend(10.0, 10.0 * ratio, 200.0, stretches, 24, true);
             let name = format!("R/r {ratio}, {stretches} stretches");
             let fitted = fit_mesh(v, f, "bend.stl", &FitOptions::default())
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
